@@ -1,0 +1,90 @@
+# meshcorr — one plain Makefile. Sources are found by wildcard, so adding a
+# file to a module folder needs no edit here.
+#   make            build everything into build/
+#   make test       unit tests + gradient checks + integration (tests/run-tests.sh)
+#   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
+#   make demo       install deps, build, run the demo job on Debian's CGAL meshes
+#   make install    PREFIX=/usr/local DESTDIR=
+PREFIX  ?= /usr/local
+DESTDIR ?=
+BUILD   ?= build
+
+CC      ?= cc
+CXX     ?= c++
+PKGS     = draco liblbfgs
+WARN     = -Wall -Wextra -Werror
+OPT     ?= -O2 -g
+CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Itests
+CFLAGS   += -std=c11 $(OPT) $(WARN) -fopenmp -pthread
+CXXFLAGS += -std=c++17 $(OPT) $(WARN) -pthread $(shell pkg-config --cflags draco)
+LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lm -lstdc++ -fopenmp -pthread
+
+# The engine library: everything under workers/ except the worker main.
+ENGINE_C   := $(filter-out workers/main/%,$(wildcard workers/*/*.c))
+ENGINE_CXX := $(wildcard workers/*/*.cpp)
+ENGINE_OBJ := $(ENGINE_C:%.c=$(BUILD)/obj/%.o) $(ENGINE_CXX:%.cpp=$(BUILD)/obj/%.o)
+ENGINE_LIB := $(BUILD)/libmcengine.a
+
+CLI_C   := $(wildcard client-c/cli/*.c)
+CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
+
+TEST_SUPPORT_C   := $(wildcard tests/support/*.c)
+TEST_SUPPORT_OBJ := $(TEST_SUPPORT_C:%.c=$(BUILD)/obj/%.o)
+TEST_C    := $(wildcard tests/unit/test_*.c)
+TEST_BIN  := $(TEST_C:tests/unit/%.c=$(BUILD)/tests/%)
+BENCH_C   := $(wildcard tests/bench/bench_*.c)
+BENCH_BIN := $(BENCH_C:tests/bench/%.c=$(BUILD)/bench/%)
+FUZZ_C    := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_BIN  := $(FUZZ_C:tests/fuzz/%.c=$(BUILD)/fuzz/%)
+
+PROGRAMS := $(BUILD)/meshcorr
+
+.PHONY: all test bench demo install clean
+all: $(PROGRAMS)
+
+$(BUILD)/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/obj/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
+
+$(ENGINE_LIB): $(ENGINE_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/meshcorr: $(CLI_OBJ) $(ENGINE_LIB)
+	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(ENGINE_LIB) $(LDLIBS)
+
+$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(LDLIBS)
+
+$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(LDLIBS)
+
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(LDLIBS)
+
+test: $(PROGRAMS) $(TEST_BIN) $(FUZZ_BIN)
+	@sh tests/run-tests.sh $(TEST_BIN) $(FUZZ_BIN)
+
+bench: $(PROGRAMS) $(BENCH_BIN)
+	@for b in $(BENCH_BIN); do echo "== $$b"; ./$$b || exit 1; done
+
+demo:
+	sh deploy/install-deps.sh
+	$(MAKE) all
+	sh deploy/demo.sh $(BUILD)
+
+install: $(PROGRAMS)
+	install -d $(DESTDIR)$(PREFIX)/bin
+	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
+
+clean:
+	rm -rf $(BUILD)
+
+-include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)

@@ -1,0 +1,10 @@
+/* cli.h — the `meshcorr` command-line tool's subcommands. Each cli_<verb>.c
+ * holds one subcommand; meshcorr.c only dispatches. Exit status: 0 ok,
+ * 1 the input is unusable or the job failed, 2 bad usage. */
+#ifndef CLI_H
+#define CLI_H
+
+int cli_info(int argc, char **argv);
+int cli_convert(int argc, char **argv);
+
+#endif

@@ -1,0 +1,35 @@
+/* meshcorr.c — main() of the `meshcorr` CLI: dispatch to a subcommand. */
+#include "cli/cli.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const struct {
+    const char *name;
+    int (*run)(int, char **);
+    const char *help;
+} commands[] = {
+    { "info",    cli_info,    "MESH             print counts, topology, area, problems" },
+    { "convert", cli_convert, "IN OUT           convert between .off .obj .ply .drc" },
+};
+
+static void usage(FILE *fp)
+{
+    fprintf(fp, "usage: meshcorr COMMAND [ARGS]\n\ncommands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(fp, "  %-8s %s\n", commands[i].name, commands[i].help);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(argv[1], commands[i].name) == 0)
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "meshcorr: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return 2;
+}

@@ -1,0 +1,34 @@
+#!/bin/sh
+# install-deps.sh — installs the Debian 12 packages meshcorr builds, tests and
+# demos with. Idempotent and non-interactive; fetches nothing but Debian
+# packages. Must not build or configure anything of the project itself.
+set -eu
+
+PACKAGES="
+build-essential pkg-config g++
+libembree-dev
+libdraco-dev draco
+liblbfgs-dev
+libsuitesparse-dev
+libcgal-demo
+"
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+
+missing=""
+for p in $PACKAGES; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        missing="$missing $p"
+    fi
+done
+
+if [ -n "$missing" ]; then
+    echo "install-deps: installing:$missing"
+    export DEBIAN_FRONTEND=noninteractive
+    $SUDO apt-get update -qq
+    # shellcheck disable=SC2086
+    $SUDO apt-get install -y -qq --no-install-recommends $missing
+else
+    echo "install-deps: all packages present"
+fi

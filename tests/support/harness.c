@@ -1,0 +1,118 @@
+/* harness.c — runs each registered test in a forked child under alarm();
+ * prints "PASS|FAIL|SKIP <binary>.<test>" lines. Holds no test logic. */
+#include "support/harness.h"
+
+#include <signal.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#define HARNESS_MAX_TESTS 512
+
+static struct { const char *name; harness_fn fn; int timeout; } tests[HARNESS_MAX_TESTS];
+static int ntests;
+
+void harness_register(const char *name, harness_fn fn, int timeout_s)
+{
+    if (ntests == HARNESS_MAX_TESTS) {
+        fprintf(stderr, "harness: more than %d tests in one binary\n", HARNESS_MAX_TESTS);
+        exit(2);
+    }
+    tests[ntests].name = name;
+    tests[ntests].fn = fn;
+    tests[ntests].timeout = timeout_s;
+    ntests++;
+}
+
+const char *harness_data_dir(void)
+{
+    static char dir[4096];
+    const char *env = getenv("MESHCORR_DATA");
+    struct stat st;
+    if (env && *env) {
+        snprintf(dir, sizeof dir, "%s", env);
+    } else {
+        snprintf(dir, sizeof dir, "../shared/data");
+    }
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+        return NULL;
+    return dir;
+}
+
+const char *harness_data_path(const char *rel)
+{
+    static char path[4096];
+    const char *dir = harness_data_dir();
+    if (!dir)
+        SKIP("../shared/data is absent");
+    snprintf(path, sizeof path, "%s/%s", dir, rel);
+    return path;
+}
+
+const char *harness_tmpdir(void)
+{
+    static char dir[256];
+    if (!dir[0]) {
+        snprintf(dir, sizeof dir, "/tmp/meshcorr-test-XXXXXX");
+        if (!mkdtemp(dir))
+            FAILF("mkdtemp failed");
+    }
+    return dir;
+}
+
+static int run_one(const char *prog, int i)
+{
+    fflush(stdout);
+    fflush(stderr);
+    pid_t pid = fork();
+    if (pid < 0) {
+        perror("fork");
+        return 1;
+    }
+    if (pid == 0) {
+        alarm((unsigned)tests[i].timeout);
+        tests[i].fn();
+        fflush(stdout);
+        _exit(0);
+    }
+    int st = 0;
+    while (waitpid(pid, &st, 0) < 0) {}
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 0) {
+        printf("PASS %s.%s\n", prog, tests[i].name);
+        return 0;
+    }
+    if (WIFEXITED(st) && WEXITSTATUS(st) == HARNESS_SKIP_CODE) {
+        printf("SKIP %s.%s\n", prog, tests[i].name);
+        return 0;
+    }
+    if (WIFSIGNALED(st) && WTERMSIG(st) == SIGALRM)
+        printf("FAIL %s.%s (timeout after %d s)\n", prog, tests[i].name, tests[i].timeout);
+    else if (WIFSIGNALED(st))
+        printf("FAIL %s.%s (signal %d)\n", prog, tests[i].name, WTERMSIG(st));
+    else
+        printf("FAIL %s.%s (exit %d)\n", prog, tests[i].name, WEXITSTATUS(st));
+    return 1;
+}
+
+int main(int argc, char **argv)
+{
+    const char *prog = strrchr(argv[0], '/') ? strrchr(argv[0], '/') + 1 : argv[0];
+    int failed = 0, ran = 0;
+    for (int i = 0; i < ntests; i++) {
+        if (argc > 1) {  /* run only the named tests */
+            int want = 0;
+            for (int a = 1; a < argc; a++)
+                want |= strcmp(argv[a], tests[i].name) == 0;
+            if (!want)
+                continue;
+        }
+        failed += run_one(prog, i);
+        ran++;
+    }
+    if (ran == 0 && argc > 1) {
+        fprintf(stderr, "%s: no test named like that\n", prog);
+        return 2;
+    }
+    return failed ? 1 : 0;
+}

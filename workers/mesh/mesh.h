@@ -1,0 +1,61 @@
+/* mesh.h — the triangle mesh type and its file input/output.
+ *
+ * A mesh is nv vertices (v: nv by 3 doubles, row-major) and nf triangles
+ * (f: nf by 3 ints, 0-based, in the file's order). Vertex order is always the
+ * user's order: readers keep the file's order and writers write it back.
+ * (A .drc file written by someone else keeps Draco's decoded order, which may
+ * differ from the order its author had; .drc files we write keep the order.)
+ *
+ * Ownership: mesh_new/mesh_read return a mesh the caller frees with
+ * mesh_free (NULL is accepted). Errors are negative MESH_E* codes with the
+ * detail (file, field, line, limit) written into the caller's err buffer.
+ * This module reads and writes; validation lives in mesh_check.h. */
+#ifndef MESH_H
+#define MESH_H
+#include <stddef.h>
+
+/* Limits on input sizes, checked before any allocation. */
+#define MESH_MAX_VERTICES 20000000
+#define MESH_MAX_FACES    40000000
+#define MESH_MAX_FILE_BYTES (2LL << 30)
+
+#define MESH_ERRORS(X)                                                  \
+    X(MESH_OK,       0, "ok")                                           \
+    X(MESH_EIO,     -1, "cannot read or write the file")                \
+    X(MESH_EPARSE,  -2, "malformed file")                               \
+    X(MESH_ELIMIT,  -3, "size over a limit")                            \
+    X(MESH_ENOMEM,  -4, "out of memory")                                \
+    X(MESH_EFORMAT, -5, "unknown or unsupported format")                \
+    X(MESH_EDRACO,  -6, "Draco error")                                  \
+    X(MESH_EINVAL,  -7, "invalid mesh data")
+
+enum mesh_error {
+#define MESH_ENUM(name, val, msg) name = val,
+    MESH_ERRORS(MESH_ENUM)
+#undef MESH_ENUM
+};
+const char *mesh_strerror(int code);
+
+typedef struct mesh {
+    int nv;      /* number of vertices */
+    int nf;      /* number of triangles */
+    double *v;   /* nv by 3 positions */
+    int *f;      /* nf by 3 vertex indices, 0-based */
+} mesh;
+
+/* Allocates a mesh with room for nv vertices and nf faces (contents zero).
+ * Returns NULL on a bad size or out of memory. */
+mesh *mesh_new(int nv, int nf);
+void mesh_free(mesh *m);
+mesh *mesh_copy(const mesh *m);
+
+/* Reads by extension (.off .obj .ply .drc, case-insensitive). */
+int mesh_read(const char *path, mesh **out, char *err, size_t errsz);
+/* Writes by extension (.off .obj .ply .drc). */
+int mesh_write(const char *path, const mesh *m, char *err, size_t errsz);
+
+/* Per-format entry points (path is used in messages only for the _mem ones). */
+int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz);
+int mesh_write_off(const char *path, const mesh *m, char *err, size_t errsz);
+
+#endif
