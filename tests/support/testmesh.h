@@ -1,0 +1,18 @@
+/* testmesh.h — meshes the tests generate, with known closed forms:
+ * an icosphere (radius 1, closed, genus 0), a torus (radii R, r, closed,
+ * genus 1) and a flat open disk (radius 1, one boundary loop). Test code
+ * only: never linked into the engine. Caller frees with mesh_free. */
+#ifndef TESTMESH_H
+#define TESTMESH_H
+#include "mesh/mesh.h"
+
+/* Subdivided icosahedron projected to the unit sphere: 10*4^level + 2 vertices. */
+mesh *testmesh_icosphere(int level);
+/* Torus around the z axis, nu segments around the axis, nv around the tube. */
+mesh *testmesh_torus(double R, double r, int nu, int nv);
+/* Flat disk in the z = 0 plane, rings concentric rings around the centre. */
+mesh *testmesh_disk(int rings);
+/* Deterministic pseudo-random numbers in [0, 1) for tests (xorshift). */
+double testmesh_rand(unsigned long long *state);
+
+#endif
