@@ -11,7 +11,9 @@
  * where it bends towards them. Flat interior vertices get 0. Boundary
  * vertices get whatever this formula gives there (not a curvature: the
  * one-sided cotangents leave a tangential part). A vertex with zero mass
- * or zero normal gets 0. */
+ * or zero normal gets 0. Accuracy: with the barycentric mass, H converges
+ * in the area-weighted mean square but not pointwise on irregular meshes
+ * (icosphere valence-5 vertices stay ~14% off; RMS error 1.7% at level 3). */
 #ifndef GEO_CURVATURE_H
 #define GEO_CURVATURE_H
 #include "geo/geo_csr.h"
