@@ -17,7 +17,8 @@
     X(GEO_OK,            0, "ok")                                          \
     X(GEO_ENOMEM,       -1, "out of memory")                               \
     X(GEO_ENONMANIFOLD, -2, "edge with more than two faces")               \
-    X(GEO_EDEGENERATE,  -3, "degenerate geometry")
+    X(GEO_EDEGENERATE,  -3, "degenerate geometry")                     \
+    X(GEO_EMISMATCH,    -4, "edge table built from another mesh")
 
 enum geo_error {
 #define GEO_ENUM(name, val, msg) name = val,
