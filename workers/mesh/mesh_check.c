@@ -1,5 +1,5 @@
 /* mesh_check.c — see mesh_check.h. Half-edges sorted by vertex pair give the
- * edge table; union-find over faces gives components, over corners gives the
+ * edge table; union-find over vertices of faces gives components, over corners gives the
  * fans around each vertex, over vertices on boundary edges gives loops.
  * Reports only; never changes or repairs the mesh. */
 #include "mesh/mesh_check.h"
@@ -113,11 +113,11 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
     int *used = calloc((size_t)nv + 1, sizeof *used);
     half *h = malloc(sizeof *h * (3 * (size_t)nf + 1));
     tri_key *tk = malloc(sizeof *tk * ((size_t)nf + 1));
-    int *fpar = malloc(sizeof *fpar * ((size_t)nf + 1));
+    int *comp = malloc(sizeof *comp * ((size_t)nv + 1));
     int *cpar = malloc(sizeof *cpar * (3 * (size_t)nf + 1));
     int *vpar = malloc(sizeof *vpar * ((size_t)nv + 1));
     char *onb = calloc((size_t)nv + 1, 1);
-    if (!ok || !used || !h || !tk || !fpar || !cpar || !vpar || !onb) {
+    if (!ok || !used || !h || !tk || !comp || !cpar || !vpar || !onb) {
         rc = errbuf_set(err, errsz, MESH_CHECK_ENOMEM, "out of memory checking a mesh of %d vertices",
                         nv);
         goto out;
@@ -192,8 +192,13 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
 
     /* Edges: group the sorted half-edges by vertex pair. */
     qsort(h, (size_t)nh, sizeof *h, half_cmp);
+    for (int i = 0; i < nv; i++)
+        comp[i] = i;
     for (int t = 0; t < nf; t++)
-        fpar[t] = t;
+        if (ok[t]) {
+            uf_union(comp, m->f[3 * t], m->f[3 * t + 1]);
+            uf_union(comp, m->f[3 * t], m->f[3 * t + 2]);
+        }
     for (int c = 0; c < 3 * nf; c++)
         cpar[c] = c;
     for (int i = 0; i < nv; i++)
@@ -217,7 +222,6 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
             r->first_inconsistent_edge[1] = h[i].b;
         }
         for (int k = i + 1; k < j; k++) {
-            uf_union(fpar, h[i].face, h[k].face);
             uf_union(cpar, h[i].ca, h[k].ca);
             uf_union(cpar, h[i].cb, h[k].cb);
         }
@@ -230,13 +234,13 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
     for (int t = 0; t < nf; t++) {
         if (!ok[t])
             continue;
-        if (uf_find(fpar, t) == t)
-            r->components++;
         for (int k = 0; k < 3; k++)
             if (uf_find(cpar, 3 * t + k) == 3 * t + k)
                 fans[m->f[3 * t + k]]++;
     }
     for (int i = 0; i < nv; i++) {
+        if (fans[i] > 0 && uf_find(comp, i) == i)
+            r->components++;
         if (fans[i] > 1 && r->nonmanifold_vertices++ == 0)
             r->first_nonmanifold_vertex = i;
         if (onb[i] && uf_find(vpar, i) == i)
@@ -251,7 +255,7 @@ out:
     free(used);
     free(h);
     free(tk);
-    free(fpar);
+    free(comp);
     free(cpar);
     free(vpar);
     free(onb);

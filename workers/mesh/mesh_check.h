@@ -10,7 +10,7 @@
  * its area is below 1e-12 times its longest edge squared (zero up to
  * rounding). Duplicate faces use the same vertex set. Orientation is
  * inconsistent on an edge whose two faces traverse it the same way.
- * Components are connected sets of faces; boundary loops are connected sets
+ * Components are sets of faces connected through shared vertices; boundary loops are connected sets
  * of boundary edges. chi = V - E + F with V the referenced vertices; genus
  * = (2 - chi - boundary loops) / 2 when the mesh is manifold and in one
  * piece, else -1. Faces with bad indices are left out of everything else;
@@ -39,7 +39,7 @@ const char *mesh_check_strerror(int code);
 typedef struct mesh_check_report {
     /* counts */
     int nv, nf, ne;
-    int components;        /* connected components of faces */
+    int components;        /* faces connected through shared vertices */
     int boundary_loops;
     long euler;            /* chi = V - E + F */
     int genus;             /* -1 when not defined (see above) */
