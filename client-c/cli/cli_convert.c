@@ -1,7 +1,9 @@
 /* cli_convert.c — `meshcorr convert IN OUT`: format by extension, vertex
- * order kept. */
+ * order kept. Refuses to write a mesh with NaN/Inf coordinates or bad face
+ * indices (other problems are reported by `meshcorr info`, not here). */
 #include "cli/cli.h"
 #include "mesh/mesh.h"
+#include "mesh/mesh_check.h"
 
 #include <stdio.h>
 
@@ -17,9 +19,20 @@ int cli_convert(int argc, char **argv)
         fprintf(stderr, "meshcorr convert: %s\n", err);
         return 1;
     }
-    int rc = mesh_write(argv[2], m, err, sizeof err);
-    if (rc)
-        fprintf(stderr, "meshcorr convert: %s\n", err);
+    mesh_check_report r;
+    int rc = mesh_check_run(m, &r, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "meshcorr convert: %s: %s\n", argv[1], err);
+    } else if (r.nonfinite_vertices || r.bad_index_faces) {
+        char problems[2048];
+        mesh_check_problems(&r, argv[1], problems, sizeof problems);
+        fprintf(stderr, "%smeshcorr convert: %s: not written\n", problems, argv[2]);
+        rc = 1;
+    } else {
+        rc = mesh_write(argv[2], m, err, sizeof err);
+        if (rc)
+            fprintf(stderr, "meshcorr convert: %s\n", err);
+    }
     mesh_free(m);
     return rc ? 1 : 0;
 }

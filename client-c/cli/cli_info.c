@@ -1,7 +1,9 @@
-/* cli_info.c — `meshcorr info MESH`: counts and problems of one mesh.
- * Exit 0 only for a mesh the optimizer can use. */
+/* cli_info.c — `meshcorr info MESH`: counts, topology, area, bounding box
+ * and every problem of one mesh (mesh_check.h). Exit 0 only for a mesh the
+ * optimizer can use; 1 for an unusable or unreadable one. */
 #include "cli/cli.h"
 #include "mesh/mesh.h"
+#include "mesh/mesh_check.h"
 
 #include <stdio.h>
 
@@ -11,13 +13,38 @@ int cli_info(int argc, char **argv)
         fprintf(stderr, "usage: meshcorr info MESH\n");
         return 2;
     }
+    const char *path = argv[1];
     char err[1024];
     mesh *m = NULL;
-    if (mesh_read(argv[1], &m, err, sizeof err)) {
+    if (mesh_read(path, &m, err, sizeof err)) {
         fprintf(stderr, "meshcorr info: %s\n", err);
         return 1;
     }
-    printf("%s\n  vertices  %d\n  faces     %d\n", argv[1], m->nv, m->nf);
+    mesh_check_report r;
+    if (mesh_check_run(m, &r, err, sizeof err)) {
+        fprintf(stderr, "meshcorr info: %s: %s\n", path, err);
+        mesh_free(m);
+        return 1;
+    }
     mesh_free(m);
-    return 0;
+    printf("%s\n", path);
+    printf("  vertices        %d\n  faces           %d\n  edges           %d\n",
+           r.nv, r.nf, r.ne);
+    printf("  components      %d\n  boundary loops  %d\n  euler           %ld\n",
+           r.components, r.boundary_loops, r.euler);
+    if (r.genus >= 0)
+        printf("  genus           %d\n", r.genus);
+    else
+        printf("  genus           n/a (not a single manifold piece)\n");
+    printf("  total area      %.9g\n", r.area);
+    printf("  bounding box    [%.6g %.6g %.6g] .. [%.6g %.6g %.6g]\n",
+           r.bbox_min[0], r.bbox_min[1], r.bbox_min[2], r.bbox_max[0], r.bbox_max[1], r.bbox_max[2]);
+    char problems[4096];
+    int n = mesh_check_problems(&r, path, problems, sizeof problems);
+    if (n > 0) {
+        fputs(problems, stderr);
+        fprintf(stderr, "meshcorr info: %s: %d problem%s; the optimizer cannot use this mesh\n",
+                path, n, n == 1 ? "" : "s");
+    }
+    return mesh_check_usable(&r) ? 0 : 1;
 }

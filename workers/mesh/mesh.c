@@ -63,6 +63,9 @@ static const struct {
     writer_fn write;
 } formats[] = {
     { ".off", mesh_read_off, mesh_write_off },
+    { ".obj", mesh_read_obj, mesh_write_obj },
+    { ".ply", mesh_read_ply, mesh_write_ply },
+    { ".drc", mesh_read_drc, mesh_write_drc },
 };
 
 static int find_format(const char *path)

@@ -4,7 +4,10 @@
  * (f: nf by 3 ints, 0-based, in the file's order). Vertex order is always the
  * user's order: readers keep the file's order and writers write it back.
  * (A .drc file written by someone else keeps Draco's decoded order, which may
- * differ from the order its author had; .drc files we write keep the order.)
+ * differ from the order its author had; .drc files we write keep the order:
+ * they carry an int attribute with each point's original index, marked by the
+ * attribute metadata name = "meshcorr_vertex_index", and the reader puts each
+ * point back at that index.)
  *
  * Ownership: mesh_new/mesh_read return a mesh the caller frees with
  * mesh_free (NULL is accepted). Errors are negative MESH_E* codes with the
@@ -54,8 +57,25 @@ int mesh_read(const char *path, mesh **out, char *err, size_t errsz);
 /* Writes by extension (.off .obj .ply .drc). */
 int mesh_write(const char *path, const mesh *m, char *err, size_t errsz);
 
-/* Per-format entry points (path is used in messages only for the _mem ones). */
+/* Position quantization of the .drc files we write (bits per coordinate over
+ * the bounding box): the error is at most bbox_size / 2^16 per coordinate. */
+#define MESH_DRC_QUANTIZATION_BITS 16
+
+/* Per-format entry points; mesh_read/mesh_write pick one by extension.
+ * OFF and OBJ: text, triangles only (a polygon is refused naming file, line
+ * and face). OBJ: "f a", "f a/b", "f a/b/c", "f a//c", negative (relative)
+ * indices; v/f lines only, everything else skipped. PLY: ascii and
+ * binary_little_endian, vertex x y z of any scalar type, face list
+ * vertex_indices (or vertex_index), other properties and elements skipped;
+ * written as binary_little_endian with double positions (exact round trip).
+ * DRC: see draco_bridge.h for the vertex-order rule. */
 int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz);
 int mesh_write_off(const char *path, const mesh *m, char *err, size_t errsz);
+int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz);
+int mesh_write_obj(const char *path, const mesh *m, char *err, size_t errsz);
+int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz);
+int mesh_write_ply(const char *path, const mesh *m, char *err, size_t errsz);
+int mesh_read_drc(const char *path, mesh **out, char *err, size_t errsz);
+int mesh_write_drc(const char *path, const mesh *m, char *err, size_t errsz);
 
 #endif

@@ -102,10 +102,8 @@ void mesh_lex_skip_line(mesh_lex *lx)
         lx->p++;
 }
 
-int mesh_lex_double(mesh_lex *lx, double *out)
+int mesh_lex_parse_double(const char *t, size_t n, double *out)
 {
-    const char *t;
-    size_t n = mesh_lex_next(lx, &t);
     if (n == 0 || n > 63)
         return -1;
     char tmp[64];
@@ -120,10 +118,8 @@ int mesh_lex_double(mesh_lex *lx, double *out)
     return 0;
 }
 
-int mesh_lex_long(mesh_lex *lx, long *out)
+int mesh_lex_parse_long(const char *t, size_t n, long *out)
 {
-    const char *t;
-    size_t n = mesh_lex_next(lx, &t);
     if (n == 0 || n > 31)
         return -1;
     char tmp[32];
@@ -136,4 +132,25 @@ int mesh_lex_long(mesh_lex *lx, long *out)
         return -1;
     *out = v;
     return 0;
+}
+
+int mesh_lex_double(mesh_lex *lx, double *out)
+{
+    const char *t;
+    size_t n = mesh_lex_next(lx, &t);
+    return mesh_lex_parse_double(t, n, out);
+}
+
+int mesh_lex_double_inline(mesh_lex *lx, double *out)
+{
+    const char *t;
+    size_t n = mesh_lex_next_inline(lx, &t);
+    return mesh_lex_parse_double(t, n, out);
+}
+
+int mesh_lex_long(mesh_lex *lx, long *out)
+{
+    const char *t;
+    size_t n = mesh_lex_next(lx, &t);
+    return mesh_lex_parse_long(t, n, out);
 }

@@ -1,0 +1,65 @@
+/* mesh_drc.c — .drc (Draco) reader and writer: file bytes in and out, the
+ * coding itself through draco_bridge.h. Written files use
+ * MESH_DRC_QUANTIZATION_BITS and keep the vertex order (see mesh.h). */
+#include "mesh/mesh.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh_lex.h"
+#include "util/errbuf.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int mesh_read_drc(const char *path, mesh **out, char *err, size_t errsz)
+{
+    *out = NULL;
+    char *buf = NULL;
+    size_t len = 0;
+    int rc = mesh_lex_slurp(path, DRACOB_MAX_BUFFER_BYTES, &buf, &len, err, errsz);
+    if (rc)
+        return rc;
+    double *v = NULL;
+    int *f = NULL, nv = 0, nf = 0;
+    char derr[512] = "";
+    int drc = dracob_decode((const unsigned char *)buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES,
+                            &v, &nv, &f, &nf, derr, sizeof derr);
+    free(buf);
+    if (drc) {
+        rc = drc == DRACOB_ELIMIT ? MESH_ELIMIT : drc == DRACOB_ENOMEM ? MESH_ENOMEM : MESH_EDRACO;
+        return errbuf_set(err, errsz, rc, "%s: %s", path, derr);
+    }
+    mesh *m = calloc(1, sizeof *m);
+    if (!m) {
+        free(v);
+        free(f);
+        return errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
+    }
+    m->nv = nv;
+    m->nf = nf;
+    m->v = v;
+    m->f = f;
+    *out = m;
+    return MESH_OK;
+}
+
+int mesh_write_drc(const char *path, const mesh *m, char *err, size_t errsz)
+{
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    char derr[512] = "";
+    if (dracob_encode(m->v, m->nv, m->f, m->nf, MESH_DRC_QUANTIZATION_BITS, &buf, &len,
+                      derr, sizeof derr))
+        return errbuf_set(err, errsz, MESH_EDRACO, "%s: %s", path, derr);
+    int rc = MESH_OK;
+    FILE *fp = fopen(path, "wb");
+    if (!fp) {
+        rc = errbuf_set(err, errsz, MESH_EIO, "%s: cannot create: %s", path, strerror(errno));
+    } else {
+        size_t put = fwrite(buf, 1, len, fp);
+        if (fclose(fp) != 0 || put != len)
+            rc = errbuf_set(err, errsz, MESH_EIO, "%s: write failed: %s", path, strerror(errno));
+    }
+    free(buf);
+    return rc;
+}
