@@ -1,14 +1,28 @@
 /* ener_def.c — the deformation energy object: reference caches (ĝ⁻¹, â per
- * face; oriented 4 vertices, cos θ̂ and l̂²/d̂ per interior edge), the
- * admissible-edge flags, and the threaded evaluation: per-face and per-edge
- * kernels write into element-local buffers, then a per-vertex gather over
- * sorted incidence lists. Energies are summed per fixed chunk of elements and
- * the chunk sums added in order, so results do not depend on the thread
- * count. The kernels themselves live in ener_membrane.c / ener_bending.c. */
+ * face; faces, orientation sign, cos θ̂ and l̂²/d̂ per interior edge), the
+ * admissible-edge flags, and the threaded evaluation. The kernels live in
+ * ener_membrane.c and ener_normal.h / ener_bending.c; this file only runs
+ * them over the mesh.
+ *
+ * DESIGN. ener_def_eval is four data-parallel passes with a barrier between
+ * them, each writing only its own elements' slots:
+ *   A  per face: membrane energy and α-scaled gradient (9 values), unit normal
+ *   B  per admissible edge: cos θ = ±⟨n_t, n_t'⟩ from A's normals, the term
+ *      (cos θ̂ − cos θ)²·l̂²/d̂, and η·∂term/∂cos θ
+ *   C  per face: the gradient w.r.t. its normal, Σ over its edges of B's
+ *      coefficient times the neighbour's normal, back-propagated onto its
+ *      3 corners and added to A's 9 values
+ *   D  per vertex: the sum of its faces' corner gradients in the sorted
+ *      vertex -> face order of geo_edges.
+ * Sharing each face's normal between its three edges makes a bending edge
+ * cost a dot product, and puts the whole gradient into the per-face buffer,
+ * so one gather over vertex -> face lists suffices. Energies are summed per
+ * fixed chunk of elements and the chunk sums added in order. No atomics;
+ * the result has the same bits for any thread count. */
 #include "ener/ener_def.h"
+#include "ener/ener_normal.h"
 #include "util/errbuf.h"
 
-#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,7 +39,8 @@ typedef struct ener__face {
 } ener__face;
 
 typedef struct ener__edge {
-    int v[4];        /* i, j, k, l: faces (i, j, k) and (j, i, l) */
+    int t[2];        /* faces (i, j, k) and the one with l */
+    double sign;     /* +1 when face t[1] runs (j, i, l), −1 when (i, j, l) */
     double cos_ref;  /* cos θ̂ */
     double weight;   /* l̂² / d̂ */
 } ener__edge;
@@ -37,11 +52,13 @@ struct ener_def {
     const geo_edges *E;      /* caller-owned: vertex -> face lists */
     ener__face *fr;          /* nf */
     ener__edge *er;          /* ne */
-    int *et;                 /* ne by 2: the edge's faces (i, j, k), (j, i, l) */
+    int *fedge, *fnbr;       /* nf by 3: interior edge index (or −1) and the
+                                face across it, for pass C */
     unsigned char *adm;      /* ne: 1 when admissible */
     unsigned char *fok;      /* nf: scratch for ener_def_update_admissible */
-    int *ve_start, *ve_off;  /* vertex -> 12·edge + 3·slot, sorted */
-    double *gf, *ge;         /* 9·nf and 12·ne element gradients */
+    double *fn;              /* nf by 4: unit normal and 1/|c| in Y (pass A) */
+    double *gf;              /* nf by 9: corner gradients (passes A, C) */
+    double *ecoef;           /* ne: η·∂term/∂⟨n_t, n_t'⟩ (pass B) */
     double *chunk;           /* energy per chunk: faces, then edges */
 };
 
@@ -57,33 +74,17 @@ const char *ener_strerror(int code)
 
 static int nchunks(int n) { return (n + ENER_CHUNK - 1) / ENER_CHUNK; }
 
-/* Cosine of the angle between the unit normals of (xi, xj, xk) and
- * (xj, xi, xl): the reference value the bending kernel compares against. */
-static double edge_cos(const double *xi, const double *xj, const double *xk,
-                       const double *xl)
+static const double *corner(const double *Y, const int *f, int t, int k)
 {
-    double a[3], b[3], c[3], n1[3], n2[3];
-    for (int k = 0; k < 3; k++) {
-        a[k] = xj[k] - xi[k];
-        b[k] = xk[k] - xi[k];
-        c[k] = xl[k] - xj[k];
-    }
-    n1[0] = a[1] * b[2] - a[2] * b[1];
-    n1[1] = a[2] * b[0] - a[0] * b[2];
-    n1[2] = a[0] * b[1] - a[1] * b[0];
-    /* (xi − xj) × (xl − xj) = −a × c = c × a */
-    n2[0] = c[1] * a[2] - c[2] * a[1];
-    n2[1] = c[2] * a[0] - c[0] * a[2];
-    n2[2] = c[0] * a[1] - c[1] * a[0];
-    double s1 = n1[0] * n1[0] + n1[1] * n1[1] + n1[2] * n1[2];
-    double s2 = n2[0] * n2[0] + n2[1] * n2[1] + n2[2] * n2[2];
-    return (n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]) / sqrt(s1 * s2);
+    return Y + 3 * (size_t)f[3 * t + k];
 }
 
-/* |e1 × e2|² = det g of face (y0, y1, y2), without the Gram form's
- * cancellation on slivers. */
-static double face_det(const double *y0, const double *y1, const double *y2)
+/* |e1 × e2|² = det g of face t, without the Gram form's cancellation on
+ * slivers. */
+static double face_det(const double *Y, const int *f, int t)
 {
+    const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+    const double *y2 = corner(Y, f, t, 2);
     double e1[3], e2[3];
     for (int k = 0; k < 3; k++) {
         e1[k] = y1[k] - y0[k];
@@ -98,18 +99,18 @@ static double face_det(const double *y0, const double *y1, const double *y2)
 static int build_faces(ener_def *d, const mesh *X, char *err, size_t errsz)
 {
     for (int t = 0; t < d->nf; t++) {
-        const double *x0 = X->v + 3 * (size_t)X->f[3 * t];
-        const double *x1 = X->v + 3 * (size_t)X->f[3 * t + 1];
-        const double *x2 = X->v + 3 * (size_t)X->f[3 * t + 2];
+        const double *x0 = corner(X->v, X->f, t, 0), *x1 = corner(X->v, X->f, t, 1);
+        const double *x2 = corner(X->v, X->f, t, 2);
         double e1[3], e2[3];
         for (int k = 0; k < 3; k++) {
             e1[k] = x1[k] - x0[k];
-            e2[k] = x2[k] - x0[k];
+            e2[k] = -(x2[k] - x0[k]);
         }
+        /* ĝ = [e1 | −e2]ᵀ[e1 | −e2]; det ĝ = |e1 × e2|² */
         double g11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
         double g22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
-        double g12 = -(e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2]);
-        double det = face_det(x0, x1, x2);
+        double g12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
+        double det = face_det(X->v, X->f, t);
         if (!(det > 0.0) || !isfinite(det))
             return errbuf_set(err, errsz, ENER_EDEGENERATE,
                               "%s: face %d (%d, %d, %d) has zero area in the reference mesh",
@@ -124,49 +125,44 @@ static int build_faces(ener_def *d, const mesh *X, char *err, size_t errsz)
     return ENER_OK;
 }
 
+/* Interior edges in edge-table order: faces, orientation sign, weight and
+ * cos θ̂ from X's unit normals (the bending kernel's convention, see
+ * ener_bending.c), and the per-face edge lists for pass C. */
 static void build_edges(ener_def *d, const mesh *X)
 {
     const geo_edges *E = d->E;
+    for (int i = 0; i < 3 * d->nf; i++)
+        d->fedge[i] = d->fnbr[i] = -1;
     int n = 0;
     for (int e = 0; e < E->ne; e++) {
         int t1 = E->ef[2 * e], t2 = E->ef[2 * e + 1];
         if (t1 < 0 || t2 < 0)
             continue;
-        const int *f1 = X->f + 3 * (size_t)t1;
-        int ck = f1[0] == E->eo[2 * e] ? 0 : f1[1] == E->eo[2 * e] ? 1 : 2;
-        d->et[2 * n] = t1;
-        d->et[2 * n + 1] = t2;
-        ener__edge *r = &d->er[n++];
-        r->v[0] = f1[(ck + 1) % 3];
-        r->v[1] = f1[(ck + 2) % 3];
-        r->v[2] = f1[ck];
-        r->v[3] = E->eo[2 * e + 1];
-        const double *xi = X->v + 3 * (size_t)r->v[0], *xj = X->v + 3 * (size_t)r->v[1];
+        const int *f1 = X->f + 3 * (size_t)t1, *f2 = X->f + 3 * (size_t)t2;
+        int c1 = f1[0] == E->eo[2 * e] ? 0 : f1[1] == E->eo[2 * e] ? 1 : 2;
+        int c2 = f2[0] == E->eo[2 * e + 1] ? 0 : f2[1] == E->eo[2 * e + 1] ? 1 : 2;
+        int vi = f1[(c1 + 1) % 3], vj = f1[(c1 + 2) % 3];
+        ener__edge *r = &d->er[n];
+        r->t[0] = t1;
+        r->t[1] = t2;
+        /* face t2 = (l, a, b) runs (j, i, l) cyclically when a = j */
+        r->sign = f2[(c2 + 1) % 3] == vj ? 1.0 : -1.0;
+        const double *xi = X->v + 3 * (size_t)vi, *xj = X->v + 3 * (size_t)vj;
         double l2 = 0.0;
         for (int k = 0; k < 3; k++)
             l2 += (xj[k] - xi[k]) * (xj[k] - xi[k]);
         r->weight = 3.0 * l2 / (d->fr[t1].ahat + d->fr[t2].ahat);
-        r->cos_ref = edge_cos(xi, xj, X->v + 3 * (size_t)r->v[2],
-                              X->v + 3 * (size_t)r->v[3]);
+        double n1[3], n2[3];
+        ener__unit_normal(corner(X->v, X->f, t1, 0), corner(X->v, X->f, t1, 1),
+                          corner(X->v, X->f, t1, 2), n1);
+        ener__unit_normal(corner(X->v, X->f, t2, 0), corner(X->v, X->f, t2, 1),
+                          corner(X->v, X->f, t2, 2), n2);
+        r->cos_ref = r->sign * (n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]);
+        d->fedge[3 * t1 + c1] = d->fedge[3 * t2 + c2] = n;
+        d->fnbr[3 * t1 + c1] = t2;
+        d->fnbr[3 * t2 + c2] = t1;
+        n++;
     }
-}
-
-/* Vertex -> (edge, slot) incidence as buffer offsets 12·edge + 3·slot,
- * sorted by edge then slot (filled in that order). */
-static void build_vertex_edges(ener_def *d)
-{
-    for (int e = 0; e < d->ne; e++)
-        for (int s = 0; s < 4; s++)
-            d->ve_start[d->er[e].v[s] + 1]++;
-    for (int i = 0; i < d->nv; i++)
-        d->ve_start[i + 1] += d->ve_start[i];
-    int *fill = d->ve_start; /* reuse as cursor, restored below */
-    for (int e = 0; e < d->ne; e++)
-        for (int s = 0; s < 4; s++)
-            d->ve_off[fill[d->er[e].v[s]]++] = 12 * e + 3 * s;
-    for (int i = d->nv; i > 0; i--)
-        d->ve_start[i] = d->ve_start[i - 1];
-    d->ve_start[0] = 0;
 }
 
 ener_def *ener_def_new(const mesh *X, const geo_edges *E, const ener_def_params *p,
@@ -185,40 +181,34 @@ ener_def *ener_def_new(const mesh *X, const geo_edges *E, const ener_def_params 
                    ener_strerror(ENER_EINVAL), p->alpha, p->eta, p->log_eps);
         goto fail;
     }
-    int ne = E->ne - geo_edges_boundary_count(E);
-    if (ne > INT_MAX / 12) {
-        errbuf_set(err, errsz, ENER_EINVAL, "%s: %d interior edges is over %d",
-                   ener_strerror(ENER_EINVAL), ne, INT_MAX / 12);
-        goto fail;
-    }
     d = calloc(1, sizeof *d);
     if (!d)
         goto nomem;
     d->p = *p;
     d->nv = X->nv;
     d->nf = X->nf;
-    d->ne = ne;
+    d->ne = E->ne - geo_edges_boundary_count(E);
     d->f = X->f;
     d->E = E;
-    size_t nf = (size_t)d->nf, nen = (size_t)ne, nv = (size_t)d->nv;
-    d->fr = malloc((nf ? nf : 1) * sizeof *d->fr);
-    d->er = malloc((nen ? nen : 1) * sizeof *d->er);
-    d->et = malloc((2 * nen + 1) * sizeof *d->et);
-    d->adm = malloc(nen + 1);
+    size_t nf = (size_t)d->nf, ne = (size_t)d->ne;
+    d->fr = malloc((nf + 1) * sizeof *d->fr);
+    d->er = malloc((ne + 1) * sizeof *d->er);
+    d->fedge = malloc((3 * nf + 1) * sizeof *d->fedge);
+    d->fnbr = malloc((3 * nf + 1) * sizeof *d->fnbr);
+    d->adm = malloc(ne + 1);
     d->fok = malloc(nf + 1);
-    d->ve_start = calloc(nv + 1, sizeof *d->ve_start);
-    d->ve_off = malloc((4 * nen + 1) * sizeof *d->ve_off);
+    d->fn = malloc((4 * nf + 1) * sizeof *d->fn);
     d->gf = malloc((9 * nf + 1) * sizeof *d->gf);
-    d->ge = calloc(12 * nen + 1, sizeof *d->ge);
-    d->chunk = malloc(((size_t)nchunks(d->nf) + (size_t)nchunks(ne) + 1) * sizeof *d->chunk);
-    if (!d->fr || !d->er || !d->et || !d->adm || !d->fok || !d->ve_start || !d->ve_off ||
-        !d->gf || !d->ge || !d->chunk)
+    d->ecoef = malloc((ne + 1) * sizeof *d->ecoef);
+    d->chunk = malloc(((size_t)nchunks(d->nf) + (size_t)nchunks(d->ne) + 1) *
+                      sizeof *d->chunk);
+    if (!d->fr || !d->er || !d->fedge || !d->fnbr || !d->adm || !d->fok || !d->fn ||
+        !d->gf || !d->ecoef || !d->chunk)
         goto nomem;
     if (build_faces(d, X, err, errsz) != ENER_OK)
         goto fail;
     build_edges(d, X);
-    build_vertex_edges(d);
-    memset(d->adm, 1, nen);
+    memset(d->adm, 1, ne);
     return d;
 nomem:
     errbuf_set(err, errsz, ENER_ENOMEM, "%s: energy caches for %d faces",
@@ -234,13 +224,13 @@ void ener_def_free(ener_def *d)
         return;
     free(d->fr);
     free(d->er);
-    free(d->et);
+    free(d->fedge);
+    free(d->fnbr);
     free(d->adm);
     free(d->fok);
-    free(d->ve_start);
-    free(d->ve_off);
+    free(d->fn);
     free(d->gf);
-    free(d->ge);
+    free(d->ecoef);
     free(d->chunk);
     free(d);
 }
@@ -248,21 +238,17 @@ void ener_def_free(ener_def *d)
 int ener_def_update_admissible(ener_def *d, const double *Y)
 {
     const int nf = d->nf, ne = d->ne;
-    const int *f = d->f;
     const double r2 = 4.0 * ENER_ADMISSIBLE_AREA_RATIO * ENER_ADMISSIBLE_AREA_RATIO;
     int count = 0;
 #pragma omp parallel
     {
+        /* area > ratio·â  ⟺  det g > 4·ratio²·â² */
 #pragma omp for schedule(static)
-        for (int t = 0; t < nf; t++) {
-            double det = face_det(Y + 3 * (size_t)f[3 * t], Y + 3 * (size_t)f[3 * t + 1],
-                                  Y + 3 * (size_t)f[3 * t + 2]);
-            /* area > ratio·â  ⟺  det g > 4·ratio²·â² */
-            d->fok[t] = det > r2 * d->fr[t].ahat * d->fr[t].ahat;
-        }
+        for (int t = 0; t < nf; t++)
+            d->fok[t] = face_det(Y, d->f, t) > r2 * d->fr[t].ahat * d->fr[t].ahat;
 #pragma omp for schedule(static) reduction(+ : count)
         for (int e = 0; e < ne; e++) {
-            d->adm[e] = d->fok[d->et[2 * e]] && d->fok[d->et[2 * e + 1]];
+            d->adm[e] = d->fok[d->er[e].t[0]] && d->fok[d->er[e].t[1]];
             count += d->adm[e];
         }
     }
@@ -275,68 +261,85 @@ double ener_def_eval(ener_def *d, const double *Y, double *grad,
     const int nf = d->nf, ne = d->ne, nv = d->nv;
     const int ncf = nchunks(nf), nce = nchunks(ne);
     const double log_eps = d->p.log_eps, alpha = d->p.alpha, eta = d->p.eta;
-    const int *f = d->f;
+    const int *f = d->f, *fedge = d->fedge, *fnbr = d->fnbr;
     const ener__face *fr = d->fr;
     const ener__edge *er = d->er;
     const unsigned char *adm = d->adm;
-    double *gf = d->gf, *ge = d->ge, *chunk = d->chunk;
+    double *fn = d->fn, *gf = d->gf, *ecoef = d->ecoef, *chunk = d->chunk;
     const int *vf_start = d->E->vf_start, *vf_face = d->E->vf_face;
     const int *vf_corner = d->E->vf_corner;
-    const int *ve_start = d->ve_start, *ve_off = d->ve_off;
 
 #pragma omp parallel
     {
-#pragma omp for schedule(static) nowait
+        /* A: membrane and normals */
+#pragma omp for schedule(static)
         for (int c = 0; c < ncf; c++) {
-            const int t1 = c * ENER_CHUNK + ENER_CHUNK < nf ? c * ENER_CHUNK + ENER_CHUNK : nf;
+            const int t1 = nf - c * ENER_CHUNK < ENER_CHUNK ? nf : c * ENER_CHUNK + ENER_CHUNK;
             double s = 0.0;
             for (int t = c * ENER_CHUNK; t < t1; t++) {
-                const int *ft = f + 3 * (size_t)t;
-                s += ener_membrane_face(fr[t].ginv, fr[t].ahat, log_eps,
-                                        Y + 3 * (size_t)ft[0], Y + 3 * (size_t)ft[1],
-                                        Y + 3 * (size_t)ft[2],
-                                        grad ? gf + 9 * (size_t)t : NULL);
+                const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+                const double *y2 = corner(Y, f, t, 2);
+                double *g = grad ? gf + 9 * (size_t)t : NULL;
+                s += ener_membrane_face(fr[t].ginv, fr[t].ahat, log_eps, y0, y1, y2, g);
+                if (g)
+                    for (int k = 0; k < 9; k++)
+                        g[k] *= alpha;
+                double *n = fn + 4 * (size_t)t;
+                n[3] = ener__unit_normal(y0, y1, y2, n);
             }
             chunk[c] = s;
         }
+        /* B: bending terms */
 #pragma omp for schedule(static)
         for (int c = 0; c < nce; c++) {
-            const int e1 = c * ENER_CHUNK + ENER_CHUNK < ne ? c * ENER_CHUNK + ENER_CHUNK : ne;
+            const int e1 = ne - c * ENER_CHUNK < ENER_CHUNK ? ne : c * ENER_CHUNK + ENER_CHUNK;
             double s = 0.0;
             for (int e = c * ENER_CHUNK; e < e1; e++) {
-                double *g = grad ? ge + 12 * (size_t)e : NULL;
-                if (!adm[e]) {
-                    if (g)
-                        memset(g, 0, 12 * sizeof *g);
+                const double *n1 = fn + 4 * (size_t)er[e].t[0];
+                const double *n2 = fn + 4 * (size_t)er[e].t[1];
+                if (!adm[e] || n1[3] == 0.0 || n2[3] == 0.0) {
+                    ecoef[e] = 0.0;
                     continue;
                 }
-                const int *v = er[e].v;
-                s += ener_bending_edge(er[e].cos_ref, er[e].weight,
-                                       Y + 3 * (size_t)v[0], Y + 3 * (size_t)v[1],
-                                       Y + 3 * (size_t)v[2], Y + 3 * (size_t)v[3], g);
+                const double cs = er[e].sign * (n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]);
+                const double diff = er[e].cos_ref - cs;
+                s += er[e].weight * diff * diff;
+                ecoef[e] = -2.0 * eta * er[e].weight * diff * er[e].sign;
             }
             chunk[ncf + c] = s;
         }
         if (grad) {
+            /* C: bending gradient per face through its normal */
+#pragma omp for schedule(static)
+            for (int t = 0; t < nf; t++) {
+                double u[3] = {0.0, 0.0, 0.0};
+                for (int k = 0; k < 3; k++) {
+                    const int e = fedge[3 * t + k];
+                    if (e < 0)
+                        continue;
+                    const double *m = fn + 4 * (size_t)fnbr[3 * t + k];
+                    u[0] += ecoef[e] * m[0];
+                    u[1] += ecoef[e] * m[1];
+                    u[2] += ecoef[e] * m[2];
+                }
+                const double *n = fn + 4 * (size_t)t;
+                ener__unit_normal_backprop(corner(Y, f, t, 0), corner(Y, f, t, 1),
+                                           corner(Y, f, t, 2), n, n[3], u,
+                                           gf + 9 * (size_t)t);
+            }
+            /* D: gather per vertex in sorted face order */
 #pragma omp for schedule(static)
             for (int i = 0; i < nv; i++) {
-                double mx = 0.0, my = 0.0, mz = 0.0, bx = 0.0, by = 0.0, bz = 0.0;
+                double gx = 0.0, gy = 0.0, gz = 0.0;
                 for (int s = vf_start[i]; s < vf_start[i + 1]; s++) {
                     const double *g = gf + 9 * (size_t)vf_face[s] + 3 * vf_corner[s];
-                    mx += g[0];
-                    my += g[1];
-                    mz += g[2];
+                    gx += g[0];
+                    gy += g[1];
+                    gz += g[2];
                 }
-                for (int s = ve_start[i]; s < ve_start[i + 1]; s++) {
-                    const double *g = ge + ve_off[s];
-                    bx += g[0];
-                    by += g[1];
-                    bz += g[2];
-                }
-                double *o = grad + 3 * (size_t)i;
-                o[0] = alpha * mx + eta * bx;
-                o[1] = alpha * my + eta * by;
-                o[2] = alpha * mz + eta * bz;
+                grad[3 * (size_t)i] = gx;
+                grad[3 * (size_t)i + 1] = gy;
+                grad[3 * (size_t)i + 2] = gz;
             }
         }
     }
