@@ -31,6 +31,19 @@
 
 #define ENER_LOG_EPS_DEFAULT 1e-20
 
+#define ENER_ERRORS(X)                                                     \
+    X(ENER_OK,          0, "ok")                                           \
+    X(ENER_ENOMEM,     -1, "out of memory")                                \
+    X(ENER_EINVAL,     -2, "invalid argument")                             \
+    X(ENER_EDEGENERATE, -3, "degenerate reference face")
+
+enum ener_error {
+#define ENER_ENUM(name, val, msg) name = val,
+    ENER_ERRORS(ENER_ENUM)
+#undef ENER_ENUM
+};
+const char *ener_strerror(int code);
+
 typedef struct ener_def_params {
     double alpha;    /* membrane weight (≥ 0) */
     double eta;      /* bending weight (≥ 0) */
@@ -39,8 +52,9 @@ typedef struct ener_def_params {
 
 typedef struct ener_def ener_def;
 
-/* Returns NULL (detail in err) on out of memory or a degenerate reference
- * face (zero area in X). */
+/* Returns NULL (detail in err, prefixed by the ENER_E* message) on out of
+ * memory, a bad parameter (α < 0, η < 0, log_eps ≤ 0, E not built from X),
+ * or a degenerate reference face (zero area in X). */
 ener_def *ener_def_new(const mesh *X, const geo_edges *E, const ener_def_params *p,
                        char *err, size_t errsz);
 void ener_def_free(ener_def *d);

@@ -1,0 +1,67 @@
+/* ener_normal.h — internal to workers/ener: the unit face normal and the
+ * back-propagation of a gradient w.r.t. that normal onto the face's three
+ * corners. The bending term is built from these two pieces both in the
+ * single-edge kernel (ener_bending.c) and in the per-face passes of
+ * ener_def_eval (ener_def.c), so the two cannot drift apart. static inline
+ * because they sit in the per-face hot loop and the build has no LTO.
+ *
+ * For c = (y1 − y0) × (y2 − y0) = e1 × e2 and n = c/|c|:
+ *   ∂⟨n, u⟩/∂c = (u − ⟨n, u⟩·n)/|c| =: v,   and for ⟨e1 × e2, v⟩
+ *   ∂/∂e1 = e2 × v,  ∂/∂e2 = v × e1,  ∂/∂y0 = −(∂/∂e1 + ∂/∂e2).
+ * The normal is the same for every cyclic rotation of the corners. */
+#ifndef ENER_NORMAL_H
+#define ENER_NORMAL_H
+#include <math.h>
+
+/* sin² of the face angle at y0 below which a face has no normal. */
+#define ENER_NORMAL_SIN2_MIN 1e-30
+
+/* Writes the unit normal of (y0, y1, y2) into n and returns 1/|c|; a face
+ * with no normal gets n = 0 and returns 0, which makes the back-propagation
+ * below add nothing. */
+static inline double ener__unit_normal(const double *y0, const double *y1,
+                                       const double *y2, double n[3])
+{
+    const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+    const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+    const double c0 = e1[1] * e2[2] - e1[2] * e2[1];
+    const double c1 = e1[2] * e2[0] - e1[0] * e2[2];
+    const double c2 = e1[0] * e2[1] - e1[1] * e2[0];
+    const double s = c0 * c0 + c1 * c1 + c2 * c2;
+    const double l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    const double l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    if (!(s > ENER_NORMAL_SIN2_MIN * l1 * l2)) {
+        n[0] = n[1] = n[2] = 0.0;
+        return 0.0;
+    }
+    const double r = 1.0 / sqrt(s);
+    n[0] = c0 * r;
+    n[1] = c1 * r;
+    n[2] = c2 * r;
+    return r;
+}
+
+/* Adds to g (9 values: y0, y1, y2) the gradient of a function of the unit
+ * normal n = ener__unit_normal(y0, y1, y2) (r its return value) whose
+ * gradient w.r.t. n is u. */
+static inline void ener__unit_normal_backprop(const double *y0, const double *y1,
+                                              const double *y2, const double n[3],
+                                              double r, const double u[3], double g[9])
+{
+    const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+    const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+    const double nu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+    const double v[3] = {(u[0] - nu * n[0]) * r, (u[1] - nu * n[1]) * r,
+                         (u[2] - nu * n[2]) * r};
+    const double d1[3] = {e2[1] * v[2] - e2[2] * v[1], e2[2] * v[0] - e2[0] * v[2],
+                          e2[0] * v[1] - e2[1] * v[0]};
+    const double d2[3] = {v[1] * e1[2] - v[2] * e1[1], v[2] * e1[0] - v[0] * e1[2],
+                          v[0] * e1[1] - v[1] * e1[0]};
+    for (int k = 0; k < 3; k++) {
+        g[k] -= d1[k] + d2[k];
+        g[3 + k] += d1[k];
+        g[6 + k] += d2[k];
+    }
+}
+
+#endif
