@@ -14,8 +14,8 @@
  * listed order) and cost[i] (squared R^d distance; cost may be NULL). Exact:
  * the same cost as brute force (ties may pick another face of equal cost).
  * Rows run in parallel (OpenMP) on the committed scene. Degenerate triangles
- * (zero area, in R^3 or R^d) are handled: their closest point is that of
- * their longest edge.
+ * (zero area, in R^3 or R^d) are handled: their closest point is the best of
+ * their three edges (a zero-length edge is a point).
  *
  * Ownership: proj_tree_new returns a tree freed by proj_tree_free (NULL ok);
  * it copies what it needs from target and keeps no pointer to it. */
@@ -24,12 +24,29 @@
 #include <stddef.h>
 #include "mesh/mesh.h"
 
+#define PROJ_ERRORS(X)                                                      \
+    X(PROJ_OK,      0, "ok")                                                \
+    X(PROJ_EINVAL, -1, "invalid argument (d < 3, s <= 0 or n < 0)")         \
+    X(PROJ_EFACE,  -2, "previous assignment face index out of range")       \
+    X(PROJ_EMESH,  -3, "target mesh has a bad index or non-finite vertex")  \
+    X(PROJ_EEMBREE,-4, "Embree error")                                      \
+    X(PROJ_ENOMEM, -5, "out of memory")
+
+enum proj_error {
+#define PROJ_ENUM(name, val, msg) name = val,
+    PROJ_ERRORS(PROJ_ENUM)
+#undef PROJ_ENUM
+};
+const char *proj_strerror(int code);
+
 typedef struct proj_tree proj_tree;
 
 proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz);
 void proj_tree_free(proj_tree *t);
 
-/* Returns 0, or a negative value if d < 3 or s <= 0. */
+/* Returns 0, PROJ_EINVAL if d < 3, s <= 0 or n < 0, or PROJ_EFACE if an
+ * entry face[i] >= target->nf (negative entries mean "no previous
+ * assignment"). Nothing is written on error. */
 int proj_closest(const proj_tree *t, int d, const double *Z, double s,
                  int n, const double *Q, int *face, double *bary, double *cost);
 
