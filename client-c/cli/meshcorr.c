@@ -11,6 +11,7 @@ static const struct {
 } commands[] = {
     { "info",    cli_info,    "MESH             print counts, topology, area, problems" },
     { "convert", cli_convert, "IN OUT           convert between .off .obj .ply .drc" },
+    { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
 };
 
 static void usage(FILE *fp)

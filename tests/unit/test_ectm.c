@@ -1,0 +1,284 @@
+/* test_ectm.c — the ECTM alternating optimisation: parameters, monotone
+ * energy at fixed β, cancellation, injective and partial models, and the
+ * authors' own demo input (SHREC'07 381 -> 390, HOT initial maps) against
+ * their published result. */
+#include "support/harness.h"
+#include "ectm/ectm.h"
+#include "geo/geo_area.h"
+#include "metric/metric.h"
+
+#include <float.h>
+#include <string.h>
+
+#define DEMO "ectm_demo_381_390/"
+
+typedef struct demo {
+    mesh *S, *T;
+    bmap *P0, *Q0;
+} demo;
+
+static void demo_load(demo *d)
+{
+    char err[1024];
+    memset(d, 0, sizeof *d);
+    CHECK_INT(mesh_read(harness_data_path("shrec07_bim/Meshes/381.off"), &d->S, err, sizeof err), 0);
+    CHECK_INT(mesh_read(harness_data_path("shrec07_bim/Meshes/390.off"), &d->T, err, sizeof err), 0);
+    if (bmap_read(harness_data_path(DEMO "init_381_to_390.map"), d->S, d->T, &d->P0, err, sizeof err))
+        FAILF("%s", err);
+    if (bmap_read(harness_data_path(DEMO "init_390_to_381.map"), d->T, d->S, &d->Q0, err, sizeof err))
+        FAILF("%s", err);
+}
+
+static void demo_free(demo *d)
+{
+    mesh_free(d->S);
+    mesh_free(d->T);
+    bmap_free(d->P0);
+    bmap_free(d->Q0);
+}
+
+/* The demo's texture rule: uv = (z, y) of each target vertex, minus the
+ * per-column minimum, divided by the largest value of the result. Returns the
+ * mean distance of the pulled-back uv to the authors' result. */
+static double uv_distance(const demo *d, const bmap *P)
+{
+    int nt = d->T->nv;
+    double *uv = malloc(sizeof(double) * 2 * nt), mn[2] = {DBL_MAX, DBL_MAX}, mx = 0;
+    for (int j = 0; j < nt; j++) {
+        uv[2 * j] = d->T->v[3 * j + 2];
+        uv[2 * j + 1] = d->T->v[3 * j + 1];
+        for (int c = 0; c < 2; c++)
+            mn[c] = fmin(mn[c], uv[2 * j + c]);
+    }
+    for (int j = 0; j < 2 * nt; j++) {
+        uv[j] -= mn[j % 2];
+        mx = fmax(mx, uv[j]);
+    }
+    for (int j = 0; j < 2 * nt; j++)
+        uv[j] /= mx;
+    double *pulled = malloc(sizeof(double) * 2 * P->n);
+    bmap_apply(P, d->T->f, uv, 2, pulled);
+    FILE *fp = fopen(harness_data_path(DEMO "reference_final_uv_381.txt"), "r");
+    CHECK(fp);
+    char line[512];
+    int i = 0;
+    double sum = 0;
+    while (fgets(line, sizeof line, fp)) {
+        if (line[0] == '#')
+            continue;
+        double u, v;
+        CHECK_INT(sscanf(line, "%lf %lf", &u, &v), 2);
+        CHECK(i < P->n);
+        sum += hypot(pulled[2 * i] - u, pulled[2 * i + 1] - v);
+        i++;
+    }
+    fclose(fp);
+    CHECK_INT(i, P->n);
+    free(uv);
+    free(pulled);
+    return sum / P->n;
+}
+
+typedef struct trace {
+    int n;
+    double energy[400];
+    double beta[400];
+    int cancel_at;
+} trace;
+
+static int record(void *ctx, const ectm_report *r)
+{
+    trace *t = ctx;
+    if (t->n < 400) {
+        t->energy[t->n] = r->energy;
+        t->beta[t->n] = r->beta;
+        t->n++;
+    }
+    CHECK(r->dir[0].inner_iterations <= 50);
+    CHECK(isfinite(r->dir[0].w_mem) && isfinite(r->dir[0].w_bnd));
+    CHECK(r->elapsed >= 0);
+    return t->cancel_at && r->outer >= t->cancel_at;
+}
+
+TEST(params_defaults_are_released_code_values)
+{
+    ectm_params p;
+    ectm_params_init(&p);
+    CHECK_NEAR(p.alpha, 20, 0);
+    CHECK_NEAR(p.eta, 2e-3 / 3, 1e-18);
+    CHECK_NEAR(ectm_beta(&p, 1), 500, 1e-9);
+    CHECK_NEAR(ectm_beta(&p, 2), 1000, 1e-9);
+    CHECK_NEAR(ectm_beta(&p, 100), 50000, 1e-6);
+    CHECK_NEAR(ectm_beta(&p, 200), 1e5, 1e-9);
+    CHECK_NEAR(ectm_beta(&p, 300), 1e5, 1e-9);
+    CHECK_NEAR(p.gamma, 1e4, 0);
+    CHECK_INT(p.iterations, 300);
+    ectm_params_paper(&p);
+    CHECK_NEAR(ectm_beta(&p, 1), 1e3, 1e-9);
+    CHECK_NEAR(ectm_beta(&p, 200), 2e5, 1e-9);
+    CHECK_NEAR(p.gamma, 2e4, 0);
+}
+
+TEST(params_check_names_the_bad_field)
+{
+    ectm_params p;
+    char err[256];
+    ectm_params_init(&p);
+    p.alpha = -1;
+    CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
+    CHECK_STR_HAS(err, "alpha");
+    ectm_params_init(&p);
+    p.gamma = NAN;
+    CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
+    CHECK_STR_HAS(err, "gamma");
+    ectm_params_init(&p);
+    p.beta_ramp = 0;
+    CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
+    CHECK_STR_HAS(err, "beta-ramp");
+}
+
+TEST(map_sized_for_other_meshes_is_refused)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    ectm_result r;
+    char err[256];
+    CHECK_INT(ectm_run(d.T, d.S, d.P0, NULL, &p, NULL, NULL, &r, err, sizeof err), ECTM_EMAP);
+    CHECK_STR_HAS(err, "6938 -> 9239");
+    demo_free(&d);
+}
+
+TEST_T(energy_never_increases_at_fixed_beta, 300)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.beta0 = p.beta1 = 5e4;
+    p.iterations = 6;
+    trace t = {0};
+    ectm_result r;
+    char err[256];
+    if (ectm_run(d.S, d.T, d.P0, d.Q0, &p, record, &t, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(t.n, 6);
+    for (int k = 1; k < t.n; k++) {
+        printf("  outer %d energy %.12g\n", k + 1, t.energy[k]);
+        if (t.energy[k] > t.energy[k - 1] * (1 + 1e-9))
+            FAILF("energy rose from %.12g to %.12g at outer iteration %d",
+                  t.energy[k - 1], t.energy[k], k + 1);
+    }
+    ectm_result_close(&r);
+    demo_free(&d);
+}
+
+TEST_T(progress_callback_cancels_run, 300)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    trace t = {0};
+    t.cancel_at = 2;
+    ectm_result r;
+    char err[256];
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &p, record, &t, &r, err, sizeof err), ECTM_ECANCELED);
+    CHECK_INT(t.n, 2);
+    CHECK(r.P == NULL);
+    CHECK_STR_HAS(err, "cancelled");
+    demo_free(&d);
+}
+
+TEST_T(injective_model_runs_and_improves_area_distortion, 300)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.model = ECTM_INJECTIVE;
+    p.iterations = 15;
+    trace t = {0};
+    ectm_result r;
+    char err[256];
+    if (ectm_run(d.S, d.T, d.P0, NULL, &p, record, &t, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(r.Q == NULL && r.Yt == NULL);
+    metric_summary m0, m1;
+    CHECK_INT(metric_summarize(d.S, d.T, d.P0, &m0), 0);
+    CHECK_INT(metric_summarize(d.S, d.T, r.P, &m1), 0);
+    printf("  area distortion %.3f -> %.3f\n", m0.mean_abs_log_area, m1.mean_abs_log_area);
+    CHECK(m1.mean_abs_log_area < m0.mean_abs_log_area);
+    ectm_result_close(&r);
+    demo_free(&d);
+}
+
+TEST_T(missing_reverse_map_is_built_by_nearest_neighbour, 300)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 2;
+    ectm_result r;
+    char err[256];
+    if (ectm_run(d.S, d.T, d.P0, NULL, &p, NULL, NULL, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(r.Q != NULL);
+    CHECK_INT(r.Q->n, d.T->nv);
+    for (int j = 0; j < r.Q->n; j++) {
+        CHECK(r.Q->face[j] >= 0 && r.Q->face[j] < d.S->nf);
+        CHECK_NEAR(r.Q->w[3 * j] + r.Q->w[3 * j + 1] + r.Q->w[3 * j + 2], 1.0, 1e-9);
+    }
+    ectm_result_close(&r);
+    demo_free(&d);
+}
+
+TEST_T(partial_matching_keeps_scale_and_runs, 300)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.partial = 1;
+    p.iterations = 2;
+    ectm_result r;
+    char err[256];
+    if (ectm_run(d.S, d.T, d.P0, d.Q0, &p, NULL, NULL, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(r.P && r.Q);
+    CHECK(isfinite(r.last.energy));
+    ectm_result_close(&r);
+    demo_free(&d);
+}
+
+/* The authors' demo, full length with the released code's parameters: the
+ * final map must land far closer to their result than the initial map. */
+TEST_T(demo_381_390_matches_authors_result, 1800)
+{
+    demo d;
+    demo_load(&d);
+    ectm_params p;
+    ectm_params_init(&p);
+    trace t = {0};
+    ectm_result r;
+    char err[256];
+    if (ectm_run(d.S, d.T, d.P0, d.Q0, &p, record, &t, &r, err, sizeof err))
+        FAILF("%s", err);
+    double uv0 = uv_distance(&d, d.P0), uv1 = uv_distance(&d, r.P);
+    metric_summary m0, m1;
+    CHECK_INT(metric_summarize(d.S, d.T, d.P0, &m0), 0);
+    CHECK_INT(metric_summarize(d.S, d.T, r.P, &m1), 0);
+    printf("  uv distance to the authors' result: initial %.4f, final %.4f\n", uv0, uv1);
+    printf("  mean |log area ratio|: initial %.3f, final %.3f\n", m0.mean_abs_log_area, m1.mean_abs_log_area);
+    printf("  median conformal distortion: initial %.3f, final %.3f\n", m0.median_conformal, m1.median_conformal);
+    printf("  flipped %.2f%%, collapsed %.2f%%; time %.1f s (projection %.1f s, L-BFGS %.1f s)\n",
+           100 * m1.flipped_fraction, 100 * m1.collapsed_fraction, r.last.elapsed,
+           r.last.t_project, r.last.t_solve);
+    CHECK_NEAR(uv0, 0.0447, 0.0005);     /* the README's figure for the initial map */
+    CHECK(uv1 < uv0 / 4);
+    CHECK(m1.mean_abs_log_area < 0.75 * m0.mean_abs_log_area);
+    ectm_result_close(&r);
+    demo_free(&d);
+}

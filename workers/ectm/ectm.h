@@ -1,0 +1,110 @@
+/* ectm.h — Elastic Correspondence between Triangle Meshes (Ezuz et al. 2019):
+ * the alternating optimisation of ../shared/DESIGN.md.
+ *
+ * Source S (X, n vertices) and target S̃ (X̃, ñ vertices). Bijective model:
+ *   E_bij = W_def(X,Y) + β‖PX̃ − Y‖²_X + W_def(X̃,Ỹ) + β‖QX − Ỹ‖²_X̃
+ *         + γ‖PỸ − X‖²_X + γ‖QY − X̃‖²_X̃
+ * Locally injective model: E_inj = W_def(X,Y) + β‖PX̃ − Y‖²_X (no Q, Ỹ).
+ * Each outer iteration k = 1..K: β_k from the schedule, then
+ *   P ← projection, Y ← L-BFGS, (bijective:) Q ← projection, Ỹ ← L-BFGS.
+ * Both meshes are scaled to unit area first (not with `partial`, which
+ * instead divides α by the source area s and β by s·s̃) and the outputs are
+ * returned in the input frames.
+ *
+ * This module knows nothing about files, sockets or processes: it takes
+ * meshes and maps, reports each outer iteration through a callback (whose
+ * non-zero return cancels the run) and returns maps. */
+#ifndef ECTM_H
+#define ECTM_H
+#include <stddef.h>
+#include "mesh/mesh.h"
+#include "map/bmap.h"
+
+#define ECTM_ERRORS(X)                                                          \
+    X(ECTM_OK,          0, "ok")                                                \
+    X(ECTM_EPARAM,     -1, "invalid parameter")                                 \
+    X(ECTM_EMESH,      -2, "mesh not usable by the optimizer")                  \
+    X(ECTM_EMAP,       -3, "initial map does not fit the meshes")               \
+    X(ECTM_ENOMEM,     -4, "out of memory")                                     \
+    X(ECTM_ECANCELED,  -5, "cancelled")                                         \
+    X(ECTM_ENUMERIC,   -6, "numerical failure (non-finite energy)")
+
+enum ectm_error {
+#define ECTM_ENUM(name, val, msg) name = val,
+    ECTM_ERRORS(ECTM_ENUM)
+#undef ECTM_ENUM
+};
+const char *ectm_strerror(int code);
+
+typedef enum ectm_model { ECTM_BIJECTIVE = 0, ECTM_INJECTIVE = 1 } ectm_model;
+
+typedef struct ectm_params {
+    ectm_model model;
+    double alpha;          /* membrane weight                         (> 0)  */
+    double eta;            /* bending weight                          (>= 0) */
+    double beta0, beta1;   /* β at k = 1 and at k >= beta_ramp        (> 0)  */
+    int beta_ramp;         /* iterations of the linear ramp           (>= 1) */
+    double gamma;          /* reversibility weight, bijective only    (>= 0) */
+    int iterations;        /* outer iterations K                      (>= 1) */
+    int inner_iterations;  /* L-BFGS iterations per Y-step            (>= 1) */
+    double tolerance;      /* L-BFGS gradient tolerance               (> 0)  */
+    double stop_change;    /* stop when |ΔE|/E < this at fixed β; 0: never */
+    double log_eps;        /* −log extension threshold on det G       (> 0)  */
+    int partial;           /* partial matching: no rescaling          (0/1)  */
+    int threads;           /* OpenMP threads; 0: all cores                   */
+} ectm_params;
+
+/* The authors' released code's values, which produced their published demo
+ * result (../shared/data/ectm_demo_381_390/README.md): α = 20,
+ * η = 6.667e-4, β = 500·min(k, 200), γ = 1e4, K = 300, 50 L-BFGS
+ * iterations, tolerance 1e-8, ε = 1e-20, bijective. */
+void ectm_params_init(ectm_params *p);
+/* The values the paper's text gives: α = 20, η = 1e-3, β 1e3 → 2e5 over
+ * 200 iterations, γ = 2e4 (twice the released code's β and γ). */
+void ectm_params_paper(ectm_params *p);
+/* 0 or ECTM_EPARAM with the offending field named in err. */
+int ectm_params_check(const ectm_params *p, char *err, size_t errsz);
+/* β at outer iteration k (1-based). */
+double ectm_beta(const ectm_params *p, int k);
+
+/* One direction's terms: 0 = source (P, Y), 1 = target (Q, Ỹ). */
+typedef struct ectm_terms {
+    double w_mem, w_bnd;   /* unweighted membrane and bending energies      */
+    double mismatch;       /* β‖PX̃ − Y‖²_X  (resp. β‖QX − Ỹ‖²_X̃)           */
+    double reverse;        /* γ‖QY − X̃‖²_X̃ (resp. γ‖PỸ − X‖²_X), the γ term
+                              that depends on this direction's deformation  */
+    double energy;         /* α·w_mem + η·w_bnd + mismatch + reverse        */
+    int inner_iterations;  /* L-BFGS iterations of this direction's Y-step  */
+    int admissible_edges;
+} ectm_terms;
+
+typedef struct ectm_report {
+    int outer, total;      /* this outer iteration (1-based) and K          */
+    double beta, gamma;
+    ectm_terms dir[2];     /* dir[1] is zero for the injective model        */
+    double energy;         /* E_bij (or E_inj) after this iteration         */
+    double elapsed;        /* seconds since the start of ectm_run           */
+    double t_project, t_solve; /* cumulated seconds in P/Q-steps, Y-steps   */
+} ectm_report;
+
+/* Return non-zero to cancel the run. */
+typedef int (*ectm_progress_fn)(void *ctx, const ectm_report *r);
+
+typedef struct ectm_result {
+    bmap *P;       /* source -> target                                   */
+    bmap *Q;       /* target -> source (bijective; NULL for injective)   */
+    double *Y;     /* n by 3: the deformed source, in the target's frame */
+    double *Yt;    /* ñ by 3: the deformed target, in the source's frame (bijective) */
+    ectm_report last;
+} ectm_result;
+void ectm_result_close(ectm_result *r);
+
+/* Runs the optimisation. P0 is required; Q0 may be NULL (bijective: then it
+ * is built by nearest neighbour — each target vertex goes to the closest
+ * point of the source's image P0·X̃). The meshes must be manifold with no
+ * degenerate faces (validate with mesh_check first). */
+int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
+             const ectm_params *p, ectm_progress_fn progress, void *ctx,
+             ectm_result *out, char *err, size_t errsz);
+
+#endif

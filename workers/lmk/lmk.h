@@ -1,0 +1,47 @@
+/* lmk.h — landmark pairs (source vertex, target vertex) and their files.
+ *
+ * Files: either one pairs file ("source_vertex target_vertex" per line) or
+ * two lists (one vertex per line, line k of one <-> line k of the other; the
+ * BIM .vts layout "id x y z" is accepted: only the first column is read).
+ * '#' starts a comment; blank lines are skipped. Indices are 0-based unless
+ * one_based is set. Reading validates against the meshes: index in range,
+ * no duplicate source landmark, at least LMK_MIN_PAIRS pairs, at most
+ * LMK_MAX_PAIRS; errors name the file and line.
+ * Ownership: lmk_read* return a set freed with lmk_free (NULL ok). */
+#ifndef LMK_H
+#define LMK_H
+#include <stddef.h>
+#include "mesh/mesh.h"
+
+#define LMK_MIN_PAIRS 4        /* the affine initialisation needs 4 points */
+#define LMK_MAX_PAIRS 100000
+
+#define LMK_ERRORS(X)                                                     \
+    X(LMK_OK,        0, "ok")                                             \
+    X(LMK_EIO,      -1, "cannot read the landmark file")                  \
+    X(LMK_EPARSE,   -2, "malformed landmark file")                        \
+    X(LMK_ERANGE,   -3, "landmark index out of range")                    \
+    X(LMK_EDUP,     -4, "duplicate source landmark")                      \
+    X(LMK_ECOUNT,   -5, "wrong number of landmarks")                      \
+    X(LMK_ENOMEM,   -6, "out of memory")
+
+enum lmk_error {
+#define LMK_ENUM(name, val, msg) name = val,
+    LMK_ERRORS(LMK_ENUM)
+#undef LMK_ENUM
+};
+const char *lmk_strerror(int code);
+
+typedef struct lmk_set {
+    int n;      /* number of pairs */
+    int *src;   /* n source vertex indices (0-based) */
+    int *tgt;   /* n target vertex indices (0-based) */
+} lmk_set;
+
+void lmk_free(lmk_set *l);
+int lmk_read_pairs(const char *path, int one_based, const mesh *S, const mesh *T,
+                   lmk_set **out, char *err, size_t errsz);
+int lmk_read_lists(const char *src_path, const char *tgt_path, int one_based,
+                   const mesh *S, const mesh *T, lmk_set **out, char *err, size_t errsz);
+
+#endif
