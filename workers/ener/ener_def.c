@@ -1,17 +1,18 @@
 /* ener_def.c — the deformation energy object: reference caches (ĝ⁻¹, â per
  * face; faces, orientation sign, cos θ̂ and l̂²/d̂ per interior edge), the
- * admissible-edge flags, and the threaded evaluation. The kernels live in
- * ener_membrane.c and ener_normal.h / ener_bending.c; this file only runs
- * them over the mesh.
+ * admissible-edge flags, and the threaded evaluation. The arithmetic lives
+ * in ener_membrane.h and ener_normal.h (shared with the single-element
+ * kernels ener_membrane.c and ener_bending.c); this file runs it over the
+ * mesh.
  *
  * DESIGN. ener_def_eval is four data-parallel passes with a barrier between
  * them, each writing only its own elements' slots:
- *   A  per face: membrane energy and α-scaled gradient (9 values), unit normal
+ *   A  per face: membrane energy and gradient (9 values), unit normal
  *   B  per admissible edge: cos θ = ±⟨n_t, n_t'⟩ from A's normals, the term
  *      (cos θ̂ − cos θ)²·l̂²/d̂, and η·∂term/∂cos θ
  *   C  per face: the gradient w.r.t. its normal, Σ over its edges of B's
  *      coefficient times the neighbour's normal, back-propagated onto its
- *      3 corners and added to A's 9 values
+ *      3 corners and added to α times A's 9 values
  *   D  per vertex: the sum of its faces' corner gradients in the sorted
  *      vertex -> face order of geo_edges.
  * Sharing each face's normal between its three edges makes a bending edge
@@ -20,6 +21,7 @@
  * fixed chunk of elements and the chunk sums added in order. No atomics;
  * the result has the same bits for any thread count. */
 #include "ener/ener_def.h"
+#include "ener/ener_membrane.h"
 #include "ener/ener_normal.h"
 #include "util/errbuf.h"
 
@@ -279,13 +281,15 @@ double ener_def_eval(ener_def *d, const double *Y, double *grad,
             for (int t = c * ENER_CHUNK; t < t1; t++) {
                 const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
                 const double *y2 = corner(Y, f, t, 2);
-                double *g = grad ? gf + 9 * (size_t)t : NULL;
-                s += ener_membrane_face(fr[t].ginv, fr[t].ahat, log_eps, y0, y1, y2, g);
-                if (g)
-                    for (int k = 0; k < 9; k++)
-                        g[k] *= alpha;
+                const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+                const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+                const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                                     e1[2] * e2[0] - e1[0] * e2[2],
+                                     e1[0] * e2[1] - e1[1] * e2[0]};
+                s += ener__membrane(fr[t].ginv, fr[t].ahat, log_eps, e1, e2, c,
+                                    grad ? gf + 9 * (size_t)t : NULL);
                 double *n = fn + 4 * (size_t)t;
-                n[3] = ener__unit_normal(y0, y1, y2, n);
+                n[3] = ener__unit_normal_of(e1, e2, c, n);
             }
             chunk[c] = s;
         }
@@ -322,10 +326,14 @@ double ener_def_eval(ener_def *d, const double *Y, double *grad,
                     u[1] += ecoef[e] * m[1];
                     u[2] += ecoef[e] * m[2];
                 }
+                /* α here rather than in A: there it would reload the
+                 * kernel's fresh stores and stall on store forwarding */
+                double *g = gf + 9 * (size_t)t;
+                for (int k = 0; k < 9; k++)
+                    g[k] *= alpha;
                 const double *n = fn + 4 * (size_t)t;
                 ener__unit_normal_backprop(corner(Y, f, t, 0), corner(Y, f, t, 1),
-                                           corner(Y, f, t, 2), n, n[3], u,
-                                           gf + 9 * (size_t)t);
+                                           corner(Y, f, t, 2), n, n[3], u, g);
             }
             /* D: gather per vertex in sorted face order */
 #pragma omp for schedule(static)
