@@ -5,6 +5,8 @@
 #include "ener/ener_def.h"
 #include "ener/ener_membrane.h"
 
+#include <math.h>
+
 double ener_membrane_face(const double ginv[3], double ahat, double log_eps,
                           const double *y0, const double *y1, const double *y2,
                           double g[9])
@@ -13,5 +15,7 @@ double ener_membrane_face(const double ginv[3], double ahat, double log_eps,
     const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                          e1[0] * e2[1] - e1[1] * e2[0]};
-    return ener__membrane(ginv, ahat, log_eps, e1, e2, n, g);
+    const double det = ener__membrane_det(ginv, n);
+    return ener__membrane_finish(ginv, ahat, ahat, log_eps, e1, e2, n, det,
+                                 log(det > log_eps ? det : log_eps), g);
 }

@@ -2,7 +2,7 @@
  * â·W(G) of one face from its edge vectors, shared by ener_membrane_face
  * (ener_membrane.c) and the per-face pass of ener_def_eval, which computes
  * the edge vectors and their cross product once for this and the face
- * normal. static inline because it sits in the per-face hot loop and the
+ * normal, in two steps around the log. static inline because it sits in the per-face hot loop and the
  * build has no LTO.
  *
  * With e1 = y1 − y0, e2 = y2 − y0 and ĝ⁻¹ = [[a, b], [b, c]]:
@@ -17,36 +17,44 @@
 #define ENER_MEMBRANE_H
 #include <math.h>
 
-/* e1 = y1 − y0, e2 = y2 − y0, n = e1 × e2; g (9 values: y0, y1, y2, may be
- * NULL) receives the gradient. */
-static inline double ener__membrane(const double ginv[3], double ahat, double log_eps,
-                                    const double e1[3], const double e2[3],
-                                    const double n[3], double g[9])
+/* det G = |e1 × e2|²/det ĝ with n = e1 × e2 (e1 = y1 − y0, e2 = y2 − y0).
+ * The cross product, not g11·g22 − g12²: the Gram form cancels
+ * catastrophically on slivers. */
+static inline double ener__membrane_det(const double ginv[3], const double n[3])
+{
+    return (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (ginv[0] * ginv[2] - ginv[1] * ginv[1]);
+}
+
+/* â·W(G) given det = ener__membrane_det(ginv, n) and
+ * logd = log(max(det, log_eps)); g (9 values: y0, y1, y2, may be NULL)
+ * receives the gradient times gscale/â (gscale = â for the plain gradient;
+ * ener_def_eval passes α·â to fold its weight in). The log is the caller's so that ener_def_eval can
+ * take a chunk's logs in one tight loop, away from this longer dependency
+ * chain. Below ε, log(max(det, ε)) = log ε is the tangent line's constant. */
+static inline double ener__membrane_finish(const double ginv[3], double ahat, double gscale,
+                                           double log_eps, const double e1[3],
+                                           const double e2[3], const double n[3],
+                                           double det, double logd, double g[9])
 {
     const double a = ginv[0], b = ginv[1], c = ginv[2];
     const double g11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
     const double g22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
     const double g12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
-    /* det g = |e1 × e2|² from the cross product, not g11·g22 − g12²: the
-     * Gram form cancels catastrophically on slivers. */
-    const double kinv = a * c - b * b;            /* 1 / det ĝ */
     const double tr = a * g11 - 2.0 * b * g12 + c * g22;
-    const double det = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * kinv;
-
     double neglog, dneglog;
     if (det > log_eps) {
-        neglog = -log(det);
+        neglog = -logd;
         dneglog = -1.0 / det;
     } else {
-        neglog = -log(log_eps) - (det - log_eps) / log_eps;
+        neglog = -logd - (det - log_eps) / log_eps;
         dneglog = -1.0 / log_eps;
     }
     const double w = 0.5 * tr + 0.25 * det + 0.75 * neglog - 1.25;
     if (g) {
-        /* ahat·∂W/∂tr·∂tr/∂e and ahat·∂W/∂det·(1/det ĝ)·∂|n|²/∂e with
-         * ∂|n|²/∂e1 = 2·e2 × n, ∂|n|²/∂e2 = 2·n × e1. */
-        const double sd = 2.0 * ahat * (0.25 + 0.75 * dneglog) * kinv;
-        const double ta = ahat * a, tb = ahat * b, tc = ahat * c;
+        /* â·∂W/∂tr·∂tr/∂e and â·∂W/∂det·(1/det ĝ)·∂|n|²/∂e with
+         * ∂|n|²/∂e1 = 2·e2 × n, ∂|n|²/∂e2 = 2·n × e1 (â → gscale). */
+        const double sd = 2.0 * gscale * (0.25 + 0.75 * dneglog) * (a * c - b * b);
+        const double ta = gscale * a, tb = gscale * b, tc = gscale * c;
         const double m1[3] = {e2[1] * n[2] - e2[2] * n[1], e2[2] * n[0] - e2[0] * n[2],
                               e2[0] * n[1] - e2[1] * n[0]};
         const double m2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2],
