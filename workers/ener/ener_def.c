@@ -1,12 +1,14 @@
 /* ener_def.c — the deformation energy object: reference caches (ĝ⁻¹, â per
  * face; faces, orientation sign, cos θ̂ and l̂²/d̂ per interior edge), the
- * admissible-edge flags, and the threaded evaluation. The kernels live in
- * ener_membrane.c and ener_normal.h / ener_bending.c; this file only runs
- * them over the mesh.
+ * admissible-edge flags, and the threaded evaluation. The arithmetic lives
+ * in ener_membrane.h and ener_normal.h (shared with the single-element
+ * kernels ener_membrane.c and ener_bending.c); this file runs it over the
+ * mesh.
  *
  * DESIGN. ener_def_eval is four data-parallel passes with a barrier between
  * them, each writing only its own elements' slots:
- *   A  per face: membrane energy and α-scaled gradient (9 values), unit normal
+ *   A  per face: membrane energy and α times its gradient (9 values), unit
+ *      normal
  *   B  per admissible edge: cos θ = ±⟨n_t, n_t'⟩ from A's normals, the term
  *      (cos θ̂ − cos θ)²·l̂²/d̂, and η·∂term/∂cos θ
  *   C  per face: the gradient w.r.t. its normal, Σ over its edges of B's
@@ -20,6 +22,7 @@
  * fixed chunk of elements and the chunk sums added in order. No atomics;
  * the result has the same bits for any thread count. */
 #include "ener/ener_def.h"
+#include "ener/ener_membrane.h"
 #include "ener/ener_normal.h"
 #include "util/errbuf.h"
 
@@ -271,21 +274,40 @@ double ener_def_eval(ener_def *d, const double *Y, double *grad,
 
 #pragma omp parallel
     {
-        /* A: membrane and normals */
+        /* A: normals and det G, the chunk's logs in one tight loop, then
+         * the membrane terms */
 #pragma omp for schedule(static)
         for (int c = 0; c < ncf; c++) {
-            const int t1 = nf - c * ENER_CHUNK < ENER_CHUNK ? nf : c * ENER_CHUNK + ENER_CHUNK;
-            double s = 0.0;
-            for (int t = c * ENER_CHUNK; t < t1; t++) {
+            const int t0 = c * ENER_CHUNK;
+            const int t1 = nf - t0 < ENER_CHUNK ? nf : t0 + ENER_CHUNK;
+            double det[ENER_CHUNK], logd[ENER_CHUNK];
+            for (int t = t0; t < t1; t++) {
                 const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
                 const double *y2 = corner(Y, f, t, 2);
-                double *g = grad ? gf + 9 * (size_t)t : NULL;
-                s += ener_membrane_face(fr[t].ginv, fr[t].ahat, log_eps, y0, y1, y2, g);
-                if (g)
-                    for (int k = 0; k < 9; k++)
-                        g[k] *= alpha;
-                double *n = fn + 4 * (size_t)t;
-                n[3] = ener__unit_normal(y0, y1, y2, n);
+                const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+                const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+                const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                                     e1[2] * e2[0] - e1[0] * e2[2],
+                                     e1[0] * e2[1] - e1[1] * e2[0]};
+                double *un = fn + 4 * (size_t)t;
+                un[3] = ener__unit_normal_of(e1, e2, n, un);
+                det[t - t0] = ener__membrane_det(fr[t].ginv, n);
+            }
+            for (int k = 0; k < t1 - t0; k++)
+                logd[k] = log(det[k] > log_eps ? det[k] : log_eps);
+            double s = 0.0;
+            for (int t = t0; t < t1; t++) {
+                const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+                const double *y2 = corner(Y, f, t, 2);
+                const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+                const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+                const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                                     e1[2] * e2[0] - e1[0] * e2[2],
+                                     e1[0] * e2[1] - e1[1] * e2[0]};
+                s += ener__membrane_finish(fr[t].ginv, fr[t].ahat, alpha * fr[t].ahat,
+                                           log_eps, e1, e2, n,
+                                           det[t - t0], logd[t - t0],
+                                           grad ? gf + 9 * (size_t)t : NULL);
             }
             chunk[c] = s;
         }

@@ -15,9 +15,12 @@
  *   An edge is admissible when both its faces are non-degenerate in the
  *   current Y (ener_def_update_admissible; all interior edges at creation).
  *
- * Layout: per face and per edge into element-local buffers, then a
- * per-vertex gather over sorted incidence lists: deterministic (the same
- * bits for any thread count), no atomics, OpenMP threads.
+ * Layout: per face (membrane, unit normal) and per edge (bending, from the
+ * two normals) into element-local buffers, the bending gradient taken back
+ * through each face's normal into that face's corner slots, then a
+ * per-vertex gather over the sorted vertex -> face lists of geo_edges:
+ * deterministic (the same bits for any thread count), no atomics, OpenMP
+ * threads. ener_def.c's DESIGN comment has the passes.
  *
  * Reference quantities (ĝ⁻¹, â, l̂², d̂, cos θ̂) are computed once in
  * ener_def_new. The object keeps pointers to X's faces and to the edge table

@@ -1,16 +1,9 @@
 /* ener_membrane.c — the membrane density â·W(G) of one face and its
  * gradient w.r.t. the face's 9 corner coordinates (ener_def.h states the
- * model). Pure arithmetic on one element: no allocation, no mesh access.
- *
- * With e1 = y1 − y0, e2 = y2 − y0 and ĝ⁻¹ = [[a, b], [b, c]]:
- *   tr G  = a·|e1|² − 2b·⟨e1, e2⟩ + c·|e2|²     (the −e2 flips the sign of b)
- *   det G = (|e1|²|e2|² − ⟨e1, e2⟩²)·(ac − b²) = |e1 × e2|² / det ĝ
- *   ∂tr/∂e1 = 2(a·e1 − b·e2),  ∂tr/∂e2 = 2(c·e2 − b·e1)
- *   det g = |n|², n = e1 × e2:  ∂det g/∂e1 = 2·e2 × n,  ∂det g/∂e2 = 2·n × e1
- * and W(A) = ½·tr A + ¼·det A + ¾·L(det A) − 5/4 with L(x) = −log x above ε
- * and its tangent −log ε − (x − ε)/ε below, so ∂W/∂tr = ½ and
- * ∂W/∂det = ¼ + ¾·L'(det) with L' ∈ [−1/ε, 0): finite for every input. */
+ * model; ener_membrane.h holds the arithmetic and its derivation). Pure
+ * arithmetic on one element: no allocation, no mesh access. */
 #include "ener/ener_def.h"
+#include "ener/ener_membrane.h"
 
 #include <math.h>
 
@@ -18,45 +11,11 @@ double ener_membrane_face(const double ginv[3], double ahat, double log_eps,
                           const double *y0, const double *y1, const double *y2,
                           double g[9])
 {
-    const double a = ginv[0], b = ginv[1], c = ginv[2];
     const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
     const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
-    const double g11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
-    const double g22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
-    const double g12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2];
-    /* det g = |e1 × e2|² from the cross product, not g11·g22 − g12²: the
-     * Gram form cancels catastrophically on slivers. */
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                          e1[0] * e2[1] - e1[1] * e2[0]};
-    const double kinv = a * c - b * b;            /* 1 / det ĝ */
-    const double tr = a * g11 - 2.0 * b * g12 + c * g22;
-    const double det = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * kinv;
-
-    double neglog, dneglog;
-    if (det > log_eps) {
-        neglog = -log(det);
-        dneglog = -1.0 / det;
-    } else {
-        neglog = -log(log_eps) - (det - log_eps) / log_eps;
-        dneglog = -1.0 / log_eps;
-    }
-    const double w = 0.5 * tr + 0.25 * det + 0.75 * neglog - 1.25;
-    if (g) {
-        /* ahat·∂W/∂tr·∂tr/∂e and ahat·∂W/∂det·(1/det ĝ)·∂|n|²/∂e with
-         * ∂|n|²/∂e1 = 2·e2 × n, ∂|n|²/∂e2 = 2·n × e1. */
-        const double sd = 2.0 * ahat * (0.25 + 0.75 * dneglog) * kinv;
-        const double ta = ahat * a, tb = ahat * b, tc = ahat * c;
-        const double m1[3] = {e2[1] * n[2] - e2[2] * n[1], e2[2] * n[0] - e2[0] * n[2],
-                              e2[0] * n[1] - e2[1] * n[0]};
-        const double m2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2],
-                              n[0] * e1[1] - n[1] * e1[0]};
-        for (int k = 0; k < 3; k++) {
-            const double d1 = ta * e1[k] - tb * e2[k] + sd * m1[k];
-            const double d2 = tc * e2[k] - tb * e1[k] + sd * m2[k];
-            g[3 + k] = d1;
-            g[6 + k] = d2;
-            g[k] = -d1 - d2;
-        }
-    }
-    return ahat * w;
+    const double det = ener__membrane_det(ginv, n);
+    return ener__membrane_finish(ginv, ahat, ahat, log_eps, e1, e2, n, det,
+                                 log(det > log_eps ? det : log_eps), g);
 }

@@ -16,18 +16,13 @@
 /* sin² of the face angle at y0 below which a face has no normal. */
 #define ENER_NORMAL_SIN2_MIN 1e-30
 
-/* Writes the unit normal of (y0, y1, y2) into n and returns 1/|c|; a face
- * with no normal gets n = 0 and returns 0, which makes the back-propagation
- * below add nothing. */
-static inline double ener__unit_normal(const double *y0, const double *y1,
-                                       const double *y2, double n[3])
+/* The unit normal from c = e1 × e2 (e1 = y1 − y0, e2 = y2 − y0) into n;
+ * returns 1/|c|, or 0 with n = 0 for a face with no normal, which makes the
+ * back-propagation below add nothing. */
+static inline double ener__unit_normal_of(const double e1[3], const double e2[3],
+                                          const double c[3], double n[3])
 {
-    const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
-    const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
-    const double c0 = e1[1] * e2[2] - e1[2] * e2[1];
-    const double c1 = e1[2] * e2[0] - e1[0] * e2[2];
-    const double c2 = e1[0] * e2[1] - e1[1] * e2[0];
-    const double s = c0 * c0 + c1 * c1 + c2 * c2;
+    const double s = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
     const double l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
     const double l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
     if (!(s > ENER_NORMAL_SIN2_MIN * l1 * l2)) {
@@ -35,10 +30,21 @@ static inline double ener__unit_normal(const double *y0, const double *y1,
         return 0.0;
     }
     const double r = 1.0 / sqrt(s);
-    n[0] = c0 * r;
-    n[1] = c1 * r;
-    n[2] = c2 * r;
+    n[0] = c[0] * r;
+    n[1] = c[1] * r;
+    n[2] = c[2] * r;
     return r;
+}
+
+/* The same from the corners (y0, y1, y2). */
+static inline double ener__unit_normal(const double *y0, const double *y1,
+                                       const double *y2, double n[3])
+{
+    const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+    const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+    const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+    return ener__unit_normal_of(e1, e2, c, n);
 }
 
 /* Adds to g (9 values: y0, y1, y2) the gradient of a function of the unit
