@@ -27,6 +27,7 @@ static void usage(FILE *fp)
         "         [--model bijective|injective] [--preset release|paper]\n"
         "         [--alpha A] [--eta E] [--beta0 B] [--beta1 B] [--beta-ramp K] [--gamma G]\n"
         "         [--iterations K] [--inner-iterations N] [--tolerance T] [--stop-change C]\n"
+        "         [--log-eps E]\n"
         "         [--partial] [--threads N] [--progress auto|text|json|none]\n"
         "Defaults are the authors' released code's (--preset release): alpha 20, eta 6.667e-4,\n"
         "beta 500 -> 1e5 over 200 iterations, gamma 1e4, 300 iterations, 50 L-BFGS steps.\n"
@@ -149,6 +150,7 @@ int cli_match(int argc, char **argv)
         {"progress", required_argument, 0, 'G'},    {"help", no_argument, 0, 'h'},
         {"landmarks", required_argument, 0, 'L'},   {"source-landmarks", required_argument, 0, 'x'},
         {"target-landmarks", required_argument, 0, 'y'}, {"one-based", no_argument, 0, '1'},
+        {"log-eps", required_argument, 0, 'E'},
         {0, 0, 0, 0}};
     const char *init = NULL, *init_rev = NULL, *out = NULL, *out_rev = NULL;
     const char *out_def = NULL, *out_rem = NULL;
@@ -193,6 +195,7 @@ int cli_match(int argc, char **argv)
         case 'n': bad |= parse_int("inner-iterations", optarg, &p.inner_iterations) != 0; break;
         case 't': bad |= parse_double("tolerance", optarg, &p.tolerance) != 0; break;
         case 's': bad |= parse_double("stop-change", optarg, &p.stop_change) != 0; break;
+        case 'E': bad |= parse_double("log-eps", optarg, &p.log_eps) != 0; break;
         case 'P': p.partial = 1; break;
         case 'T': bad |= parse_int("threads", optarg, &p.threads) != 0; break;
         case 'G':

@@ -33,8 +33,11 @@
 /* Elements per energy chunk: fixed, so sums are the same for any thread count. */
 #define ENER_CHUNK 512
 /* A face is non-degenerate in Y when its area exceeds this fraction of its
- * reference area. */
-#define ENER_ADMISSIBLE_AREA_RATIO 1e-12
+ * reference area. Below about 1e-6 the unit normal of a sliver turns so fast
+ * that no line-search step is accepted: with 1e-12, the reverse Y-step of the
+ * cow -> camel demo (nearest-neighbour initial Q) stalled at iteration 0 with
+ * liblbfgs' minimum-step error; with 1e-6 it runs its 50 iterations. */
+#define ENER_ADMISSIBLE_AREA_RATIO 1e-6
 
 typedef struct ener__face {
     double ginv[3];  /* ĝ⁻¹ as {a, b, c} */

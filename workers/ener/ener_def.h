@@ -63,7 +63,7 @@ ener_def *ener_def_new(const mesh *X, const geo_edges *E, const ener_def_params 
 void ener_def_free(ener_def *d);
 
 /* Marks admissible the interior edges whose two faces have non-zero area in
- * Y (area > 1e-12 of its reference area). Returns the number admissible. */
+ * Y (area > 1e-6 of its reference area). Returns the number admissible. */
 int ener_def_update_admissible(ener_def *d, const double *Y);
 
 /* Returns α·W_mem + η·W_bnd at Y; grad (nv by 3) is overwritten with the
