@@ -1,5 +1,6 @@
 /* meshcorr.c — main() of the `meshcorr` CLI: dispatch to a subcommand. */
 #include "cli/cli.h"
+#include "util/ompenv.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -23,6 +24,7 @@ static void usage(FILE *fp)
 
 int main(int argc, char **argv)
 {
+    ompenv_ensure_passive(argv);
     if (argc < 2 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0) {
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;

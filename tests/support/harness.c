@@ -1,6 +1,7 @@
 /* harness.c — runs each registered test in a forked child under alarm();
  * prints "PASS|FAIL|SKIP <binary>.<test>" lines. Holds no test logic. */
 #include "support/harness.h"
+#include "util/ompenv.h"
 
 #include <signal.h>
 #include <string.h>
@@ -97,6 +98,7 @@ static int run_one(const char *prog, int i)
 
 int main(int argc, char **argv)
 {
+    ompenv_ensure_passive(argv);
     const char *prog = strrchr(argv[0], '/') ? strrchr(argv[0], '/') + 1 : argv[0];
     int failed = 0, ran = 0;
     for (int i = 0; i < ntests; i++) {
