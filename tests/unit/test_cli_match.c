@@ -1,0 +1,191 @@
+/* test_cli_match.c — `meshcorr match` as a user runs it: refusals name the
+ * file, line or field; a short real run writes every output; JSON progress
+ * is one object per outer iteration. */
+#include "support/harness.h"
+#include "support/testfile.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
+
+#include <string.h>
+#include <sys/wait.h>
+
+/* Runs cmd through the shell; returns its exit status and its stdout+stderr
+ * in out (truncated). */
+static int run(const char *cmd, char *out, size_t outsz)
+{
+    char full[4096];
+    snprintf(full, sizeof full, "%s 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    CHECK(p);
+    size_t n = fread(out, 1, outsz - 1, p);
+    out[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static const char *mesh381(void) { return harness_data_path("shrec07_bim/Meshes/381.off"); }
+
+static char s381[512], s390[512], p0[512], q0[512];
+
+static void paths(void)
+{
+    snprintf(s381, sizeof s381, "%s", mesh381());
+    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
+    snprintf(p0, sizeof p0, "%s", harness_data_path("ectm_demo_381_390/init_381_to_390.map"));
+    snprintf(q0, sizeof q0, "%s", harness_data_path("ectm_demo_381_390/init_390_to_381.map"));
+}
+
+/* A copy of the demo's initial map with row `row` (0-based) replaced. */
+static const char *map_with_row(const char *name, int row, const char *text)
+{
+    size_t len;
+    char *buf = (char *)testfile_read(p0, &len);
+    char *out = malloc(len + 256), *w = out;
+    int line = 0, data_row = -3;  /* two comment lines + the counts line */
+    for (char *p = buf; p < buf + len;) {
+        char *nl = memchr(p, '\n', (size_t)(buf + len - p));
+        size_t l = nl ? (size_t)(nl - p + 1) : (size_t)(buf + len - p);
+        if (data_row == row) {
+            w += sprintf(w, "%s\n", text);
+        } else {
+            memcpy(w, p, l);
+            w += l;
+        }
+        data_row++;
+        line++;
+        p += l;
+    }
+    const char *path = testfile_write(name, out, (size_t)(w - out));
+    free(buf);
+    free(out);
+    return path;
+}
+
+TEST(match_refuses_map_row_not_summing_to_one_naming_file_and_line)
+{
+    paths();
+    const char *bad = map_with_row("bad.map", 10, "5 0.5 0.2 0.2");
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map",
+             s381, s390, bad, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "bad.map:14");
+    CHECK_STR_HAS(out, "sum");
+}
+
+TEST(match_refuses_face_index_out_of_range)
+{
+    paths();
+    const char *bad = map_with_row("range.map", 0, "18474 0.2 0.3 0.5");
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map",
+             s381, s390, bad, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "range.map:4");
+    CHECK_STR_HAS(out, "18474");
+}
+
+TEST(match_refuses_map_sized_for_other_meshes)
+{
+    paths();
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map",
+             s381, s390, q0, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "init_390_to_381.map");
+    CHECK_STR_HAS(out, "9239");
+}
+
+TEST(match_refuses_non_manifold_mesh)
+{
+    paths();
+    char cmd[4096], out[8192];
+    const char *scape = harness_data_path("scape/Meshes/mesh000.off");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map",
+             scape, s390, p0, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "not usable");
+    CHECK_STR_HAS(out, "non-manifold");
+}
+
+TEST(match_refuses_nan_coordinate)
+{
+    paths();
+    const char *nan = testfile_text("nan.off",
+        "OFF\n4 4 0\n0 0 0\n1 0 0\n0 nan 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n");
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map",
+             nan, s390, p0, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "nan.off");
+    CHECK_STR_HAS(out, "NaN");
+}
+
+TEST(match_refuses_landmark_out_of_range_naming_it)
+{
+    paths();
+    const char *l = testfile_text("l.txt", "# pairs\n0 0\n10 20\n30 40\n50 9239\n");
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s --out %s/p.map",
+             s381, s390, l, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "l.txt");
+    CHECK_STR_HAS(out, "landmark 4");
+    CHECK_STR_HAS(out, "9239 out of range");
+}
+
+TEST(match_refuses_bad_option_value)
+{
+    paths();
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --alpha abc",
+             s381, s390, p0);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--alpha: 'abc' is not a number");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --gamma -1",
+             s381, s390, p0);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "gamma");
+}
+
+TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)
+{
+    paths();
+    const char *d = harness_tmpdir();
+    char cmd[4096], out[65536];
+    snprintf(cmd, sizeof cmd,
+             "build/meshcorr match %s %s --init %s --init-reverse %s --iterations 3 "
+             "--out %s/p.map --out-reverse %s/q.map --out-deformed %s/y.ply "
+             "--out-remeshed %s/t.off --progress json", s381, s390, p0, q0, d, d, d, d);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    int objects = 0;
+    for (char *p = out; (p = strstr(p, "{\"outer\":")); p++)
+        objects++;
+    CHECK_INT(objects, 3);
+    CHECK_STR_HAS(out, "\"membrane\":");
+    CHECK_STR_HAS(out, "\"bending\":");
+    CHECK_STR_HAS(out, "\"reverse\":");
+    char err[512], path[600];
+    mesh *S = NULL, *T = NULL, *Y = NULL, *R = NULL;
+    bmap *P = NULL, *Q = NULL;
+    CHECK_INT(mesh_read(s381, &S, err, sizeof err), 0);
+    CHECK_INT(mesh_read(s390, &T, err, sizeof err), 0);
+    snprintf(path, sizeof path, "%s/p.map", d);
+    if (bmap_read(path, S, T, &P, err, sizeof err)) FAILF("%s", err);
+    snprintf(path, sizeof path, "%s/q.map", d);
+    if (bmap_read(path, T, S, &Q, err, sizeof err)) FAILF("%s", err);
+    snprintf(path, sizeof path, "%s/y.ply", d);
+    CHECK_INT(mesh_read(path, &Y, err, sizeof err), 0);
+    CHECK_INT(Y->nv, S->nv);
+    CHECK(memcmp(Y->f, S->f, sizeof(int) * 3 * S->nf) == 0);
+    snprintf(path, sizeof path, "%s/t.off", d);
+    CHECK_INT(mesh_read(path, &R, err, sizeof err), 0);
+    /* The remeshed target's vertices are P·X̃ in the target's frame. */
+    double *px = malloc(sizeof(double) * 3 * S->nv);
+    bmap_apply(P, T->f, T->v, 3, px);
+    for (int i = 0; i < 3 * S->nv; i++)
+        CHECK_NEAR(R->v[i], px[i], 1e-9);
+    free(px);
+    mesh_free(S); mesh_free(T); mesh_free(Y); mesh_free(R);
+    bmap_free(P); bmap_free(Q);
+}
