@@ -8,7 +8,9 @@
 static char long_str[PROTO_MAX_STRING + 1];
 static uint8_t mesh_a[3000], mesh_b[777];
 static proto_landmark lms[40];
-static proto_map_row rows_p[100], rows_q[60];
+static proto_map_row rows_p[100], rows_q[60];  /* SUBMIT's */
+static proto_map_row res_p[100], res_q[60];    /* RESULT_OK's */
+static uint8_t res_mesh[2500];
 static proto_job_summary jobs[5];
 static proto_metric metrics[4];
 static proto_slot slots[3];
@@ -125,7 +127,7 @@ void protosample_fill(int type, int v, proto_msg *m)
     case PROTO_MSG_LIST_OK:
         for (int i = 0; i < 5; i++)
             jobs[i] = (proto_job_summary){ 100u + (uint64_t)i, (uint8_t)(i % 7), i - 2,
-                                           1700000000000 + i, i ? "carol" : s, i == 3 ? "" : "run",
+                                           1700000000000 + i, i ? "carol" : max_string(), i == 3 ? "" : "run",
                                            (uint32_t)i, 40 };
         m->u.list_ok = (proto_list_ok){ v ? NULL : jobs, v ? 0 : 5 };
         break;
@@ -144,13 +146,13 @@ void protosample_fill(int type, int v, proto_msg *m)
     case PROTO_MSG_RESULT_OK: {
         proto_result_ok *u = &m->u.result_ok;
         u->job_id = 5;
-        fill_rows(rows_p, 100, 0.3);
-        fill_rows(rows_q, 60, 0.2);
-        u->p = (proto_map){ rows_p, v ? 1 : 100 };
+        fill_rows(res_p, 100, 0.3);
+        fill_rows(res_q, 60, 0.2);
+        u->p = (proto_map){ res_p, v ? 1 : 100 };
         if (!v) {
-            u->q = (proto_map){ rows_q, 60 };
-            fill_bytes(mesh_a, sizeof mesh_a, 3);
-            u->deformed = (proto_blob){ mesh_a, sizeof mesh_a };
+            u->q = (proto_map){ res_q, 60 };
+            fill_bytes(res_mesh, sizeof res_mesh, 3);
+            u->deformed = (proto_blob){ res_mesh, sizeof res_mesh };
             metrics[0] = (proto_metric){ "geodesic_error_mean", 0.0123 };
             metrics[1] = (proto_metric){ "flipped_faces", 0.0 };
             metrics[2] = (proto_metric){ s, -INFINITY };
