@@ -321,7 +321,8 @@ int proto_msg_decode(const proto_hdr *hdr, const void *payload, proto_msg *m,
                      char *err, size_t errsz);
 
 /* proto_frame_scan + proto_msg_decode on the start of buf: returns
- * PROTO_READY with *used = frame length, PROTO_NEED_MORE, or an error. */
+ * PROTO_READY with *used = frame length, PROTO_NEED_MORE, or an error;
+ * m is zeroed unless PROTO_READY. */
 int proto_decode(const void *buf, size_t len, size_t max_frame, proto_msg *m,
                  size_t *used, char *err, size_t errsz);
 

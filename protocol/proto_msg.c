@@ -542,6 +542,7 @@ int proto_decode(const void *buf, size_t len, size_t max_frame, proto_msg *m,
 {
     proto_hdr h;
     *used = 0;
+    memset(m, 0, sizeof *m);
     int rc = proto_frame_scan(buf, len, max_frame, &h, err, errsz);
     if (rc != PROTO_READY)
         return rc;

@@ -11,9 +11,9 @@
 void *__libc_malloc(size_t);
 void *__libc_calloc(size_t, size_t);
 void *__libc_realloc(void *, size_t);
-static long nalloc;
+static long nalloc, fail_at = -1;  /* the allocation numbered fail_at fails */
 void *malloc(size_t n) { nalloc++; return __libc_malloc(n); }
-void *calloc(size_t k, size_t n) { nalloc++; return __libc_calloc(k, n); }
+void *calloc(size_t k, size_t n) { return ++nalloc == fail_at ? NULL : __libc_calloc(k, n); }
 void *realloc(void *p, size_t n) { nalloc++; return __libc_realloc(p, n); }
 
 static void header(uint8_t out[PROTO_HDR_SIZE], uint8_t version, uint8_t type,
@@ -186,4 +186,33 @@ TEST(decoder_takes_frames_one_after_another_from_one_buffer)
     }
     CHECK_INT(at, stream.len);
     proto_buf_free(&stream);
+}
+
+TEST(decoder_out_of_memory_at_each_allocation_reports_nomem)
+{
+    proto_buf b;
+    proto_msg in, m;
+    size_t used;
+    int failures = 0;
+    proto_buf_init(&b);
+    for (int t = PROTO_MSG_SUBMIT; t <= PROTO_MSG_STATS_OK; t += PROTO_MSG_STATS_OK - PROTO_MSG_SUBMIT) {
+        protosample_fill(t, 0, &in);
+        proto_buf_reset(&b);
+        CHECK_INT(proto_msg_encode(&b, &in, NULL, 0), 0);
+        for (long k = 1;; k++) {
+            fail_at = nalloc + k;
+            int rc = proto_decode(b.data, b.len, 0, &m, &used, NULL, 0);
+            fail_at = -1;
+            if (rc == PROTO_READY) {
+                CHECK(protosample_diff(&in, &m) == NULL);
+                proto_msg_free(&m);
+                break;
+            }
+            CHECK_INT(rc, PROTO_ENOMEM);
+            CHECK_INT(m.type, 0);
+            failures++;
+        }
+    }
+    CHECK_INT(failures, 3 + 2);   /* SUBMIT: landmarks, P, Q; STATS_OK: slots, devices */
+    proto_buf_free(&b);
 }
