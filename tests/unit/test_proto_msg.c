@@ -6,13 +6,13 @@
 
 #include <string.h>
 
-static proto_buf frame;   /* the frame under test */
+static proto_buf frame;   /* the frame under test (zeroed = initialised) */
 
 static void encode(int type, int variant)
 {
     char err[256] = "";
     proto_msg m;
-    proto_buf_init(&frame);
+    proto_buf_free(&frame);
     protosample_fill(type, variant, &m);
     if (proto_msg_encode(&frame, &m, err, sizeof err) != 0)
         FAILF("encoding %s: %s", proto_type_name(type), err);
