@@ -223,9 +223,11 @@ typedef struct proto_limits {         /* what the server enforces */
 typedef struct proto_params {
     uint8_t model;                    /* enum proto_model */
     uint8_t partial;                  /* 0 or 1 */
-    double alpha, eta, beta0, beta1, beta_ramp, gamma;
-    uint32_t iterations, inner_iterations;
-    double tolerance, stop_change;
+    double alpha, eta;                /* membrane and bending weights */
+    double beta0, beta1, beta_ramp;   /* mismatch weight: start, cap, increase per outer it. */
+    double gamma;                     /* reverse-map weight (bijective) */
+    uint32_t iterations, inner_iterations;  /* outer; L-BFGS per outer */
+    double tolerance, stop_change;    /* gradient tolerance; relative energy change */
     const char *backend;              /* "" = server default */
 } proto_params;
 
