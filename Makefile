@@ -25,6 +25,11 @@ ENGINE_CXX := $(wildcard workers/*/*.cpp)
 ENGINE_OBJ := $(ENGINE_C:%.c=$(BUILD)/obj/%.o) $(ENGINE_CXX:%.cpp=$(BUILD)/obj/%.o)
 ENGINE_LIB := $(BUILD)/libmcengine.a
 
+# The wire protocol codec (pure C, libc only): its own library.
+PROTO_C   := $(wildcard protocol/*.c)
+PROTO_OBJ := $(PROTO_C:%.c=$(BUILD)/obj/%.o)
+PROTO_LIB := $(BUILD)/libmcproto.a
+
 CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
 
@@ -54,20 +59,24 @@ $(ENGINE_LIB): $(ENGINE_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/meshcorr: $(CLI_OBJ) $(ENGINE_LIB)
-	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(ENGINE_LIB) $(LDLIBS)
-
-$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB)
+$(PROTO_LIB): $(PROTO_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(LDLIBS)
+	rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB)
-	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(LDLIBS)
+$(BUILD)/meshcorr: $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB)
+$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+
+$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
 test: $(PROGRAMS) $(TEST_BIN) $(FUZZ_BIN)
 	@sh tests/run-tests.sh $(TEST_BIN) $(FUZZ_BIN)

@@ -1,0 +1,333 @@
+/* proto.h — the meshcorr wire protocol: limits, error codes, message types
+ * and the pure codec (frames and messages). No I/O, no global state; the
+ * spec is protocol/PROTOCOL.md and repeats every limit named here.
+ *
+ * Ownership. Encoders append whole frames to a caller-owned proto_buf
+ * (proto_buf_init / proto_buf_free); they only read the message they are
+ * given. A message filled by proto_msg_decode borrows from the payload it was
+ * decoded from and owns the rest: blobs (proto_blob: Draco mesh bytes) and
+ * strings (const char *, always non-NULL and NUL-terminated after decoding,
+ * because the wire carries the terminator) point INTO the payload buffer,
+ * which must outlive the message and stay unmodified; every array (landmarks,
+ * map rows, job summaries, metrics, worker slots, device name pointers) is
+ * allocated by the decoder and released by proto_msg_free, which accepts NULL
+ * and zeroed messages and leaves the message zeroed. Call proto_msg_free only
+ * on decoded messages; messages you build for encoding stay yours.
+ *
+ * Errors are negative PROTO_E* codes (the same numbers travel in ERROR
+ * frames); detail such as "landmark count 70000 over PROTO_MAX_LANDMARKS
+ * (65536)" goes into the caller's err buffer. Every size from the wire is
+ * checked against its limit and against the bytes left before anything is
+ * allocated. */
+#ifndef PROTO_H
+#define PROTO_H
+#include <stddef.h>
+#include <stdint.h>
+
+/* ---- framing ------------------------------------------------------------ */
+#define PROTO_MAGIC      0x5052434Du  /* bytes "MCRP" on the wire */
+#define PROTO_VERSION    1
+#define PROTO_HDR_SIZE   20
+
+/* ---- limits (PROTOCOL.md repeats each one) ------------------------------ */
+#define PROTO_MAX_FRAME         (1u << 30)   /* hard cap, header included */
+#define PROTO_DEFAULT_MAX_FRAME (256u << 20) /* daemon default, <= hard cap */
+#define PROTO_MAX_MESH_BYTES    (256u << 20) /* one Draco blob */
+#define PROTO_MAX_MAP_ROWS      (1u << 24)   /* rows of P or Q */
+#define PROTO_MAX_LANDMARKS     65536u       /* landmark pairs */
+#define PROTO_MAX_STRING        1024u        /* bytes, terminator excluded */
+#define PROTO_MAX_LIST          4096u        /* job summaries in LIST_OK */
+#define PROTO_MAX_METRICS       256u         /* key/value pairs in RESULT_OK */
+#define PROTO_MAX_SLOTS         1024u        /* worker slots in STATS_OK */
+#define PROTO_MAX_DEVICES       64u          /* device names in STATS_OK */
+
+/* ---- errors: one list, the same codes in C and on the wire ------------- */
+#define PROTO_ERRORS(X)                                                              \
+    X(PROTO_OK,             0, "OK",            "ok")                                 \
+    X(PROTO_EBAD_FRAME,    -1, "BAD_FRAME",     "malformed frame or field value")     \
+    X(PROTO_EBAD_MAGIC,    -2, "BAD_MAGIC",     "not a meshcorr frame (bad magic)")   \
+    X(PROTO_EBAD_VERSION,  -3, "BAD_VERSION",   "unsupported protocol version")       \
+    X(PROTO_EBAD_TYPE,     -4, "BAD_TYPE",      "unknown message type")               \
+    X(PROTO_ETOO_LARGE,    -5, "TOO_LARGE",     "frame larger than the allowed maximum") \
+    X(PROTO_ETRUNCATED,    -6, "TRUNCATED",     "payload ends inside a field")        \
+    X(PROTO_ETRAILING,     -7, "TRAILING",      "bytes left after the message")       \
+    X(PROTO_EOVER_LIMIT,   -8, "OVER_LIMIT",    "a count or length is over its limit") \
+    X(PROTO_EBAD_CHECKSUM, -9, "BAD_CHECKSUM",  "checksum mismatch")                  \
+    X(PROTO_EBAD_STRING,  -10, "BAD_STRING",    "string not UTF-8, has NUL, or lacks its terminator") \
+    X(PROTO_ENOMEM,       -11, "NOMEM",         "out of memory")                      \
+    X(PROTO_EUNEXPECTED,  -12, "UNEXPECTED",    "message not valid here")             \
+    X(PROTO_EUNAUTHORIZED,-13, "UNAUTHORIZED",  "authentication missing or failed")   \
+    X(PROTO_EFORBIDDEN,   -14, "FORBIDDEN",     "not allowed for this user")          \
+    X(PROTO_ENOT_FOUND,   -15, "NOT_FOUND",     "no such job")                        \
+    X(PROTO_EBAD_STATE,   -16, "BAD_STATE",     "job is not in a state that allows this") \
+    X(PROTO_EQUEUE_FULL,  -17, "QUEUE_FULL",    "queue full, job refused")            \
+    X(PROTO_EUSER_LIMIT,  -18, "USER_LIMIT",    "per-user job limit reached")         \
+    X(PROTO_EBAD_MESH,    -19, "BAD_MESH",      "mesh does not decode or is invalid") \
+    X(PROTO_EBAD_LANDMARKS,-20,"BAD_LANDMARKS", "landmarks out of range or duplicated") \
+    X(PROTO_EBAD_PARAMS,  -21, "BAD_PARAMS",    "parameter out of range")             \
+    X(PROTO_ESTORAGE,     -22, "STORAGE",       "job could not be stored durably")    \
+    X(PROTO_EINTERNAL,    -23, "INTERNAL",      "internal server error")              \
+    X(PROTO_ESHUTTING_DOWN,-24,"SHUTTING_DOWN", "server shutting down")
+
+enum proto_error {
+#define PROTO_ENUM(sym, val, name, msg) sym = val,
+    PROTO_ERRORS(PROTO_ENUM)
+#undef PROTO_ENUM
+};
+const char *proto_strerror(int code);  /* "checksum mismatch"; unknown -> "unknown error" */
+const char *proto_err_name(int code);  /* "BAD_CHECKSUM"; unknown -> "UNKNOWN" */
+
+/* ---- enumerations carried on the wire (u8) ------------------------------ */
+#define PROTO_TYPES(X)                                                        \
+    X(HELLO, 1) X(HELLO_OK, 2) X(SUBMIT, 3) X(SUBMIT_OK, 4) X(STATUS, 5)      \
+    X(STATUS_OK, 6) X(LIST, 7) X(LIST_OK, 8) X(WATCH, 9) X(PROGRESS, 10)      \
+    X(END, 11) X(CANCEL, 12) X(OK, 13) X(RESULT, 14) X(RESULT_OK, 15)         \
+    X(DELETE, 16) X(STATS, 17) X(STATS_OK, 18) X(PING, 19) X(PONG, 20)        \
+    X(ERROR, 21)
+enum proto_type {
+#define PROTO_ENUM(name, val) PROTO_MSG_##name = val,
+    PROTO_TYPES(PROTO_ENUM)
+#undef PROTO_ENUM
+    PROTO_MSG_LAST = 21
+};
+
+/* Job states use Slurm's names. */
+#define PROTO_STATES(X)                                                       \
+    X(PENDING, 0) X(RUNNING, 1) X(COMPLETED, 2) X(FAILED, 3)                  \
+    X(CANCELLED, 4) X(TIMEOUT, 5) X(OUT_OF_MEMORY, 6)
+enum proto_state {
+#define PROTO_ENUM(name, val) PROTO_STATE_##name = val,
+    PROTO_STATES(PROTO_ENUM)
+#undef PROTO_ENUM
+    PROTO_STATE_LAST = 6
+};
+
+#define PROTO_STAGES(X) X(VORONOI, 0) X(RHM, 1) X(ECTM, 2)
+enum proto_stage {
+#define PROTO_ENUM(name, val) PROTO_STAGE_##name = val,
+    PROTO_STAGES(PROTO_ENUM)
+#undef PROTO_ENUM
+    PROTO_STAGE_LAST = 2
+};
+
+#define PROTO_SLOTS(X) X(IDLE, 0) X(STARTING, 1) X(BUSY, 2) X(DRAINING, 3)
+enum proto_slot_state {
+#define PROTO_ENUM(name, val) PROTO_SLOT_##name = val,
+    PROTO_SLOTS(PROTO_ENUM)
+#undef PROTO_ENUM
+    PROTO_SLOT_LAST = 3
+};
+
+enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1, PROTO_MODEL_LAST = 1 };
+
+/* Energy terms reported per direction in PROGRESS (index into terms[d][]). */
+enum proto_term {
+    PROTO_TERM_MEMBRANE, PROTO_TERM_BENDING, PROTO_TERM_MISMATCH,
+    PROTO_TERM_REVERSE, PROTO_TERM_ENERGY, PROTO_NTERMS
+};
+
+/* RESULT's `what` bits. */
+#define PROTO_WANT_P        1u
+#define PROTO_WANT_Q        2u
+#define PROTO_WANT_DEFORMED 4u
+#define PROTO_WANT_METRICS  8u
+#define PROTO_WANT_ALL      15u
+
+/* Names for logs and the CLI; NULL for a value outside the list. */
+const char *proto_type_name(int type);    /* "SUBMIT" */
+const char *proto_state_name(int state);  /* "OUT_OF_MEMORY" */
+const char *proto_stage_name(int stage);  /* "rhm" */
+const char *proto_slot_name(int slot);    /* "busy" */
+
+/* ---- CRC32C (Castagnoli, reflected 0x82F63B78) -------------------------- */
+/* Continues `crc` (start with 0) over n bytes; proto_crc32c(0,"123456789",9)
+ * is 0xE3069283. */
+uint32_t proto_crc32c(uint32_t crc, const void *data, size_t n);
+
+/* ---- growable output buffer --------------------------------------------- */
+typedef struct proto_buf {
+    uint8_t *data;
+    size_t len;   /* bytes written */
+    size_t cap;   /* bytes allocated */
+    int err;      /* first error (PROTO_ENOMEM), sticky; 0 while fine */
+} proto_buf;
+
+void proto_buf_init(proto_buf *b);
+void proto_buf_free(proto_buf *b);          /* NULL ok; leaves b initialised */
+void proto_buf_reset(proto_buf *b);         /* len = 0, err = 0, keeps memory */
+/* Removes the first n bytes (a sent or consumed frame). */
+void proto_buf_consume(proto_buf *b, size_t n);
+/* Little-endian appends; on failure they set b->err and append nothing. */
+void proto_buf_put(proto_buf *b, const void *p, size_t n);
+void proto_buf_put_u8(proto_buf *b, uint8_t v);
+void proto_buf_put_u16(proto_buf *b, uint16_t v);
+void proto_buf_put_u32(proto_buf *b, uint32_t v);
+void proto_buf_put_u64(proto_buf *b, uint64_t v);
+void proto_buf_put_f64(proto_buf *b, double v);
+/* Little-endian loads from at least 2/4/8 readable bytes. */
+uint16_t proto_le16(const uint8_t *p);
+uint32_t proto_le32(const uint8_t *p);
+uint64_t proto_le64(const uint8_t *p);
+void proto_set_le32(uint8_t *p, uint32_t v);
+
+/* ---- frame header ------------------------------------------------------- */
+/* Wire layout (20 bytes, little-endian):
+ *   0 u32 magic  4 u8 version  5 u8 type  6 u16 flags (0)  8 u32 request id
+ *  12 u32 payload length  16 u32 CRC32C of bytes 0..15 */
+typedef struct proto_hdr {
+    uint8_t version;
+    uint8_t type;
+    uint16_t flags;
+    uint32_t request_id;  /* chosen by the client, echoed in every reply */
+    uint32_t payload_len;
+} proto_hdr;
+
+#define PROTO_READY     0  /* a whole frame is in the buffer */
+#define PROTO_NEED_MORE 1  /* not yet: read more bytes and call again */
+
+/* Looks at the start of buf[0..len). Returns PROTO_READY (hdr filled; the
+ * frame is PROTO_HDR_SIZE + hdr->payload_len bytes), PROTO_NEED_MORE (hdr
+ * filled once the 20 header bytes are there, so the caller may size its
+ * buffer), or a negative error: BAD_MAGIC (checked on the first bytes as
+ * they arrive), BAD_CHECKSUM, BAD_VERSION, BAD_TYPE, BAD_FRAME (flags),
+ * TOO_LARGE (frame over max_frame, or over PROTO_MAX_FRAME whatever
+ * max_frame says; 0 means PROTO_MAX_FRAME). Never allocates. */
+int proto_frame_scan(const void *buf, size_t len, size_t max_frame,
+                     proto_hdr *hdr, char *err, size_t errsz);
+/* Writes the 20 header bytes (version and magic included, CRC computed). */
+void proto_frame_put_header(uint8_t out[PROTO_HDR_SIZE], const proto_hdr *hdr);
+
+/* ---- messages ----------------------------------------------------------- */
+typedef struct proto_blob {           /* Draco bytes; len 0 = absent */
+    const uint8_t *data;
+    uint32_t len;
+} proto_blob;
+
+typedef struct proto_landmark { uint32_t src, tgt; } proto_landmark;  /* vertex ids */
+
+typedef struct proto_map_row {        /* a point on a face of the other mesh */
+    uint32_t face;
+    double w[3];                      /* barycentric weights */
+} proto_map_row;
+
+typedef struct proto_map {            /* one row per vertex; n 0 = absent */
+    proto_map_row *rows;
+    uint32_t n;
+} proto_map;
+
+typedef struct proto_limits {         /* what the server enforces */
+    uint32_t max_frame, max_vertices, max_landmarks;
+    uint32_t max_jobs_per_user, max_queue, max_wall_s;
+} proto_limits;
+
+typedef struct proto_params {
+    uint8_t model;                    /* enum proto_model */
+    uint8_t partial;                  /* 0 or 1 */
+    double alpha, eta;                /* membrane and bending weights */
+    double beta0, beta1, beta_ramp;   /* mismatch weight: start, cap, increase per outer it. */
+    double gamma;                     /* reverse-map weight (bijective) */
+    uint32_t iterations, inner_iterations;  /* outer; L-BFGS per outer */
+    double tolerance, stop_change;    /* gradient tolerance; relative energy change */
+    const char *backend;              /* "" = server default */
+} proto_params;
+
+typedef struct proto_progress {
+    uint64_t job_id;
+    uint8_t stage;                    /* enum proto_stage */
+    uint32_t outer, total;            /* outer iteration, planned total */
+    uint32_t inner[2];                /* inner iterations: [0] forward, [1] reverse */
+    double terms[2][PROTO_NTERMS];    /* per direction, enum proto_term */
+    double beta, gamma, elapsed_s;
+} proto_progress;
+
+typedef struct proto_job_summary {
+    uint64_t job_id;
+    uint8_t state;
+    int32_t priority;
+    int64_t submit_ms;                /* Unix time in milliseconds */
+    const char *user, *label;
+    uint32_t outer, total;
+} proto_job_summary;
+
+typedef struct proto_metric { const char *key; double value; } proto_metric;
+typedef struct proto_slot { uint64_t job_id; uint8_t state; } proto_slot;  /* job 0 = none */
+
+typedef struct proto_hello { uint16_t version; const char *token, *client; } proto_hello;
+typedef struct proto_hello_ok {
+    uint16_t version; const char *user; uint8_t admin; proto_limits limits;
+} proto_hello_ok;
+typedef struct proto_submit {
+    proto_blob source, target;
+    proto_landmark *landmarks; uint32_t nlandmarks;
+    proto_map p, q;                   /* optional initial maps */
+    proto_params params;
+    int32_t priority;                 /* higher runs first */
+    const char *label;
+} proto_submit;
+/* SUBMIT_OK, STATUS, CANCEL, DELETE and OK carry only a job id. */
+typedef struct proto_job_ref { uint64_t job_id; } proto_job_ref;
+typedef struct proto_status_ok {
+    uint64_t job_id; uint8_t state; int32_t priority;
+    const char *user, *label, *reason;
+    int64_t submit_ms, start_ms, end_ms;  /* 0 = not yet */
+    uint8_t has_progress; proto_progress progress;
+} proto_status_ok;
+typedef struct proto_list {
+    uint32_t state_mask;              /* bit s = state s; 0 = every state */
+    const char *user;                 /* "" = me; another user: admin only */
+    uint32_t max_count;               /* 0 = server's page size */
+    uint64_t after_id;                /* ids greater than this (paging) */
+} proto_list;
+typedef struct proto_list_ok { proto_job_summary *jobs; uint32_t n; } proto_list_ok;
+typedef struct proto_watch { uint64_t job_id; uint32_t from_outer; } proto_watch;
+typedef struct proto_end { uint64_t job_id; uint8_t state; const char *reason; } proto_end;
+typedef struct proto_result { uint64_t job_id; uint32_t what; } proto_result;  /* PROTO_WANT_* */
+typedef struct proto_result_ok {
+    uint64_t job_id;
+    proto_map p, q;                   /* q absent for the injective model */
+    proto_blob deformed;              /* Draco; absent unless asked */
+    proto_metric *metrics; uint32_t nmetrics;
+} proto_result_ok;
+typedef struct proto_stats_ok {
+    uint32_t queued, running, workers;
+    uint64_t completed, failed, cancelled;
+    proto_slot *slots; uint32_t nslots;
+    const char **devices; uint32_t ndevices;
+} proto_stats_ok;
+typedef struct proto_error_msg { int32_t code; const char *message; } proto_error_msg;
+
+typedef struct proto_msg {
+    uint8_t type;                     /* enum proto_type */
+    uint32_t request_id;
+    union {
+        proto_hello hello;       proto_hello_ok hello_ok;
+        proto_submit submit;     proto_job_ref submit_ok;
+        proto_job_ref status;    proto_status_ok status_ok;
+        proto_list list;         proto_list_ok list_ok;
+        proto_watch watch;       proto_progress progress;
+        proto_end end;           proto_job_ref cancel;
+        proto_job_ref ok;        proto_result result;
+        proto_result_ok result_ok; proto_job_ref del;
+        proto_stats_ok stats_ok; proto_error_msg error;
+    } u;                              /* STATS, PING, PONG have no payload */
+} proto_msg;
+
+/* Appends one whole frame (header + payload) for m to b. Refuses what a
+ * decoder would refuse (limits, bad strings, enum values) with the same
+ * codes, leaving b as it was. */
+int proto_msg_encode(proto_buf *b, const proto_msg *m, char *err, size_t errsz);
+
+/* Decodes the payload of a frame whose header scanned as hdr (payload holds
+ * hdr->payload_len bytes). On error m is left zeroed. */
+int proto_msg_decode(const proto_hdr *hdr, const void *payload, proto_msg *m,
+                     char *err, size_t errsz);
+
+/* proto_frame_scan + proto_msg_decode on the start of buf: returns
+ * PROTO_READY with *used = frame length, PROTO_NEED_MORE, or an error;
+ * m is zeroed unless PROTO_READY. */
+int proto_decode(const void *buf, size_t len, size_t max_frame, proto_msg *m,
+                 size_t *used, char *err, size_t errsz);
+
+void proto_msg_free(proto_msg *m);
+
+#endif
