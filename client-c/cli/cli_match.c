@@ -3,12 +3,10 @@
  * meshes, and shows progress (bar on a terminal, text lines, or JSON lines on
  * stderr). Holds no numerics: everything is workers/ectm. */
 #include "cli/cli.h"
-#include "ectm/ectm.h"
-#include "init/init_affine.h"
+#include "corr/corr.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
-#include "mesh/mesh_check.h"
 
 #include <getopt.h>
 #include <stdio.h>
@@ -63,12 +61,20 @@ typedef struct progress_state {
     enum progress_mode mode;
 } progress_state;
 
-static int on_progress(void *ctx, const ectm_report *r)
+static int on_progress(void *ctx, const corr_progress *cp)
 {
     progress_state *ps = ctx;
+    if (cp->stage != CORR_STAGE_ECTM) {
+        if (ps->mode == PROGRESS_JSON)
+            fprintf(stderr, "{\"stage\":\"%s\",\"elapsed\":%.3f}\n", corr_stage_name(cp->stage), cp->elapsed);
+        else if (ps->mode != PROGRESS_NONE)
+            fprintf(stderr, "stage %s\n", corr_stage_name(cp->stage));
+        return 0;
+    }
+    const ectm_report *r = cp->ectm;
     if (ps->mode == PROGRESS_JSON) {
         fprintf(stderr,
-                "{\"outer\":%d,\"total\":%d,\"beta\":%.17g,\"gamma\":%.17g,\"energy\":%.17g,"
+                "{\"stage\":\"ectm\",\"outer\":%d,\"total\":%d,\"beta\":%.17g,\"gamma\":%.17g,\"energy\":%.17g,"
                 "\"elapsed\":%.3f,\"t_project\":%.3f,\"t_solve\":%.3f",
                 r->outer, r->total, r->beta, r->gamma, r->energy, r->elapsed,
                 r->t_project, r->t_solve);
@@ -98,25 +104,14 @@ static int on_progress(void *ctx, const ectm_report *r)
     return 0;
 }
 
-/* Reads a mesh and refuses one the optimizer cannot use, naming the problems. */
-static mesh *load_usable(const char *path)
+/* Reads a mesh and refuses one the optimizer cannot use before any other
+ * input is read, so the user hears about the mesh first. */
+static mesh *load(const char *path)
 {
-    char err[1024];
+    char err[4096];
     mesh *m = NULL;
-    if (mesh_read(path, &m, err, sizeof err)) {
+    if (mesh_read(path, &m, err, sizeof err) || corr_validate(m, path, err, sizeof err)) {
         fprintf(stderr, "meshcorr match: %s\n", err);
-        return NULL;
-    }
-    mesh_check_report rep;
-    if (mesh_check_run(m, &rep, err, sizeof err)) {
-        fprintf(stderr, "meshcorr match: %s: %s\n", path, err);
-        mesh_free(m);
-        return NULL;
-    }
-    if (!mesh_check_usable(&rep)) {
-        char lines[4096];
-        mesh_check_problems(&rep, path, lines, sizeof lines);
-        fprintf(stderr, "meshcorr match: %s is not usable by the optimizer:\n%s", path, lines);
         mesh_free(m);
         return NULL;
     }
@@ -241,32 +236,27 @@ int cli_match(int argc, char **argv)
     int status = 1;
     mesh *S = NULL, *T = NULL;
     bmap *P0 = NULL, *Q0 = NULL;
+    lmk_set *L = NULL;
     ectm_result res = {0};
     const char *src = argv[optind], *tgt = argv[optind + 1];
-    if (!(S = load_usable(src)) || !(T = load_usable(tgt)))
+    if (!(S = load(src)) || !(T = load(tgt)))
         goto done;
     if (init) {
         if (bmap_read(init, S, T, &P0, err, sizeof err)) {
             fprintf(stderr, "meshcorr match: %s\n", err);
             goto done;
         }
-    } else {
-        lmk_set *L = NULL;
-        int lr = lmk_pairs ? lmk_read_pairs(lmk_pairs, one_based, S, T, &L, err, sizeof err)
-                           : lmk_read_lists(lmk_src, lmk_tgt, one_based, S, T, &L, err, sizeof err);
-        if (!lr)
-            lr = init_affine_map(S, T, L, &P0, err, sizeof err);
-        lmk_free(L);
-        if (lr) {
-            fprintf(stderr, "meshcorr match: %s\n", err);
-            goto done;
-        }
+    } else if (lmk_pairs ? lmk_read_pairs(lmk_pairs, one_based, S, T, &L, err, sizeof err)
+                         : lmk_read_lists(lmk_src, lmk_tgt, one_based, S, T, &L, err, sizeof err)) {
+        fprintf(stderr, "meshcorr match: %s\n", err);
+        goto done;
     }
     if (init_rev && bmap_read(init_rev, T, S, &Q0, err, sizeof err)) {
         fprintf(stderr, "meshcorr match: %s\n", err);
         goto done;
     }
-    if (ectm_run(S, T, P0, Q0, &p, on_progress, &ps, &res, err, sizeof err)) {
+    corr_input in = { S, T, src, tgt, L, P0, Q0 };
+    if (corr_run(&in, &p, on_progress, &ps, &res, err, sizeof err)) {
         fprintf(stderr, "\nmeshcorr match: %s\n", err);
         goto done;
     }
@@ -297,6 +287,7 @@ int cli_match(int argc, char **argv)
     status = 0;
 done:
     ectm_result_close(&res);
+    lmk_free(L);
     bmap_free(P0);
     bmap_free(Q0);
     mesh_free(S);

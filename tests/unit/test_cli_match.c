@@ -159,7 +159,7 @@ TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)
              "--out-remeshed %s/t.off --progress json", s381, s390, p0, q0, d, d, d, d);
     CHECK_INT(run(cmd, out, sizeof out), 0);
     int objects = 0;
-    for (char *p = out; (p = strstr(p, "{\"outer\":")); p++)
+    for (char *p = out; (p = strstr(p, "{\"stage\":\"ectm\",\"outer\":")); p++)
         objects++;
     CHECK_INT(objects, 3);
     CHECK_STR_HAS(out, "\"membrane\":");

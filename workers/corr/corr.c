@@ -1,0 +1,104 @@
+/* corr.c — the correspondence pipeline (see corr.h): validation, initial map,
+ * ECTM, progress fan-in. Combines modules; computes nothing itself. */
+#include "corr/corr.h"
+#include "init/init_affine.h"
+#include "mesh/mesh_check.h"
+#include "util/errbuf.h"
+
+#include <string.h>
+#include <time.h>
+
+const char *corr_strerror(int code)
+{
+    switch (code) {
+#define CORR_STR(name, val, msg) case name: return msg;
+        CORR_ERRORS(CORR_STR)
+#undef CORR_STR
+    }
+    return "unknown pipeline error";
+}
+
+const char *corr_stage_name(corr_stage s)
+{
+    return s == CORR_STAGE_ECTM ? "ectm" : "init";
+}
+
+int corr_validate(const mesh *m, const char *name, char *err, size_t errsz)
+{
+    mesh_check_report rep;
+    char detail[512];
+    if (mesh_check_run(m, &rep, detail, sizeof detail))
+        return errbuf_set(err, errsz, CORR_ENOMEM, "%s: %s", name, detail);
+    if (mesh_check_usable(&rep))
+        return CORR_OK;
+    char lines[2048];
+    mesh_check_problems(&rep, name, lines, sizeof lines);
+    size_t n = strlen(lines);
+    if (n && lines[n - 1] == '\n')
+        lines[n - 1] = '\0';
+    return errbuf_set(err, errsz, CORR_EMESH, "%s is not usable by the optimizer:\n%s", name, lines);
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct relay {
+    corr_progress_fn fn;
+    void *ctx;
+    double t0;
+} relay;
+
+static int relay_ectm(void *ctx, const ectm_report *r)
+{
+    relay *rl = ctx;
+    if (!rl->fn)
+        return 0;
+    corr_progress p = { CORR_STAGE_ECTM, r, now() - rl->t0 };
+    return rl->fn(rl->ctx, &p);
+}
+
+int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
+             void *ctx, ectm_result *out, char *err, size_t errsz)
+{
+    memset(out, 0, sizeof *out);
+    relay rl = { progress, ctx, now() };
+    int rc = ectm_params_check(p, err, errsz);
+    if (rc)
+        return CORR_EINPUT;
+    if ((rc = corr_validate(in->S, in->S_name, err, errsz)) ||
+        (rc = corr_validate(in->T, in->T_name, err, errsz)))
+        return rc;
+    if (!in->P0 && !in->L)
+        return errbuf_set(err, errsz, CORR_EINPUT, "neither an initial map nor landmarks were given");
+    if (in->Q0 && !in->P0)
+        return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs an initial map");
+    if (in->Q0 && p->model == ECTM_INJECTIVE)
+        return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs the bijective model");
+
+    bmap *init = NULL;
+    const bmap *P0 = in->P0;
+    if (!P0) {
+        if (progress) {
+            corr_progress cp = { CORR_STAGE_INIT, NULL, now() - rl.t0 };
+            if (progress(ctx, &cp))
+                return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before the initial map");
+        }
+        if ((rc = init_affine_map(in->S, in->T, in->L, &init, err, errsz)))
+            return rc == INIT_ENOMEM ? CORR_ENOMEM : CORR_EINIT;
+        P0 = init;
+    }
+    rc = ectm_run(in->S, in->T, P0, in->Q0, p, relay_ectm, &rl, out, err, errsz);
+    bmap_free(init);
+    switch (rc) {
+    case ECTM_OK: return CORR_OK;
+    case ECTM_ECANCELED: return CORR_ECANCELED;
+    case ECTM_ENOMEM: return CORR_ENOMEM;
+    case ECTM_EMAP: case ECTM_EPARAM: return CORR_EINPUT;
+    case ECTM_EMESH: return CORR_EMESH;
+    default: return CORR_EFAILED;
+    }
+}

@@ -1,0 +1,61 @@
+/* corr.h — one correspondence job from inputs to maps: the pipeline that
+ * `meshcorr match` runs in-process and `meshcorr-worker` runs for the daemon.
+ *
+ *   validate both meshes (manifold, one component, finite, no degenerate face)
+ *   initial map: the uploaded P (and Q), or from landmarks
+ *   ECTM refinement
+ *
+ * Stages report progress through one callback; a non-zero return cancels.
+ * This module reads no files and knows no sockets: callers load meshes,
+ * landmarks and maps, and write the result. */
+#ifndef CORR_H
+#define CORR_H
+#include <stddef.h>
+#include "ectm/ectm.h"
+#include "lmk/lmk.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
+
+#define CORR_ERRORS(X)                                                          \
+    X(CORR_OK,         0, "ok")                                                 \
+    X(CORR_EMESH,     -1, "mesh not usable")                                    \
+    X(CORR_EINPUT,    -2, "inputs do not fit together")                         \
+    X(CORR_EINIT,     -3, "initial map could not be built")                     \
+    X(CORR_ENOMEM,    -4, "out of memory")                                      \
+    X(CORR_ECANCELED, -5, "cancelled")                                          \
+    X(CORR_EFAILED,   -6, "optimisation failed")
+
+enum corr_error {
+#define CORR_ENUM(name, val, msg) name = val,
+    CORR_ERRORS(CORR_ENUM)
+#undef CORR_ENUM
+};
+const char *corr_strerror(int code);
+
+typedef enum corr_stage { CORR_STAGE_INIT = 0, CORR_STAGE_ECTM = 1 } corr_stage;
+const char *corr_stage_name(corr_stage s);   /* "init", "ectm" */
+
+typedef struct corr_input {
+    const mesh *S, *T;        /* source and target (required)               */
+    const char *S_name, *T_name; /* for messages (file names or labels)     */
+    const lmk_set *L;         /* landmark pairs, or NULL                     */
+    const bmap *P0, *Q0;      /* uploaded initial maps, or NULL              */
+} corr_input;
+
+typedef struct corr_progress {
+    corr_stage stage;
+    const ectm_report *ectm;  /* the outer iteration's report (stage ECTM)  */
+    double elapsed;           /* seconds since corr_run started             */
+} corr_progress;
+
+typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
+
+/* 0 when the optimizer can use m; else CORR_EMESH with one line per problem
+ * ("name: ...") in err. */
+int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
+
+/* Runs the pipeline. Needs P0 or at least LMK_MIN_PAIRS landmarks. */
+int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
+             void *ctx, ectm_result *out, char *err, size_t errsz);
+
+#endif
