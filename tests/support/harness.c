@@ -43,7 +43,7 @@ const char *harness_data_dir(void)
 
 const char *harness_data_path(const char *rel)
 {
-    static char path[4096];
+    static char path[8192];
     const char *dir = harness_data_dir();
     if (!dir)
         SKIP("../shared/data is absent");
