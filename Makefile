@@ -17,7 +17,7 @@ OPT     ?= -O2 -g
 CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Itests
 CFLAGS   += -std=c11 $(OPT) $(WARN) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) -pthread $(shell pkg-config --cflags draco)
-LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lm -lstdc++ -fopenmp -pthread
+LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lcholmod -llapack -lm -lstdc++ -fopenmp -pthread
 
 # The engine library: everything under workers/ except the worker main.
 ENGINE_C   := $(filter-out workers/main/%,$(wildcard workers/*/*.c))

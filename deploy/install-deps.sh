@@ -9,7 +9,7 @@ build-essential pkg-config g++
 libembree-dev
 libdraco-dev draco
 liblbfgs-dev
-libsuitesparse-dev
+libsuitesparse-dev liblapack-dev
 libcgal-demo
 "
 

@@ -1,0 +1,48 @@
+/* embed_fps.c — farthest-point sampling of landmarks on geodesic distances;
+ * see embed.h. Keeps every field it computes: LMDS needs them all. */
+#include "embed/embed.h"
+#include "util/errbuf.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int embed_farthest_points(geod_solver *s, int start, int k, int *pts, double *fields,
+                          char *err, size_t errsz)
+{
+    int nv = geod_solver_nv(s);
+    if (k < 1 || k > nv || start < 0 || start >= nv)
+        return errbuf_set(err, errsz, EMBED_EINVAL,
+                          "farthest points: k = %d not in 1..%d or start %d out of range",
+                          k, nv, start);
+    double *mind = malloc((size_t)nv * sizeof *mind);
+    if (!mind)
+        return errbuf_set(err, errsz, EMBED_ENOMEM, "out of memory");
+    int rc = EMBED_OK;
+    pts[0] = start;
+    for (int j = 0; j < k; j++) {
+        double *f = fields + (size_t)j * nv;
+        int g = geod_distances(s, &pts[j], 1, f);
+        if (g != GEOD_OK) {
+            rc = errbuf_set(err, errsz, EMBED_EGEOD, "distances from vertex %d: %s", pts[j],
+                            geod_strerror(g));
+            break;
+        }
+        int far = 0;
+        for (int i = 0; i < nv; i++) {
+            if (!isfinite(f[i])) {
+                rc = errbuf_set(err, errsz, EMBED_EDISCONNECTED,
+                                "vertex %d unreachable from vertex %d", i, pts[j]);
+                goto out;
+            }
+            mind[i] = j == 0 || f[i] < mind[i] ? f[i] : mind[i];
+            if (mind[i] > mind[far])
+                far = i;
+        }
+        if (j + 1 < k)
+            pts[j + 1] = far;
+    }
+out:
+    free(mind);
+    return rc;
+}

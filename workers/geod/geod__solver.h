@@ -1,0 +1,27 @@
+/* geod__solver.h — internal (geod__): the solver's state, shared by
+ * geod_solver.c (building and factorising) and geod_distances.c (solving).
+ * Not part of the public geod_ API. */
+#ifndef GEOD__SOLVER_H
+#define GEOD__SOLVER_H
+#include "geod/geod.h"
+
+#include <suitesparse/cholmod.h>
+
+struct geod_solver {
+    const mesh *m;           /* borrowed */
+    int nv, nf;
+    double t;                /* heat time */
+    double *grad;            /* nf by 9: gradients of the 3 hat functions, 0 on degenerate faces */
+    double *area;            /* nf */
+    int *comp;               /* nv: connected component of each vertex */
+    int ncomp;
+    int n_interior;          /* vertices not on the boundary (all when closed) */
+    int *interior;           /* n_interior: their vertex indices, ascending; NULL when closed */
+    cholmod_common cc;
+    int cc_started;
+    cholmod_factor *heat;    /* M + t L */
+    cholmod_factor *heat_dir;/* interior block of M + t L; NULL when closed */
+    cholmod_factor *poisson; /* L + eps M */
+};
+
+#endif
