@@ -42,7 +42,10 @@ BENCH_BIN := $(BENCH_C:tests/bench/%.c=$(BUILD)/bench/%)
 FUZZ_C    := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_BIN  := $(FUZZ_C:tests/fuzz/%.c=$(BUILD)/fuzz/%)
 
-PROGRAMS := $(BUILD)/meshcorr
+WORKER_C   := $(wildcard workers/main/*.c)
+WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
+
+PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker
 
 .PHONY: all test bench demo install clean
 all: $(PROGRAMS)
@@ -65,6 +68,9 @@ $(PROTO_LIB): $(PROTO_OBJ)
 
 $(BUILD)/meshcorr: $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+
+$(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
 $(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)

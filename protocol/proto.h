@@ -67,7 +67,8 @@
     X(PROTO_EBAD_PARAMS,  -21, "BAD_PARAMS",    "parameter out of range")             \
     X(PROTO_ESTORAGE,     -22, "STORAGE",       "job could not be stored durably")    \
     X(PROTO_EINTERNAL,    -23, "INTERNAL",      "internal server error")              \
-    X(PROTO_ESHUTTING_DOWN,-24,"SHUTTING_DOWN", "server shutting down")
+    X(PROTO_ESHUTTING_DOWN,-24,"SHUTTING_DOWN", "server shutting down")              \
+    X(PROTO_ECANCELLED,   -25, "CANCELLED",     "job cancelled")
 
 enum proto_error {
 #define PROTO_ENUM(sym, val, name, msg) sym = val,
@@ -102,12 +103,12 @@ enum proto_state {
     PROTO_STATE_LAST = 6
 };
 
-#define PROTO_STAGES(X) X(VORONOI, 0) X(RHM, 1) X(ECTM, 2)
+#define PROTO_STAGES(X) X(VORONOI, 0) X(RHM, 1) X(ECTM, 2) X(INIT, 3)
 enum proto_stage {
 #define PROTO_ENUM(name, val) PROTO_STAGE_##name = val,
     PROTO_STAGES(PROTO_ENUM)
 #undef PROTO_ENUM
-    PROTO_STAGE_LAST = 2
+    PROTO_STAGE_LAST = 3
 };
 
 #define PROTO_SLOTS(X) X(IDLE, 0) X(STARTING, 1) X(BUSY, 2) X(DRAINING, 3)

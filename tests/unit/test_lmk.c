@@ -125,3 +125,25 @@ TEST(affine_fit_refuses_coplanar_landmarks)
     CHECK_STR_HAS(err, "coplanar");
     mesh_free(m);
 }
+
+TEST(arrays_follow_the_file_rule_with_one_based_messages)
+{
+    mesh *m = testmesh_icosphere(1);   /* 42 vertices */
+    lmk_set *L = NULL;
+    char err[256];
+    const long a[5] = { 1, 2, 3, 4, 5 }, b[5] = { 5, 4, 3, 2, 1 };
+    CHECK_INT(lmk_from_arrays(a, b, 5, 1, "wire", "wire", m, m, &L, err, sizeof err), 0);
+    CHECK_INT(L->n, 5);
+    CHECK_INT(L->src[0], 0);
+    CHECK_INT(L->tgt[0], 4);
+    lmk_free(L);
+    const long big[5] = { 1, 2, 3, 43, 5 };
+    CHECK_INT(lmk_from_arrays(big, b, 5, 1, "wire", "wire", m, m, &L, err, sizeof err), LMK_ERANGE);
+    CHECK_STR_HAS(err, "wire: landmark 4: source vertex 43 out of range [1, 42]");
+    CHECK(L == NULL);
+    const long dup[5] = { 1, 2, 3, 2, 5 };
+    CHECK_INT(lmk_from_arrays(dup, b, 5, 0, "wire", "wire", m, m, &L, err, sizeof err), LMK_EDUP);
+    CHECK_STR_HAS(err, "landmarks 2 and 4 both use source vertex 2");
+    CHECK_INT(lmk_from_arrays(a, b, 3, 0, "wire", "wire", m, m, &L, err, sizeof err), LMK_ECOUNT);
+    mesh_free(m);
+}

@@ -175,3 +175,27 @@ TEST_T(drc_random_61_byte_buffers_never_crash, 60)
     }
     CHECK(refused > 2900);
 }
+
+TEST(drc_unquantized_encoding_keeps_float32_positions_nan_included)
+{
+    mesh *m = testmesh_icosphere(1);
+    m->v[4] = NAN;
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    char err[512];
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, 0, &buf, &len, err, sizeof err), 0);
+    double *v = NULL;
+    int *f = NULL, nv = 0, nf = 0;
+    CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf,
+                            err, sizeof err), 0);
+    CHECK_INT(nv, m->nv);
+    CHECK(isnan(v[4]));
+    for (int i = 0; i < 3 * nv; i++)
+        if (i != 4)
+            CHECK(v[i] == (double)(float)m->v[i]);
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, -1, &buf, &len, err, sizeof err),
+              DRACOB_EARG);
+    free(v);
+    free(f);
+    mesh_free(m);
+}

@@ -276,8 +276,9 @@ TEST(error_names_and_messages_come_from_one_list)
     CHECK(proto_type_name(0) == NULL);
     CHECK(strcmp(proto_state_name(PROTO_STATE_OUT_OF_MEMORY), "OUT_OF_MEMORY") == 0);
     CHECK(strcmp(proto_stage_name(PROTO_STAGE_RHM), "rhm") == 0);
-    CHECK(proto_stage_name(3) == NULL);
+    CHECK(strcmp(proto_stage_name(PROTO_STAGE_INIT), "init") == 0);
+    CHECK(proto_stage_name(PROTO_STAGE_LAST + 1) == NULL);
     CHECK(strcmp(proto_slot_name(PROTO_SLOT_BUSY), "busy") == 0);
-    for (int c = 0; c >= PROTO_ESHUTTING_DOWN; c--)
+    for (int c = 0; c >= PROTO_ECANCELLED; c--)
         CHECK(strcmp(proto_err_name(c), "UNKNOWN") != 0);
 }

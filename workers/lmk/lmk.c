@@ -4,6 +4,7 @@
 #include "util/errbuf.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,8 +29,8 @@ void lmk_free(lmk_set *l)
 }
 
 /* Reads `cols` integers per data line (first `cols` columns; the rest of the
- * line is ignored) into a growing array. Returns rows read or a negative code. */
-static int read_columns(const char *path, int cols, int one_based, long **vals, int *rows,
+ * line is ignored), as written in the file, into a growing array. */
+static int read_columns(const char *path, int cols, long **vals, int *rows,
                         char *err, size_t errsz)
 {
     FILE *fp = fopen(path, "r");
@@ -67,13 +68,12 @@ static int read_columns(const char *path, int cols, int one_based, long **vals, 
             char *e;
             errno = 0;
             double d = strtod(p, &e);
-            if (e == p || errno == ERANGE || d != (double)(long)d) {
+            if (e == p || errno == ERANGE || !(fabs(d) < 1e15) || d != (double)(long)d) {
                 rc = errbuf_set(err, errsz, LMK_EPARSE,
                                 "%s:%ld: column %d is not a vertex index", path, lineno, c + 1);
                 goto out;
             }
-            long idx = (long)d - (one_based ? 1 : 0);
-            v[(size_t)n * cols + c] = idx;
+            v[(size_t)n * cols + c] = (long)d;
             p = e;
         }
         n++;
@@ -89,37 +89,12 @@ out:
     return LMK_OK;
 }
 
-static int check_set(lmk_set *l, const char *spath, const char *tpath, int one_based,
-                     const mesh *S, const mesh *T, char *err, size_t errsz)
-{
-    int base = one_based ? 1 : 0;
-    if (l->n < LMK_MIN_PAIRS)
-        return errbuf_set(err, errsz, LMK_ECOUNT, "%s: %d landmark pairs, at least %d are needed",
-                          spath, l->n, LMK_MIN_PAIRS);
-    for (int k = 0; k < l->n; k++) {
-        if (l->src[k] < 0 || l->src[k] >= S->nv)
-            return errbuf_set(err, errsz, LMK_ERANGE,
-                              "%s: landmark %d: source vertex %d out of range [%d, %d]",
-                              spath, k + 1, l->src[k] + base, base, S->nv - 1 + base);
-        if (l->tgt[k] < 0 || l->tgt[k] >= T->nv)
-            return errbuf_set(err, errsz, LMK_ERANGE,
-                              "%s: landmark %d: target vertex %d out of range [%d, %d]",
-                              tpath, k + 1, l->tgt[k] + base, base, T->nv - 1 + base);
-        for (int j = 0; j < k; j++)
-            if (l->src[j] == l->src[k])
-                return errbuf_set(err, errsz, LMK_EDUP,
-                                  "%s: landmarks %d and %d both use source vertex %d",
-                                  spath, j + 1, k + 1, l->src[k] + base);
-    }
-    return LMK_OK;
-}
-
-static lmk_set *set_new(int n)
+static lmk_set *set_new(long n)
 {
     lmk_set *l = calloc(1, sizeof *l);
     if (!l)
         return NULL;
-    l->n = n;
+    l->n = (int)n;
     l->src = malloc(sizeof(int) * ((size_t)n + 1));
     l->tgt = malloc(sizeof(int) * ((size_t)n + 1));
     if (!l->src || !l->tgt) {
@@ -129,7 +104,58 @@ static lmk_set *set_new(int n)
     return l;
 }
 
-static int clamp_int(long v) { return v < -1 ? -1 : v > 2147483647L ? 2147483647 : (int)v; }
+int lmk_from_arrays(const long *src, const long *tgt, long n, int one_based,
+                    const char *src_name, const char *tgt_name, const mesh *S, const mesh *T,
+                    lmk_set **out, char *err, size_t errsz)
+{
+    *out = NULL;
+    long base = one_based ? 1 : 0;
+    if (n < LMK_MIN_PAIRS)
+        return errbuf_set(err, errsz, LMK_ECOUNT, "%s: %ld landmark pairs, at least %d are needed",
+                          src_name, n, LMK_MIN_PAIRS);
+    if (n > LMK_MAX_PAIRS)
+        return errbuf_set(err, errsz, LMK_ECOUNT, "%s: %ld landmark pairs, at most %d are allowed",
+                          src_name, n, LMK_MAX_PAIRS);
+    for (long k = 0; k < n; k++) {
+        if (src[k] < base || src[k] - base >= S->nv)
+            return errbuf_set(err, errsz, LMK_ERANGE,
+                              "%s: landmark %ld: source vertex %ld out of range [%ld, %ld]",
+                              src_name, k + 1, src[k], base, S->nv - 1 + base);
+        if (tgt[k] < base || tgt[k] - base >= T->nv)
+            return errbuf_set(err, errsz, LMK_ERANGE,
+                              "%s: landmark %ld: target vertex %ld out of range [%ld, %ld]",
+                              tgt_name, k + 1, tgt[k], base, T->nv - 1 + base);
+    }
+    lmk_set *l = set_new(n);
+    int *first = malloc(sizeof(int) * ((size_t)S->nv + 1)); /* landmark using each vertex */
+    if (!l || !first) {
+        lmk_free(l);
+        free(first);
+        return errbuf_set(err, errsz, LMK_ENOMEM, "%s: out of memory", src_name);
+    }
+    for (int i = 0; i < S->nv; i++)
+        first[i] = -1;
+    int rc = LMK_OK;
+    for (long k = 0; k < n; k++) {
+        int s = (int)(src[k] - base);
+        if (first[s] >= 0) {
+            rc = errbuf_set(err, errsz, LMK_EDUP,
+                            "%s: landmarks %d and %ld both use source vertex %ld",
+                            src_name, first[s] + 1, k + 1, src[k]);
+            break;
+        }
+        first[s] = (int)k;
+        l->src[k] = s;
+        l->tgt[k] = (int)(tgt[k] - base);
+    }
+    free(first);
+    if (rc) {
+        lmk_free(l);
+        return rc;
+    }
+    *out = l;
+    return LMK_OK;
+}
 
 int lmk_read_pairs(const char *path, int one_based, const mesh *S, const mesh *T,
                    lmk_set **out, char *err, size_t errsz)
@@ -137,25 +163,23 @@ int lmk_read_pairs(const char *path, int one_based, const mesh *S, const mesh *T
     *out = NULL;
     long *v = NULL;
     int n = 0;
-    int rc = read_columns(path, 2, one_based, &v, &n, err, errsz);
+    int rc = read_columns(path, 2, &v, &n, err, errsz);
     if (rc)
         return rc;
-    lmk_set *l = set_new(n);
-    if (!l) {
-        free(v);
-        return errbuf_set(err, errsz, LMK_ENOMEM, "%s: out of memory", path);
+    long *a = malloc(sizeof(long) * ((size_t)n + 1)), *b = malloc(sizeof(long) * ((size_t)n + 1));
+    if (!a || !b) {
+        rc = errbuf_set(err, errsz, LMK_ENOMEM, "%s: out of memory", path);
+    } else {
+        for (int k = 0; k < n; k++) {
+            a[k] = v[2 * k];
+            b[k] = v[2 * k + 1];
+        }
+        rc = lmk_from_arrays(a, b, n, one_based, path, path, S, T, out, err, errsz);
     }
-    for (int k = 0; k < n; k++) {
-        l->src[k] = clamp_int(v[2 * k]);
-        l->tgt[k] = clamp_int(v[2 * k + 1]);
-    }
+    free(a);
+    free(b);
     free(v);
-    if ((rc = check_set(l, path, path, one_based, S, T, err, errsz))) {
-        lmk_free(l);
-        return rc;
-    }
-    *out = l;
-    return LMK_OK;
+    return rc;
 }
 
 int lmk_read_lists(const char *src_path, const char *tgt_path, int one_based,
@@ -164,33 +188,18 @@ int lmk_read_lists(const char *src_path, const char *tgt_path, int one_based,
     *out = NULL;
     long *a = NULL, *b = NULL;
     int na = 0, nb = 0;
-    int rc = read_columns(src_path, 1, one_based, &a, &na, err, errsz);
+    int rc = read_columns(src_path, 1, &a, &na, err, errsz);
     if (rc)
         return rc;
-    if ((rc = read_columns(tgt_path, 1, one_based, &b, &nb, err, errsz))) {
-        free(a);
-        return rc;
-    }
-    lmk_set *l = NULL;
+    if ((rc = read_columns(tgt_path, 1, &b, &nb, err, errsz)))
+        goto out;
     if (na != nb) {
         rc = errbuf_set(err, errsz, LMK_ECOUNT, "%s has %d landmarks but %s has %d",
                         src_path, na, tgt_path, nb);
         goto out;
     }
-    if (!(l = set_new(na))) {
-        rc = errbuf_set(err, errsz, LMK_ENOMEM, "out of memory");
-        goto out;
-    }
-    for (int k = 0; k < na; k++) {
-        l->src[k] = clamp_int(a[k]);
-        l->tgt[k] = clamp_int(b[k]);
-    }
-    if ((rc = check_set(l, src_path, tgt_path, one_based, S, T, err, errsz)))
-        goto out;
-    *out = l;
-    l = NULL;
+    rc = lmk_from_arrays(a, b, na, one_based, src_path, tgt_path, S, T, out, err, errsz);
 out:
-    lmk_free(l);
     free(a);
     free(b);
     return rc;

@@ -7,7 +7,9 @@
  * one_based is set. Reading validates against the meshes: index in range,
  * no duplicate source landmark, at least LMK_MIN_PAIRS pairs, at most
  * LMK_MAX_PAIRS; errors name the file and line.
- * Ownership: lmk_read* return a set freed with lmk_free (NULL ok). */
+ * lmk_from_arrays is that one rule for pairs from anywhere (the file readers
+ * and the worker's wire landmarks both go through it).
+ * Ownership: lmk_read* and lmk_from_arrays return a set freed with lmk_free (NULL ok). */
 #ifndef LMK_H
 #define LMK_H
 #include <stddef.h>
@@ -39,6 +41,14 @@ typedef struct lmk_set {
 } lmk_set;
 
 void lmk_free(lmk_set *l);
+/* Builds a set from n pairs as given (1-based when one_based) and validates
+ * it: LMK_MIN_PAIRS <= n <= LMK_MAX_PAIRS, each index in range for its mesh,
+ * no source vertex used twice. Messages start with src_name or tgt_name and
+ * count landmarks from 1: "NAME: landmark 3: source vertex 9999 out of range
+ * [0, 6937]". */
+int lmk_from_arrays(const long *src, const long *tgt, long n, int one_based,
+                    const char *src_name, const char *tgt_name, const mesh *S, const mesh *T,
+                    lmk_set **out, char *err, size_t errsz);
 int lmk_read_pairs(const char *path, int one_based, const mesh *S, const mesh *T,
                    lmk_set **out, char *err, size_t errsz);
 int lmk_read_lists(const char *src_path, const char *tgt_path, int one_based,

@@ -80,23 +80,27 @@ static int parse_double(const char **s, double *out)
     return 0;
 }
 
-/* Checks one row's weights; clamps small negatives and renormalises when the
- * sum is off by more than rounding (so a written map reads back bit-exact). */
-static int fix_weights(double w[3], const char *path, long line, char *err, size_t errsz)
+int bmap_check_row(long face, double w[3], int target_nf, const char *where,
+                   char *err, size_t errsz)
 {
+    if (face < 0 || face >= target_nf)
+        return errbuf_set(err, errsz, BMAP_ERANGE, "%s: face %ld out of range [0, %d)",
+                          where, face, target_nf);
     for (int k = 0; k < 3; k++) {
         if (!isfinite(w[k]))
-            return errbuf_set(err, errsz, BMAP_EWEIGHT, "%s:%ld: weight %d is not a finite number",
-                              path, line, k);
+            return errbuf_set(err, errsz, BMAP_EWEIGHT, "%s: weight %d is not a finite number",
+                              where, k);
         if (w[k] < -BMAP_WEIGHT_TOL)
-            return errbuf_set(err, errsz, BMAP_EWEIGHT, "%s:%ld: weight %d is negative (%g)",
-                              path, line, k, w[k]);
+            return errbuf_set(err, errsz, BMAP_EWEIGHT, "%s: weight %d is negative (%g)",
+                              where, k, w[k]);
     }
     double sum = w[0] + w[1] + w[2];
     if (!(fabs(sum - 1) <= BMAP_WEIGHT_TOL))
         return errbuf_set(err, errsz, BMAP_EWEIGHT,
-                          "%s:%ld: weights sum to %.17g, not 1 (tolerance %g)", path, line, sum,
+                          "%s: weights sum to %.17g, not 1 (tolerance %g)", where, sum,
                           BMAP_WEIGHT_TOL);
+    /* clamp small negatives and renormalise only when the sum is off by more
+     * than rounding, so a written map reads back bit-exact */
     for (int k = 0; k < 3; k++)
         w[k] = w[k] > 0 ? w[k] : 0;
     sum = w[0] + w[1] + w[2];
@@ -168,12 +172,9 @@ int bmap_read(const char *path, const mesh *source, const mesh *target,
                             path, line, row);
             goto done;
         }
-        if (f < 0 || f >= target->nf) {
-            rc = errbuf_set(err, errsz, BMAP_ERANGE, "%s:%ld: face %ld out of range [0, %d)",
-                            path, line, f, target->nf);
-            goto done;
-        }
-        if ((rc = fix_weights(w, path, line, err, errsz)) < 0)
+        char where[1024];
+        snprintf(where, sizeof where, "%s:%ld", path, line);
+        if ((rc = bmap_check_row(f, w, target->nf, where, err, errsz)) < 0)
             goto done;
         P->face[row++] = (int)f;
     }

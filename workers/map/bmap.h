@@ -49,6 +49,13 @@ void bmap_free(bmap *P);
  * summing to 1 within BMAP_WEIGHT_TOL (then clamped and renormalised). */
 int bmap_read(const char *path, const mesh *source, const mesh *target,
               bmap **out, char *err, size_t errsz);
+/* The rule for one row, from a file or from the wire: face in
+ * [0, target_nf), weights finite, >= -BMAP_WEIGHT_TOL and summing to 1
+ * within BMAP_WEIGHT_TOL; then clamps negatives to 0 and renormalises (a
+ * sum already 1 within rounding is left bit-exact). where prefixes the
+ * message ("P.map:12", "initial map p: row 5"). */
+int bmap_check_row(long face, double w[3], int target_nf, const char *where,
+                   char *err, size_t errsz);
 /* Writes the text format; comment (may be NULL, may hold several lines
  * separated by '\n') goes into '#' lines after the header line. */
 int bmap_write(const char *path, const bmap *P, const char *comment,

@@ -161,7 +161,8 @@ int encode(const double *v, int nv, const int *f, int nf, int bits,
     }
     draco::Encoder enc;
     enc.SetEncodingMethod(draco::MESH_SEQUENTIAL_ENCODING);
-    enc.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
+    if (bits > 0)   // 0: positions stored as float32, unquantized
+        enc.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
     draco::EncoderBuffer eb;
     const draco::Status st = enc.EncodeMeshToBuffer(dm, &eb);
     if (!st.ok())
@@ -221,8 +222,8 @@ extern "C" int dracob_encode(const double *v, int nv, const int *f, int nf,
     *len = 0;
     if (nv < 0 || nf < 0 || (nv > 0 && !v) || (nf > 0 && !f))
         return fail(err, errsz, DRACOB_EARG, "dracob_encode: bad sizes or NULL arrays");
-    if (quantization_bits < 1 || quantization_bits > 30)
-        return fail(err, errsz, DRACOB_EARG, "quantization of %d bits; expected 1..30",
+    if (quantization_bits < 0 || quantization_bits > 30)
+        return fail(err, errsz, DRACOB_EARG, "quantization of %d bits; expected 0..30",
                     quantization_bits);
     for (long long i = 0; i < 3LL * nf; i++)
         if (f[i] < 0 || f[i] >= nv)

@@ -51,7 +51,8 @@ int dracob_decode(const unsigned char *buf, size_t len, int max_points, int max_
                   double **v, int *nv, int **f, int *nf, char *err, size_t errsz);
 
 /* Encodes nv by 3 positions and nf by 3 faces, positions quantized to
- * quantization_bits (1..30; 16 is the usual). Indices must be in range. */
+ * quantization_bits (1..30; 16 is the usual; 0 stores float32 positions
+ * unquantized, as other tools may). Indices must be in range. */
 int dracob_encode(const double *v, int nv, const int *f, int nf, int quantization_bits,
                   unsigned char **buf, size_t *len, char *err, size_t errsz);
 

@@ -78,4 +78,11 @@ int mesh_write_ply(const char *path, const mesh *m, char *err, size_t errsz);
 int mesh_read_drc(const char *path, mesh **out, char *err, size_t errsz);
 int mesh_write_drc(const char *path, const mesh *m, char *err, size_t errsz);
 
+/* Draco in memory (the worker's blobs): decode with at most max_nv vertices
+ * and max_nf faces (MESH_ELIMIT over them); name prefixes messages
+ * ("source mesh: ..."). Encode: the .drc writer's bytes, *buf malloc()ed. */
+int mesh_read_drc_mem(const void *buf, size_t len, int max_nv, int max_nf, const char *name,
+                      mesh **out, char *err, size_t errsz);
+int mesh_encode_drc(const mesh *m, unsigned char **buf, size_t *len, char *err, size_t errsz);
+
 #endif

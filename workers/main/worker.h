@@ -1,0 +1,82 @@
+/* worker.h — meshcorr-worker, the process that runs one spooled job for the
+ * daemon (the contract is workers/WORKER.md). Declarations shared by the
+ * worker's own files (prefix wrk_); this folder is not part of the engine
+ * library and nothing here is called from outside the worker program.
+ *
+ * Every function that can fail returns 0 or a negative PROTO_E* code (the
+ * code that goes into error.frame) with a message naming the field in the
+ * caller's err buffer. */
+#ifndef WORKER_H
+#define WORKER_H
+#include <stddef.h>
+#include <stdint.h>
+#include "proto.h"
+#include "corr/corr.h"
+
+/* Exit statuses (WORKER.md). */
+#define WRK_EXIT_OK        0
+#define WRK_EXIT_JOB       1   /* error.frame written (or, if that failed, nothing) */
+#define WRK_EXIT_USAGE     2   /* bad command line or job directory; no error.frame */
+#define WRK_EXIT_CANCELLED 3   /* SIGTERM; error.frame holds CANCELLED */
+
+#define WRK_JOB_FRAME    "job.frame"
+#define WRK_RESULT_FRAME "result.frame"
+#define WRK_ERROR_FRAME  "error.frame"
+
+typedef struct wrk_limits {
+    int max_vertices, max_faces;   /* per mesh, checked while decoding */
+    int threads;                   /* ectm_params.threads (0: all cores) */
+} wrk_limits;
+
+/* A job ready for corr_run; everything owned (wrk_job_close). */
+typedef struct wrk_job {
+    mesh *S, *T;
+    lmk_set *L;                    /* NULL when the SUBMIT has no landmarks */
+    bmap *P0, *Q0;                 /* NULL when absent */
+    ectm_params params;
+} wrk_job;
+
+/* worker_job.c — the one mapping from a SUBMIT to a job: decodes both Draco
+ * meshes (BAD_MESH naming "source mesh"/"target mesh", over the limits
+ * included), validates them (corr_validate), maps the parameters onto
+ * ectm_params (BAD_PARAMS naming the field), builds the landmark set
+ * (lmk_from_arrays: BAD_LANDMARKS) and the initial maps (bmap_check_row:
+ * BAD_PARAMS). On error job is left closed. */
+int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
+                        char *err, size_t errsz);
+void wrk_job_close(wrk_job *job);
+
+/* worker_io.c — the spool files. wrk_frame_read reads path whole and decodes
+ * one frame filling it exactly (*buf holds the payload m borrows from; free
+ * it after proto_msg_free). I/O errors are PROTO_ESTORAGE. wrk_frame_write
+ * encodes m and writes dir/name atomically: name.tmp, fsync, rename, fsync
+ * of dir; the .tmp is removed on failure. */
+int wrk_frame_read(const char *path, unsigned char **buf, proto_msg *m, char *err, size_t errsz);
+int wrk_frame_write(const char *dir, const char *name, const proto_msg *m, char *err, size_t errsz);
+
+/* worker_progress.c — PROGRESS frames (request id 0) on a pipe. fd < 0: no
+ * progress. The first write error closes the channel for good (the daemon
+ * is gone); the job carries on. */
+typedef struct wrk_progress {
+    int fd;
+    uint64_t job_id;
+    int total;                     /* planned outer iterations */
+} wrk_progress;
+void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, double elapsed,
+                       proto_progress *out);
+void wrk_progress_send(wrk_progress *pg, const corr_progress *cp, double elapsed);
+
+/* worker_result.c — the RESULT_OK message of a finished job: P, Q
+ * (bijective), the deformed source as Draco (our order-keeping encoder) and
+ * the metrics (WORKER.md lists the keys). The message borrows from r. */
+typedef struct wrk_result {
+    proto_msg msg;
+    proto_map_row *p, *q;
+    unsigned char *deformed;
+    proto_metric metrics[8];
+} wrk_result;
+int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
+                     double elapsed, wrk_result *r, char *err, size_t errsz);
+void wrk_result_close(wrk_result *r);
+
+#endif

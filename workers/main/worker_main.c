@@ -1,0 +1,232 @@
+/* worker_main.c — meshcorr-worker's main: command line, signals, and the
+ * order of one job (read job.frame, build the job, run, write result.frame
+ * or error.frame). The contract with the daemon is workers/WORKER.md; the
+ * pieces are in the other worker_*.c files. */
+#include "main/worker.h"
+#include "util/ompenv.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+static volatile sig_atomic_t cancel_requested;
+
+static void on_term(int sig)
+{
+    (void)sig;
+    cancel_requested = 1;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void usage(void)
+{
+    fprintf(stderr,
+        "usage: meshcorr-worker --job DIR --job-id ID [--progress-fd N] [--threads N]\n"
+        "                       [--max-vertices N] [--max-faces N]\n"
+        "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
+        "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage. See workers/WORKER.md.\n");
+}
+
+/* Decimal in [lo, hi]; -1 (with a message) otherwise. */
+static int parse_num(const char *opt, const char *s, unsigned long long lo, unsigned long long hi,
+                     unsigned long long *out)
+{
+    char *e;
+    errno = 0;
+    unsigned long long v = strtoull(s, &e, 10);
+    if (*s < '0' || *s > '9' || *e || errno || v < lo || v > hi) {
+        fprintf(stderr, "meshcorr-worker: --%s: '%s' is not an integer in [%llu, %llu]\n", opt, s,
+                lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+typedef struct run_ctx {
+    wrk_progress pg;
+    double t0;
+    int last_outer;
+} run_ctx;
+
+static int on_progress(void *ctx, const corr_progress *cp)
+{
+    run_ctx *rc = ctx;
+    if (cp->ectm)
+        rc->last_outer = cp->ectm->outer;
+    wrk_progress_send(&rc->pg, cp, now() - rc->t0);
+    return cancel_requested != 0;
+}
+
+static int proto_code_of(int corr_rc)
+{
+    switch (corr_rc) {
+    case CORR_EMESH: return PROTO_EBAD_MESH;
+    case CORR_EINPUT: return PROTO_EBAD_PARAMS;
+    case CORR_EINIT: return PROTO_EBAD_LANDMARKS;
+    case CORR_ENOMEM: return PROTO_ENOMEM;
+    case CORR_ECANCELED: return PROTO_ECANCELLED;
+    default: return PROTO_EINTERNAL;
+    }
+}
+
+/* Writes error.frame; returns the exit status for code. */
+static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
+{
+    fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": %s: %s\n", job_id, proto_err_name(code), msg);
+    proto_msg m;
+    memset(&m, 0, sizeof m);
+    m.type = PROTO_MSG_ERROR;
+    m.u.error.code = code;
+    char text[PROTO_MAX_STRING + 1];
+    /* the wire string limit, cut on a UTF-8 character boundary */
+    size_t n = strlen(msg);
+    if (n > PROTO_MAX_STRING) {
+        n = PROTO_MAX_STRING;
+        while (n && ((unsigned char)msg[n] & 0xC0) == 0x80)
+            n--;
+    }
+    memcpy(text, msg, n);
+    text[n] = '\0';
+    m.u.error.message = text;
+    char err[1024];
+    if (wrk_frame_write(dir, WRK_ERROR_FRAME, &m, err, sizeof err))
+        fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": cannot write %s: %s\n", job_id,
+                WRK_ERROR_FRAME, err);
+    return code == PROTO_ECANCELLED ? WRK_EXIT_CANCELLED : WRK_EXIT_JOB;
+}
+
+int main(int argc, char **argv)
+{
+    ompenv_ensure_passive(argv);
+    double t0 = now();
+    static const struct option opts[] = {
+        {"job", required_argument, 0, 'j'},          {"job-id", required_argument, 0, 'i'},
+        {"progress-fd", required_argument, 0, 'p'},  {"threads", required_argument, 0, 't'},
+        {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
+        {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
+    const char *dir = NULL;
+    uint64_t job_id = 0;
+    int have_id = 0, progress_fd = -1, bad = 0;
+    wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
+    unsigned long long v;
+    int c;
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'j': dir = optarg; break;
+        case 'i':
+            if (!(bad |= parse_num("job-id", optarg, 1, UINT64_MAX, &v) != 0)) {
+                job_id = v;
+                have_id = 1;
+            }
+            break;
+        case 'p':
+            if (!(bad |= parse_num("progress-fd", optarg, 0, 1 << 20, &v) != 0))
+                progress_fd = (int)v;
+            break;
+        case 't':
+            if (!(bad |= parse_num("threads", optarg, 0, 1024, &v) != 0))
+                lim.threads = (int)v;
+            break;
+        case 'v':
+            if (!(bad |= parse_num("max-vertices", optarg, 3, MESH_MAX_VERTICES, &v) != 0))
+                lim.max_vertices = (int)v;
+            break;
+        case 'f':
+            if (!(bad |= parse_num("max-faces", optarg, 1, MESH_MAX_FACES, &v) != 0))
+                lim.max_faces = (int)v;
+            break;
+        case 'h': usage(); return WRK_EXIT_USAGE;
+        default: bad = 1;
+        }
+    }
+    if (!bad && (!dir || !have_id || optind != argc)) {
+        fprintf(stderr, "meshcorr-worker: --job and --job-id are required, nothing else\n");
+        bad = 1;
+    }
+    struct stat st;
+    if (!bad && (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
+        fprintf(stderr, "meshcorr-worker: --job %s: not a directory\n", dir);
+        bad = 1;
+    }
+    if (!bad && progress_fd >= 0 && fcntl(progress_fd, F_GETFD) < 0) {
+        fprintf(stderr, "meshcorr-worker: --progress-fd %d: not an open descriptor\n", progress_fd);
+        bad = 1;
+    }
+    if (bad) {
+        usage();
+        return WRK_EXIT_USAGE;
+    }
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_term;
+    sa.sa_flags = SA_RESTART;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGINT, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);   /* a closed progress pipe is EPIPE, not death */
+
+    int status;
+    char err[4096] = "", path[4096];
+    unsigned char *frame = NULL;
+    proto_msg sub;
+    wrk_job job;
+    ectm_result res;
+    wrk_result out;
+    memset(&job, 0, sizeof job);
+    memset(&res, 0, sizeof res);
+    memset(&out, 0, sizeof out);
+    snprintf(path, sizeof path, "%s/%s", dir, WRK_JOB_FRAME);
+    int rc = wrk_frame_read(path, &frame, &sub, err, sizeof err);
+    if (rc) {
+        status = fail(dir, job_id, rc, err);
+        goto done;
+    }
+    if ((rc = wrk_job_from_submit(&sub.u.submit, &lim, &job, err, sizeof err))) {
+        status = fail(dir, job_id, rc, err);
+        goto done;
+    }
+    run_ctx ctx = { { progress_fd, job_id, job.params.iterations }, t0, 0 };
+    corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0 };
+    if (cancel_requested)
+        rc = CORR_ECANCELED;
+    else
+        rc = corr_run(&in, &job.params, on_progress, &ctx, &res, err, sizeof err);
+    if (rc == CORR_OK && cancel_requested)
+        rc = CORR_ECANCELED;                 /* SIGTERM during the last iteration */
+    if (rc == CORR_ECANCELED)
+        snprintf(err, sizeof err, "cancelled by SIGTERM after %d of %d outer iterations",
+                 ctx.last_outer, job.params.iterations);
+    if (rc) {
+        status = fail(dir, job_id, proto_code_of(rc), err);
+        goto done;
+    }
+    if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err)) ||
+        (rc = wrk_frame_write(dir, WRK_RESULT_FRAME, &out.msg, err, sizeof err))) {
+        status = fail(dir, job_id, rc, err);
+        goto done;
+    }
+    status = WRK_EXIT_OK;
+done:
+    wrk_result_close(&out);
+    ectm_result_close(&res);
+    wrk_job_close(&job);
+    proto_msg_free(&sub);
+    free(frame);
+    return status;
+}

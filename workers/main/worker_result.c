@@ -1,0 +1,81 @@
+/* worker_result.c — a finished job's RESULT_OK message (see worker.h):
+ * maps to wire rows, the deformed source to Draco, the metric summary to
+ * key/value pairs. Computes no map itself. */
+#include "main/worker.h"
+#include "metric/metric.h"
+#include "util/errbuf.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void wrk_result_close(wrk_result *r)
+{
+    if (!r)
+        return;
+    free(r->p);
+    free(r->q);
+    free(r->deformed);
+    memset(r, 0, sizeof *r);
+}
+
+static proto_map_row *rows_of(const bmap *P)
+{
+    proto_map_row *rows = malloc(sizeof *rows * ((size_t)P->n + 1));
+    if (!rows)
+        return NULL;
+    for (int i = 0; i < P->n; i++) {
+        rows[i].face = (uint32_t)P->face[i];
+        memcpy(rows[i].w, P->w + 3 * (size_t)i, sizeof rows[i].w);
+    }
+    return rows;
+}
+
+int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
+                     double elapsed, wrk_result *r, char *err, size_t errsz)
+{
+    memset(r, 0, sizeof *r);
+    proto_result_ok *ok = &r->msg.u.result_ok;
+    r->msg.type = PROTO_MSG_RESULT_OK;
+    ok->job_id = job_id;
+    if (!(r->p = rows_of(res->P)) || (res->Q && !(r->q = rows_of(res->Q)))) {
+        wrk_result_close(r);
+        return errbuf_set(err, errsz, PROTO_ENOMEM, "result maps: out of memory");
+    }
+    ok->p = (proto_map){ r->p, (uint32_t)res->P->n };
+    if (res->Q)
+        ok->q = (proto_map){ r->q, (uint32_t)res->Q->n };
+
+    mesh deformed = { job->S->nv, job->S->nf, res->Y, job->S->f };
+    size_t len = 0;
+    char detail[512];
+    if (mesh_encode_drc(&deformed, &r->deformed, &len, detail, sizeof detail)) {
+        wrk_result_close(r);
+        return errbuf_set(err, errsz, PROTO_EINTERNAL, "deformed mesh: %s", detail);
+    }
+    if (len > PROTO_MAX_MESH_BYTES) {
+        wrk_result_close(r);
+        return errbuf_set(err, errsz, PROTO_EOVER_LIMIT,
+                          "deformed mesh: %zu Draco bytes, over PROTO_MAX_MESH_BYTES (%u)", len,
+                          PROTO_MAX_MESH_BYTES);
+    }
+    ok->deformed = (proto_blob){ r->deformed, (uint32_t)len };
+
+    metric_summary ms;
+    if (metric_summarize(job->S, job->T, res->P, &ms)) {
+        wrk_result_close(r);
+        return errbuf_set(err, errsz, PROTO_ENOMEM, "metrics: out of memory");
+    }
+    const proto_metric m[] = {
+        { "mean_abs_log_area", ms.mean_abs_log_area },
+        { "median_conformal", ms.median_conformal },
+        { "flipped_fraction", ms.flipped_fraction },
+        { "collapsed_fraction", ms.collapsed_fraction },
+        { "final_energy", res->last.energy },
+        { "elapsed_s", elapsed },
+        { "iterations", res->last.outer },
+    };
+    memcpy(r->metrics, m, sizeof m);
+    ok->metrics = r->metrics;
+    ok->nmetrics = sizeof m / sizeof m[0];
+    return 0;
+}
