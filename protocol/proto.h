@@ -225,7 +225,8 @@ typedef struct proto_params {
     uint8_t model;                    /* enum proto_model */
     uint8_t partial;                  /* 0 or 1 */
     double alpha, eta;                /* membrane and bending weights */
-    double beta0, beta1, beta_ramp;   /* mismatch weight: start, cap, increase per outer it. */
+    double beta0, beta1;              /* mismatch weight at outer iteration 1, and after the ramp */
+    uint32_t beta_ramp;               /* outer iterations of the linear ramp beta0 -> beta1 (>= 1) */
     double gamma;                     /* reverse-map weight (bijective) */
     uint32_t iterations, inner_iterations;  /* outer; L-BFGS per outer */
     double tolerance, stop_change;    /* gradient tolerance; relative energy change */

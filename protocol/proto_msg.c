@@ -326,7 +326,7 @@ static void io_params(io *c, proto_params *p)
     io_f64(c, &p->eta);
     io_f64(c, &p->beta0);
     io_f64(c, &p->beta1);
-    io_f64(c, &p->beta_ramp);
+    io_u32(c, &p->beta_ramp);
     io_f64(c, &p->gamma);
     io_u32(c, &p->iterations);
     io_u32(c, &p->inner_iterations);

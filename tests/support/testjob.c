@@ -16,10 +16,9 @@ void testjob_params_to_wire(const ectm_params *p, proto_params *w)
     w->partial = (uint8_t)(p->partial != 0);
     w->alpha = p->alpha;
     w->eta = p->eta;
-    /* the engine: β = beta1 from k = R on; linear from beta0 at k = 1 */
-    w->beta0 = p->beta_ramp <= 1 ? p->beta1 : p->beta0;
+    w->beta0 = p->beta0;
     w->beta1 = p->beta1;
-    w->beta_ramp = p->beta_ramp <= 1 ? 0 : (p->beta1 - p->beta0) / (p->beta_ramp - 1);
+    w->beta_ramp = (uint32_t)p->beta_ramp;
     w->gamma = p->gamma;
     w->iterations = (uint32_t)p->iterations;
     w->inner_iterations = (uint32_t)p->inner_iterations;

@@ -35,37 +35,6 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
     return 0;
 }
 
-/* The wire's β schedule is β_k = min(beta0 + (k−1)·beta_ramp, beta1); the
- * engine's is linear from beta0 at k = 1 to beta1 at k = R. They agree when
- * (beta1 − beta0)/beta_ramp is a whole number R − 1; anything else is
- * refused rather than silently bent. */
-static int map_beta(const proto_params *w, ectm_params *p, char *err, size_t errsz)
-{
-    p->beta0 = w->beta0;
-    p->beta1 = w->beta1;
-    p->beta_ramp = 1;
-    if (!isfinite(w->beta_ramp) || w->beta_ramp < 0)
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS,
-                          "parameter beta_ramp must be a finite number >= 0 (beta increase per "
-                          "outer iteration), not %g", w->beta_ramp);
-    if (!isfinite(w->beta0) || !isfinite(w->beta1))
-        return 0;                       /* ectm_params_check names the field */
-    if (w->beta1 < w->beta0)
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS,
-                          "parameter beta1 (%g) must be >= beta0 (%g)", w->beta1, w->beta0);
-    if (w->beta_ramp == 0 || w->beta1 == w->beta0) {
-        p->beta1 = w->beta0;            /* β stays at beta0 */
-        return 0;
-    }
-    double steps = (w->beta1 - w->beta0) / w->beta_ramp, whole = nearbyint(steps);
-    if (!(steps < 1e6) || fabs(steps - whole) > 1e-6 * fmax(1, steps))
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS,
-                          "parameter beta_ramp: (beta1 - beta0) / beta_ramp = %.9g is not a whole "
-                          "number of outer iterations below 1e6", steps);
-    p->beta_ramp = (int)whole + 1;
-    return 0;
-}
-
 static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params *p,
                       char *err, size_t errsz)
 {
@@ -85,9 +54,9 @@ static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params 
     p->tolerance = w->tolerance;
     p->stop_change = w->stop_change;
     p->threads = lim->threads;
-    int rc = map_beta(w, p, err, errsz);
-    if (rc)
-        return rc;
+    p->beta0 = w->beta0;
+    p->beta1 = w->beta1;
+    p->beta_ramp = w->beta_ramp > INT_MAX ? INT_MAX : (int)w->beta_ramp;
     if (ectm_params_check(p, err, errsz))
         return PROTO_EBAD_PARAMS;
     return 0;
