@@ -61,8 +61,10 @@ double rhm__energy(const rhm__problem *pb, double beta, rhm_terms dir[2]);
 
 /* The projection of direction i as rhm__step_p sets it up: Z (n_j by 2m),
  * the queries Q (n_i by 2m) and the lower-bound scale s. Z and Q are
- * caller-allocated. For tests and rhm__step_p itself. */
-void rhm__projection_setup(const rhm__problem *pb, int i, double beta,
-                           double *Z, double *Q, double *s);
+ * caller-allocated. Returns 0 when the first block is √(β/(s_i s_j))·X_j
+ * (the side's fixed tree applies), 1 when it is the reversibility block
+ * √(1−α)/s_i·X_ji (then first Z columns / s are the tree's positions). */
+int rhm__projection_setup(const rhm__problem *pb, int i, double beta,
+                          double *Z, double *Q, double *s);
 
 #endif

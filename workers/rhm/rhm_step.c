@@ -16,30 +16,42 @@
  * βĒ_Q(P_ij, X_ij); row l costs M_i(l)·[(1−α)/s_i² |p X_ji − x_i,l|² +
  * β/(s_i s_j) |x_ij,l − p X_j|²], the common M_i(l) drops out, and the
  * minimiser is the closest point of [√(β/(s_i s_j)) x_ij,l | √(1−α)/s_i x_i,l]
- * on M_j embedded with vertices [√(β/(s_i s_j)) X_j | √(1−α)/s_i X_ji]. */
+ * on M_j embedded with vertices [√(β/(s_i s_j)) X_j | √(1−α)/s_i X_ji].
+ * The projection's lower bound comes from the first three coordinates of
+ * the block listed first; early on (small β) the reversibility block
+ * weighs more, and a bound from X_j alone would prune almost nothing
+ * (measured: the first 20 iterations on FAUST 5K cost 19 s that way), so
+ * that block goes first, on a tree rebuilt over the current X_ji. */
 #include "rhm/rhm__problem.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-void rhm__projection_setup(const rhm__problem *pb, int i, double beta,
-                           double *Z, double *Q, double *s)
+int rhm__projection_setup(const rhm__problem *pb, int i, double beta,
+                          double *Z, double *Q, double *s)
 {
     const rhm__side *a = &pb->side[i], *b = &pb->side[1 - i];
     int m = pb->dim, d = 2 * m;
     double sq = sqrt(beta / (a->s * b->s)), sr = sqrt(1 - pb->p.alpha) / a->s;
+    /* the block with the larger weight goes first: its three leading
+     * columns give the tree's lower bound */
+    int rev = sr > sq;
+    double w0 = rev ? sr : sq, w1 = rev ? sq : sr;
+    const double *z0 = rev ? b->Xij : b->X, *z1 = rev ? b->X : b->Xij;
+    const double *q0 = rev ? a->X : a->Xij, *q1 = rev ? a->Xij : a->X;
     for (int v = 0; v < b->n; v++)
         for (int c = 0; c < m; c++) {
-            Z[(size_t)v * d + c] = sq * b->X[(size_t)v * m + c];
-            Z[(size_t)v * d + m + c] = sr * b->Xij[(size_t)v * m + c];
+            Z[(size_t)v * d + c] = w0 * z0[(size_t)v * m + c];
+            Z[(size_t)v * d + m + c] = w1 * z1[(size_t)v * m + c];
         }
     for (int l = 0; l < a->n; l++)
         for (int c = 0; c < m; c++) {
-            Q[(size_t)l * d + c] = sq * a->Xij[(size_t)l * m + c];
-            Q[(size_t)l * d + m + c] = sr * a->X[(size_t)l * m + c];
+            Q[(size_t)l * d + c] = w0 * q0[(size_t)l * m + c];
+            Q[(size_t)l * d + m + c] = w1 * q1[(size_t)l * m + c];
         }
-    *s = sq;
+    *s = w0;
+    return rev;
 }
 
 int rhm__step_p(rhm__problem *pb, int i, double beta)
@@ -48,13 +60,30 @@ int rhm__step_p(rhm__problem *pb, int i, double beta)
     int d = 2 * pb->dim;
     double *Z = malloc(sizeof(double) * (size_t)b->n * d);
     double *Q = malloc(sizeof(double) * (size_t)a->n * d);
+    mesh *emb = NULL;
+    proj_tree *tmp = NULL;
     int rc = RHM_ENOMEM;
-    if (Z && Q) {
-        double s;
-        rhm__projection_setup(pb, i, beta, Z, Q, &s);
-        rc = proj_closest(b->tree, d, Z, s, a->n, Q, a->P->face, a->P->w, NULL)
-                 ? RHM_ENUMERIC : RHM_OK;
+    if (!Z || !Q)
+        goto out;
+    double s;
+    const proj_tree *tree = b->tree;
+    if (rhm__projection_setup(pb, i, beta, Z, Q, &s)) {
+        /* a tree over the current X_ji: rebuilt, as X_ji moves */
+        if (!(emb = mesh_new(b->n, b->m->nf)))
+            goto out;
+        for (int v = 0; v < b->n; v++)
+            for (int c = 0; c < 3; c++)
+                emb->v[3 * v + c] = Z[(size_t)v * d + c] / s;
+        memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
+        rc = RHM_ENUMERIC;
+        if (!(tmp = proj_tree_new(emb, NULL, 0)))
+            goto out;
+        tree = tmp;
     }
+    rc = proj_closest(tree, d, Z, s, a->n, Q, a->P->face, a->P->w, NULL) ? RHM_ENUMERIC : RHM_OK;
+out:
+    proj_tree_free(tmp);
+    mesh_free(emb);
     free(Z);
     free(Q);
     return rc;
