@@ -37,8 +37,6 @@
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 
-#define RHM_MIN_LANDMARKS 3   /* fewer cannot fix orientation on a surface */
-
 #define RHM_ERRORS(X)                                                           \
     X(RHM_OK,         0, "ok")                                                  \
     X(RHM_EPARAM,    -1, "invalid parameter")                                   \
@@ -102,7 +100,7 @@ typedef struct rhm_result {
 void rhm_result_close(rhm_result *r);
 
 /* Runs RHM from the landmark pairs L (L->src on S = M1, L->tgt on T = M2,
- * at least RHM_MIN_LANDMARKS). The meshes must be validated (manifold,
+ * at least LMK_MIN_PAIRS). The meshes must be validated (manifold,
  * connected, no degenerate face). Errors: RHM_EPARAM, RHM_EINPUT,
  * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC; detail in err. */
 int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,

@@ -88,13 +88,10 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
     geo_vertex_areas(m, sd->mass);
     if (!(sd->geod = geod_solver_new(m, 0, detail, sizeof detail)))
         return errbuf_set(err, errsz, RHM_EMESH, "%s: geodesics: %s", name, detail);
-    int k = EMBED_MIN_LANDMARKS > 3 * pb->dim ? EMBED_MIN_LANDMARKS : 3 * pb->dim;
-    if (k > m->nv)
-        k = m->nv;
-    if (k <= pb->dim)
+    if (m->nv <= pb->dim)
         return errbuf_set(err, errsz, RHM_EMESH, "%s: %d vertices are too few for a %d-D embedding",
                           name, m->nv, pb->dim);
-    if ((rc = embed_lmds(sd->geod, pb->dim, k, 0, sd->X, NULL, detail, sizeof detail)))
+    if ((rc = embed_lmds(sd->geod, pb->dim, 0, 0, sd->X, NULL, detail, sizeof detail)))
         return errbuf_set(err, errsz, rc == EMBED_ENOMEM ? RHM_ENOMEM : RHM_EMESH,
                           "%s: embedding: %s", name, detail);
     if ((rc = geo_edges_build(m, &e, detail, sizeof detail)) ||
@@ -130,9 +127,9 @@ int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_p
     int rc = rhm_params_check(p, err, errsz);
     if (rc)
         return rc;
-    if (!L || L->n < RHM_MIN_LANDMARKS)
+    if (!L || L->n < LMK_MIN_PAIRS)
         return errbuf_set(err, errsz, RHM_EINPUT, "RHM needs at least %d landmark pairs, got %d",
-                          RHM_MIN_LANDMARKS, L ? L->n : 0);
+                          LMK_MIN_PAIRS, L ? L->n : 0);
     for (int r = 0; r < L->n; r++) {
         if (L->src[r] < 0 || L->src[r] >= S->nv || L->tgt[r] < 0 || L->tgt[r] >= T->nv)
             return errbuf_set(err, errsz, RHM_EINPUT, "landmark %d (%d, %d) out of range",
