@@ -41,11 +41,13 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
  * norm weighted by S's unit-area lumped mass: √(Σ_i m_i (PH̃ − H)_i²). */
 int metric_curvature_error(const mesh *S, const mesh *T, const bmap *P, double *out);
 
-/* Coverage of the target by the map P: the fraction of T's area in faces
- * that hold at least one mapped source vertex (P->face), so 1 when every
- * target face is hit; a map that collapses onto a region covers little.
- * Meaningful when S is at least about as fine as T. */
-double metric_coverage(const mesh *T, const bmap *P);
+/* Coverage of the target by the map P: the fraction of T's area (lumped
+ * vertex masses) at target vertices lying within `radius` (unit-area
+ * scale, e.g. METRIC_COVER_RADIUS) of a mapped source vertex P·X̃. 1 for a
+ * map whose image is spread over the whole target at that resolution; a map
+ * that collapses onto a region covers little. NAN when out of memory. */
+#define METRIC_COVER_RADIUS 0.05
+double metric_coverage(const mesh *T, const bmap *P, double radius);
 
 /* The round trip T -> S -> T: ‖Q·(P·X̃) − X̃‖_X̃, the target-mass-weighted
  * RMS distance (unit-area target) between each target vertex and where Q

@@ -6,25 +6,34 @@
 #include <math.h>
 #include <stdlib.h>
 
-double metric_coverage(const mesh *T, const bmap *P)
+double metric_coverage(const mesh *T, const bmap *P, double radius)
 {
-    double *area = malloc(sizeof(double) * ((size_t)T->nf + 1));
-    unsigned char *hit = calloc((size_t)T->nf + 1, 1);
+    double *img = malloc(sizeof(double) * 3 * ((size_t)P->n + 1));
+    double *mass = malloc(sizeof(double) * ((size_t)T->nv + 1));
     double covered = 0, total = 0;
-    if (!area || !hit) {
-        free(area);
-        free(hit);
+    if (!img || !mass) {
+        free(img);
+        free(mass);
         return NAN;
     }
-    geo_face_areas(T, area);
-    for (int r = 0; r < P->n; r++)
-        hit[P->face[r]] = 1;
-    for (int t = 0; t < T->nf; t++) {
-        total += area[t];
-        covered += hit[t] ? area[t] : 0;
+    bmap_apply(P, T->f, T->v, 3, img);
+    geo_vertex_areas(T, mass);
+    double r = radius * sqrt(geo_total_area(T)), r2 = r * r;
+    #pragma omp parallel for reduction(+:covered, total) schedule(static)
+    for (int v = 0; v < T->nv; v++) {
+        const double *x = T->v + 3 * v;
+        int hit = 0;
+        for (int k = 0; k < P->n && !hit; k++) {
+            const double *y = img + 3 * k;
+            double d2 = (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
+                        (x[2] - y[2]) * (x[2] - y[2]);
+            hit = d2 <= r2;
+        }
+        total += mass[v];
+        covered += hit ? mass[v] : 0;
     }
-    free(area);
-    free(hit);
+    free(img);
+    free(mass);
     return total > 0 ? covered / total : NAN;
 }
 
