@@ -230,6 +230,10 @@ typedef struct proto_params {
     double gamma;                     /* reverse-map weight (bijective) */
     uint32_t iterations, inner_iterations;  /* outer; L-BFGS per outer */
     double tolerance, stop_change;    /* gradient tolerance; relative energy change */
+    /* RHM (landmark jobs): 0 means the release default for each */
+    uint32_t rhm_iterations, rhm_dim;  /* at most K iterations; embedding dimension m */
+    double rhm_alpha;                 /* harmonic vs reversibility, in (0, 1) */
+    double rhm_landmark_weight;       /* weak landmark term γ (>= 0; 0 = off) */
     const char *backend;              /* "" = server default */
 } proto_params;
 

@@ -332,6 +332,10 @@ static void io_params(io *c, proto_params *p)
     io_u32(c, &p->inner_iterations);
     io_f64(c, &p->tolerance);
     io_f64(c, &p->stop_change);
+    io_u32(c, &p->rhm_iterations);
+    io_u32(c, &p->rhm_dim);
+    io_f64(c, &p->rhm_alpha);
+    io_f64(c, &p->rhm_landmark_weight);
     io_str(c, &p->backend, "backend");
 }
 

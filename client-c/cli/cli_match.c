@@ -1,7 +1,8 @@
 /* cli_match.c — `meshcorr match`: the in-process engine on two mesh files.
- * Reads and validates the inputs, runs ECTM, writes the maps and optional
- * meshes, and shows progress (bar on a terminal, text lines, or JSON lines on
- * stderr). Holds no numerics: everything is workers/ectm. */
+ * Reads and validates the inputs, runs the pipeline (workers/corr: RHM from
+ * landmarks, then ECTM), writes the maps and optional meshes, and shows
+ * progress (bar on a terminal, text lines, or JSON lines on stderr). Holds
+ * no numerics. */
 #include "cli/cli.h"
 #include "corr/corr.h"
 #include "lmk/lmk.h"
@@ -26,11 +27,15 @@ static void usage(FILE *fp)
         "         [--alpha A] [--eta E] [--beta0 B] [--beta1 B] [--beta-ramp K] [--gamma G]\n"
         "         [--iterations K] [--inner-iterations N] [--tolerance T] [--stop-change C]\n"
         "         [--log-eps E]\n"
+        "         [--stages all|rhm|ectm] [--rhm-alpha A] [--rhm-iterations K] [--rhm-dim M]\n"
+        "         [--rhm-landmark-weight G]\n"
         "         [--partial] [--threads N] [--progress auto|text|json|none]\n"
         "Defaults are the authors' released code's (--preset release): alpha 20, eta 6.667e-4,\n"
         "beta 500 -> 1e5 over 200 iterations, gamma 1e4, 300 iterations, 50 L-BFGS steps.\n"
-        "Without --init, the initial map comes from the landmarks: the best affine map of the\n"
-        "source landmarks onto the target landmarks, then the closest target point.\n");
+        "Without --init, the initial maps come from the landmarks: a geodesic Voronoi map, then\n"
+        "Reversible Harmonic Maps (alpha 5e-4, beta 5e-3 min(k, 100), 8-D embedding, at most\n"
+        "200 iterations, landmark weight 0). --stages rhm stops there and writes RHM's maps;\n"
+        "--stages ectm runs ECTM alone and needs --init.\n");
 }
 
 static int parse_double(const char *opt, const char *s, double *out)
@@ -61,9 +66,43 @@ typedef struct progress_state {
     enum progress_mode mode;
 } progress_state;
 
+/* One RHM report (stage voronoi: the start, rhm: an iteration). */
+static void rhm_progress(progress_state *ps, const corr_progress *cp)
+{
+    const rhm_report *r = cp->rhm;
+    if (ps->mode == PROGRESS_JSON) {
+        fprintf(stderr, "{\"stage\":\"%s\",\"iteration\":%d,\"total\":%d,\"beta\":%.17g,"
+                "\"energy\":%.17g,\"elapsed\":%.3f,\"t_setup\":%.3f,\"t_project\":%.3f,"
+                "\"t_solve\":%.3f", corr_stage_name(cp->stage), r->iteration, r->total, r->beta,
+                r->energy, r->elapsed, r->t_setup, r->t_project, r->t_solve);
+        static const char *names[2] = {"forward", "backward"};
+        for (int d = 0; d < 2; d++)
+            fprintf(stderr, ",\"%s\":{\"dirichlet\":%.17g,\"reverse\":%.17g,\"mismatch\":%.17g,"
+                    "\"landmark\":%.17g}", names[d], r->dir[d].dirichlet, r->dir[d].reverse,
+                    r->dir[d].mismatch, r->dir[d].landmark);
+        fprintf(stderr, "}\n");
+    } else if (ps->mode == PROGRESS_TEXT) {
+        fprintf(stderr, "rhm %d/%d beta %.4g energy %.10g (dirichlet %.4g, reverse %.4g, "
+                "mismatch %.4g, landmark %.4g)  %.1f s\n", r->iteration, r->total, r->beta,
+                r->energy, r->dir[0].dirichlet + r->dir[1].dirichlet,
+                r->dir[0].reverse + r->dir[1].reverse, r->dir[0].mismatch + r->dir[1].mismatch,
+                r->dir[0].landmark + r->dir[1].landmark, r->elapsed);
+    } else if (ps->mode == PROGRESS_AUTO) {
+        int width = 30, done = (int)((long)width * r->iteration / r->total);
+        fprintf(stderr, "\r[%.*s%*s] rhm %d/%d energy %.6g  %.1f s ", done,
+                "##############################", width - done, "", r->iteration, r->total,
+                r->energy, r->elapsed);
+    }
+}
+
 static int on_progress(void *ctx, const corr_progress *cp)
 {
     progress_state *ps = ctx;
+    if (cp->rhm) {
+        rhm_progress(ps, cp);
+        fflush(stderr);
+        return 0;
+    }
     if (cp->stage != CORR_STAGE_ECTM) {
         if (ps->mode == PROGRESS_JSON)
             fprintf(stderr, "{\"stage\":\"%s\",\"elapsed\":%.3f}\n", corr_stage_name(cp->stage), cp->elapsed);
@@ -146,11 +185,17 @@ int cli_match(int argc, char **argv)
         {"landmarks", required_argument, 0, 'L'},   {"source-landmarks", required_argument, 0, 'x'},
         {"target-landmarks", required_argument, 0, 'y'}, {"one-based", no_argument, 0, '1'},
         {"log-eps", required_argument, 0, 'E'},
+        {"stages", required_argument, 0, 'S'},      {"rhm-alpha", required_argument, 0, 'A'},
+        {"rhm-iterations", required_argument, 0, 'K'}, {"rhm-dim", required_argument, 0, 'M'},
+        {"rhm-landmark-weight", required_argument, 0, 'W'},
         {0, 0, 0, 0}};
     const char *init = NULL, *init_rev = NULL, *out = NULL, *out_rev = NULL;
     const char *out_def = NULL, *out_rem = NULL;
     const char *lmk_pairs = NULL, *lmk_src = NULL, *lmk_tgt = NULL;
     int one_based = 0;
+    corr_stages stages = CORR_STAGES_ALL;
+    rhm_params rp;
+    rhm_params_init(&rp);
     ectm_params p;
     ectm_params_init(&p);
     /* The preset is applied first, whatever its position: explicit weights win. */
@@ -204,6 +249,16 @@ int cli_match(int argc, char **argv)
         case 'x': lmk_src = optarg; break;
         case 'y': lmk_tgt = optarg; break;
         case '1': one_based = 1; break;
+        case 'S':
+            if (strcmp(optarg, "all") == 0) stages = CORR_STAGES_ALL;
+            else if (strcmp(optarg, "rhm") == 0) stages = CORR_STAGES_RHM;
+            else if (strcmp(optarg, "ectm") == 0) stages = CORR_STAGES_ECTM;
+            else { fprintf(stderr, "meshcorr match: --stages: '%s' is not all, rhm or ectm\n", optarg); bad = 1; }
+            break;
+        case 'A': bad |= parse_double("rhm-alpha", optarg, &rp.alpha) != 0; break;
+        case 'K': bad |= parse_int("rhm-iterations", optarg, &rp.iterations) != 0; break;
+        case 'M': bad |= parse_int("rhm-dim", optarg, &rp.dim) != 0; break;
+        case 'W': bad |= parse_double("rhm-landmark-weight", optarg, &rp.gamma) != 0; break;
         case 'h': usage(stdout); return 0;
         default: bad = 1;
         }
@@ -221,12 +276,21 @@ int cli_match(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if (stages == CORR_STAGES_ECTM && !init) {
+        fprintf(stderr, "meshcorr match: --stages ectm needs --init\n");
+        return 2;
+    }
+    if (stages == CORR_STAGES_RHM && (init || out_def)) {
+        fprintf(stderr, "meshcorr match: --stages rhm starts from landmarks and has no deformation "
+                "(no --init, no --out-deformed)\n");
+        return 2;
+    }
     if (p.model == ECTM_INJECTIVE && (init_rev || out_rev)) {
         fprintf(stderr, "meshcorr match: --init-reverse/--out-reverse need the bijective model\n");
         return 2;
     }
     char err[1024];
-    if (ectm_params_check(&p, err, sizeof err)) {
+    if (ectm_params_check(&p, err, sizeof err) || rhm_params_check(&rp, err, sizeof err)) {
         fprintf(stderr, "meshcorr match: %s\n", err);
         return 2;
     }
@@ -255,16 +319,20 @@ int cli_match(int argc, char **argv)
         fprintf(stderr, "meshcorr match: %s\n", err);
         goto done;
     }
-    corr_input in = { S, T, src, tgt, L, P0, Q0 };
+    rp.threads = p.threads;
+    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages };
     if (corr_run(&in, &p, on_progress, &ps, &res, err, sizeof err)) {
         fprintf(stderr, "\nmeshcorr match: %s\n", err);
         goto done;
     }
     char comment[512];
-    snprintf(comment, sizeof comment,
-             "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",
-             src, tgt, p.model == ECTM_BIJECTIVE ? "bijective" : "injective",
-             res.last.outer, res.last.energy);
+    if (stages == CORR_STAGES_RHM)
+        snprintf(comment, sizeof comment, "meshcorr match %s -> %s, reversible harmonic map", src, tgt);
+    else
+        snprintf(comment, sizeof comment,
+                 "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",
+                 src, tgt, p.model == ECTM_BIJECTIVE ? "bijective" : "injective",
+                 res.last.outer, res.last.energy);
     if (bmap_write(out, res.P, comment, err, sizeof err) ||
         (out_rev && res.Q && bmap_write(out_rev, res.Q, comment, err, sizeof err))) {
         fprintf(stderr, "meshcorr match: %s\n", err);

@@ -13,6 +13,7 @@ static const struct {
     { "info",    cli_info,    "MESH             print counts, topology, area, problems" },
     { "convert", cli_convert, "IN OUT           convert between .off .obj .ply .drc" },
     { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
+    { "eval",    cli_eval,    "SOURCE TARGET P.map .. quality of a map (see meshcorr eval --help)" },
 };
 
 static void usage(FILE *fp)

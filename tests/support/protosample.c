@@ -94,8 +94,9 @@ void protosample_fill(int type, int v, proto_msg *m)
             u->q = (proto_map){ rows_q, 60 };
         }
         u->params = (proto_params){ (uint8_t)(v ? PROTO_MODEL_INJECTIVE : PROTO_MODEL_BIJECTIVE),
-                                    (uint8_t)!v, 1e-3, 0.1, 1.0, 1e4, 1.5, 0.25, 30, 200,
-                                    1e-8, 1e-6, v ? "" : "opencl:pocl" };
+                                    (uint8_t)!v, 1e-3, 0.1, 1.0, 1e4, 2, 0.25, 30, 200,
+                                    1e-8, 1e-6, v ? 0 : 150, v ? 0 : 12, v ? 0 : 1e-3,
+                                    v ? 0 : 0.5, v ? "" : "opencl:pocl" };
         u->priority = v ? 0 : -7;
         u->label = s;
         break;
@@ -245,7 +246,9 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
         const proto_params *p = &x->params, *q = &y->params;
         DIFF(p->model != q->model || p->partial != q->partial, "params.model/partial");
         DIFF(p->alpha != q->alpha || p->eta != q->eta || p->beta0 != q->beta0 ||
-             p->beta1 != q->beta1 || p->beta_ramp != q->beta_ramp || p->gamma != q->gamma,
+             p->beta1 != q->beta1 || p->beta_ramp != q->beta_ramp || p->gamma != q->gamma ||
+             p->rhm_iterations != q->rhm_iterations || p->rhm_dim != q->rhm_dim ||
+             p->rhm_alpha != q->rhm_alpha || p->rhm_landmark_weight != q->rhm_landmark_weight,
              "params weights");
         DIFF(p->iterations != q->iterations || p->inner_iterations != q->inner_iterations,
              "params iterations");

@@ -189,3 +189,46 @@ TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)
     mesh_free(S); mesh_free(T); mesh_free(Y); mesh_free(R);
     bmap_free(P); bmap_free(Q);
 }
+
+/* The landmark path end to end with few iterations: JSON progress shows the
+ * voronoi start, every RHM iteration and every ECTM iteration; --stages rhm
+ * writes RHM's maps; --stages ectm without --init is refused. */
+TEST_T(match_from_landmarks_reports_voronoi_rhm_and_ectm_stages, 120)
+{
+    char s0[512], s1[512], cmd[4096], out[65536];
+    snprintf(s0, sizeof s0, "%s", harness_data_path("faust_r/vtx_5k/tr_reg_000.off"));
+    snprintf(s1, sizeof s1, "%s", harness_data_path("faust_r/vtx_5k/tr_reg_001.off"));
+    const char *l = testfile_text("l.txt", "0 10\n1000 1200\n2000 2100\n3000 3300\n");
+    const char *d = harness_tmpdir();
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s --rhm-iterations 3 "
+             "--iterations 2 --out %s/p.map --out-reverse %s/q.map --progress json",
+             s0, s1, l, d, d);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_STR_HAS(out, "{\"stage\":\"voronoi\",\"iteration\":0,");
+    int rhm = 0, ectm = 0;
+    for (char *p = out; (p = strstr(p, "{\"stage\":\"rhm\",\"iteration\":")); p++)
+        rhm++;
+    for (char *p = out; (p = strstr(p, "{\"stage\":\"ectm\",\"outer\":")); p++)
+        ectm++;
+    CHECK_INT(rhm, 3);
+    CHECK_INT(ectm, 2);
+    CHECK_STR_HAS(out, "\"dirichlet\":");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s --rhm-iterations 2 "
+             "--stages rhm --out %s/r.map --progress text", s0, s1, l, d);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_STR_HAS(out, "rhm 2/2 beta");
+    char path[600], err[512];
+    mesh *S = NULL, *T = NULL;
+    bmap *P = NULL;
+    CHECK_INT(mesh_read(s0, &S, err, sizeof err), 0);
+    CHECK_INT(mesh_read(s1, &T, err, sizeof err), 0);
+    snprintf(path, sizeof path, "%s/r.map", d);
+    if (bmap_read(path, S, T, &P, err, sizeof err)) FAILF("%s", err);
+    bmap_free(P);
+    mesh_free(S);
+    mesh_free(T);
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s --stages ectm --out x.map",
+             s0, s1, l);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--stages ectm needs --init");
+}

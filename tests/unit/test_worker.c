@@ -261,7 +261,7 @@ TEST_T(worker_demo_job_gives_the_in_process_map_with_progress_and_metrics, 90)
     bmap *P0 = NULL, *Q0 = NULL;
     if (bmap_read(p0, S, T, &P0, err, sizeof err) || bmap_read(q0, T, S, &Q0, err, sizeof err))
         FAILF("%s", err);
-    corr_input in = { S, T, "source", "target", NULL, P0, Q0 };
+    corr_input in = { S, T, "source", "target", NULL, P0, Q0, NULL, CORR_STAGES_ALL };
     ectm_result res;
     if (corr_run(&in, &prm, NULL, NULL, &res, err, sizeof err))
         FAILF("%s", err);
@@ -323,19 +323,33 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     proto_landmark L[8];
     unsigned n = faust_landmarks(L);
     ectm_params prm = short_params(2);
-    if (testjob_write(job_dir(), src, tgt, L, n, NULL, NULL, &prm, err, sizeof err))
+    testjob j;
+    if (testjob_build(&j, src, tgt, L, n, NULL, NULL, &prm, err, sizeof err))
         FAILF("%s", err);
+    j.msg.u.submit.params.rhm_iterations = 3;
+    if (testjob_save(&j, job_dir(), err, sizeof err))
+        FAILF("%s", err);
+    testjob_close(&j);
     int rfd;
     pid_t pid = spawn_worker(job_dir(), NULL, 1, &rfd);
     size_t plen;
     unsigned char *pbuf = read_all(rfd, &plen);
     CHECK_INT(wait_exit(pid), 0);
-    proto_progress pr[8];
-    int np = progress_frames(pbuf, plen, pr, 8);
-    CHECK_INT(np, 3);
+    proto_progress pr[16];
+    int np = progress_frames(pbuf, plen, pr, 16);
+    /* init, the Voronoi start, 3 RHM iterations, 2 ECTM iterations */
+    CHECK_INT(np, 7);
     CHECK_INT(pr[0].stage, PROTO_STAGE_INIT);
-    CHECK_INT(pr[1].stage, PROTO_STAGE_ECTM);
-    CHECK_INT(pr[2].outer, 2);
+    CHECK_INT(pr[1].stage, PROTO_STAGE_VORONOI);
+    CHECK_INT(pr[1].outer, 0);
+    for (int k = 2; k <= 4; k++) {
+        CHECK_INT(pr[k].stage, PROTO_STAGE_RHM);
+        CHECK_INT(pr[k].outer, k - 1);
+        CHECK_INT(pr[k].total, 3);
+        CHECK(isfinite(pr[k].terms[0][PROTO_TERM_ENERGY]) && pr[k].terms[0][PROTO_TERM_ENERGY] > 0);
+    }
+    CHECK_INT(pr[5].stage, PROTO_STAGE_ECTM);
+    CHECK_INT(pr[6].outer, 2);
     free(pbuf);
     proto_msg m;
     unsigned char *file;

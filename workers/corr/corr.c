@@ -1,7 +1,7 @@
-/* corr.c — the correspondence pipeline (see corr.h): validation, initial map,
- * ECTM, progress fan-in. Combines modules; computes nothing itself. */
+/* corr.c — the correspondence pipeline (see corr.h): validation, initial
+ * maps (Voronoi + RHM), ECTM, progress fan-in. Combines modules; computes
+ * nothing itself. */
 #include "corr/corr.h"
-#include "init/init_affine.h"
 #include "mesh/mesh_check.h"
 #include "util/errbuf.h"
 
@@ -20,7 +20,12 @@ const char *corr_strerror(int code)
 
 const char *corr_stage_name(corr_stage s)
 {
-    return s == CORR_STAGE_ECTM ? "ectm" : "init";
+    switch (s) {
+    case CORR_STAGE_ECTM: return "ectm";
+    case CORR_STAGE_VORONOI: return "voronoi";
+    case CORR_STAGE_RHM: return "rhm";
+    default: return "init";
+    }
 }
 
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz)
@@ -57,8 +62,30 @@ static int relay_ectm(void *ctx, const ectm_report *r)
     relay *rl = ctx;
     if (!rl->fn)
         return 0;
-    corr_progress p = { CORR_STAGE_ECTM, r, now() - rl->t0 };
+    corr_progress p = { CORR_STAGE_ECTM, r, now() - rl->t0, NULL };
     return rl->fn(rl->ctx, &p);
+}
+
+static int relay_rhm(void *ctx, const rhm_report *r)
+{
+    relay *rl = ctx;
+    if (!rl->fn)
+        return 0;
+    corr_progress p = { r->iteration ? CORR_STAGE_RHM : CORR_STAGE_VORONOI, NULL,
+                        now() - rl->t0, r };
+    return rl->fn(rl->ctx, &p);
+}
+
+static int from_rhm(int rc)
+{
+    switch (rc) {
+    case RHM_OK: return CORR_OK;
+    case RHM_ECANCELED: return CORR_ECANCELED;
+    case RHM_ENOMEM: return CORR_ENOMEM;
+    case RHM_EPARAM: case RHM_EINPUT: return CORR_EINPUT;
+    case RHM_EMESH: return CORR_EMESH;
+    default: return CORR_EINIT;
+    }
 }
 
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
@@ -78,21 +105,38 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs an initial map");
     if (in->Q0 && p->model == ECTM_INJECTIVE)
         return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs the bijective model");
+    if (in->stages == CORR_STAGES_ECTM && !in->P0)
+        return errbuf_set(err, errsz, CORR_EINPUT, "the ECTM stage alone needs an initial map");
+    if (in->stages == CORR_STAGES_RHM && (in->P0 || !in->L))
+        return errbuf_set(err, errsz, CORR_EINPUT, "the RHM stage starts from landmarks, not from a map");
+    rhm_params rp;
+    if (in->rhm)
+        rp = *in->rhm;
+    else
+        rhm_params_init(&rp);
+    if (!in->P0 && rhm_params_check(&rp, err, errsz))
+        return CORR_EINPUT;
 
-    bmap *init = NULL;
-    const bmap *P0 = in->P0;
+    rhm_result init = {0};
+    const bmap *P0 = in->P0, *Q0 = in->Q0;
     if (!P0) {
         if (progress) {
-            corr_progress cp = { CORR_STAGE_INIT, NULL, now() - rl.t0 };
+            corr_progress cp = { CORR_STAGE_INIT, NULL, now() - rl.t0, NULL };
             if (progress(ctx, &cp))
                 return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before the initial map");
         }
-        if ((rc = init_affine_map(in->S, in->T, in->L, &init, err, errsz)))
-            return rc == INIT_ENOMEM ? CORR_ENOMEM : CORR_EINIT;
-        P0 = init;
+        if ((rc = rhm_run(in->S, in->T, in->L, &rp, relay_rhm, &rl, &init, err, errsz)))
+            return from_rhm(rc);
+        if (in->stages == CORR_STAGES_RHM) {
+            out->P = init.P12;
+            out->Q = init.P21;
+            return CORR_OK;
+        }
+        P0 = init.P12;
+        Q0 = p->model == ECTM_BIJECTIVE ? init.P21 : NULL;
     }
-    rc = ectm_run(in->S, in->T, P0, in->Q0, p, relay_ectm, &rl, out, err, errsz);
-    bmap_free(init);
+    rc = ectm_run(in->S, in->T, P0, Q0, p, relay_ectm, &rl, out, err, errsz);
+    rhm_result_close(&init);
     switch (rc) {
     case ECTM_OK: return CORR_OK;
     case ECTM_ECANCELED: return CORR_ECANCELED;

@@ -2,7 +2,8 @@
  * `meshcorr match` runs in-process and `meshcorr-worker` runs for the daemon.
  *
  *   validate both meshes (manifold, one component, finite, no degenerate face)
- *   initial map: the uploaded P (and Q), or from landmarks
+ *   initial maps: the uploaded P (and Q), or from landmarks: geodesic
+ *     Voronoi map, then Reversible Harmonic Maps (rhm.h) giving P and Q
  *   ECTM refinement
  *
  * Stages report progress through one callback; a non-zero return cancels.
@@ -15,6 +16,7 @@
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "rhm/rhm.h"
 
 #define CORR_ERRORS(X)                                                          \
     X(CORR_OK,         0, "ok")                                                 \
@@ -32,20 +34,33 @@ enum corr_error {
 };
 const char *corr_strerror(int code);
 
-typedef enum corr_stage { CORR_STAGE_INIT = 0, CORR_STAGE_ECTM = 1 } corr_stage;
-const char *corr_stage_name(corr_stage s);   /* "init", "ectm" */
+typedef enum corr_stage {
+    CORR_STAGE_INIT = 0,     /* building the initial map starts             */
+    CORR_STAGE_ECTM = 1,     /* one report per ECTM outer iteration         */
+    CORR_STAGE_VORONOI = 2,  /* the Voronoi map is built (its RHM energies) */
+    CORR_STAGE_RHM = 3       /* one report per RHM iteration                */
+} corr_stage;
+const char *corr_stage_name(corr_stage s);   /* "init", "ectm", "voronoi", "rhm" */
+
+/* Which stages run: all (landmarks -> Voronoi -> RHM -> ECTM, or ECTM from
+ * an uploaded map), RHM only (from landmarks; its maps are the result), or
+ * ECTM only (from an uploaded map). */
+typedef enum corr_stages { CORR_STAGES_ALL = 0, CORR_STAGES_RHM = 1, CORR_STAGES_ECTM = 2 } corr_stages;
 
 typedef struct corr_input {
     const mesh *S, *T;        /* source and target (required)               */
     const char *S_name, *T_name; /* for messages (file names or labels)     */
     const lmk_set *L;         /* landmark pairs, or NULL                     */
     const bmap *P0, *Q0;      /* uploaded initial maps, or NULL              */
+    const rhm_params *rhm;    /* RHM parameters, NULL: rhm_params_init's     */
+    corr_stages stages;
 } corr_input;
 
 typedef struct corr_progress {
     corr_stage stage;
     const ectm_report *ectm;  /* the outer iteration's report (stage ECTM)  */
     double elapsed;           /* seconds since corr_run started             */
+    const rhm_report *rhm;    /* the RHM report (stages VORONOI and RHM)    */
 } corr_progress;
 
 typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
@@ -54,7 +69,9 @@ typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
-/* Runs the pipeline. Needs P0 or at least LMK_MIN_PAIRS landmarks. */
+/* Runs the pipeline. Needs P0 or at least LMK_MIN_PAIRS landmarks. With
+ * stages RHM, out->P and out->Q are RHM's maps and out->Y, out->Yt, out->last
+ * stay empty. */
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz);
 

@@ -15,7 +15,8 @@
 #include <stddef.h>
 #include "mesh/mesh.h"
 
-#define LMK_MIN_PAIRS 4        /* the affine initialisation needs 4 points */
+#define LMK_MIN_PAIRS 3        /* three pairs fix orientation: fewer leave the
+                                  Voronoi/RHM start free to mirror the shape */
 #define LMK_MAX_PAIRS 100000
 
 #define LMK_ERRORS(X)                                                     \

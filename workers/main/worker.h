@@ -34,6 +34,7 @@ typedef struct wrk_job {
     lmk_set *L;                    /* NULL when the SUBMIT has no landmarks */
     bmap *P0, *Q0;                 /* NULL when absent */
     ectm_params params;
+    rhm_params rhm;                /* for landmark jobs */
 } wrk_job;
 
 /* worker_job.c — the one mapping from a SUBMIT to a job: decodes both Draco

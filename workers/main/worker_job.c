@@ -36,8 +36,21 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
 }
 
 static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params *p,
-                      char *err, size_t errsz)
+                      rhm_params *r, char *err, size_t errsz)
 {
+    rhm_params_init(r);
+    r->threads = lim->threads;
+    if (w->rhm_iterations) {
+        r->iterations = w->rhm_iterations > 1000000 ? 1000001 : (int)w->rhm_iterations;
+    }
+    if (w->rhm_dim)
+        r->dim = w->rhm_dim > 1000 ? 1001 : (int)w->rhm_dim;
+    if (w->rhm_alpha != 0)
+        r->alpha = w->rhm_alpha;
+    r->gamma = w->rhm_landmark_weight;
+    char detail[256];
+    if (rhm_params_check(r, detail, sizeof detail))
+        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "RHM %s", detail);
     ectm_params_init(p);
     if (w->backend[0] && strcmp(w->backend, "cpu") != 0)
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS,
@@ -119,7 +132,7 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
 {
     memset(job, 0, sizeof *job);
     int rc;
-    if ((rc = map_params(&s->params, lim, &job->params, err, errsz)) ||
+    if ((rc = map_params(&s->params, lim, &job->params, &job->rhm, err, errsz)) ||
         (rc = load_mesh(&s->source, "source mesh", lim, &job->S, err, errsz)) ||
         (rc = load_mesh(&s->target, "target mesh", lim, &job->T, err, errsz)) ||
         (rc = map_landmarks(s, job->S, job->T, &job->L, err, errsz)) ||

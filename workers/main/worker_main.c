@@ -202,7 +202,8 @@ int main(int argc, char **argv)
         goto done;
     }
     run_ctx ctx = { { progress_fd, job_id, job.params.iterations }, t0, 0 };
-    corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0 };
+    corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0,
+                      &job.rhm, CORR_STAGES_ALL };
     if (cancel_requested)
         rc = CORR_ECANCELED;
     else

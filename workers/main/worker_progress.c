@@ -14,7 +14,27 @@ void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, doub
     out->job_id = job_id;
     out->total = (uint32_t)total;
     out->elapsed_s = elapsed;
-    out->stage = cp->stage == CORR_STAGE_ECTM ? PROTO_STAGE_ECTM : PROTO_STAGE_INIT;
+    switch (cp->stage) {
+    case CORR_STAGE_ECTM: out->stage = PROTO_STAGE_ECTM; break;
+    case CORR_STAGE_VORONOI: out->stage = PROTO_STAGE_VORONOI; break;
+    case CORR_STAGE_RHM: out->stage = PROTO_STAGE_RHM; break;
+    default: out->stage = PROTO_STAGE_INIT; break;
+    }
+    if (cp->rhm) {  /* RHM's terms in the slots PROTOCOL.md names */
+        const rhm_report *h = cp->rhm;
+        out->outer = (uint32_t)h->iteration;
+        out->total = (uint32_t)h->total;
+        out->beta = h->beta;
+        for (int d = 0; d < 2; d++) {
+            out->terms[d][PROTO_TERM_MEMBRANE] = h->dir[d].dirichlet;
+            out->terms[d][PROTO_TERM_BENDING] = h->dir[d].landmark;
+            out->terms[d][PROTO_TERM_MISMATCH] = h->dir[d].mismatch;
+            out->terms[d][PROTO_TERM_REVERSE] = h->dir[d].reverse;
+            out->terms[d][PROTO_TERM_ENERGY] = h->dir[d].dirichlet + h->dir[d].landmark
+                                             + h->dir[d].mismatch + h->dir[d].reverse;
+        }
+        return;
+    }
     const ectm_report *r = cp->ectm;
     if (!r)
         return;

@@ -70,7 +70,7 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
     double *tn = malloc(sizeof(double) * ((size_t)T->nv * 3 + 1));
     double *lr = malloc(sizeof(double) * ((size_t)nf + 1));
     double *cf = malloc(sizeof(double) * ((size_t)nf + 1));
-    out->mean_abs_log_area = out->median_conformal = NAN;
+    out->mean_abs_log_area = out->median_conformal = out->mean_conformal = NAN;
     out->flipped_fraction = out->collapsed_fraction = NAN;
     if (!img || !tn || !lr || !cf)
         goto out;
@@ -79,7 +79,7 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
     metric_area_distortion(S, img, geo_total_area(S), geo_total_area(T), lr);
     metric_conformal_distortion(S, img, cf);
     int ok = 0, collapsed = 0, flipped = 0;
-    double sum = 0;
+    double sum = 0, csum = 0;
     for (int t = 0; t < nf; t++) {
         const int *f = S->f + 3 * t;
         if (!(exp(lr[t]) > 1e-12) || !isfinite(cf[t])) {
@@ -101,12 +101,14 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
         }
         flipped += dot < 0;
         sum += fabs(lr[t]);
+        csum += cf[t];
         cf[ok++] = cf[t];
     }
     out->collapsed_fraction = (double)collapsed / nf;
     out->flipped_fraction = (double)flipped / nf;
     if (ok) {
         out->mean_abs_log_area = sum / ok;
+        out->mean_conformal = csum / ok;
         qsort(cf, (size_t)ok, sizeof *cf, cmp_double);
         out->median_conformal = ok % 2 ? cf[ok / 2] : 0.5 * (cf[ok / 2 - 1] + cf[ok / 2]);
     }

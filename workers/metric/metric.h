@@ -5,10 +5,14 @@
  * Areas are compared after scaling both meshes to unit total area, which the
  * caller passes as the two total areas. A triangle whose image is collapsed
  * (zero area) has area distortion −inf and conformal distortion +inf;
- * metric_summary counts those apart. Pure functions, no allocation but the
- * caller's arrays. */
+ * metric_summary counts those apart. Then per map: mean-curvature error,
+ * coverage of the target, round trip, and geodesic error to a ground truth
+ * (definitions at each function). Every measure is taken with both meshes
+ * scaled to unit area. Functions returning int allocate their scratch and
+ * return -1 when out of memory; nothing here reads files. */
 #ifndef METRIC_H
 #define METRIC_H
+#include "geod/geod.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 
@@ -22,6 +26,7 @@ void metric_conformal_distortion(const mesh *S, const double *img, double *conf)
 typedef struct metric_summary {
     double mean_abs_log_area;   /* over non-collapsed triangles */
     double median_conformal;    /* over non-collapsed triangles */
+    double mean_conformal;      /* over non-collapsed triangles */
     double flipped_fraction;    /* image triangle's normal opposite to the
                                    target's normal where it lands            */
     double collapsed_fraction;  /* image area below 1e-12 of the source's     */
@@ -30,5 +35,36 @@ typedef struct metric_summary {
 /* Summary of the map P from S onto T (images P·X̃). Returns 0, or -1 when
  * out of memory (out is then NaN-filled). */
 int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary *out);
+
+/* The mean-curvature error ‖P·H̃ − H‖_X with H, H̃ the mean curvatures
+ * (geo_curvature.h) of S and T after scaling each to unit area, and the
+ * norm weighted by S's unit-area lumped mass: √(Σ_i m_i (PH̃ − H)_i²). */
+int metric_curvature_error(const mesh *S, const mesh *T, const bmap *P, double *out);
+
+/* Coverage of the target by the map P: the fraction of T's area (lumped
+ * vertex masses) at target vertices lying within `radius` (unit-area
+ * scale, e.g. METRIC_COVER_RADIUS) of a mapped source vertex P·X̃. 1 for a
+ * map whose image is spread over the whole target at that resolution; a map
+ * that collapses onto a region covers little. NAN when out of memory. */
+#define METRIC_COVER_RADIUS 0.05
+double metric_coverage(const mesh *T, const bmap *P, double radius);
+
+/* The round trip T -> S -> T: ‖Q·(P·X̃) − X̃‖_X̃, the target-mass-weighted
+ * RMS distance (unit-area target) between each target vertex and where Q
+ * then P take it. Q maps T to S. */
+int metric_round_trip(const mesh *S, const mesh *T, const bmap *P, const bmap *Q, double *out);
+
+/* Geodesic error to a ground truth: for pair k (source vertex src[k],
+ * target vertex tgt[k]), the geodesic distance on T from tgt[k] to P's image
+ * of src[k], as the barycentric interpolation at that point of the
+ * heat-method distance field from tgt[k] (gT: T's solver), divided by
+ * √(area of T). err: nmaps by n, row a for maps[a] (the fields are shared,
+ * so scoring several maps together costs one field per distinct tgt).
+ * Returns 0, -1 when out of memory, or the geod error code. */
+int metric_geodesic_errors(geod_solver *gT, const mesh *T, const bmap *const *maps, int nmaps,
+                           const int *src, const int *tgt, int n, double *err);
+
+/* curve[s] = fraction of the n errors <= tmax·s/(nsteps − 1), s = 0..nsteps−1. */
+void metric_error_curve(const double *err, int n, double tmax, int nsteps, double *curve);
 
 #endif

@@ -1,0 +1,156 @@
+/* test_cli_eval.c — `meshcorr eval` as a user runs it: the figures of the
+ * demo maps against the demo README, a ground truth in both layouts, and
+ * refusals that name the file. */
+#include "support/harness.h"
+#include "support/testfile.h"
+
+#include <string.h>
+#include <sys/wait.h>
+
+static int run(const char *cmd, char *out, size_t outsz)
+{
+    char full[4096];
+    snprintf(full, sizeof full, "%s 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    CHECK(p);
+    size_t n = fread(out, 1, outsz - 1, p);
+    out[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static double field(const char *json, const char *key)
+{
+    char k[64];
+    snprintf(k, sizeof k, "\"%s\":", key);
+    const char *p = strstr(json, k);
+    if (!p)
+        FAILF("no %s in %s", key, json);
+    return atof(p + strlen(k));
+}
+
+static char s381[512], s390[512], demo[512];
+
+static void paths(void)
+{
+    snprintf(s381, sizeof s381, "%s", harness_data_path("shrec07_bim/Meshes/381.off"));
+    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
+    snprintf(demo, sizeof demo, "%s", harness_data_path("ectm_demo_381_390"));
+}
+
+/* README: authors' final map mean |log area| 0.50, median conformal 0.27,
+ * 2 % flipped, 0.16 % collapsed, 99.4 % of the target within 0.05; initial
+ * map 1.01 and 0.17, nothing flipped or collapsed. */
+TEST(eval_of_demo_maps_matches_the_demo_readme)
+{
+    paths();
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s/reference_final_381_to_390.map "
+             "--reverse %s/reference_final_390_to_381.map --json", s381, s390, demo, demo);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_NEAR(field(out, "area_mean_abs_log"), 0.50, 0.06);
+    CHECK_NEAR(field(out, "conformal_median"), 0.27, 0.02);
+    CHECK_NEAR(field(out, "flipped"), 0.02, 0.005);
+    CHECK_NEAR(field(out, "collapsed"), 0.0016, 0.0005);
+    CHECK_NEAR(field(out, "coverage"), 0.994, 0.005);
+    CHECK(field(out, "round_trip") < 0.02);
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s/init_381_to_390.map", s381, s390, demo);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_STR_HAS(out, "mean |log area ratio| 1.01");
+    CHECK_STR_HAS(out, "median 0.168");
+    CHECK_STR_HAS(out, "flipped triangles: 0.00 %");
+    CHECK_STR_HAS(out, "collapsed triangles: 0.00 %");
+    CHECK_STR_HAS(out, "mean-curvature error:");
+}
+
+/* The identity map of a mesh onto itself has zero geodesic error in both
+ * ground-truth layouts, and a shifted ground truth does not. */
+TEST(eval_geodesic_error_against_ground_truth_layouts)
+{
+    const char *wolf = harness_data_path("tosca_hires/Meshes/wolf0.off");
+    char w[512], cmd[4096], out[16384], map[600];
+    snprintf(w, sizeof w, "%s", wolf);
+    snprintf(map, sizeof map, "%s/id.map", harness_tmpdir());
+    /* the identity map: vertex v as a corner of its first face, read from
+     * the OFF face list */
+    FILE *fp = fopen(w, "r");
+    CHECK(fp);
+    char line[256];
+    int nv, nf, e;
+    CHECK(fgets(line, sizeof line, fp) && fscanf(fp, "%d %d %d", &nv, &nf, &e) == 3);
+    for (int v = 0; v < nv; v++) {
+        double x, y, z;
+        CHECK(fscanf(fp, "%lf %lf %lf", &x, &y, &z) == 3);
+    }
+    int *face = malloc(sizeof(int) * nv), *corner = malloc(sizeof(int) * nv);
+    for (int v = 0; v < nv; v++)
+        face[v] = -1;
+    for (int t = 0; t < nf; t++) {
+        int k, a[3];
+        CHECK(fscanf(fp, "%d %d %d %d", &k, &a[0], &a[1], &a[2]) == 4);
+        for (int q = 0; q < 3; q++)
+            if (face[a[q]] < 0) {
+                face[a[q]] = t;
+                corner[a[q]] = q;
+            }
+    }
+    fclose(fp);
+    FILE *mp = fopen(map, "w");
+    fprintf(mp, "# meshcorr-map 1\n%d %d\n", nv, nv);
+    for (int v = 0; v < nv; v++)
+        fprintf(mp, "%d %d %d %d\n", face[v], corner[v] == 0, corner[v] == 1, corner[v] == 2);
+    fclose(mp);
+    /* vertex-list written as floats, 0-based */
+    char *gt = malloc((size_t)nv * 16 + 1), *p = gt;
+    for (int v = 0; v < nv; v++)
+        p += sprintf(p, "%.3e\n", (double)v);
+    char gtp[600];
+    snprintf(gtp, sizeof gtp, "%s", testfile_text("gt.txt", gt));
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-format vertex-list --json",
+             w, w, map, gtp);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK(field(out, "mean") < 1e-9);
+    CHECK_STR_HAS(out, "[0.25,1]");
+    /* vts pairs, 1-based, a few lines; the second list shifted by one vertex */
+    char a[600];
+    snprintf(a, sizeof a, "%s", testfile_text("a.vts", "1\n101\n2001\n4001\n"));
+    const char *b = testfile_text("b.vts", "2\n102\n2002\n4002\n");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-target %s "
+             "--gt-format vts-pair --json", w, w, map, a, b);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_STR_HAS(out, "\"points\":4,");
+    CHECK(field(out, "mean") > 1e-4 && field(out, "mean") < 0.05);   /* one edge away */
+    free(gt);
+    free(face);
+    free(corner);
+}
+
+TEST(eval_refuses_wrong_ground_truth_and_map_naming_the_file)
+{
+    paths();
+    char cmd[4096], out[8192];
+    const char *g = testfile_text("short_gt.txt", "1\n2\n3\n");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s/init_381_to_390.map --gt %s "
+             "--gt-format vertex-list", s381, s390, demo, g);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "short_gt.txt has 3 lines");
+    CHECK_STR_HAS(out, "6938 vertices");
+    g = testfile_text("range_gt.txt", "1\n99999\n");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s/init_381_to_390.map --gt %s "
+             "--gt-format vertex-list", s381, s390, demo, g);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "range_gt.txt:2: vertex 99999 out of range");
+    char a[600];
+    snprintf(a, sizeof a, "%s", testfile_text("a.vts", "1\n2\n3\n"));
+    const char *b = testfile_text("b.vts", "1\n2\n");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s/init_381_to_390.map --gt %s "
+             "--gt-target %s --gt-format vts-pair", s381, s390, demo, a, b);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "a.vts has 3 lines but");
+    /* a map sized for other meshes: the reverse map given as the forward one */
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s/init_390_to_381.map", s381, s390, demo);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "init_390_to_381.map");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s", s381, s390);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+}

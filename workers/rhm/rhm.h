@@ -1,0 +1,110 @@
+/* rhm.h — Reversible Harmonic Maps (Ezuz, Solomon, Ben-Chen 2019; thesis
+ * chapter 3, §3.2–3.3): a pair of maps P12: M1 -> M2, P21: M2 -> M1 from a
+ * handful of landmark pairs, used as ECTM's initial P and Q.
+ *
+ * Energy (3.11), summed over (i, j) = (1, 2) and (2, 1):
+ *   α·Ē_D(X_ij) + (1−α)·Ē_R(P_ij, X_ji) + β·Ē_Q(P_ij, X_ij) [+ γ·Ē_L(X_ij)]
+ *   Ē_D = (1/s_j) tr(X_ijᵀ W_i X_ij)              (harmonic energy)
+ *   Ē_R = (1/s_i²) ‖P_ij X_ji − X_i‖²_{M_i}        (reversibility)
+ *   Ē_Q = (1/(s_i s_j)) ‖X_ij − P_ij X_j‖²_{M_i}   (splitting)
+ *   Ē_L = (1/(s_i s_j)) Σ_r M_i(a_r) ‖X_ij(a_r) − X_j(b_r)‖²   (weak
+ *         landmarks (3.13), a_r on M_i and b_r on M_j; the 1/(s_i s_j) is
+ *         ours, for the same scale invariance as Ē_Q)
+ * X_i: nv_i by m landmark-MDS embedding of M_i's geodesic distances
+ * (embed.h); W_i: cotan Laplacian (geo_cotan.h, xᵀWx = ∫|∇x|²); M_i: lumped
+ * mass; s_i: total area. All in the meshes' own units (the energy is
+ * scale-invariant as written).
+ *
+ * Initialisation (§3.3.2): P12 sends every vertex of a geodesic Voronoi
+ * cell of M1 (centres: source landmarks) to the cell's target landmark;
+ * P21 sends every vertex v of M2 to the source landmark whose target
+ * landmark is nearest to v in M2's embedding (the nearest neighbour of v
+ * among the images T12(V1), which are exactly the target landmarks; ties
+ * to the lower landmark index); X_ij = P_ij X_j.
+ *
+ * Iteration k = 1..K (Algorithm 3.1), β_k = beta_step·min(k, beta_ramp):
+ * for i = 1, 2: P_ij <- projection, X_ij <- sparse linear solve. Each block
+ * step minimises the energy over its block exactly, so at fixed β the
+ * energy never increases. Stops after K iterations, or from iteration
+ * min_iterations on when |E_k − E_{k−1}| < stop_change·E_{k−1}.
+ *
+ * This module reads no files. rhm_run reports the initial map (iteration 0)
+ * and every iteration through a callback whose non-zero return cancels. */
+#ifndef RHM_H
+#define RHM_H
+#include <stddef.h>
+#include "lmk/lmk.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
+
+#define RHM_ERRORS(X)                                                           \
+    X(RHM_OK,         0, "ok")                                                  \
+    X(RHM_EPARAM,    -1, "invalid parameter")                                   \
+    X(RHM_EMESH,     -2, "mesh not usable (geodesics or embedding failed)")     \
+    X(RHM_EINPUT,    -3, "landmarks do not fit the meshes")                     \
+    X(RHM_ENOMEM,    -4, "out of memory")                                       \
+    X(RHM_ECANCELED, -5, "cancelled")                                           \
+    X(RHM_ENUMERIC,  -6, "numerical failure (factorisation or projection)")
+
+enum rhm_error {
+#define RHM_ENUM(name, val, msg) name = val,
+    RHM_ERRORS(RHM_ENUM)
+#undef RHM_ENUM
+};
+const char *rhm_strerror(int code);
+
+typedef struct rhm_params {
+    double alpha;          /* harmonic vs reversibility, (0, 1)             */
+    double beta_step;      /* β_k = beta_step·min(k, beta_ramp)    (> 0)    */
+    int beta_ramp;         /*                                      (>= 1)   */
+    double gamma;          /* weak landmark weight; 0 = off        (>= 0)   */
+    int dim;               /* embedding dimension m      (3..EMBED_MAX_DIM) */
+    int iterations;        /* at most K iterations                 (>= 1)   */
+    int min_iterations;    /* no early stop before this iteration  (>= 1)   */
+    double stop_change;    /* relative energy change to stop; 0 = never     */
+    int threads;           /* OpenMP threads; 0: all cores                  */
+} rhm_params;
+
+/* The authors' release: α = 5e-4, β = 5e-3·min(k, 100), γ = 0, m = 8,
+ * K = 200, stop when the relative change is below 1e-9 after iteration 110. */
+void rhm_params_init(rhm_params *p);
+/* 0 or RHM_EPARAM with the offending field named in err. */
+int rhm_params_check(const rhm_params *p, char *err, size_t errsz);
+double rhm_beta(const rhm_params *p, int k);
+
+/* One direction's weighted terms: dir[0] is (i, j) = (1, 2), dir[1] (2, 1). */
+typedef struct rhm_terms {
+    double dirichlet;      /* α·Ē_D(X_ij)                                    */
+    double reverse;        /* (1−α)·Ē_R(P_ij, X_ji)                          */
+    double mismatch;       /* β·Ē_Q(P_ij, X_ij)                              */
+    double landmark;       /* γ·Ē_L(X_ij)                                    */
+} rhm_terms;
+
+typedef struct rhm_report {
+    int iteration, total;  /* 0 = the initial (Voronoi) map; total = K      */
+    double beta;
+    rhm_terms dir[2];
+    double energy;         /* sum of the eight terms                        */
+    double elapsed;        /* seconds since rhm_run started                 */
+    double t_setup;        /* seconds in geodesics, embeddings, operators   */
+    double t_project, t_solve; /* cumulated seconds in P-steps, X-steps     */
+} rhm_report;
+
+typedef int (*rhm_progress_fn)(void *ctx, const rhm_report *r);
+
+typedef struct rhm_result {
+    bmap *P12;             /* M1 -> M2 (ECTM's P0)                          */
+    bmap *P21;             /* M2 -> M1 (ECTM's Q0)                          */
+    rhm_report last;
+} rhm_result;
+void rhm_result_close(rhm_result *r);
+
+/* Runs RHM from the landmark pairs L (L->src on S = M1, L->tgt on T = M2,
+ * at least LMK_MIN_PAIRS). The meshes must be validated (manifold,
+ * connected, no degenerate face). Errors: RHM_EPARAM, RHM_EINPUT,
+ * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC; detail in err. */
+int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+            rhm_progress_fn progress, void *ctx, rhm_result *out,
+            char *err, size_t errsz);
+
+#endif

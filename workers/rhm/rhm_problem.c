@@ -1,0 +1,162 @@
+/* rhm_problem.c — building and freeing an RHM job's state (rhm__problem.h):
+ * per side the heat-method solver, the landmark-MDS embedding, cotan
+ * Laplacian, lumped mass, the projection tree over the embedding's first
+ * three coordinates, and the X-step matrix pattern with its symbolic
+ * factorisation. Computes no iteration. */
+#include "rhm/rhm__problem.h"
+#include "embed/embed.h"
+#include "geo/geo_area.h"
+#include "geo/geo_cotan.h"
+#include "geo/geo_edges.h"
+#include "util/errbuf.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static void side_close(rhm__side *sd, cholmod_common *cc, int cc_started)
+{
+    free(sd->mass);
+    geo_csr_free(sd->W);
+    free(sd->X);
+    geod_solver_free(sd->geod);
+    proj_tree_free(sd->tree);
+    free(sd->lmk);
+    bmap_free(sd->P);
+    free(sd->Xij);
+    if (cc_started) {
+        cholmod_free_sparse(&sd->A, cc);
+        cholmod_free_factor(&sd->F, cc);
+    }
+}
+
+void rhm__problem_free(rhm__problem *pb)
+{
+    if (!pb)
+        return;
+    for (int i = 0; i < 2; i++)
+        side_close(&pb->side[i], &pb->cc, pb->cc_started);
+    if (pb->cc_started)
+        cholmod_finish(&pb->cc);
+    free(pb);
+}
+
+/* The upper triangle of W's pattern as a CHOLMOD symmetric matrix, values
+ * W + diag(mass) (only the pattern matters to the analysis). Faces are
+ * edges of the mesh, so every product P_jiᵀ M_j P_ji fits this pattern. */
+static cholmod_sparse *pattern(const rhm__side *sd, cholmod_common *cc)
+{
+    const geo_csr *W = sd->W;
+    size_t nnz = 0;
+    for (int c = 0; c < W->n; c++)
+        for (int q = W->row_start[c]; q < W->row_start[c + 1]; q++)
+            nnz += W->col[q] <= c;
+    cholmod_sparse *A = cholmod_allocate_sparse((size_t)W->n, (size_t)W->n, nnz, 1, 1, 1,
+                                                CHOLMOD_REAL, cc);
+    if (!A)
+        return NULL;
+    int *cp = A->p, *ri = A->i;
+    double *x = A->x;
+    size_t at = 0;
+    for (int c = 0; c < W->n; c++) {   /* W symmetric: row c = column c */
+        cp[c] = (int)at;
+        for (int q = W->row_start[c]; q < W->row_start[c + 1]; q++) {
+            if (W->col[q] > c)
+                continue;
+            ri[at] = W->col[q];
+            x[at] = W->val[q] + (W->col[q] == c ? sd->mass[c] : 0);
+            at++;
+        }
+    }
+    cp[W->n] = (int)at;
+    return A;
+}
+
+static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char *name,
+                      char *err, size_t errsz)
+{
+    char detail[512];
+    int rc;
+    geo_edges e = {0};
+    sd->m = m;
+    sd->n = m->nv;
+    sd->s = geo_total_area(m);
+    sd->mass = malloc(sizeof(double) * (size_t)m->nv);
+    sd->X = malloc(sizeof(double) * (size_t)m->nv * (size_t)pb->dim);
+    sd->Xij = malloc(sizeof(double) * (size_t)m->nv * (size_t)pb->dim);
+    if (!sd->mass || !sd->X || !sd->Xij)
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    geo_vertex_areas(m, sd->mass);
+    if (!(sd->geod = geod_solver_new(m, 0, detail, sizeof detail)))
+        return errbuf_set(err, errsz, RHM_EMESH, "%s: geodesics: %s", name, detail);
+    if (m->nv <= pb->dim)
+        return errbuf_set(err, errsz, RHM_EMESH, "%s: %d vertices are too few for a %d-D embedding",
+                          name, m->nv, pb->dim);
+    if ((rc = embed_lmds(sd->geod, pb->dim, 0, 0, sd->X, NULL, detail, sizeof detail)))
+        return errbuf_set(err, errsz, rc == EMBED_ENOMEM ? RHM_ENOMEM : RHM_EMESH,
+                          "%s: embedding: %s", name, detail);
+    if ((rc = geo_edges_build(m, &e, detail, sizeof detail)) ||
+        (rc = geo_cotan_laplacian(m, &e, &sd->W, detail, sizeof detail))) {
+        geo_edges_close(&e);
+        return errbuf_set(err, errsz, RHM_EMESH, "%s: Laplacian: %s", name, detail);
+    }
+    geo_edges_close(&e);
+    /* the tree: M's connectivity, positions = the embedding's first three columns */
+    mesh *emb = mesh_new(m->nv, m->nf);
+    if (!emb)
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    for (int v = 0; v < m->nv; v++)
+        memcpy(emb->v + 3 * v, sd->X + (size_t)v * pb->dim, 3 * sizeof(double));
+    memcpy(emb->f, m->f, sizeof(int) * 3 * (size_t)m->nf);
+    sd->tree = proj_tree_new(emb, detail, sizeof detail);
+    mesh_free(emb);
+    if (!sd->tree)
+        return errbuf_set(err, errsz, RHM_ENUMERIC, "%s: projection tree: %s", name, detail);
+    if (!(sd->A = pattern(sd, &pb->cc)))
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    sd->F = cholmod_analyze(sd->A, &pb->cc);
+    if (!sd->F || pb->cc.status != CHOLMOD_OK)
+        return errbuf_set(err, errsz, RHM_ENUMERIC, "%s: analysing the X-step matrix failed "
+                          "(CHOLMOD status %d)", name, pb->cc.status);
+    return RHM_OK;
+}
+
+int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+                     rhm__problem **out, char *err, size_t errsz)
+{
+    *out = NULL;
+    int rc = rhm_params_check(p, err, errsz);
+    if (rc)
+        return rc;
+    if (!L || L->n < LMK_MIN_PAIRS)
+        return errbuf_set(err, errsz, RHM_EINPUT, "RHM needs at least %d landmark pairs, got %d",
+                          LMK_MIN_PAIRS, L ? L->n : 0);
+    for (int r = 0; r < L->n; r++) {
+        if (L->src[r] < 0 || L->src[r] >= S->nv || L->tgt[r] < 0 || L->tgt[r] >= T->nv)
+            return errbuf_set(err, errsz, RHM_EINPUT, "landmark %d (%d, %d) out of range",
+                              r + 1, L->src[r], L->tgt[r]);
+    }
+    rhm__problem *pb = calloc(1, sizeof *pb);
+    if (!pb)
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    pb->p = *p;
+    pb->dim = p->dim;
+    pb->nl = L->n;
+    cholmod_start(&pb->cc);
+    pb->cc_started = 1;
+    pb->cc.print = 0;
+    for (int i = 0; i < 2; i++) {
+        const int *src = i ? L->tgt : L->src;
+        if (!(pb->side[i].lmk = malloc(sizeof(int) * (size_t)L->n))) {
+            rc = errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+            goto fail;
+        }
+        memcpy(pb->side[i].lmk, src, sizeof(int) * (size_t)L->n);
+        if ((rc = side_build(pb, &pb->side[i], i ? T : S, i ? "target" : "source", err, errsz)))
+            goto fail;
+    }
+    *out = pb;
+    return RHM_OK;
+fail:
+    rhm__problem_free(pb);
+    return rc;
+}

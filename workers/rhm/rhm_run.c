@@ -1,0 +1,82 @@
+/* rhm_run.c — the RHM loop (rhm.h): set-up, Voronoi start, block coordinate
+ * descent with the β schedule and the stopping rule, progress and
+ * cancellation. The numerics are rhm_step.c's. */
+#include "rhm/rhm__problem.h"
+#include "util/errbuf.h"
+
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+            rhm_progress_fn progress, void *ctx, rhm_result *out,
+            char *err, size_t errsz)
+{
+    memset(out, 0, sizeof *out);
+    double t0 = now();
+    if (p->threads > 0)
+        omp_set_num_threads(p->threads);
+    rhm__problem *pb = NULL;
+    int rc = rhm__problem_new(S, T, L, p, &pb, err, errsz);
+    if (rc)
+        return rc;
+    if ((rc = rhm__init_voronoi(pb, err, errsz)))
+        goto out;
+    rhm_report r;
+    memset(&r, 0, sizeof r);
+    r.total = p->iterations;
+    r.beta = rhm_beta(p, 1);
+    r.energy = rhm__energy(pb, r.beta, r.dir);
+    r.t_setup = r.elapsed = now() - t0;
+    if (progress && progress(ctx, &r)) {
+        rc = errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled after the initial map");
+        goto out;
+    }
+    for (int k = 1; k <= p->iterations; k++) {
+        double prev = r.energy, beta = rhm_beta(p, k);
+        for (int i = 0; i < 2; i++) {
+            double ta = now();
+            if ((rc = rhm__step_p(pb, i, beta))) {
+                errbuf_set(err, errsz, rc, "RHM iteration %d: projection failed", k);
+                goto out;
+            }
+            double tb = now();
+            if ((rc = rhm__step_x(pb, i, beta))) {
+                errbuf_set(err, errsz, rc, "RHM iteration %d: X-step solve failed "
+                           "(CHOLMOD status %d)", k, pb->cc.status);
+                goto out;
+            }
+            r.t_project += tb - ta;
+            r.t_solve += now() - tb;
+        }
+        r.iteration = k;
+        r.beta = beta;
+        r.energy = rhm__energy(pb, beta, r.dir);
+        r.elapsed = now() - t0;
+        if (!isfinite(r.energy)) {
+            rc = errbuf_set(err, errsz, RHM_ENUMERIC, "RHM iteration %d: energy is not finite", k);
+            goto out;
+        }
+        if (progress && progress(ctx, &r)) {
+            rc = errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled at iteration %d", k);
+            goto out;
+        }
+        if (k >= p->min_iterations && fabs(r.energy - prev) < p->stop_change * prev)
+            break;
+    }
+    out->last = r;
+    out->P12 = pb->side[0].P;
+    out->P21 = pb->side[1].P;
+    pb->side[0].P = pb->side[1].P = NULL;
+out:
+    rhm__problem_free(pb);
+    return rc;
+}
