@@ -27,12 +27,14 @@ static void usage(FILE *fp)
         "         [--model bijective|injective] [--preset release|paper]\n"
         "         [--alpha A] [--eta E] [--beta0 B] [--beta1 B] [--beta-ramp K] [--gamma G]\n"
         "         [--iterations K] [--inner-iterations N] [--tolerance T] [--stop-change C]\n"
-        "         [--log-eps E]\n"
+        "         [--log-eps E] [--backend cpu|opencl|auto] [--device NAME]\n"
         "         [--partial] [--threads N] [--progress auto|text|json|none]\n"
         "Defaults are the authors' released code's (--preset release): alpha 20, eta 6.667e-4,\n"
         "beta 500 -> 1e5 over 200 iterations, gamma 1e4, 300 iterations, 50 L-BFGS steps.\n"
         "Without --init, the initial map comes from the landmarks: the best affine map of the\n"
-        "source landmarks onto the target landmarks, then the closest target point.\n");
+        "source landmarks onto the target landmarks, then the closest target point.\n"
+        "--backend opencl computes the elastic energy on an OpenCL device with fp64 whose\n"
+        "platform or device name contains NAME (see meshcorr devices); auto: a GPU, else the CPU.\n");
 }
 
 static int parse_double(const char *opt, const char *s, double *out)
@@ -151,6 +153,7 @@ int cli_match(int argc, char **argv)
         {"landmarks", required_argument, 0, 'L'},   {"source-landmarks", required_argument, 0, 'x'},
         {"target-landmarks", required_argument, 0, 'y'}, {"one-based", no_argument, 0, '1'},
         {"log-eps", required_argument, 0, 'E'},
+        {"backend", required_argument, 0, 'K'},     {"device", required_argument, 0, 'D'},
         {0, 0, 0, 0}};
     const char *init = NULL, *init_rev = NULL, *out = NULL, *out_rev = NULL;
     const char *out_def = NULL, *out_rem = NULL;
@@ -196,6 +199,23 @@ int cli_match(int argc, char **argv)
         case 't': bad |= parse_double("tolerance", optarg, &p.tolerance) != 0; break;
         case 's': bad |= parse_double("stop-change", optarg, &p.stop_change) != 0; break;
         case 'E': bad |= parse_double("log-eps", optarg, &p.log_eps) != 0; break;
+        case 'K':
+            if (strcmp(optarg, "cpu") && strcmp(optarg, "opencl") && strcmp(optarg, "auto")) {
+                fprintf(stderr, "meshcorr match: --backend: '%s' is not cpu, opencl or auto\n", optarg);
+                bad = 1;
+            } else {
+                snprintf(p.backend, sizeof p.backend, "%s", optarg);
+            }
+            break;
+        case 'D':
+            if (strlen(optarg) >= sizeof p.device) {
+                fprintf(stderr, "meshcorr match: --device: name longer than %zu bytes\n",
+                        sizeof p.device - 1);
+                bad = 1;
+            } else {
+                snprintf(p.device, sizeof p.device, "%s", optarg);
+            }
+            break;
         case 'P': p.partial = 1; break;
         case 'T': bad |= parse_int("threads", optarg, &p.threads) != 0; break;
         case 'G':

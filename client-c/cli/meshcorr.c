@@ -12,6 +12,7 @@ static const struct {
     { "info",    cli_info,    "MESH             print counts, topology, area, problems" },
     { "convert", cli_convert, "IN OUT           convert between .off .obj .ply .drc" },
     { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
+    { "devices", cli_devices, "                 list OpenCL devices for --backend opencl|auto" },
 };
 
 static void usage(FILE *fp)
