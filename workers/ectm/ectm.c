@@ -1,6 +1,6 @@
 /* ectm.c — the ECTM alternating optimisation (see ectm.h): set-up of the two
  * sides, the P/Q projections, the Y/Ỹ L-BFGS solves with their quadratic
- * terms, reporting and cancellation. Energies of the shells are ener_def's,
+ * terms, reporting and cancellation. Energies of the shells are ener_backend's,
  * projections proj's, the solver opt's: this file only combines them. */
 #include "ectm/ectm.h"
 #include "ener/ener_backend.h"

@@ -237,7 +237,7 @@ static int ocl_pick(const char *want, int gpu_only, const char *note, cl_device_
         return rc;
     char seen[1024] = "";
     size_t used = 0;
-    int matched = 0, matched_no_fp64 = 0, matched_gpu = 0;
+    int matched = 0, matched_no_fp64 = 0;
     for (int pass = 0; pass < (gpu_only ? 1 : 2); pass++)
         for (cl_uint i = 0; i < np; i++) {
             cl_device_id dev[ENER_OCL_DEVICES_MAX];
@@ -257,7 +257,6 @@ static int ocl_pick(const char *want, int gpu_only, const char *note, cl_device_
                 if (gpu != (pass == 0) || !name_matches(&d, want))
                     continue;
                 matched = 1;
-                matched_gpu |= gpu;
                 if (!d.fp64) {
                     matched_no_fp64 = 1;
                     continue;
@@ -279,7 +278,6 @@ static int ocl_pick(const char *want, int gpu_only, const char *note, cl_device_
                           "%s: no OpenCL %s matches '%s'; devices: %s%s",
                           ener_strerror(ENER_ENODEVICE), gpu_only ? "GPU" : "device", want,
                           used ? seen : "none", note);
-    (void)matched_gpu;
     return errbuf_set(err, errsz, ENER_ENODEVICE, "%s: no OpenCL %s; devices: %s%s",
                       ener_strerror(ENER_ENODEVICE), gpu_only ? "GPU" : "device",
                       used ? seen : "none", note);
@@ -290,11 +288,12 @@ static int ocl_build(cl_context ctx, cl_device_id dev, const char **srcs, cl_uin
                      cl_program *out, char *err, size_t errsz)
 {
     const char *all[8];
+    const cl_uint m = n < 7 ? n : 7;
     all[0] = ocl_prelude;
-    for (cl_uint i = 0; i < n && i < 7; i++)
+    for (cl_uint i = 0; i < m; i++)
         all[i + 1] = srcs[i];
     cl_int e;
-    *out = clCreateProgramWithSource(ctx, n + 1, all, NULL, &e);
+    *out = clCreateProgramWithSource(ctx, m + 1, all, NULL, &e);
     if (e != CL_SUCCESS)
         return ocl_cl_err(err, errsz, e, "clCreateProgramWithSource");
     e = clBuildProgram(*out, 1, &dev, "-cl-std=CL1.2", NULL, NULL);
