@@ -14,10 +14,10 @@ CXX     ?= c++
 PKGS     = draco liblbfgs
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
-CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Itests
+CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Itests -I$(BUILD)/gen
 CFLAGS   += -std=c11 $(OPT) $(WARN) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) -pthread $(shell pkg-config --cflags draco)
-LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lcholmod -llapack -lm -lstdc++ -fopenmp -pthread
+LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lcholmod -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
 
 # The engine library: everything under workers/ except the worker main.
 ENGINE_C   := $(filter-out workers/main/%,$(wildcard workers/*/*.c))
@@ -57,6 +57,14 @@ $(BUILD)/obj/%.o: %.c
 $(BUILD)/obj/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
+
+# The OpenCL program text, embedded as C arrays (ener_ocl.c includes them).
+OCL_SRC := workers/ener/ener_normal.h workers/ener/ener_membrane.h workers/ener/ener_ocl_kernels.cl
+$(BUILD)/gen/ener_ocl_src.h: $(OCL_SRC)
+	@mkdir -p $(dir $@)
+	set -e; for s in $(OCL_SRC); do echo "static const char ener__ocl_$$(basename $$s | tr . _)[] = {"; \
+	  xxd -i < $$s; echo ", 0};"; done > $@.tmp; mv $@.tmp $@
+$(BUILD)/obj/workers/ener/ener_ocl.o: $(BUILD)/gen/ener_ocl_src.h
 
 $(ENGINE_LIB): $(ENGINE_OBJ)
 	@mkdir -p $(dir $@)

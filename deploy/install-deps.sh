@@ -11,6 +11,7 @@ libdraco-dev draco
 liblbfgs-dev
 libsuitesparse-dev liblapack-dev
 libcgal-demo
+ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd
 "
 
 SUDO=""

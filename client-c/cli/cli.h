@@ -8,5 +8,6 @@ int cli_info(int argc, char **argv);
 int cli_convert(int argc, char **argv);
 int cli_match(int argc, char **argv);
 int cli_eval(int argc, char **argv);
+int cli_devices(int argc, char **argv);
 
 #endif

@@ -26,7 +26,7 @@ static void usage(FILE *fp)
         "         [--model bijective|injective] [--preset release|paper]\n"
         "         [--alpha A] [--eta E] [--beta0 B] [--beta1 B] [--beta-ramp K] [--gamma G]\n"
         "         [--iterations K] [--inner-iterations N] [--tolerance T] [--stop-change C]\n"
-        "         [--log-eps E]\n"
+        "         [--log-eps E] [--backend cpu|opencl|auto] [--device NAME]\n"
         "         [--stages all|rhm|ectm] [--rhm-alpha A] [--rhm-iterations K] [--rhm-dim M]\n"
         "         [--rhm-landmark-weight G]\n"
         "         [--partial] [--threads N] [--progress auto|text|json|none]\n"
@@ -35,7 +35,9 @@ static void usage(FILE *fp)
         "Without --init, the initial maps come from the landmarks: a geodesic Voronoi map, then\n"
         "Reversible Harmonic Maps (alpha 5e-4, beta 5e-3 min(k, 100), 8-D embedding, at most\n"
         "200 iterations, landmark weight 0). --stages rhm stops there and writes RHM's maps;\n"
-        "--stages ectm runs ECTM alone and needs --init.\n");
+        "--stages ectm runs ECTM alone and needs --init.\n"
+        "--backend opencl computes the elastic energy on an OpenCL device with fp64 whose\n"
+        "platform or device name contains NAME (see meshcorr devices); auto: a GPU, else the CPU.\n");
 }
 
 static int parse_double(const char *opt, const char *s, double *out)
@@ -188,6 +190,7 @@ int cli_match(int argc, char **argv)
         {"stages", required_argument, 0, 'S'},      {"rhm-alpha", required_argument, 0, 'A'},
         {"rhm-iterations", required_argument, 0, 'K'}, {"rhm-dim", required_argument, 0, 'M'},
         {"rhm-landmark-weight", required_argument, 0, 'W'},
+        {"backend", required_argument, 0, 'Z'},     {"device", required_argument, 0, 'D'},
         {0, 0, 0, 0}};
     const char *init = NULL, *init_rev = NULL, *out = NULL, *out_rev = NULL;
     const char *out_def = NULL, *out_rem = NULL;
@@ -236,6 +239,23 @@ int cli_match(int argc, char **argv)
         case 't': bad |= parse_double("tolerance", optarg, &p.tolerance) != 0; break;
         case 's': bad |= parse_double("stop-change", optarg, &p.stop_change) != 0; break;
         case 'E': bad |= parse_double("log-eps", optarg, &p.log_eps) != 0; break;
+        case 'Z':
+            if (strcmp(optarg, "cpu") && strcmp(optarg, "opencl") && strcmp(optarg, "auto")) {
+                fprintf(stderr, "meshcorr match: --backend: '%s' is not cpu, opencl or auto\n", optarg);
+                bad = 1;
+            } else {
+                snprintf(p.backend, sizeof p.backend, "%s", optarg);
+            }
+            break;
+        case 'D':
+            if (strlen(optarg) >= sizeof p.device) {
+                fprintf(stderr, "meshcorr match: --device: name longer than %zu bytes\n",
+                        sizeof p.device - 1);
+                bad = 1;
+            } else {
+                snprintf(p.device, sizeof p.device, "%s", optarg);
+            }
+            break;
         case 'P': p.partial = 1; break;
         case 'T': bad |= parse_int("threads", optarg, &p.threads) != 0; break;
         case 'G':

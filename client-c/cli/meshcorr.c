@@ -14,6 +14,7 @@ static const struct {
     { "convert", cli_convert, "IN OUT           convert between .off .obj .ply .drc" },
     { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
     { "eval",    cli_eval,    "SOURCE TARGET P.map .. quality of a map (see meshcorr eval --help)" },
+    { "devices", cli_devices, "                 list OpenCL devices for --backend opencl|auto" },
 };
 
 static void usage(FILE *fp)

@@ -1,9 +1,9 @@
 /* ectm.c — the ECTM alternating optimisation (see ectm.h): set-up of the two
  * sides, the P/Q projections, the Y/Ỹ L-BFGS solves with their quadratic
- * terms, reporting and cancellation. Energies of the shells are ener_def's,
+ * terms, reporting and cancellation. Energies of the shells are ener_backend's,
  * projections proj's, the solver opt's: this file only combines them. */
 #include "ectm/ectm.h"
-#include "ener/ener_def.h"
+#include "ener/ener_backend.h"
 #include "geo/geo_area.h"
 #include "geo/geo_edges.h"
 #include "opt/opt_lbfgs.h"
@@ -41,6 +41,7 @@ void ectm_params_init(ectm_params *p)
     p->tolerance = 1e-8;
     p->stop_change = 0;
     p->log_eps = ENER_LOG_EPS_DEFAULT;
+    strcpy(p->backend, "cpu");
 }
 
 void ectm_params_paper(ectm_params *p)
@@ -70,6 +71,10 @@ int ectm_params_check(const ectm_params *p, char *err, size_t errsz)
     NEED(isfinite(p->stop_change) && p->stop_change >= 0, "stop-change", "a finite number >= 0");
     NEED(isfinite(p->log_eps) && p->log_eps > 0 && p->log_eps < 1, "log-eps", "in (0, 1)");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");
+    NEED(memchr(p->backend, 0, sizeof p->backend) &&
+         (!p->backend[0] || !strcmp(p->backend, "cpu") || !strcmp(p->backend, "opencl") ||
+          !strcmp(p->backend, "auto")), "backend", "cpu, opencl or auto");
+    NEED(memchr(p->device, 0, sizeof p->device), "device", "shorter than 128 bytes");
 #undef NEED
     return ECTM_OK;
 }
@@ -98,7 +103,7 @@ typedef struct side {
     mesh *X;              /* scaled copy of the input                       */
     geo_scaling frame;    /* how X was scaled from the input (identity when partial) */
     geo_edges E;
-    ener_def *def;
+    ener_backend *def;
     double *mass;         /* lumped vertex areas of X                       */
     proj_tree *tree;      /* BVH over X: the other side projects onto it    */
     double *Y;            /* deformation of X (nv by 3)                     */
@@ -120,7 +125,7 @@ static void side_close(side *s)
 {
     mesh_free(s->X);
     geo_edges_close(&s->E);
-    ener_def_free(s->def);
+    ener_backend_free(s->def);
     free(s->mass);
     proj_tree_free(s->tree);
     free(s->Y);
@@ -143,7 +148,7 @@ static double now(void)
 }
 
 static int side_open(side *s, const mesh *in, int partial, const ener_def_params *dp,
-                     const char *which, char *err, size_t errsz)
+                     const ectm_params *p, const char *which, char *err, size_t errsz)
 {
     char detail[512];
     memset(s, 0, sizeof *s);
@@ -155,9 +160,13 @@ static int side_open(side *s, const mesh *in, int partial, const ener_def_params
         return errbuf_set(err, errsz, ECTM_EMESH, "%s mesh: %s", which, detail);
     if (geo_edges_build(s->X, &s->E, detail, sizeof detail))
         return errbuf_set(err, errsz, ECTM_EMESH, "%s mesh: %s", which, detail);
-    s->def = ener_def_new(s->X, &s->E, dp, detail, sizeof detail);
-    if (!s->def)
-        return errbuf_set(err, errsz, ECTM_EMESH, "%s mesh: %s", which, detail);
+    int erc = ener_backend_new(s->X, &s->E, dp, p->backend, p->device, p->threads, &s->def,
+                               detail, sizeof detail);
+    if (erc)
+        return errbuf_set(err, errsz, erc == ENER_ENOMEM ? ECTM_ENOMEM
+                                      : erc == ENER_EDEGENERATE || erc == ENER_EINVAL ? ECTM_EMESH
+                                      : ECTM_EBACKEND,
+                          "%s mesh: %s", which, detail);
     s->tree = proj_tree_new(s->X, detail, sizeof detail);
     if (!s->tree)
         return errbuf_set(err, errsz, ECTM_ENOMEM, "%s mesh: %s", which, detail);
@@ -219,7 +228,7 @@ static double ystep_eval(void *ctx, const double *Y, double *g, int n3)
     side *a = st->a;
     const side *b = st->b;
     double w_mem, w_bnd;
-    double e = ener_def_eval(a->def, Y, g, &w_mem, &w_bnd);
+    double e = ener_backend_eval(a->def, Y, g, &w_mem, &w_bnd);
     double mis = 0;
     const double beta = st->beta, gamma = st->gamma;
     int nv = n3 / 3;
@@ -277,7 +286,7 @@ static int ystep_iter(void *ctx, const double *Y, double fx, double gnorm, int i
 {
     (void)fx; (void)gnorm; (void)iter;
     ystep *st = ctx;
-    int count = ener_def_update_admissible(st->a->def, Y);
+    int count = ener_backend_update_admissible(st->a->def, Y);
     if (count != st->admissible) {
         st->admissible = count;
         return OPT_ITER_RESTART;
@@ -330,7 +339,7 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
     st.beta = beta;
     st.gamma = pr->p.gamma;
     st.bijective = pr->bijective;
-    st.admissible = ener_def_update_admissible(a->def, a->Y);
+    st.admissible = ener_backend_update_admissible(a->def, a->Y);
     opt_params op;
     opt_params_init(&op);
     op.max_iter = pr->p.inner_iterations;
@@ -434,9 +443,9 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         pr.p.alpha = dp.alpha;
         beta_scale = 1.0 / (s * st);
     }
-    if ((rc = side_open(&pr.s[0], S, p->partial, &dp, "source", err, errsz)))
+    if ((rc = side_open(&pr.s[0], S, p->partial, &dp, p, "source", err, errsz)))
         goto done;
-    if ((rc = side_open(&pr.s[1], T, p->partial, &dp, "target", err, errsz)))
+    if ((rc = side_open(&pr.s[1], T, p->partial, &dp, p, "target", err, errsz)))
         goto done;
     side *a = &pr.s[0], *b = &pr.s[1];
     a->Zt = malloc(sizeof(double) * ((size_t)a->X->nv * 6 + 1));
@@ -490,9 +499,13 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
             r.t_project += ts - tp;
             rc = solve_y(&pr, dir, beta, &r.dir[dir], scratch);
             r.t_solve += now() - ts;
+            const char *be = ener_backend_error(u->def);
+            if (rc && be)
+                rc = ECTM_EBACKEND;
             if (rc) {
-                errbuf_set(err, errsz, rc, "%s in the %s Y-step at outer iteration %d",
-                           ectm_strerror(rc), dir ? "target" : "source", k);
+                errbuf_set(err, errsz, rc, "%s in the %s Y-step at outer iteration %d%s%s",
+                           ectm_strerror(rc), dir ? "target" : "source", k, be ? ": " : "",
+                           be ? be : "");
                 goto done;
             }
         }

@@ -27,7 +27,8 @@
     X(ECTM_EMAP,       -3, "initial map does not fit the meshes")               \
     X(ECTM_ENOMEM,     -4, "out of memory")                                     \
     X(ECTM_ECANCELED,  -5, "cancelled")                                         \
-    X(ECTM_ENUMERIC,   -6, "numerical failure (non-finite energy)")
+    X(ECTM_ENUMERIC,   -6, "numerical failure (non-finite energy)")         \
+    X(ECTM_EBACKEND,   -7, "energy backend unavailable or failed")
 
 enum ectm_error {
 #define ECTM_ENUM(name, val, msg) name = val,
@@ -52,6 +53,9 @@ typedef struct ectm_params {
     double log_eps;        /* −log extension threshold on det G       (> 0)  */
     int partial;           /* partial matching: no rescaling          (0/1)  */
     int threads;           /* OpenMP threads; 0: all cores                   */
+    char backend[16];      /* W_def engine: "cpu" (default; "" too), "opencl",
+                              "auto" (ener_backend.h)                        */
+    char device[128];      /* OpenCL platform or device name substring; "" any */
 } ectm_params;
 
 /* The authors' released code's values, which produced their published demo

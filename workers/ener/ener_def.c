@@ -22,6 +22,7 @@
  * fixed chunk of elements and the chunk sums added in order. No atomics;
  * the result has the same bits for any thread count. */
 #include "ener/ener_def.h"
+#include "ener/ener_def_ref.h"
 #include "ener/ener_membrane.h"
 #include "ener/ener_normal.h"
 #include "util/errbuf.h"
@@ -32,24 +33,6 @@
 
 /* Elements per energy chunk: fixed, so sums are the same for any thread count. */
 #define ENER_CHUNK 512
-/* A face is non-degenerate in Y when its area exceeds this fraction of its
- * reference area. Below about 1e-6 the unit normal of a sliver turns so fast
- * that no line-search step is accepted: with 1e-12, the reverse Y-step of the
- * cow -> camel demo (nearest-neighbour initial Q) stalled at iteration 0 with
- * liblbfgs' minimum-step error; with 1e-6 it runs its 50 iterations. */
-#define ENER_ADMISSIBLE_AREA_RATIO 1e-6
-
-typedef struct ener__face {
-    double ginv[3];  /* ĝ⁻¹ as {a, b, c} */
-    double ahat;     /* reference area */
-} ener__face;
-
-typedef struct ener__edge {
-    int t[2];        /* faces (i, j, k) and the one with l */
-    double sign;     /* +1 when face t[1] runs (j, i, l), −1 when (i, j, l) */
-    double cos_ref;  /* cos θ̂ */
-    double weight;   /* l̂² / d̂ */
-} ener__edge;
 
 struct ener_def {
     ener_def_params p;
@@ -239,6 +222,20 @@ void ener_def_free(ener_def *d)
     free(d->ecoef);
     free(d->chunk);
     free(d);
+}
+
+void ener__def_ref_get(const ener_def *d, ener__def_ref *out)
+{
+    out->p = d->p;
+    out->nv = d->nv;
+    out->nf = d->nf;
+    out->ne = d->ne;
+    out->f = d->f;
+    out->E = d->E;
+    out->fr = d->fr;
+    out->er = d->er;
+    out->fedge = d->fedge;
+    out->fnbr = d->fnbr;
 }
 
 int ener_def_update_admissible(ener_def *d, const double *Y)

@@ -38,7 +38,10 @@
     X(ENER_OK,          0, "ok")                                           \
     X(ENER_ENOMEM,     -1, "out of memory")                                \
     X(ENER_EINVAL,     -2, "invalid argument")                             \
-    X(ENER_EDEGENERATE, -3, "degenerate reference face")
+    X(ENER_EDEGENERATE, -3, "degenerate reference face")                   \
+    X(ENER_ENODEVICE,  -4, "no usable OpenCL device")                      \
+    X(ENER_EBUILD,     -5, "OpenCL kernel build failed")                   \
+    X(ENER_EDEVICE,    -6, "OpenCL device error")
 
 enum ener_error {
 #define ENER_ENUM(name, val, msg) name = val,

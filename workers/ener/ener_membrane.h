@@ -15,7 +15,10 @@
  * ∂W/∂det = ¼ + ¾·L'(det) with L' ∈ [−1/ε, 0): finite for every input. */
 #ifndef ENER_MEMBRANE_H
 #define ENER_MEMBRANE_H
+/* Also compiled as OpenCL C (ener_ocl.c puts this file in its program). */
+#ifndef __OPENCL_VERSION__
 #include <math.h>
+#endif
 
 /* det G = |e1 × e2|²/det ĝ with n = e1 × e2 (e1 = y1 − y0, e2 = y2 − y0).
  * The cross product, not g11·g22 − g12²: the Gram form cancels

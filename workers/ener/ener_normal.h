@@ -11,7 +11,10 @@
  * The normal is the same for every cyclic rotation of the corners. */
 #ifndef ENER_NORMAL_H
 #define ENER_NORMAL_H
+/* Also compiled as OpenCL C (ener_ocl.c puts this file in its program). */
+#ifndef __OPENCL_VERSION__
 #include <math.h>
+#endif
 
 /* sin² of the face angle at y0 below which a face has no normal. */
 #define ENER_NORMAL_SIN2_MIN 1e-30

@@ -52,10 +52,18 @@ static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params 
     if (rhm_params_check(r, detail, sizeof detail))
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "RHM %s", detail);
     ectm_params_init(p);
-    if (w->backend[0] && strcmp(w->backend, "cpu") != 0)
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS,
-                          "parameter backend: '%s' is not available in this worker (only \"cpu\")",
-                          w->backend);
+    /* backend: "" (cpu), "cpu", "opencl", "auto", optionally ":DEVICE" */
+    if (w->backend[0]) {
+        const char *colon = strchr(w->backend, ':');
+        size_t n = colon ? (size_t)(colon - w->backend) : strlen(w->backend);
+        if (n >= sizeof p->backend || (colon && strlen(colon + 1) >= sizeof p->device))
+            return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "parameter backend: '%s' is too long",
+                              w->backend);
+        memcpy(p->backend, w->backend, n);
+        p->backend[n] = '\0';
+        if (colon)
+            snprintf(p->device, sizeof p->device, "%s", colon + 1);
+    }
     p->model = w->model == PROTO_MODEL_INJECTIVE ? ECTM_INJECTIVE : ECTM_BIJECTIVE;
     p->partial = w->partial;
     p->alpha = w->alpha;
