@@ -14,7 +14,7 @@ CXX     ?= c++
 PKGS     = draco liblbfgs
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
-CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Itests
+CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests
 CFLAGS   += -std=c11 $(OPT) $(WARN) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) -pthread $(shell pkg-config --cflags draco)
 LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lm -lstdc++ -fopenmp -pthread
@@ -33,6 +33,19 @@ PROTO_LIB := $(BUILD)/libmcproto.a
 CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
 
+# libmeshcorr: the client library (client-c/*.c). Users link it with
+# libmcengine.a (mesh reading and Draco encoding) and libmcproto.a.
+CLIENT_C   := $(wildcard client-c/*.c)
+CLIENT_OBJ := $(CLIENT_C:%.c=$(BUILD)/obj/%.o)
+CLIENT_LIB := $(BUILD)/libmeshcorr.a
+
+# meshcorrd: daemon/*.c; every file but main.c also goes into libmcdaemon.a
+# so tests can drive a module (the scheduler) directly.
+DAEMON_C    := $(wildcard daemon/*.c)
+DAEMON_OBJ  := $(DAEMON_C:%.c=$(BUILD)/obj/%.o)
+DAEMON_LIB  := $(BUILD)/libmcdaemon.a
+DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3
+
 TEST_SUPPORT_C   := $(wildcard tests/support/*.c)
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_C:%.c=$(BUILD)/obj/%.o)
 TEST_C    := $(wildcard tests/unit/test_*.c)
@@ -43,6 +56,7 @@ FUZZ_C    := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_BIN  := $(FUZZ_C:tests/fuzz/%.c=$(BUILD)/fuzz/%)
 
 PROGRAMS := $(BUILD)/meshcorr
+PROGRAMS += $(BUILD)/meshcorrd
 
 .PHONY: all test bench demo install clean
 all: $(PROGRAMS)
@@ -63,12 +77,23 @@ $(PROTO_LIB): $(PROTO_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/meshcorr: $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
-	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
-
-$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+$(CLIENT_LIB): $(CLIENT_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	rm -f $@ && ar rcs $@ $^
+
+$(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/meshcorr: $(CLI_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+
+$(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $< $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DAEMON_LIBS) -lm
+
+$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS)
 
 $(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)

@@ -11,6 +11,8 @@ libdraco-dev draco
 liblbfgs-dev
 libsuitesparse-dev
 libcgal-demo
+libuv1-dev
+libsqlite3-dev
 "
 
 SUDO=""
