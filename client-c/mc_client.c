@@ -347,10 +347,12 @@ int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
     p->partial = (uint8_t)s->partial;
     p->alpha = s->alpha;
     p->eta = s->eta;
-    p->beta0 = s->beta0;
+    /* The wire carries β's increase per outer iteration; the engine ramps
+     * linearly from beta0 (k = 1) to beta1 (k = beta_ramp), so beta_ramp <= 1
+     * means β = beta1 throughout. */
+    p->beta0 = s->beta_ramp > 1 ? s->beta0 : s->beta1;
     p->beta1 = s->beta1;
-    /* the wire carries β's increase per outer iteration */
-    p->beta_ramp = s->beta_ramp > 1 ? (s->beta1 - s->beta0) / (s->beta_ramp - 1) : s->beta1 - s->beta0;
+    p->beta_ramp = s->beta_ramp > 1 ? (s->beta1 - s->beta0) / (s->beta_ramp - 1) : 0;
     p->gamma = s->gamma;
     p->iterations = s->iterations;
     p->inner_iterations = s->inner_iterations;
