@@ -95,13 +95,13 @@ $(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS)
 
-$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
 test: $(PROGRAMS) $(TEST_BIN) $(FUZZ_BIN)
 	@sh tests/run-tests.sh $(TEST_BIN) $(FUZZ_BIN)
