@@ -14,7 +14,7 @@ CXX     ?= c++
 PKGS     = draco liblbfgs
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
-CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Itests -I$(BUILD)/gen
+CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(BUILD)/gen
 CFLAGS   += -std=c11 $(OPT) $(WARN) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) -pthread $(shell pkg-config --cflags draco)
 LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lcholmod -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
@@ -29,6 +29,19 @@ ENGINE_LIB := $(BUILD)/libmcengine.a
 PROTO_C   := $(wildcard protocol/*.c)
 PROTO_OBJ := $(PROTO_C:%.c=$(BUILD)/obj/%.o)
 PROTO_LIB := $(BUILD)/libmcproto.a
+
+# libmeshcorr: the client library (client-c/*.c). Users link it with
+# libmcengine.a (mesh reading and Draco encoding) and libmcproto.a.
+CLIENT_C   := $(wildcard client-c/*.c)
+CLIENT_OBJ := $(CLIENT_C:%.c=$(BUILD)/obj/%.o)
+CLIENT_LIB := $(BUILD)/libmeshcorr.a
+
+# meshcorrd: daemon/*.c; every file but main.c also goes into libmcdaemon.a
+# so tests can drive a module (the scheduler) directly.
+DAEMON_C    := $(wildcard daemon/*.c)
+DAEMON_OBJ  := $(DAEMON_C:%.c=$(BUILD)/obj/%.o)
+DAEMON_LIB  := $(BUILD)/libmcdaemon.a
+DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3
 
 CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
@@ -45,7 +58,7 @@ FUZZ_BIN  := $(FUZZ_C:tests/fuzz/%.c=$(BUILD)/fuzz/%)
 WORKER_C   := $(wildcard workers/main/*.c)
 WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
-PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker
+PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
 
 .PHONY: all test bench demo install clean
 all: $(PROGRAMS)
@@ -74,23 +87,34 @@ $(PROTO_LIB): $(PROTO_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/meshcorr: $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
-	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+$(CLIENT_LIB): $(CLIENT_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/meshcorr: $(CLI_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+
+$(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $< $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DAEMON_LIBS) $(LDLIBS)
 
 $(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS)
 
-$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+$(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+$(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
 test: $(PROGRAMS) $(TEST_BIN) $(FUZZ_BIN)
 	@sh tests/run-tests.sh $(TEST_BIN) $(FUZZ_BIN)

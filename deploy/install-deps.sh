@@ -12,6 +12,8 @@ liblbfgs-dev
 libsuitesparse-dev liblapack-dev
 libcgal-demo
 ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd
+libuv1-dev
+libsqlite3-dev
 "
 
 SUDO=""

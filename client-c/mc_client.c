@@ -1,0 +1,666 @@
+/* mc_client.c — libmeshcorr's connection and requests: connect, HELLO, one
+ * request at a time with blocking I/O under a timeout, replies decoded by
+ * the protocol codec and copied into the public structs of meshcorr.h. Holds
+ * no mesh code (mc_mesh.c) and no command-line code (cli/). */
+#include "meshcorr.h"
+#include "proto.h"
+#include "ectm/ectm.h"
+
+#include <errno.h>
+#include <netdb.h>
+#include <poll.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#define MC_DEFAULT_TIMEOUT_MS 30000
+#define MC_MAX_REPLY PROTO_MAX_FRAME
+
+struct mc_client {
+    int fd;
+    int timeout_ms;
+    uint32_t next_rid;
+    char user[256];
+    int admin;
+    char errmsg[1200];
+    uint8_t *rbuf;             /* the last reply frame; decoded messages borrow from it */
+    size_t rcap;
+};
+
+const char *mc_strerror(int code)
+{
+    switch (code) {
+#define MC_CASE(name, val, msg) case val: return msg;
+    MC_ERRORS(MC_CASE)
+#undef MC_CASE
+    default: return proto_strerror(code);
+    }
+}
+
+const char *mc_state_name(int state) { return proto_state_name(state); }
+
+int mc_state_parse(const char *name)
+{
+    for (int i = 0; i <= PROTO_STATE_LAST; i++)
+        if (strcasecmp(name, proto_state_name(i)) == 0)
+            return i;
+    return -1;
+}
+
+static int fail(mc_client *c, int code, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->errmsg, sizeof c->errmsg, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+void mc_set_timeout(mc_client *c, int ms) { c->timeout_ms = ms; }
+const char *mc_errmsg(const mc_client *c) { return c->errmsg; }
+const char *mc_user(const mc_client *c) { return c->user; }
+int mc_is_admin(const mc_client *c) { return c->admin; }
+
+void mc_job_spec_init(mc_job_spec *s)
+{
+    ectm_params p;
+    ectm_params_init(&p);
+    memset(s, 0, sizeof *s);
+    s->model = p.model == ECTM_INJECTIVE ? MC_INJECTIVE : MC_BIJECTIVE;
+    s->partial = p.partial;
+    s->alpha = p.alpha;
+    s->eta = p.eta;
+    s->beta0 = p.beta0;
+    s->beta1 = p.beta1;
+    s->beta_ramp = p.beta_ramp;
+    s->gamma = p.gamma;
+    s->iterations = (uint32_t)p.iterations;
+    s->inner_iterations = (uint32_t)p.inner_iterations;
+    s->tolerance = p.tolerance;
+    s->stop_change = p.stop_change;
+}
+
+static int64_t now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+/* Waits for fd to be readable/writable before the deadline (-1: none). */
+static int wait_fd(mc_client *c, short events, int64_t deadline)
+{
+    for (;;) {
+        int ms = -1;
+        if (deadline >= 0) {
+            int64_t left = deadline - now_ms();
+            if (left <= 0)
+                return fail(c, MC_ETIMEOUT, "no answer from the server within %d ms", c->timeout_ms);
+            ms = (int)left;
+        }
+        struct pollfd p = {c->fd, events, 0};
+        int r = poll(&p, 1, ms);
+        if (r > 0)
+            return 0;
+        if (r < 0 && errno != EINTR)
+            return fail(c, MC_EIO, "poll: %s", strerror(errno));
+    }
+}
+
+static int64_t deadline_of(const mc_client *c)
+{
+    return c->timeout_ms > 0 ? now_ms() + c->timeout_ms : -1;
+}
+
+static int send_all(mc_client *c, const void *data, size_t len)
+{
+    int64_t deadline = deadline_of(c);
+    const char *p = data;
+    while (len) {
+        ssize_t w = send(c->fd, p, len, MSG_NOSIGNAL | MSG_DONTWAIT);
+        if (w > 0) {
+            p += w;
+            len -= (size_t)w;
+            continue;
+        }
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            int rc = wait_fd(c, POLLOUT, deadline);
+            if (rc)
+                return rc;
+            continue;
+        }
+        return fail(c, MC_EIO, "send: %s", w < 0 ? strerror(errno) : "connection closed");
+    }
+    return 0;
+}
+
+static int recv_all(mc_client *c, void *data, size_t len, int64_t deadline)
+{
+    char *p = data;
+    while (len) {
+        int rc = wait_fd(c, POLLIN, deadline);
+        if (rc)
+            return rc;
+        ssize_t r = recv(c->fd, p, len, MSG_DONTWAIT);
+        if (r > 0) {
+            p += r;
+            len -= (size_t)r;
+        } else if (r == 0) {
+            return fail(c, MC_EIO, "the server closed the connection");
+        } else if (errno != EINTR && errno != EAGAIN && errno != EWOULDBLOCK) {
+            return fail(c, MC_EIO, "recv: %s", strerror(errno));
+        }
+    }
+    return 0;
+}
+
+/* Reads one frame and decodes it into m (borrowing from c->rbuf). An ERROR
+ * frame is returned as its code, with its message in errmsg. */
+static int read_frame(mc_client *c, proto_msg *m, int64_t deadline)
+{
+    uint8_t hdrb[PROTO_HDR_SIZE];
+    int rc = recv_all(c, hdrb, sizeof hdrb, deadline);
+    if (rc)
+        return rc;
+    proto_hdr hdr;
+    char err[512];
+    rc = proto_frame_scan(hdrb, sizeof hdrb, MC_MAX_REPLY, &hdr, err, sizeof err);
+    if (rc < 0)
+        return fail(c, MC_EPROTO, "reply header: %s", err);
+    size_t flen = PROTO_HDR_SIZE + (size_t)hdr.payload_len;
+    if (flen > c->rcap) {
+        uint8_t *nb = realloc(c->rbuf, flen);
+        if (!nb)
+            return fail(c, MC_ENOMEM, "out of memory for a %zu-byte reply", flen);
+        c->rbuf = nb;
+        c->rcap = flen;
+    }
+    memcpy(c->rbuf, hdrb, PROTO_HDR_SIZE);
+    if ((rc = recv_all(c, c->rbuf + PROTO_HDR_SIZE, hdr.payload_len, deadline)))
+        return rc;
+    rc = proto_msg_decode(&hdr, c->rbuf + PROTO_HDR_SIZE, m, err, sizeof err);
+    if (rc)
+        return fail(c, MC_EPROTO, "reply %s: %s", proto_type_name(hdr.type), err);
+    if (m->type == PROTO_MSG_ERROR) {
+        int code = m->u.error.code < 0 ? m->u.error.code : MC_EPROTO;
+        fail(c, code, "%s: %s", proto_err_name(code), m->u.error.message);
+        proto_msg_free(m);
+        return code;
+    }
+    return 0;
+}
+
+/* Sends req (request id assigned here) and reads the reply of type
+ * want_type into reply. */
+static int request(mc_client *c, proto_msg *req, int want_type, proto_msg *reply)
+{
+    c->errmsg[0] = '\0';
+    if (c->fd < 0)
+        return fail(c, MC_EIO, "the connection is closed");
+    req->request_id = ++c->next_rid;
+    proto_buf b;
+    proto_buf_init(&b);
+    char err[512];
+    int rc = proto_msg_encode(&b, req, err, sizeof err);
+    if (rc) {
+        proto_buf_free(&b);
+        return fail(c, rc == PROTO_ENOMEM ? MC_ENOMEM : MC_EARG, "request %s: %s",
+                    proto_type_name(req->type), err);
+    }
+    rc = send_all(c, b.data, b.len);
+    proto_buf_free(&b);
+    if (rc)
+        return rc;
+    if ((rc = read_frame(c, reply, deadline_of(c))))
+        return rc;
+    if (reply->type != want_type || reply->request_id != req->request_id) {
+        rc = fail(c, MC_EPROTO, "expected %s for request %u, got %s for request %u",
+                  proto_type_name(want_type), req->request_id, proto_type_name(reply->type),
+                  reply->request_id);
+        proto_msg_free(reply);
+    }
+    return rc;
+}
+
+static int connect_unix(mc_client *c, const char *path)
+{
+    struct sockaddr_un sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sun_family = AF_UNIX;
+    if (strlen(path) >= sizeof sa.sun_path)
+        return fail(c, MC_EADDRESS, "unix:%s: path too long", path);
+    strcpy(sa.sun_path, path);
+    c->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (c->fd < 0 || connect(c->fd, (struct sockaddr *)&sa, sizeof sa) != 0)
+        return fail(c, MC_ECONNECT, "unix:%s: %s", path, strerror(errno));
+    return 0;
+}
+
+static int connect_tcp(mc_client *c, const char *hostport)
+{
+    char host[256];
+    const char *colon = strrchr(hostport, ':');
+    if (!colon || colon == hostport || (size_t)(colon - hostport) >= sizeof host)
+        return fail(c, MC_EADDRESS, "tcp:%s: expected tcp:HOST:PORT", hostport);
+    memcpy(host, hostport, (size_t)(colon - hostport));
+    host[colon - hostport] = '\0';
+    if (host[0] == '[' && host[strlen(host) - 1] == ']') {
+        memmove(host, host + 1, strlen(host));
+        host[strlen(host) - 1] = '\0';
+    }
+    struct addrinfo hints, *res = NULL;
+    memset(&hints, 0, sizeof hints);
+    hints.ai_socktype = SOCK_STREAM;
+    int g = getaddrinfo(host, colon + 1, &hints, &res);
+    if (g)
+        return fail(c, MC_EADDRESS, "tcp:%s: %s", hostport, gai_strerror(g));
+    int rc = fail(c, MC_ECONNECT, "tcp:%s: no address", hostport);
+    for (struct addrinfo *ai = res; ai; ai = ai->ai_next) {
+        c->fd = socket(ai->ai_family, ai->ai_socktype | SOCK_CLOEXEC, ai->ai_protocol);
+        if (c->fd >= 0 && connect(c->fd, ai->ai_addr, ai->ai_addrlen) == 0) {
+            rc = 0;
+            break;
+        }
+        rc = fail(c, MC_ECONNECT, "tcp:%s: %s", hostport, strerror(errno));
+        if (c->fd >= 0)
+            close(c->fd);
+        c->fd = -1;
+    }
+    freeaddrinfo(res);
+    return rc;
+}
+
+int mc_connect(const char *address, const char *token, mc_client **out, char *err, size_t errsz)
+{
+    *out = NULL;
+    mc_client *c = calloc(1, sizeof *c);
+    if (!c) {
+        snprintf(err, errsz, "out of memory");
+        return MC_ENOMEM;
+    }
+    c->fd = -1;
+    c->timeout_ms = MC_DEFAULT_TIMEOUT_MS;
+    int rc;
+    if (!address)
+        rc = fail(c, MC_EADDRESS, "no server address");
+    else if (strncmp(address, "unix:", 5) == 0)
+        rc = connect_unix(c, address + 5);
+    else if (strncmp(address, "tcp:", 4) == 0)
+        rc = connect_tcp(c, address + 4);
+    else
+        rc = fail(c, MC_EADDRESS, "'%s' is not unix:PATH or tcp:HOST:PORT", address);
+    if (!rc) {
+        proto_msg req, rep;
+        memset(&req, 0, sizeof req);
+        req.type = PROTO_MSG_HELLO;
+        req.u.hello.version = PROTO_VERSION;
+        req.u.hello.token = token ? token : "";
+        req.u.hello.client = "libmeshcorr 1";
+        if (!(rc = request(c, &req, PROTO_MSG_HELLO_OK, &rep))) {
+            snprintf(c->user, sizeof c->user, "%s", rep.u.hello_ok.user);
+            c->admin = rep.u.hello_ok.admin;
+            proto_msg_free(&rep);
+        }
+    }
+    if (rc) {
+        snprintf(err, errsz, "%s", c->errmsg);
+        mc_close(c);
+        return rc;
+    }
+    *out = c;
+    return 0;
+}
+
+void mc_close(mc_client *c)
+{
+    if (!c)
+        return;
+    if (c->fd >= 0)
+        close(c->fd);
+    free(c->rbuf);
+    free(c);
+}
+
+int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
+{
+    if (!s || !s->source || !s->target || s->source_len > UINT32_MAX || s->target_len > UINT32_MAX)
+        return fail(c, MC_EARG, "the job needs source and target Draco bytes");
+    proto_msg req, rep;
+    memset(&req, 0, sizeof req);
+    req.type = PROTO_MSG_SUBMIT;
+    proto_submit *m = &req.u.submit;
+    m->source = (proto_blob){s->source, (uint32_t)s->source_len};
+    m->target = (proto_blob){s->target, (uint32_t)s->target_len};
+    m->landmarks = (proto_landmark *)s->landmarks;   /* (src, tgt) u32 pairs: the same layout */
+    m->nlandmarks = s->nlandmarks;
+    m->p = (proto_map){(proto_map_row *)s->p, s->np};
+    m->q = (proto_map){(proto_map_row *)s->q, s->nq};
+    proto_params *p = &m->params;
+    p->model = (uint8_t)s->model;
+    p->partial = (uint8_t)s->partial;
+    p->alpha = s->alpha;
+    p->eta = s->eta;
+    p->beta0 = s->beta0;
+    p->beta1 = s->beta1;
+    p->beta_ramp = s->beta_ramp > 0 ? (uint32_t)s->beta_ramp : 0;  /* 0: refused by the worker */
+    p->gamma = s->gamma;
+    p->iterations = s->iterations;
+    p->inner_iterations = s->inner_iterations;
+    p->tolerance = s->tolerance;
+    p->stop_change = s->stop_change;
+    p->backend = s->backend ? s->backend : "";
+    m->priority = s->priority;
+    m->label = s->label ? s->label : "";
+    int rc = request(c, &req, PROTO_MSG_SUBMIT_OK, &rep);
+    if (!rc) {
+        *job_id = rep.u.submit_ok.job_id;
+        proto_msg_free(&rep);
+    }
+    return rc;
+}
+
+static void copy_progress(mc_progress *o, const proto_progress *p)
+{
+    o->job_id = p->job_id;
+    o->stage = p->stage;
+    o->outer = p->outer;
+    o->total = p->total;
+    for (int d = 0; d < 2; d++) {
+        o->inner[d] = p->inner[d];
+        o->membrane[d] = p->terms[d][PROTO_TERM_MEMBRANE];
+        o->bending[d] = p->terms[d][PROTO_TERM_BENDING];
+        o->mismatch[d] = p->terms[d][PROTO_TERM_MISMATCH];
+        o->reverse[d] = p->terms[d][PROTO_TERM_REVERSE];
+        o->energy[d] = p->terms[d][PROTO_TERM_ENERGY];
+    }
+    o->beta = p->beta;
+    o->gamma = p->gamma;
+    o->elapsed_s = p->elapsed_s;
+}
+
+static int job_request(mc_client *c, int type, int want, uint64_t id, proto_msg *rep)
+{
+    proto_msg req;
+    memset(&req, 0, sizeof req);
+    req.type = (uint8_t)type;
+    req.u.status.job_id = id;
+    return request(c, &req, want, rep);
+}
+
+int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
+{
+    proto_msg rep;
+    int rc = job_request(c, PROTO_MSG_STATUS, PROTO_MSG_STATUS_OK, id, &rep);
+    if (rc)
+        return rc;
+    const proto_status_ok *s = &rep.u.status_ok;
+    memset(o, 0, sizeof *o);
+    o->job_id = s->job_id;
+    o->state = s->state;
+    o->priority = s->priority;
+    snprintf(o->user, sizeof o->user, "%s", s->user);
+    snprintf(o->label, sizeof o->label, "%s", s->label);
+    snprintf(o->reason, sizeof o->reason, "%s", s->reason);
+    o->submit_ms = s->submit_ms;
+    o->start_ms = s->start_ms;
+    o->end_ms = s->end_ms;
+    o->has_progress = s->has_progress;
+    if (s->has_progress)
+        copy_progress(&o->progress, &s->progress);
+    proto_msg_free(&rep);
+    return 0;
+}
+
+int mc_cancel(mc_client *c, uint64_t id)
+{
+    proto_msg rep;
+    int rc = job_request(c, PROTO_MSG_CANCEL, PROTO_MSG_OK, id, &rep);
+    if (!rc)
+        proto_msg_free(&rep);
+    return rc;
+}
+
+int mc_delete(mc_client *c, uint64_t id)
+{
+    proto_msg rep;
+    int rc = job_request(c, PROTO_MSG_DELETE, PROTO_MSG_OK, id, &rep);
+    if (!rc)
+        proto_msg_free(&rep);
+    return rc;
+}
+
+int mc_ping(mc_client *c)
+{
+    proto_msg req, rep;
+    memset(&req, 0, sizeof req);
+    req.type = PROTO_MSG_PING;
+    int rc = request(c, &req, PROTO_MSG_PONG, &rep);
+    if (!rc)
+        proto_msg_free(&rep);
+    return rc;
+}
+
+int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **jobs, uint32_t *n)
+{
+    *jobs = NULL;
+    *n = 0;
+    uint64_t after = 0;
+    for (;;) {
+        proto_msg req, rep;
+        memset(&req, 0, sizeof req);
+        req.type = PROTO_MSG_LIST;
+        req.u.list = (proto_list){state_mask, user ? user : "", 0, after};
+        int rc = request(c, &req, PROTO_MSG_LIST_OK, &rep);
+        if (rc) {
+            free(*jobs);
+            *jobs = NULL;
+            *n = 0;
+            return rc;
+        }
+        uint32_t k = rep.u.list_ok.n;
+        if (k == 0) {
+            proto_msg_free(&rep);
+            return 0;
+        }
+        mc_job_info *nj = realloc(*jobs, (*n + k) * sizeof *nj);
+        if (!nj) {
+            proto_msg_free(&rep);
+            free(*jobs);
+            *jobs = NULL;
+            *n = 0;
+            return fail(c, MC_ENOMEM, "out of memory for the job list");
+        }
+        *jobs = nj;
+        for (uint32_t i = 0; i < k; i++) {
+            const proto_job_summary *s = &rep.u.list_ok.jobs[i];
+            mc_job_info *o = &nj[*n + i];
+            o->job_id = s->job_id;
+            o->state = s->state;
+            o->priority = s->priority;
+            o->submit_ms = s->submit_ms;
+            snprintf(o->user, sizeof o->user, "%s", s->user);
+            snprintf(o->label, sizeof o->label, "%s", s->label);
+            o->outer = s->outer;
+            o->total = s->total;
+            after = s->job_id;
+        }
+        *n += k;
+        proto_msg_free(&rep);
+    }
+}
+
+int mc_watch(mc_client *c, uint64_t id, uint32_t from_outer, mc_progress_fn cb, void *ctx,
+             int *end_state, char *reason, size_t reasonsz)
+{
+    proto_msg req;
+    memset(&req, 0, sizeof req);
+    req.type = PROTO_MSG_WATCH;
+    req.u.watch = (proto_watch){id, from_outer};
+    c->errmsg[0] = '\0';
+    req.request_id = ++c->next_rid;
+    proto_buf b;
+    proto_buf_init(&b);
+    char err[256];
+    int rc = proto_msg_encode(&b, &req, err, sizeof err);
+    if (!rc)
+        rc = send_all(c, b.data, b.len);
+    proto_buf_free(&b);
+    if (rc)
+        return rc < -99 ? rc : fail(c, MC_EARG, "WATCH: %s", err);
+    for (;;) {
+        proto_msg m;
+        if ((rc = read_frame(c, &m, -1)))
+            return rc;
+        if (m.request_id != req.request_id ||
+            (m.type != PROTO_MSG_PROGRESS && m.type != PROTO_MSG_END)) {
+            rc = fail(c, MC_EPROTO, "unexpected %s during WATCH", proto_type_name(m.type));
+            proto_msg_free(&m);
+            return rc;
+        }
+        if (m.type == PROTO_MSG_END) {
+            if (end_state)
+                *end_state = m.u.end.state;
+            if (reason && reasonsz)
+                snprintf(reason, reasonsz, "%s", m.u.end.reason);
+            proto_msg_free(&m);
+            return 0;
+        }
+        mc_progress p;
+        copy_progress(&p, &m.u.progress);
+        proto_msg_free(&m);
+        if (cb && (rc = cb(ctx, &p)) != 0) {
+            close(c->fd);
+            c->fd = -1;
+            return rc;
+        }
+    }
+}
+
+static int copy_map(const proto_map *m, mc_map_row **out, uint32_t *n)
+{
+    *n = m->n;
+    *out = NULL;
+    if (!m->n)
+        return 0;
+    if (!(*out = malloc((size_t)m->n * sizeof **out)))
+        return -1;
+    for (uint32_t i = 0; i < m->n; i++) {
+        (*out)[i].face = m->rows[i].face;
+        memcpy((*out)[i].w, m->rows[i].w, sizeof (*out)[i].w);
+    }
+    return 0;
+}
+
+void mc_result_free(mc_job_result *r)
+{
+    if (!r)
+        return;
+    free(r->p);
+    free(r->q);
+    free(r->deformed);
+    for (uint32_t i = 0; r->metric_keys && i < r->nmetrics; i++)
+        free(r->metric_keys[i]);
+    free(r->metric_keys);
+    free(r->metric_values);
+    memset(r, 0, sizeof *r);
+}
+
+int mc_result(mc_client *c, uint64_t id, unsigned what, mc_job_result *out)
+{
+    memset(out, 0, sizeof *out);
+    proto_msg req, rep;
+    memset(&req, 0, sizeof req);
+    req.type = PROTO_MSG_RESULT;
+    req.u.result = (proto_result){id, what};
+    int rc = request(c, &req, PROTO_MSG_RESULT_OK, &rep);
+    if (rc)
+        return rc;
+    const proto_result_ok *r = &rep.u.result_ok;
+    int bad = copy_map(&r->p, &out->p, &out->np) || copy_map(&r->q, &out->q, &out->nq);
+    if (!bad && r->deformed.len) {
+        out->deformed_len = r->deformed.len;
+        bad = !(out->deformed = malloc(r->deformed.len));
+        if (!bad)
+            memcpy(out->deformed, r->deformed.data, r->deformed.len);
+    }
+    if (!bad && r->nmetrics) {
+        out->metric_keys = calloc(r->nmetrics, sizeof *out->metric_keys);
+        out->metric_values = calloc(r->nmetrics, sizeof *out->metric_values);
+        bad = !out->metric_keys || !out->metric_values;
+        for (uint32_t i = 0; !bad && i < r->nmetrics; i++) {
+            bad = !(out->metric_keys[i] = strdup(r->metrics[i].key));
+            out->metric_values[i] = r->metrics[i].value;
+            out->nmetrics = i + 1;
+        }
+    }
+    proto_msg_free(&rep);
+    if (bad) {
+        mc_result_free(out);
+        return fail(c, MC_ENOMEM, "out of memory for the result");
+    }
+    return 0;
+}
+
+void mc_stats_free(mc_server_stats *s)
+{
+    if (!s)
+        return;
+    free(s->slot_job);
+    free(s->slot_state);
+    memset(s, 0, sizeof *s);
+}
+
+int mc_stats(mc_client *c, mc_server_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    proto_msg req, rep;
+    memset(&req, 0, sizeof req);
+    req.type = PROTO_MSG_STATS;
+    int rc = request(c, &req, PROTO_MSG_STATS_OK, &rep);
+    if (rc)
+        return rc;
+    const proto_stats_ok *s = &rep.u.stats_ok;
+    out->queued = s->queued;
+    out->running = s->running;
+    out->workers = s->workers;
+    out->completed = s->completed;
+    out->failed = s->failed;
+    out->cancelled = s->cancelled;
+    out->slot_job = calloc(s->nslots + 1, sizeof *out->slot_job);
+    out->slot_state = calloc(s->nslots + 1, sizeof *out->slot_state);
+    if (!out->slot_job || !out->slot_state) {
+        proto_msg_free(&rep);
+        mc_stats_free(out);
+        return fail(c, MC_ENOMEM, "out of memory for the statistics");
+    }
+    out->nslots = s->nslots;
+    for (uint32_t i = 0; i < s->nslots; i++) {
+        out->slot_job[i] = s->slots[i].job_id;
+        out->slot_state[i] = s->slots[i].state;
+    }
+    for (uint32_t i = 0; i < s->ndevices && i < 8; i++)
+        snprintf(out->devices[i], sizeof out->devices[i], "%s", s->devices[i]);
+    out->ndevices = s->ndevices < 8 ? s->ndevices : 8;
+    proto_msg_free(&rep);
+    return 0;
+}
+
+int mc_send_raw(mc_client *c, const void *bytes, size_t len)
+{
+    c->errmsg[0] = '\0';
+    int rc = send_all(c, bytes, len);
+    if (rc)
+        return rc;
+    proto_msg m;
+    rc = read_frame(c, &m, deadline_of(c));
+    if (!rc)
+        proto_msg_free(&m);
+    return rc;
+}

@@ -1,0 +1,60 @@
+/* mc_mesh.c — libmeshcorr's mesh helper: a mesh file as the Draco bytes a
+ * job carries, with the engine's order-preserving encoder (landmarks and
+ * maps use the file's vertex order). A .drc file is sent as it is. */
+#include "meshcorr.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static int read_whole(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(err, errsz, "%s: cannot open", path);
+        return MC_EFILE;
+    }
+    int rc = MC_EFILE;
+    long n = -1;
+    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) > 0 && n <= DRACOB_MAX_BUFFER_BYTES &&
+        fseek(fp, 0, SEEK_SET) == 0) {
+        if (!(*bytes = malloc((size_t)n)))
+            rc = MC_ENOMEM;
+        else if (fread(*bytes, 1, (size_t)n, fp) == (size_t)n)
+            rc = 0;
+    }
+    fclose(fp);
+    if (rc) {
+        free(*bytes);
+        *bytes = NULL;
+        snprintf(err, errsz, "%s: cannot read (empty, unreadable or over %lld bytes)", path,
+                 (long long)DRACOB_MAX_BUFFER_BYTES);
+        return rc;
+    }
+    *len = (size_t)n;
+    return 0;
+}
+
+int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
+{
+    *bytes = NULL;
+    *len = 0;
+    size_t pl = strlen(path);
+    if (pl > 4 && strcasecmp(path + pl - 4, ".drc") == 0)
+        return read_whole(path, bytes, len, err, errsz);
+    mesh *m = NULL;
+    if (mesh_read(path, &m, err, errsz))
+        return MC_EFILE;
+    char derr[512];
+    int rc = dracob_encode(m->v, m->nv, m->f, m->nf, MESH_DRC_QUANTIZATION_BITS, bytes, len,
+                           derr, sizeof derr);
+    mesh_free(m);
+    if (rc) {
+        snprintf(err, errsz, "%s: %s", path, derr);
+        return rc == DRACOB_ENOMEM ? MC_ENOMEM : MC_EFILE;
+    }
+    return 0;
+}

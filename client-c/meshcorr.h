@@ -1,0 +1,183 @@
+/* meshcorr.h — libmeshcorr, the C client of meshcorrd (build/libmeshcorr.a;
+ * link it with build/libmcengine.a, build/libmcproto.a and the engine's
+ * libraries: see the Makefile's LDLIBS).
+ *
+ * One mc_client is one connection (Unix socket or TCP), authenticated at
+ * mc_connect, used by one thread at a time. Every call is blocking: requests
+ * wait at most the client's timeout (mc_set_timeout, default 30 s); mc_watch
+ * waits as long as the job runs.
+ *
+ * Errors: every function returns 0 or a negative code. Codes from -1 to -99
+ * are the server's refusals (the protocol's error list: MC_ENOT_FOUND is
+ * PROTO_ENOT_FOUND, ...); -100 and below are this library's own (MC_E* below).
+ * mc_strerror names any code; mc_errmsg(client) gives the detail of the
+ * client's last failed call (the server's message, or the system error).
+ *
+ * Ownership: mc_connect returns a client freed by mc_close (NULL ok).
+ * Arrays a call fills (mc_list's jobs, mc_result's maps and mesh, mc_stats's
+ * slots) are malloc()ed and released by the matching _free function, which
+ * accepts NULL and zeroed structs. Inputs (mc_job_spec) stay the caller's. */
+#ifndef MESHCORR_H
+#define MESHCORR_H
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MC_ERRORS(X)                                                        \
+    X(MC_EARG,     -100, "invalid argument")                                \
+    X(MC_EADDRESS, -101, "bad server address")                              \
+    X(MC_ECONNECT, -102, "cannot connect to the server")                    \
+    X(MC_EIO,      -103, "connection failed")                               \
+    X(MC_ETIMEOUT, -104, "timed out waiting for the server")                \
+    X(MC_EPROTO,   -105, "the server's reply does not follow the protocol") \
+    X(MC_ENOMEM,   -106, "out of memory")                                   \
+    X(MC_EFILE,    -107, "cannot read or encode the file")
+
+enum mc_error {
+    MC_OK = 0,
+    /* the server's codes, the same numbers as the protocol's */
+    MC_EUNAUTHORIZED = -13, MC_EFORBIDDEN = -14, MC_ENOT_FOUND = -15,
+    MC_EBAD_STATE = -16, MC_EQUEUE_FULL = -17, MC_EUSER_LIMIT = -18,
+#define MC_ENUM(name, val, msg) name = val,
+    MC_ERRORS(MC_ENUM)
+#undef MC_ENUM
+};
+const char *mc_strerror(int code);
+
+/* Job states (Slurm's names) and stages, as in the protocol. */
+enum mc_state { MC_PENDING, MC_RUNNING, MC_COMPLETED, MC_FAILED, MC_CANCELLED, MC_TIMEOUT,
+                MC_OUT_OF_MEMORY };
+const char *mc_state_name(int state);          /* "COMPLETED"; NULL when unknown */
+int mc_state_parse(const char *name);          /* state, or -1 */
+enum mc_model { MC_BIJECTIVE = 0, MC_INJECTIVE = 1 };
+
+/* RESULT parts. */
+#define MC_WANT_P        1u
+#define MC_WANT_Q        2u
+#define MC_WANT_DEFORMED 4u
+#define MC_WANT_METRICS  8u
+
+typedef struct mc_client mc_client;
+
+typedef struct mc_map_row {    /* a point on face `face` of the other mesh */
+    uint32_t face;
+    double w[3];               /* barycentric weights */
+} mc_map_row;
+
+typedef struct mc_job_spec {
+    const unsigned char *source; size_t source_len;   /* Draco bytes (mc_encode_mesh_file) */
+    const unsigned char *target; size_t target_len;
+    const uint32_t *landmarks; uint32_t nlandmarks;   /* nlandmarks (src, tgt) pairs, 2n ids */
+    const mc_map_row *p; uint32_t np;                 /* optional initial map, np = source vertices */
+    const mc_map_row *q; uint32_t nq;                 /* optional reverse map (bijective) */
+    int model;                 /* MC_BIJECTIVE or MC_INJECTIVE */
+    int partial;               /* 0 or 1 */
+    double alpha, eta;         /* membrane and bending weights */
+    double beta0, beta1;       /* mismatch weight at iteration 1, and its cap */
+    int beta_ramp;             /* iterations of the linear ramp from beta0 to beta1 */
+    double gamma;              /* reverse-map weight */
+    uint32_t iterations, inner_iterations;
+    double tolerance, stop_change;
+    const char *backend;       /* NULL or "" = server default */
+    int32_t priority;          /* higher runs first */
+    const char *label;         /* NULL = "" */
+} mc_job_spec;
+
+/* The engine's defaults (those of `meshcorr match`); no meshes, no landmarks. */
+void mc_job_spec_init(mc_job_spec *s);
+
+typedef struct mc_progress {
+    uint64_t job_id;
+    int stage;                 /* 0 voronoi, 1 rhm, 2 ectm */
+    uint32_t outer, total;     /* outer iteration, planned */
+    uint32_t inner[2];         /* L-BFGS iterations: [0] source side, [1] target side */
+    double membrane[2], bending[2], mismatch[2], reverse[2], energy[2];
+    double beta, gamma, elapsed_s;
+} mc_progress;
+
+typedef struct mc_job_status {
+    uint64_t job_id;
+    int state;
+    int32_t priority;
+    char user[256];
+    char label[1025];
+    char reason[1025];         /* why it failed or was cancelled; may be "" */
+    int64_t submit_ms, start_ms, end_ms;   /* Unix ms; 0 = not yet */
+    int has_progress;
+    mc_progress progress;      /* the latest, when has_progress */
+} mc_job_status;
+
+typedef struct mc_job_info {   /* one LIST row */
+    uint64_t job_id;
+    int state;
+    int32_t priority;
+    int64_t submit_ms;
+    char user[256];
+    char label[1025];
+    uint32_t outer, total;
+} mc_job_info;
+
+typedef struct mc_job_result {
+    mc_map_row *p; uint32_t np;          /* source -> target, one row per source vertex */
+    mc_map_row *q; uint32_t nq;          /* target -> source (bijective) */
+    unsigned char *deformed; size_t deformed_len;  /* Draco: the deformed source */
+    char **metric_keys; double *metric_values; uint32_t nmetrics;
+} mc_job_result;
+void mc_result_free(mc_job_result *r);
+
+typedef struct mc_server_stats {
+    uint32_t queued, running, workers;
+    uint64_t completed, failed, cancelled;
+    uint32_t nslots;
+    uint64_t *slot_job;                  /* nslots job ids (0 = idle or not yours) */
+    int *slot_state;                     /* 0 idle, 1 starting, 2 busy, 3 draining */
+    char devices[8][128]; uint32_t ndevices;
+} mc_server_stats;
+void mc_stats_free(mc_server_stats *s);
+
+/* address: "unix:PATH" or "tcp:HOST:PORT" (HOST a name or numeric address).
+ * token: NULL or "" on a Unix socket (the server asks the kernel who you
+ * are); the user's token on TCP. Sends HELLO; a refused token is
+ * MC_EUNAUTHORIZED. Detail in err. */
+int mc_connect(const char *address, const char *token, mc_client **out, char *err, size_t errsz);
+void mc_close(mc_client *c);
+void mc_set_timeout(mc_client *c, int ms);     /* <= 0: wait forever */
+const char *mc_errmsg(const mc_client *c);     /* detail of the last failure; "" after success */
+const char *mc_user(const mc_client *c);       /* the user the server took us for */
+int mc_is_admin(const mc_client *c);
+
+int mc_submit(mc_client *c, const mc_job_spec *spec, uint64_t *job_id);
+int mc_status(mc_client *c, uint64_t job_id, mc_job_status *out);
+/* Own jobs (user NULL) or another user's (admin); state_mask: bit s = state
+ * s, 0 = all. Every page is fetched; *jobs is free()d by the caller. */
+int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **jobs, uint32_t *n);
+/* Replays progress from outer iteration from_outer, then follows the job
+ * live, calling cb (may be NULL) for each record until the job ends; then
+ * *end_state is its final state and reason (may be NULL) its reason. A
+ * non-zero return of cb stops the watch and is returned; the client is then
+ * unusable (the server keeps streaming to it): close it. */
+typedef int (*mc_progress_fn)(void *ctx, const mc_progress *p);
+int mc_watch(mc_client *c, uint64_t job_id, uint32_t from_outer, mc_progress_fn cb, void *ctx,
+             int *end_state, char *reason, size_t reasonsz);
+int mc_result(mc_client *c, uint64_t job_id, unsigned what, mc_job_result *out);
+int mc_cancel(mc_client *c, uint64_t job_id);
+int mc_delete(mc_client *c, uint64_t job_id);
+int mc_stats(mc_client *c, mc_server_stats *out);
+int mc_ping(mc_client *c);
+
+/* Sends raw bytes as they are (testing and tools): one request, and waits
+ * for one reply frame of any kind; returns its error code if it is ERROR. */
+int mc_send_raw(mc_client *c, const void *bytes, size_t len);
+
+/* A mesh file (.off .obj .ply, or .drc sent as it is) as Draco bytes with
+ * the user's vertex order kept (the engine's order-preserving encoder).
+ * *bytes is malloc()ed. */
+int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,191 @@
+/* conf.c — meshcorrd's options: defaults, the command line and the config
+ * file (`key = value` lines, the same keys as the long options). One table
+ * lists every option once; nothing here opens sockets or the store. */
+#include "mcd.h"
+#include "util/errbuf.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG };
+
+#define OFF(f) offsetof(mcd_conf, f)
+static const struct option_def {
+    const char *name;
+    enum kind kind;
+    size_t off;
+    long long min, max;   /* numeric range */
+    const char *help;
+} options[] = {
+    {"listen", K_LISTEN, 0, 0, 0, "unix:PATH | tcp:HOST:PORT (repeatable; PORT 0 = any free port)"},
+    {"state-dir", K_PATH, OFF(state_dir), 0, 0, "DIR: jobs.db and spool/ (required)"},
+    {"workers", K_INT, OFF(workers), 1, 1024, "N worker slots (default 1)"},
+    {"config", K_CONFIG, 0, 0, 0, "FILE of `key = value` lines, read where it appears"},
+    {"tokens", K_PATH, OFF(tokens), 0, 0, "FILE of `token user [admin]` lines (TCP users)"},
+    {"worker", K_PATH, OFF(worker), 0, 0, "PATH of meshcorr-worker (default: next to meshcorrd)"},
+    {"threads-per-worker", K_INT, OFF(threads_per_worker), 0, 4096, "N OpenMP threads per worker (0: all)"},
+    {"max-frame", K_U32, OFF(max_frame), PROTO_HDR_SIZE + 1, PROTO_MAX_FRAME, "BYTES largest request frame"},
+    {"max-vertices", K_U32, OFF(max_vertices), 3, 20000000, "N vertices per mesh"},
+    {"max-landmarks", K_U32, OFF(max_landmarks), 0, PROTO_MAX_LANDMARKS, "N landmark pairs per job"},
+    {"max-jobs-per-user", K_U32, OFF(max_jobs_per_user), 1, 1000000, "N unfinished jobs per user"},
+    {"max-queue", K_U32, OFF(max_queue), 1, 10000000, "N pending jobs in all"},
+    {"job-timeout", K_U32, OFF(job_timeout_s), 1, 100000000, "SECONDS of wall time per job"},
+    {"result-ttl", K_U32, OFF(result_ttl_s), 1, 100000000, "SECONDS a finished job is kept"},
+    {"max-output", K_U32, OFF(max_output), 4096, 1u << 31, "BYTES queued to one client before a watcher is dropped"},
+    {"admin-uid", K_LONG, OFF(admin_uid), -1, INT_MAX, "UID treated as admin on the Unix socket (root always is)"},
+    {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp:HOST:PORT addresses to"},
+    {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
+};
+#define NOPTIONS (sizeof options / sizeof options[0])
+
+void conf_init(mcd_conf *c)
+{
+    memset(c, 0, sizeof *c);
+    c->workers = 1;
+    c->max_frame = PROTO_DEFAULT_MAX_FRAME;
+    c->max_vertices = CONF_DEFAULT_MAX_VERTICES;
+    c->max_landmarks = PROTO_MAX_LANDMARKS;
+    c->max_jobs_per_user = CONF_DEFAULT_MAX_JOBS_PER_USER;
+    c->max_queue = CONF_DEFAULT_MAX_QUEUE;
+    c->job_timeout_s = CONF_DEFAULT_JOB_TIMEOUT_S;
+    c->result_ttl_s = CONF_DEFAULT_RESULT_TTL_S;
+    c->max_output = CONF_DEFAULT_MAX_OUTPUT;
+    c->admin_uid = -1;
+    c->log_level = DLOG_INFO;
+}
+
+void conf_usage(FILE *fp)
+{
+    fprintf(fp, "usage: meshcorrd --state-dir DIR --listen ADDR [options]\n\noptions (also `key = value` in --config):\n");
+    for (size_t i = 0; i < NOPTIONS; i++)
+        fprintf(fp, "  --%-20s %s\n", options[i].name, options[i].help);
+}
+
+static int set_path(char *dst, const char *name, const char *v, char *err, size_t errsz)
+{
+    if (strlen(v) >= CONF_PATH)
+        return errbuf_set(err, errsz, -1, "--%s: path longer than %d bytes", name, CONF_PATH - 1);
+    strcpy(dst, v);
+    return 0;
+}
+
+int conf_set(mcd_conf *c, const char *key, const char *v, char *err, size_t errsz)
+{
+    const struct option_def *o = NULL;
+    for (size_t i = 0; i < NOPTIONS; i++)
+        if (strcmp(options[i].name, key) == 0)
+            o = &options[i];
+    if (!o)
+        return errbuf_set(err, errsz, -1, "unknown option '%s'", key);
+    char *field = (char *)c + o->off;
+    switch (o->kind) {
+    case K_PATH:
+        return set_path(field, o->name, v, err, errsz);
+    case K_LISTEN:
+        if (c->nlisten == CONF_MAX_LISTEN)
+            return errbuf_set(err, errsz, -1, "--listen: more than %d addresses", CONF_MAX_LISTEN);
+        if (strncmp(v, "unix:", 5) != 0 && strncmp(v, "tcp:", 4) != 0)
+            return errbuf_set(err, errsz, -1, "--listen: '%s' is not unix:PATH or tcp:HOST:PORT", v);
+        return set_path(c->listen[c->nlisten++], o->name, v, err, errsz);
+    case K_CONFIG:
+        return conf_load_file(c, v, err, errsz);
+    case K_LEVEL: {
+        static const char *names[] = {"error", "warn", "info", "debug"};
+        for (int i = 0; i < 4; i++)
+            if (strcmp(v, names[i]) == 0) {
+                c->log_level = i;
+                return 0;
+            }
+        return errbuf_set(err, errsz, -1, "--log-level: '%s' is not error, warn, info or debug", v);
+    }
+    default: {
+        char *e;
+        errno = 0;
+        long long n = strtoll(v, &e, 10);
+        if (*v == '\0' || *e != '\0' || errno || n < o->min || n > o->max)
+            return errbuf_set(err, errsz, -1, "--%s: '%s' is not an integer in [%lld, %lld]",
+                              o->name, v, o->min, o->max);
+        if (o->kind == K_U32)
+            *(uint32_t *)field = (uint32_t)n;
+        else if (o->kind == K_INT)
+            *(int *)field = (int)n;
+        else
+            *(long *)field = (long)n;
+        return 0;
+    }
+    }
+}
+
+static char *trim(char *s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    char *e = s + strlen(s);
+    while (e > s && isspace((unsigned char)e[-1]))
+        *--e = '\0';
+    return s;
+}
+
+int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz)
+{
+    FILE *fp = fopen(path, "r");
+    if (!fp)
+        return errbuf_set(err, errsz, -1, "%s: %s", path, strerror(errno));
+    char line[CONF_PATH + 128], sub[512];
+    int lineno = 0, rc = 0;
+    while (!rc && fgets(line, sizeof line, fp)) {
+        lineno++;
+        char *hash = strchr(line, '#');
+        if (hash)
+            *hash = '\0';
+        char *s = trim(line);
+        if (!*s)
+            continue;
+        char *eq = strchr(s, '=');
+        if (!eq) {
+            rc = errbuf_set(err, errsz, -1, "%s:%d: expected `key = value`", path, lineno);
+            break;
+        }
+        *eq = '\0';
+        if ((rc = conf_set(c, trim(s), trim(eq + 1), sub, sizeof sub)))
+            errbuf_set(err, errsz, rc, "%s:%d: %s", path, lineno, sub);
+    }
+    fclose(fp);
+    return rc;
+}
+
+int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0)
+            return 1;
+        if (strncmp(a, "--", 2) != 0)
+            return errbuf_set(err, errsz, -1, "unexpected argument '%s'", a);
+        char key[64];
+        const char *eq = strchr(a, '='), *val;
+        size_t klen = eq ? (size_t)(eq - a - 2) : strlen(a + 2);
+        if (klen >= sizeof key)
+            return errbuf_set(err, errsz, -1, "unknown option '%s'", a);
+        memcpy(key, a + 2, klen);
+        key[klen] = '\0';
+        if (eq) {
+            val = eq + 1;
+        } else {
+            if (i + 1 >= argc)
+                return errbuf_set(err, errsz, -1, "--%s needs a value", key);
+            val = argv[++i];
+        }
+        if (conf_set(c, key, val, err, errsz))
+            return -1;
+    }
+    if (!c->state_dir[0])
+        return errbuf_set(err, errsz, -1, "--state-dir is required");
+    if (c->nlisten == 0)
+        return errbuf_set(err, errsz, -1, "at least one --listen address is required");
+    return 0;
+}

@@ -1,0 +1,124 @@
+/* main.c — meshcorrd's main(): options, store recovery, the scheduler's
+ * queue rebuilt from the store, listeners, the result-expiry sweep and the
+ * signal handlers, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
+ * accepting, SIGTERM the workers, their jobs go back to PENDING, then close
+ * every handle and the store. Holds no request or job logic. */
+#include "mcd.h"
+
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int queue_pending(void *ctx, const store_job *j)
+{
+    mcd *d = ctx;
+    if (sched_add(d->sched, j->id, j->user, j->priority)) {
+        dlog(DLOG_ERROR, "out of memory rebuilding the queue");
+        return 1;
+    }
+    return 0;
+}
+
+static int expire_one(void *ctx, const store_job *j)
+{
+    mcd *d = ctx;
+    dlog(DLOG_INFO, "job %llu: %s result older than %u s: deleted", (unsigned long long)j->id,
+         proto_state_name(j->state), d->conf.result_ttl_s);
+    store_delete(d->store, j->id);
+    return 0;
+}
+
+static void on_sweep(uv_timer_t *t)
+{
+    mcd *d = t->data;
+    store_each_expired(d->store, store_now_ms() - (int64_t)d->conf.result_ttl_s * 1000, expire_one, d);
+}
+
+void mcd_drained(mcd *d)
+{
+    dlog(DLOG_INFO, "drained: no worker running; closing");
+    srv_close_all(d);
+    wsup_close(d);
+    uv_close((uv_handle_t *)&d->sweep, NULL);
+    uv_close((uv_handle_t *)&d->sigterm, NULL);
+    uv_close((uv_handle_t *)&d->sigint, NULL);
+}
+
+static void on_signal(uv_signal_t *h, int sig)
+{
+    mcd *d = h->data;
+    if (d->draining) {
+        dlog(DLOG_INFO, "signal %d: already shutting down", sig);
+        return;
+    }
+    d->draining = 1;
+    dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, wsup_busy(d));
+    srv_stop_listening(d);
+    wsup_drain(d);
+    if (!wsup_busy(d))
+        mcd_drained(d);
+}
+
+int main(int argc, char **argv)
+{
+    static mcd d;
+    char err[1024];
+    conf_init(&d.conf);
+    int rc = conf_parse_args(&d.conf, argc, argv, err, sizeof err);
+    if (rc == 1) {
+        conf_usage(stdout);
+        return 0;
+    }
+    if (rc) {
+        fprintf(stderr, "meshcorrd: %s\n", err);
+        conf_usage(stderr);
+        return 2;
+    }
+    dlog_set_level(d.conf.log_level);
+    signal(SIGPIPE, SIG_IGN);
+    int status = 1;
+    d.loop = uv_default_loop();
+    if (auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
+        store_open(d.conf.state_dir, &d.store, err, sizeof err) ||
+        store_recover(d.store, err, sizeof err)) {
+        dlog(DLOG_ERROR, "%s", err);
+        goto done;
+    }
+    if (!(d.sched = sched_new()) || store_each_pending(d.store, queue_pending, &d)) {
+        dlog(DLOG_ERROR, "cannot rebuild the queue from the store");
+        goto done;
+    }
+    if (wsup_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err)) {
+        dlog(DLOG_ERROR, "%s", err);
+        goto done;
+    }
+    uv_timer_init(d.loop, &d.sweep);
+    d.sweep.data = &d;
+    uint64_t every = d.conf.result_ttl_s < 60 ? d.conf.result_ttl_s * 1000ull : 60000;
+    uv_timer_start(&d.sweep, on_sweep, 0, every);
+    uv_signal_init(d.loop, &d.sigterm);
+    uv_signal_init(d.loop, &d.sigint);
+    d.sigterm.data = d.sigint.data = &d;
+    uv_signal_start(&d.sigterm, on_signal, SIGTERM);
+    uv_signal_start(&d.sigint, on_signal, SIGINT);
+    dlog(DLOG_INFO, "meshcorrd ready: %d worker slot(s), %u job(s) pending, state in %s", d.conf.workers,
+         sched_queued(d.sched), d.conf.state_dir);
+    wsup_schedule(&d);
+    uv_run(d.loop, UV_RUN_DEFAULT);
+    status = 0;
+    dlog(DLOG_INFO, "stopped");
+done:
+    if (status) {
+        /* a start-up failure: close whatever was opened */
+        srv_stop_listening(&d);
+        wsup_close(&d);
+        uv_run(d.loop, UV_RUN_NOWAIT);
+    }
+    uv_loop_close(d.loop);
+    store_close(d.store);
+    sched_free(d.sched);
+    auth_tokens_free(d.tokens);
+    free(d.slots);
+    free(d.listeners);
+    return status;
+}

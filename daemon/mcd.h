@@ -1,0 +1,213 @@
+/* mcd.h — meshcorrd's types and the functions each subsystem exports (one
+ * header for the program, as beanstalkd has). Subsystems, one file each:
+ *
+ *   conf.c   conf_   options from the command line and a `key = value` file
+ *   dlog.c   dlog_   leveled log lines on stderr
+ *   auth.c   auth_   tokens file (TCP) and peer credentials (Unix socket)
+ *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
+ *   sched.c  sched_  which pending job runs next (priority, fairness, age)
+ *   wsup.c   wsup_   worker processes: spawn, progress pipe, exit, timeouts
+ *   srv.c    srv_    libuv loop, listeners, connections, bounded buffers
+ *   req.c    req_    one handler per request type, WATCH fan-out
+ *   main.c          main(): wires the above together
+ *
+ * The DESIGN rule every module keeps: an acknowledged job is never lost.
+ * SUBMIT_OK goes out only after the spool file is fsynced and the row is
+ * committed; a job leaves the store only by DELETE or result expiry; a
+ * running job interrupted by anything but its own end goes back to PENDING. */
+#ifndef MCD_H
+#define MCD_H
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <uv.h>
+#include "proto.h"
+
+/* ---- conf_ ---------------------------------------------------------------- */
+#define CONF_MAX_LISTEN 8
+#define CONF_PATH 4096
+#define CONF_DEFAULT_MAX_QUEUE 1000
+#define CONF_DEFAULT_MAX_JOBS_PER_USER 100
+#define CONF_DEFAULT_MAX_VERTICES 2000000
+#define CONF_DEFAULT_JOB_TIMEOUT_S 86400
+#define CONF_DEFAULT_RESULT_TTL_S (7 * 86400)
+#define CONF_DEFAULT_MAX_OUTPUT (8u << 20)   /* bytes queued to one slow client */
+#define CONF_HELLO_MAX_FRAME 65536           /* frame limit before HELLO succeeds */
+#define CONF_KILL_GRACE_S 5                  /* SIGTERM -> SIGKILL */
+
+typedef struct mcd_conf {
+    char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH" or "tcp:HOST:PORT" */
+    int nlisten;
+    char state_dir[CONF_PATH];
+    char tokens[CONF_PATH];       /* "" = no TCP users */
+    char worker[CONF_PATH];       /* "" = meshcorr-worker next to meshcorrd */
+    char port_file[CONF_PATH];    /* "" = none; else bound TCP addresses, one a line */
+    int workers;                  /* worker slots (>= 1) */
+    int threads_per_worker;       /* 0 = the worker's default */
+    uint32_t max_frame, max_vertices, max_landmarks;
+    uint32_t max_jobs_per_user, max_queue;
+    uint32_t job_timeout_s, result_ttl_s;
+    uint32_t max_output;          /* output bytes queued per connection */
+    long admin_uid;               /* Unix-socket uid treated as admin; -1 none (root always) */
+    int log_level;                /* DLOG_* */
+} mcd_conf;
+
+void conf_init(mcd_conf *c);
+/* Applies argv (argv[0] skipped); --config FILE is read where it appears, so
+ * later options override it. 0, 1 when --help was given (usage printed), or
+ * -1 with the detail in err. */
+int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz);
+/* One option by its long name without dashes ("max-queue", "5"). */
+int conf_set(mcd_conf *c, const char *key, const char *value, char *err, size_t errsz);
+int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz);
+void conf_usage(FILE *fp);
+
+/* ---- dlog_ ---------------------------------------------------------------- */
+enum { DLOG_ERROR, DLOG_WARN, DLOG_INFO, DLOG_DEBUG };
+void dlog_set_level(int level);
+void dlog(int level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* ---- auth_ ---------------------------------------------------------------- */
+#define AUTH_MAX_USER 256
+typedef struct auth_tokens auth_tokens;
+/* Lines `token user [admin]`; '#' comments. A missing path gives an empty table. */
+int auth_tokens_load(const char *path, auth_tokens **out, char *err, size_t errsz);
+void auth_tokens_free(auth_tokens *t);
+/* 0 and the user for a known token, -1 otherwise. */
+int auth_token_user(const auth_tokens *t, const char *token, char user[AUTH_MAX_USER], int *admin);
+/* The Unix-socket peer's user from SO_PEERCRED; root and admin_uid are admin. */
+int auth_peer_user(int fd, long admin_uid, char user[AUTH_MAX_USER], int *admin,
+                   char *err, size_t errsz);
+
+/* ---- store_ --------------------------------------------------------------- */
+typedef struct store store;
+typedef struct store_job {
+    uint64_t id;
+    char user[AUTH_MAX_USER];
+    char label[PROTO_MAX_STRING + 1];
+    char reason[PROTO_MAX_STRING + 1];
+    int32_t priority;
+    int state;                    /* enum proto_state */
+    int64_t submit_ms, start_ms, end_ms;
+    uint32_t outer, total;        /* latest outer iteration, planned */
+} store_job;
+typedef int (*store_job_fn)(void *ctx, const store_job *j);          /* non-zero stops */
+typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zero stops */
+
+int64_t store_now_ms(void);
+/* Opens (creating) <dir>/jobs.db and <dir>/spool. */
+int store_open(const char *dir, store **out, char *err, size_t errsz);
+void store_close(store *s);
+/* After a restart: RUNNING jobs go back to PENDING (a leftover worker of the
+ * previous daemon is killed), spool dirs without a row are removed, unfinished
+ * rows without job.frame become FAILED. */
+int store_recover(store *s, char *err, size_t errsz);
+/* Durable insert: row and spool/<id>/job.frame (fsynced) in one transaction. */
+int store_submit(store *s, const char *user, const char *label, int32_t priority,
+                 uint32_t total, const char *params, const void *frame, size_t len,
+                 uint64_t *id, char *err, size_t errsz);
+int store_get(store *s, uint64_t id, store_job *out);  /* 0, PROTO_ENOT_FOUND, or error */
+int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid);
+/* PENDING clears the run's times; a terminal state sets end_ms and counts it. */
+int store_set_state(store *s, uint64_t id, int state, const char *reason);
+int store_add_progress(store *s, uint64_t id, const proto_progress *p);
+/* Drops a previous run's history and result files before a (re)run. */
+int store_clear_run(store *s, uint64_t id);
+int store_latest_progress(store *s, uint64_t id, proto_progress *out); /* 0 or NOT_FOUND */
+int store_history(store *s, uint64_t id, uint32_t from_outer, store_progress_fn fn, void *ctx);
+/* user NULL = every user; jobs with id > after_id in id order, at most max. */
+int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_id,
+               uint32_t max, store_job_fn fn, void *ctx);
+int store_each_pending(store *s, store_job_fn fn, void *ctx);
+/* Terminal jobs that ended before before_ms. */
+int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx);
+int store_delete(store *s, uint64_t id);
+void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *cancelled);
+/* <dir>/spool/<id>[/file] into buf. */
+const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz);
+int store_is_terminal(int state);
+
+/* ---- sched_ --------------------------------------------------------------- */
+typedef struct sched sched;
+sched *sched_new(void);
+void sched_free(sched *s);
+int sched_add(sched *s, uint64_t id, const char *user, int32_t priority); /* 0 or -1 nomem */
+int sched_remove(sched *s, uint64_t id);   /* a pending job leaves: 0, or -1 not queued */
+/* The next job to start (removed from the queue; its user counts one more
+ * running job); 0 when the queue is empty. */
+uint64_t sched_next(sched *s, char user[AUTH_MAX_USER]);
+void sched_done(sched *s, const char *user);        /* one of user's running jobs ended */
+uint32_t sched_queued(const sched *s);              /* pending, all users */
+uint32_t sched_user_pending(const sched *s, const char *user);
+uint32_t sched_user_running(const sched *s, const char *user);
+
+/* ---- the daemon ------------------------------------------------------------ */
+typedef struct conn conn;
+typedef struct wsup_slot wsup_slot;
+typedef struct req_watch req_watch;
+
+typedef struct mcd {
+    uv_loop_t *loop;
+    mcd_conf conf;
+    auth_tokens *tokens;
+    store *store;
+    sched *sched;
+    wsup_slot *slots;             /* conf.workers of them */
+    conn *conns;                  /* every open connection */
+    req_watch *watches;           /* every live WATCH */
+    uv_handle_t **listeners;
+    int nlisteners;
+    uv_signal_t sigterm, sigint;
+    uv_timer_t sweep;
+    int draining;                 /* shutdown started: no new work */
+} mcd;
+
+/* ---- wsup_ ---------------------------------------------------------------- */
+int wsup_init(mcd *d, char *err, size_t errsz);
+/* Starts pending jobs on idle slots while both exist. */
+void wsup_schedule(mcd *d);
+/* Sends SIGTERM to the worker running job id; 0, or -1 when none runs it. */
+int wsup_cancel(mcd *d, uint64_t id);
+/* Shutdown: SIGTERM every worker; their jobs return to PENDING. */
+void wsup_drain(mcd *d);
+int wsup_busy(const mcd *d);    /* slots not idle */
+/* Slot i's state (PROTO_SLOT_*) and job (0 = none). */
+void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
+void wsup_close(mcd *d);
+
+/* ---- srv_ ----------------------------------------------------------------- */
+int srv_listen(mcd *d, char *err, size_t errsz);
+void srv_stop_listening(mcd *d);
+void srv_close_all(mcd *d);
+/* Queues one encoded message; a connection over conf.max_output is paused
+ * (replies) or, with drop_if_full (WATCH frames), dropped. 0 or -1 dropped. */
+int srv_send(conn *c, const proto_msg *m, int drop_if_full);
+/* ERROR frame; close_after: close once it is written. */
+void srv_send_error(conn *c, uint32_t request_id, int code, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+void srv_close(conn *c);
+/* Stops reading and closes once the queued output is written. */
+void srv_close_soon(conn *c);
+
+/* What req_ needs to know about a connection. */
+typedef struct conn_auth {
+    int authed, admin, is_unix;
+    char user[AUTH_MAX_USER];
+} conn_auth;
+conn_auth *srv_conn_auth(conn *c);
+mcd *srv_conn_daemon(conn *c);
+int srv_conn_fd(conn *c);
+
+/* ---- main.c ---------------------------------------------------------------- */
+/* Called by wsup when the last worker has exited during a drain: closes what
+ * is left so the loop ends. */
+void mcd_drained(mcd *d);
+
+/* ---- req_ ----------------------------------------------------------------- */
+/* Handles one decoded request; frame/len are its raw bytes (SUBMIT spools them). */
+void req_handle(conn *c, const proto_msg *m, const void *frame, size_t len);
+void req_progress(mcd *d, const proto_progress *p);   /* fan out to watchers */
+void req_job_ended(mcd *d, uint64_t id);              /* END to watchers */
+void req_conn_closed(mcd *d, conn *c);                /* forget its watches */
+
+#endif

@@ -1,0 +1,551 @@
+/* req.c — one handler per request type (PROTOCOL.md, Messages) and the
+ * WATCH registry. Handlers check the session, the job's visibility and state,
+ * act through store_/sched_/wsup_, and answer through srv_send. Never reads a
+ * socket, never blocks on a client.
+ *
+ * DESIGN: visibility — a non-admin session sees only its user's jobs, and
+ * any other job is NOT_FOUND, exactly like a job that never existed, so ids
+ * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
+ * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
+ * anything is stored. Draco bytes are never decoded here (only workers do). */
+#include "mcd.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define REQ_LIST_PAGE 1000
+#define REQ_MAX_ITERATIONS 1000000u
+#define REQ_MAX_RESULT_FILE ((size_t)PROTO_MAX_FRAME)
+
+struct req_watch {
+    conn *c;                      /* NULL once the connection is gone */
+    uint32_t request_id;
+    uint64_t job_id;
+    uint32_t from_outer;
+    req_watch *next;
+};
+
+static int iterating;             /* fan-out in progress: unlink watches later */
+
+static void prune(mcd *d)
+{
+    if (iterating)
+        return;
+    for (req_watch **pw = &d->watches; *pw;) {
+        if (!(*pw)->c) {
+            req_watch *dead = *pw;
+            *pw = dead->next;
+            free(dead);
+        } else {
+            pw = &(*pw)->next;
+        }
+    }
+}
+
+void req_conn_closed(mcd *d, conn *c)
+{
+    for (req_watch *w = d->watches; w; w = w->next)
+        if (w->c == c)
+            w->c = NULL;
+    prune(d);
+}
+
+static void reply(conn *c, proto_msg *m, uint32_t request_id)
+{
+    m->request_id = request_id;
+    srv_send(c, m, 0);
+}
+
+static void reply_id(conn *c, int type, uint32_t request_id, uint64_t id)
+{
+    proto_msg m;
+    memset(&m, 0, sizeof m);
+    m.type = (uint8_t)type;
+    m.u.ok.job_id = id;
+    reply(c, &m, request_id);
+}
+
+/* The job if this session may see it; else NOT_FOUND already answered. */
+static int visible_job(conn *c, uint32_t rid, uint64_t id, store_job *j)
+{
+    conn_auth *a = srv_conn_auth(c);
+    int rc = store_get(srv_conn_daemon(c)->store, id, j);
+    if (rc == 0 && (a->admin || strcmp(j->user, a->user) == 0))
+        return 0;
+    if (rc == 0 || rc == PROTO_ENOT_FOUND)
+        srv_send_error(c, rid, PROTO_ENOT_FOUND, "no job %llu", (unsigned long long)id);
+    else
+        srv_send_error(c, rid, rc, "job store failure reading job %llu", (unsigned long long)id);
+    return -1;
+}
+
+static void on_hello(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    conn_auth *a = srv_conn_auth(c);
+    const proto_hello *h = &m->u.hello;
+    char err[256];
+    if (a->authed) {
+        srv_send_error(c, m->request_id, PROTO_EUNEXPECTED, "HELLO already done on this connection");
+        return;
+    }
+    int rc;
+    if (a->is_unix && h->token[0] == '\0')
+        rc = auth_peer_user(srv_conn_fd(c), d->conf.admin_uid, a->user, &a->admin, err, sizeof err);
+    else if ((rc = auth_token_user(d->tokens, h->token, a->user, &a->admin)) != 0)
+        snprintf(err, sizeof err, "unknown token");
+    if (rc) {
+        dlog(DLOG_WARN, "HELLO from client '%s' refused: %s", h->client, err);
+        srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "authentication failed: %s", err);
+        srv_close_soon(c);
+        return;
+    }
+    a->authed = 1;
+    dlog(DLOG_INFO, "session: user %s%s, client '%s' (protocol %u)", a->user, a->admin ? " (admin)" : "",
+         h->client, h->version);
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_HELLO_OK;
+    r.u.hello_ok.version = PROTO_VERSION;
+    r.u.hello_ok.user = a->user;
+    r.u.hello_ok.admin = (uint8_t)a->admin;
+    r.u.hello_ok.limits = (proto_limits){d->conf.max_frame, d->conf.max_vertices, d->conf.max_landmarks,
+                                         d->conf.max_jobs_per_user, d->conf.max_queue, d->conf.job_timeout_s};
+    reply(c, &r, m->request_id);
+}
+
+/* Structural checks the daemon can make without decoding Draco; the worker
+ * checks the meshes and the landmark ids against them. 0 or a code with msg. */
+static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t msz)
+{
+    const proto_params *p = &s->params;
+    const mcd_conf *cf = &d->conf;
+    if (s->source.len == 0 || s->target.len == 0)
+        return snprintf(msg, msz, "%s mesh: no Draco bytes", s->source.len ? "target" : "source"), PROTO_EBAD_MESH;
+    if (s->nlandmarks > cf->max_landmarks)
+        return snprintf(msg, msz, "landmark count %u over the server's limit (%u)", s->nlandmarks,
+                        cf->max_landmarks), PROTO_EBAD_LANDMARKS;
+    for (uint32_t i = 0; i < s->nlandmarks; i++)
+        if (s->landmarks[i].src >= cf->max_vertices || s->landmarks[i].tgt >= cf->max_vertices)
+            return snprintf(msg, msz, "landmark %u: vertex id over the vertex limit (%u)", i,
+                            cf->max_vertices), PROTO_EBAD_LANDMARKS;
+    if (s->p.n == 0 && s->nlandmarks < 4)
+        return snprintf(msg, msz, "need an initial map p or at least 4 landmark pairs (got %u)",
+                        s->nlandmarks), PROTO_EBAD_LANDMARKS;
+    if (s->p.n > cf->max_vertices || s->q.n > cf->max_vertices)
+        return snprintf(msg, msz, "initial map with %u rows over the vertex limit (%u)",
+                        s->p.n > s->q.n ? s->p.n : s->q.n, cf->max_vertices), PROTO_EBAD_PARAMS;
+    if (s->q.n && !s->p.n)
+        return snprintf(msg, msz, "initial map q without p"), PROTO_EBAD_PARAMS;
+    if (s->q.n && p->model == PROTO_MODEL_INJECTIVE)
+        return snprintf(msg, msz, "initial map q needs the bijective model"), PROTO_EBAD_PARAMS;
+    const struct { const char *name; double v, min; int open; } r[] = {
+        {"alpha", p->alpha, 0, 1}, {"eta", p->eta, 0, 0}, {"beta0", p->beta0, 0, 1},
+        {"beta1", p->beta1, 0, 1}, {"beta_ramp", p->beta_ramp, 1, 0}, {"gamma", p->gamma, 0, 0},
+        {"tolerance", p->tolerance, 0, 1}, {"stop_change", p->stop_change, 0, 0},
+    };
+    for (size_t i = 0; i < sizeof r / sizeof r[0]; i++)
+        if (!isfinite(r[i].v) || r[i].v < r[i].min || (r[i].open && r[i].v <= r[i].min))
+            return snprintf(msg, msz, "%s = %g: must be finite and %s 0", r[i].name, r[i].v,
+                            r[i].open ? ">" : ">="), PROTO_EBAD_PARAMS;
+    if (p->iterations < 1 || p->iterations > REQ_MAX_ITERATIONS ||
+        p->inner_iterations < 1 || p->inner_iterations > REQ_MAX_ITERATIONS)
+        return snprintf(msg, msz, "iterations %u / inner_iterations %u: must be in [1, %u]", p->iterations,
+                        p->inner_iterations, REQ_MAX_ITERATIONS), PROTO_EBAD_PARAMS;
+    if (p->backend[0] && strcmp(p->backend, "cpu") != 0)
+        return snprintf(msg, msz, "backend '%s': this server runs \"cpu\" only", p->backend), PROTO_EBAD_PARAMS;
+    return 0;
+}
+
+static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len)
+{
+    mcd *d = srv_conn_daemon(c);
+    conn_auth *a = srv_conn_auth(c);
+    const proto_submit *s = &m->u.submit;
+    char msg[PROTO_MAX_STRING];
+    int rc;
+    if (d->draining) {
+        srv_send_error(c, m->request_id, PROTO_ESHUTTING_DOWN, "the server is shutting down; retry later");
+        return;
+    }
+    if ((rc = check_submit(d, s, msg, sizeof msg))) {
+        srv_send_error(c, m->request_id, rc, "%s", msg);
+        return;
+    }
+    uint32_t mine = sched_user_pending(d->sched, a->user) + sched_user_running(d->sched, a->user);
+    if (mine >= d->conf.max_jobs_per_user) {
+        srv_send_error(c, m->request_id, PROTO_EUSER_LIMIT, "user %s already has %u unfinished jobs (limit %u)",
+                       a->user, mine, d->conf.max_jobs_per_user);
+        return;
+    }
+    if (sched_queued(d->sched) >= d->conf.max_queue) {
+        srv_send_error(c, m->request_id, PROTO_EQUEUE_FULL, "queue full: %u jobs pending (limit %u); nothing stored",
+                       sched_queued(d->sched), d->conf.max_queue);
+        return;
+    }
+    const proto_params *p = &s->params;
+    char params[512];
+    snprintf(params, sizeof params,
+             "model=%s partial=%u alpha=%g eta=%g beta0=%g beta1=%g beta_ramp=%u gamma=%g iterations=%u"
+             " inner=%u tolerance=%g stop_change=%g backend=%s landmarks=%u init_p=%u init_q=%u"
+             " source_bytes=%u target_bytes=%u",
+             p->model == PROTO_MODEL_BIJECTIVE ? "bijective" : "injective", p->partial, p->alpha, p->eta,
+             p->beta0, p->beta1, p->beta_ramp, p->gamma, p->iterations, p->inner_iterations, p->tolerance,
+             p->stop_change, p->backend[0] ? p->backend : "default", s->nlandmarks, s->p.n, s->q.n,
+             s->source.len, s->target.len);
+    uint64_t id;
+    if ((rc = store_submit(d->store, a->user, s->label, s->priority, p->iterations, params, frame, len,
+                           &id, msg, sizeof msg))) {
+        dlog(DLOG_ERROR, "SUBMIT from %s: %s", a->user, msg);
+        srv_send_error(c, m->request_id, rc, "job not stored: %s", msg);
+        return;
+    }
+    if (sched_add(d->sched, id, a->user, s->priority))
+        dlog(DLOG_ERROR, "job %llu: out of memory queueing it (it runs after a restart)", (unsigned long long)id);
+    dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', %s", (unsigned long long)id, a->user,
+         s->priority, s->label, params);
+    reply_id(c, PROTO_MSG_SUBMIT_OK, m->request_id, id);
+    wsup_schedule(d);
+}
+
+static void on_status(conn *c, const proto_msg *m)
+{
+    store_job j;
+    if (visible_job(c, m->request_id, m->u.status.job_id, &j))
+        return;
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_STATUS_OK;
+    proto_status_ok *s = &r.u.status_ok;
+    s->job_id = j.id;
+    s->state = (uint8_t)j.state;
+    s->priority = j.priority;
+    s->user = j.user;
+    s->label = j.label;
+    s->reason = j.reason;
+    s->submit_ms = j.submit_ms;
+    s->start_ms = j.start_ms;
+    s->end_ms = j.end_ms;
+    s->has_progress = store_latest_progress(srv_conn_daemon(c)->store, j.id, &s->progress) == 0;
+    reply(c, &r, m->request_id);
+}
+
+typedef struct list_ctx {
+    store_job *jobs;
+    uint32_t n, cap;
+} list_ctx;
+
+static int list_add(void *ctx, const store_job *j)
+{
+    list_ctx *l = ctx;
+    if (l->n == l->cap)
+        return 1;
+    l->jobs[l->n++] = *j;
+    return 0;
+}
+
+static void on_list(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    conn_auth *a = srv_conn_auth(c);
+    const proto_list *q = &m->u.list;
+    const char *user = q->user[0] ? q->user : a->user;
+    if (strcmp(user, a->user) != 0 && !a->admin) {
+        srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", user);
+        return;
+    }
+    uint32_t max = q->max_count ? q->max_count : REQ_LIST_PAGE;
+    if (max > PROTO_MAX_LIST)
+        max = PROTO_MAX_LIST;
+    list_ctx l = {calloc(max, sizeof(store_job)), 0, max};
+    proto_job_summary *sum = calloc(max, sizeof *sum);
+    if (!l.jobs || !sum) {
+        srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory for %u job summaries", max);
+        goto done;
+    }
+    int rc = store_list(d->store, user, q->state_mask, q->after_id, max, list_add, &l);
+    if (rc) {
+        srv_send_error(c, m->request_id, rc, "job store failure listing jobs");
+        goto done;
+    }
+    for (uint32_t i = 0; i < l.n; i++)
+        sum[i] = (proto_job_summary){l.jobs[i].id, (uint8_t)l.jobs[i].state, l.jobs[i].priority,
+                                     l.jobs[i].submit_ms, l.jobs[i].user, l.jobs[i].label,
+                                     l.jobs[i].outer, l.jobs[i].total};
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_LIST_OK;
+    r.u.list_ok.jobs = sum;
+    r.u.list_ok.n = l.n;
+    reply(c, &r, m->request_id);
+done:
+    free(l.jobs);
+    free(sum);
+}
+
+typedef struct replay_ctx {
+    conn *c;
+    uint32_t request_id;
+    int dropped;
+} replay_ctx;
+
+static int send_progress(conn *c, uint32_t rid, const proto_progress *p)
+{
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_PROGRESS;
+    r.request_id = rid;
+    r.u.progress = *p;
+    return srv_send(c, &r, 1);
+}
+
+static int replay_one(void *ctx, const proto_progress *p)
+{
+    replay_ctx *rc = ctx;
+    if (send_progress(rc->c, rc->request_id, p))
+        rc->dropped = 1;
+    return rc->dropped;
+}
+
+static int send_end(conn *c, uint32_t rid, const store_job *j)
+{
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_END;
+    r.request_id = rid;
+    r.u.end.job_id = j->id;
+    r.u.end.state = (uint8_t)j->state;
+    r.u.end.reason = j->reason;
+    return srv_send(c, &r, 1);
+}
+
+static void on_watch(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    const proto_watch *w = &m->u.watch;
+    store_job j;
+    if (visible_job(c, m->request_id, w->job_id, &j))
+        return;
+    replay_ctx rc = {c, m->request_id, 0};
+    if (store_history(d->store, j.id, w->from_outer, replay_one, &rc)) {
+        srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure reading the history of job %llu",
+                       (unsigned long long)j.id);
+        return;
+    }
+    if (rc.dropped)
+        return;
+    if (store_is_terminal(j.state)) {
+        send_end(c, m->request_id, &j);
+        return;
+    }
+    req_watch *nw = calloc(1, sizeof *nw);
+    if (!nw) {
+        srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory for the watch");
+        return;
+    }
+    *nw = (req_watch){c, m->request_id, j.id, w->from_outer, d->watches};
+    d->watches = nw;
+}
+
+void req_progress(mcd *d, const proto_progress *p)
+{
+    iterating = 1;
+    for (req_watch *w = d->watches; w; w = w->next)
+        if (w->c && w->job_id == p->job_id && p->outer >= w->from_outer)
+            send_progress(w->c, w->request_id, p);
+    iterating = 0;
+    prune(d);
+}
+
+void req_job_ended(mcd *d, uint64_t id)
+{
+    store_job j;
+    if (store_get(d->store, id, &j))
+        return;
+    iterating = 1;
+    for (req_watch *w = d->watches; w; w = w->next)
+        if (w->c && w->job_id == id) {
+            conn *c = w->c;
+            w->c = NULL;
+            send_end(c, w->request_id, &j);
+        }
+    iterating = 0;
+    prune(d);
+}
+
+static void on_cancel(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    store_job j;
+    if (visible_job(c, m->request_id, m->u.cancel.job_id, &j))
+        return;
+    if (j.state == PROTO_STATE_PENDING) {
+        sched_remove(d->sched, j.id);
+        if (store_set_state(d->store, j.id, PROTO_STATE_CANCELLED, "cancelled by request before it ran")) {
+            srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure cancelling job %llu",
+                           (unsigned long long)j.id);
+            return;
+        }
+        dlog(DLOG_INFO, "job %llu: CANCELLED while pending", (unsigned long long)j.id);
+        req_job_ended(d, j.id);
+    } else if (j.state != PROTO_STATE_RUNNING || wsup_cancel(d, j.id) != 0) {
+        srv_send_error(c, m->request_id, PROTO_EBAD_STATE, "job %llu is %s: nothing to cancel",
+                       (unsigned long long)j.id, proto_state_name(j.state));
+        return;
+    } else {
+        dlog(DLOG_INFO, "job %llu: cancel requested: SIGTERM to its worker", (unsigned long long)j.id);
+    }
+    reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
+}
+
+static void on_result(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    const proto_result *q = &m->u.result;
+    store_job j;
+    if (visible_job(c, m->request_id, q->job_id, &j))
+        return;
+    if (j.state != PROTO_STATE_COMPLETED) {
+        srv_send_error(c, m->request_id, PROTO_EBAD_STATE, "job %llu is %s: results exist for COMPLETED jobs only",
+                       (unsigned long long)j.id, proto_state_name(j.state));
+        return;
+    }
+    char path[CONF_PATH + 64], err[256];
+    store_spool_path(d->store, j.id, "result.frame", path, sizeof path);
+    FILE *fp = fopen(path, "rb");
+    uint8_t *buf = NULL;
+    size_t n = 0;
+    if (fp) {
+        fseek(fp, 0, SEEK_END);
+        long sz = ftell(fp);
+        fseek(fp, 0, SEEK_SET);
+        if (sz > 0 && (size_t)sz <= REQ_MAX_RESULT_FILE && (buf = malloc((size_t)sz)))
+            n = fread(buf, 1, (size_t)sz, fp);
+        fclose(fp);
+    }
+    proto_msg res;
+    size_t used;
+    int rc = buf ? proto_decode(buf, n, PROTO_MAX_FRAME, &res, &used, err, sizeof err) : PROTO_EINTERNAL;
+    if (rc != PROTO_READY || res.type != PROTO_MSG_RESULT_OK) {
+        dlog(DLOG_ERROR, "job %llu: result.frame unreadable: %s", (unsigned long long)j.id,
+             rc < 0 ? err : "missing or wrong type");
+        srv_send_error(c, m->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
+                       (unsigned long long)j.id);
+        if (rc == PROTO_READY)
+            proto_msg_free(&res);
+        free(buf);
+        return;
+    }
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_RESULT_OK;
+    proto_result_ok *o = &r.u.result_ok;
+    o->job_id = j.id;
+    if (q->what & PROTO_WANT_P)
+        o->p = res.u.result_ok.p;
+    if (q->what & PROTO_WANT_Q)
+        o->q = res.u.result_ok.q;
+    if (q->what & PROTO_WANT_DEFORMED)
+        o->deformed = res.u.result_ok.deformed;
+    if (q->what & PROTO_WANT_METRICS) {
+        o->metrics = res.u.result_ok.metrics;
+        o->nmetrics = res.u.result_ok.nmetrics;
+    }
+    reply(c, &r, m->request_id);
+    proto_msg_free(&res);
+    free(buf);
+}
+
+static void on_delete(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    store_job j;
+    if (visible_job(c, m->request_id, m->u.del.job_id, &j))
+        return;
+    if (!store_is_terminal(j.state)) {
+        srv_send_error(c, m->request_id, PROTO_EBAD_STATE, "job %llu is %s: cancel it first",
+                       (unsigned long long)j.id, proto_state_name(j.state));
+        return;
+    }
+    if (store_delete(d->store, j.id)) {
+        srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure deleting job %llu",
+                       (unsigned long long)j.id);
+        return;
+    }
+    dlog(DLOG_INFO, "job %llu: deleted by %s", (unsigned long long)j.id, srv_conn_auth(c)->user);
+    reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
+}
+
+static void on_stats(conn *c, const proto_msg *m)
+{
+    mcd *d = srv_conn_daemon(c);
+    conn_auth *a = srv_conn_auth(c);
+    proto_msg r;
+    memset(&r, 0, sizeof r);
+    r.type = PROTO_MSG_STATS_OK;
+    proto_stats_ok *s = &r.u.stats_ok;
+    int nslots = d->conf.workers > (int)PROTO_MAX_SLOTS ? (int)PROTO_MAX_SLOTS : d->conf.workers;
+    proto_slot *slots = calloc((size_t)nslots, sizeof *slots);
+    if (!slots) {
+        srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory");
+        return;
+    }
+    uint32_t running = 0;
+    for (int i = 0; i < nslots; i++) {
+        wsup_slot_info(d, i, &slots[i].state, &slots[i].job_id);
+        store_job j;
+        if (slots[i].job_id && !a->admin &&
+            (store_get(d->store, slots[i].job_id, &j) || strcmp(j.user, a->user) != 0))
+            slots[i].job_id = 0;
+        running += slots[i].state != PROTO_SLOT_IDLE && (a->admin || slots[i].job_id);
+    }
+    s->queued = a->admin ? sched_queued(d->sched) : sched_user_pending(d->sched, a->user);
+    s->running = running;
+    s->workers = (uint32_t)d->conf.workers;
+    store_counters(d->store, &s->completed, &s->failed, &s->cancelled);
+    s->slots = slots;
+    s->nslots = (uint32_t)nslots;
+    char dev[64];
+    long ncpu = d->conf.threads_per_worker ? d->conf.threads_per_worker : sysconf(_SC_NPROCESSORS_ONLN);
+    snprintf(dev, sizeof dev, "cpu:%ld", ncpu);
+    const char *devs[1] = {dev};
+    s->devices = devs;
+    s->ndevices = 1;
+    reply(c, &r, m->request_id);
+    free(slots);
+}
+
+void req_handle(conn *c, const proto_msg *m, const void *frame, size_t len)
+{
+    conn_auth *a = srv_conn_auth(c);
+    if (!a->authed && m->type != PROTO_MSG_HELLO) {
+        dlog(DLOG_WARN, "%s before HELLO: closing", proto_type_name(m->type));
+        srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "%s before HELLO", proto_type_name(m->type));
+        srv_close_soon(c);
+        return;
+    }
+    dlog(DLOG_DEBUG, "%s: %s (request %u)", a->authed ? a->user : "-", proto_type_name(m->type), m->request_id);
+    switch (m->type) {
+    case PROTO_MSG_HELLO:  on_hello(c, m); break;
+    case PROTO_MSG_SUBMIT: on_submit(c, m, frame, len); break;
+    case PROTO_MSG_STATUS: on_status(c, m); break;
+    case PROTO_MSG_LIST:   on_list(c, m); break;
+    case PROTO_MSG_WATCH:  on_watch(c, m); break;
+    case PROTO_MSG_CANCEL: on_cancel(c, m); break;
+    case PROTO_MSG_RESULT: on_result(c, m); break;
+    case PROTO_MSG_DELETE: on_delete(c, m); break;
+    case PROTO_MSG_STATS:  on_stats(c, m); break;
+    case PROTO_MSG_PING: {
+        proto_msg r;
+        memset(&r, 0, sizeof r);
+        r.type = PROTO_MSG_PONG;
+        reply(c, &r, m->request_id);
+        break;
+    }
+    default:
+        srv_send_error(c, m->request_id, PROTO_EUNEXPECTED, "%s is a reply; the server does not take it",
+                       proto_type_name(m->type));
+    }
+}

@@ -1,0 +1,580 @@
+/* store.c — the job store: SQLite in WAL mode (<state-dir>/jobs.db) and the
+ * spool directories (<state-dir>/spool/<id>/).
+ *
+ * DESIGN: an acknowledged job is never lost. store_submit writes
+ * spool/<id>/job.frame (tmp, fsync, rename, fsync the directories) inside the
+ * transaction that inserts the row and commits only after that, with
+ * synchronous=FULL; the caller answers SUBMIT_OK only after it returns 0. A
+ * crash between the two leaves a spool directory without a row, which
+ * store_recover removes (the client never heard of that job). Ids come from
+ * AUTOINCREMENT and are never reused.
+ *
+ * Tables: jobs (one row per job; state as its Slurm name; the latest outer
+ * iteration and energy), history (one row per PROGRESS record), counters
+ * (jobs ended per final state since the store was created). Runs in the
+ * event loop thread only; it never talks to clients or workers. */
+#include "mcd.h"
+#include "util/errbuf.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <sqlite3.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+struct store {
+    sqlite3 *db;
+    char dir[CONF_PATH];
+};
+
+static const char schema[] =
+    "CREATE TABLE IF NOT EXISTS jobs("
+    " id INTEGER PRIMARY KEY AUTOINCREMENT,"
+    " user TEXT NOT NULL, label TEXT NOT NULL, priority INTEGER NOT NULL,"
+    " state TEXT NOT NULL, reason TEXT NOT NULL DEFAULT '',"
+    " submit_ms INTEGER NOT NULL, start_ms INTEGER NOT NULL DEFAULT 0,"
+    " end_ms INTEGER NOT NULL DEFAULT 0,"
+    " params TEXT NOT NULL,"               /* parameter summary, for people */
+    " total INTEGER NOT NULL,"             /* planned outer iterations */
+    " outer_it INTEGER NOT NULL DEFAULT 0," /* latest progress */
+    " energy REAL,"
+    " pid INTEGER NOT NULL DEFAULT 0);"    /* worker of the current run */
+    "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
+    "CREATE TABLE IF NOT EXISTS history("
+    " job INTEGER NOT NULL, stage INTEGER NOT NULL, outer_it INTEGER NOT NULL,"
+    " total INTEGER NOT NULL, inner0 INTEGER NOT NULL, inner1 INTEGER NOT NULL,"
+    " membrane0 REAL, bending0 REAL, mismatch0 REAL, reverse0 REAL, energy0 REAL,"
+    " membrane1 REAL, bending1 REAL, mismatch1 REAL, reverse1 REAL, energy1 REAL,"
+    " beta REAL, gamma REAL, elapsed_s REAL);"
+    "CREATE INDEX IF NOT EXISTS history_job ON history(job, outer_it);"
+    "CREATE TABLE IF NOT EXISTS counters(name TEXT PRIMARY KEY, value INTEGER NOT NULL);";
+
+#define HISTORY_COLS "stage, outer_it, total, inner0, inner1, membrane0, bending0, mismatch0," \
+    " reverse0, energy0, membrane1, bending1, mismatch1, reverse1, energy1, beta, gamma, elapsed_s"
+#define JOB_COLS "id, user, label, priority, state, reason, submit_ms, start_ms, end_ms, outer_it, total"
+
+int64_t store_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+int store_is_terminal(int state)
+{
+    return state != PROTO_STATE_PENDING && state != PROTO_STATE_RUNNING;
+}
+
+static int state_from_name(const char *s)
+{
+    for (int i = 0; i <= PROTO_STATE_LAST; i++)
+        if (strcmp(s, proto_state_name(i)) == 0)
+            return i;
+    return PROTO_STATE_FAILED;
+}
+
+const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz)
+{
+    if (file)
+        snprintf(buf, sz, "%s/spool/%llu/%s", s->dir, (unsigned long long)id, file);
+    else
+        snprintf(buf, sz, "%s/spool/%llu", s->dir, (unsigned long long)id);
+    return buf;
+}
+
+/* Runs one statement with optional int64/text binds given as a format:
+ * 'i' int64_t, 't' const char *, 'd' double. */
+static int exec_v(store *s, const char *sql, const char *fmt, ...)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL) != SQLITE_OK) {
+        dlog(DLOG_ERROR, "store: %s: %s", sql, sqlite3_errmsg(s->db));
+        return PROTO_ESTORAGE;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    for (int i = 0; fmt && fmt[i]; i++) {
+        if (fmt[i] == 'i')
+            sqlite3_bind_int64(st, i + 1, va_arg(ap, int64_t));
+        else if (fmt[i] == 'd')
+            sqlite3_bind_double(st, i + 1, va_arg(ap, double));
+        else
+            sqlite3_bind_text(st, i + 1, va_arg(ap, const char *), -1, SQLITE_TRANSIENT);
+    }
+    va_end(ap);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE && rc != SQLITE_ROW) {
+        dlog(DLOG_ERROR, "store: %s: %s", sql, sqlite3_errmsg(s->db));
+        return PROTO_ESTORAGE;
+    }
+    return 0;
+}
+
+static int fsync_path(const char *path)
+{
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return -1;
+    int rc = fsync(fd);
+    close(fd);
+    return rc;
+}
+
+/* Removes spool/<id>/ and the files in it (the directory is flat). */
+static void spool_remove(const store *s, uint64_t id)
+{
+    char dir[CONF_PATH + 64], path[CONF_PATH + 400];
+    store_spool_path(s, id, NULL, dir, sizeof dir);
+    DIR *dp = opendir(dir);
+    if (!dp)
+        return;
+    struct dirent *de;
+    while ((de = readdir(dp)))
+        if (strcmp(de->d_name, ".") && strcmp(de->d_name, "..")) {
+            snprintf(path, sizeof path, "%s/%s", dir, de->d_name);
+            unlink(path);
+        }
+    closedir(dp);
+    if (rmdir(dir) != 0)
+        dlog(DLOG_WARN, "store: cannot remove %s: %s", dir, strerror(errno));
+}
+
+int store_open(const char *dir, store **out, char *err, size_t errsz)
+{
+    *out = NULL;
+    store *s = calloc(1, sizeof *s);
+    if (!s)
+        return errbuf_set(err, errsz, PROTO_ENOMEM, "out of memory");
+    snprintf(s->dir, sizeof s->dir, "%s", dir);
+    char path[CONF_PATH + 32];
+    int rc = PROTO_ESTORAGE;
+    if (mkdir(dir, 0700) != 0 && errno != EEXIST) {
+        errbuf_set(err, errsz, rc, "%s: %s", dir, strerror(errno));
+        goto fail;
+    }
+    snprintf(path, sizeof path, "%s/spool", dir);
+    if (mkdir(path, 0700) != 0 && errno != EEXIST) {
+        errbuf_set(err, errsz, rc, "%s: %s", path, strerror(errno));
+        goto fail;
+    }
+    snprintf(path, sizeof path, "%s/jobs.db", dir);
+    if (sqlite3_open_v2(path, &s->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK) {
+        errbuf_set(err, errsz, rc, "%s: %s", path, s->db ? sqlite3_errmsg(s->db) : "cannot open");
+        goto fail;
+    }
+    char *msg = NULL;
+    if (sqlite3_exec(s->db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
+                     "PRAGMA busy_timeout=5000;", NULL, NULL, &msg) != SQLITE_OK ||
+        sqlite3_exec(s->db, schema, NULL, NULL, &msg) != SQLITE_OK) {
+        errbuf_set(err, errsz, rc, "%s: %s", path, msg ? msg : "cannot set up");
+        sqlite3_free(msg);
+        goto fail;
+    }
+    *out = s;
+    return 0;
+fail:
+    store_close(s);
+    return rc;
+}
+
+void store_close(store *s)
+{
+    if (!s)
+        return;
+    if (s->db) {
+        if (sqlite3_close(s->db) != SQLITE_OK)
+            dlog(DLOG_ERROR, "store: close: %s", sqlite3_errmsg(s->db));
+    }
+    free(s);
+}
+
+/* The leftover worker of a previous daemon still running job id: its
+ * /proc/<pid>/cmdline holds "--job-id" followed by the id. */
+static void kill_leftover_worker(long pid, uint64_t id)
+{
+    if (pid <= 0)
+        return;
+    char path[64], cmd[8192], want[32];
+    snprintf(path, sizeof path, "/proc/%ld/cmdline", pid);
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return;
+    ssize_t n = read(fd, cmd, sizeof cmd - 1);
+    close(fd);
+    if (n <= 0)
+        return;
+    cmd[n] = '\0';
+    snprintf(want, sizeof want, "%llu", (unsigned long long)id);
+    for (ssize_t i = 0; i < n; i += (ssize_t)strlen(cmd + i) + 1)
+        if (strcmp(cmd + i, "--job-id") == 0 && i + 9 < n && strcmp(cmd + i + 9, want) == 0) {
+            dlog(DLOG_WARN, "store: killing leftover worker %ld of job %s", pid, want);
+            kill((pid_t)pid, SIGKILL);
+            return;
+        }
+}
+
+int store_recover(store *s, char *err, size_t errsz)
+{
+    sqlite3_stmt *st;
+    int rc = 0;
+    /* 1. RUNNING -> PENDING (the run was cut off by the daemon's end). */
+    if (sqlite3_prepare_v2(s->db, "SELECT id, pid FROM jobs WHERE state = 'RUNNING'", -1, &st, NULL) != SQLITE_OK)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
+    while (sqlite3_step(st) == SQLITE_ROW)
+        kill_leftover_worker((long)sqlite3_column_int64(st, 1), (uint64_t)sqlite3_column_int64(st, 0));
+    sqlite3_finalize(st);
+    if ((rc = exec_v(s, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
+                     " energy = NULL WHERE state = 'RUNNING'", NULL)))
+        return errbuf_set(err, errsz, rc, "recover: cannot re-queue running jobs");
+    int requeued = sqlite3_changes(s->db);
+    /* 2. spool directories without a committed row. */
+    char spool[CONF_PATH + 16];
+    snprintf(spool, sizeof spool, "%s/spool", s->dir);
+    DIR *dp = opendir(spool);
+    if (!dp)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
+    struct dirent *de;
+    int removed = 0;
+    while ((de = readdir(dp))) {
+        char *e;
+        unsigned long long id = strtoull(de->d_name, &e, 10);
+        if (de->d_name[0] == '.' || *e != '\0' || id == 0)
+            continue;
+        store_job j;
+        if (store_get(s, id, &j) == PROTO_ENOT_FOUND) {
+            spool_remove(s, id);
+            removed++;
+        }
+    }
+    closedir(dp);
+    /* 3. unfinished rows whose job.frame is gone. */
+    if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs WHERE state = 'PENDING'", -1, &st, NULL) != SQLITE_OK)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
+    uint64_t *lost = NULL;
+    size_t nlost = 0;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+        uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
+        char path[CONF_PATH + 64];
+        if (access(store_spool_path(s, id, "job.frame", path, sizeof path), R_OK) != 0) {
+            uint64_t *l = realloc(lost, (nlost + 1) * sizeof *l);
+            if (l) {
+                lost = l;
+                lost[nlost++] = id;
+            }
+        }
+    }
+    sqlite3_finalize(st);
+    for (size_t i = 0; i < nlost; i++) {
+        dlog(DLOG_WARN, "store: job %llu has no spool/job.frame: FAILED", (unsigned long long)lost[i]);
+        store_set_state(s, lost[i], PROTO_STATE_FAILED, "spool file job.frame missing after restart");
+    }
+    free(lost);
+    dlog(DLOG_INFO, "store: recovered: %d running job(s) re-queued, %d orphan spool dir(s) removed,"
+         " %zu job(s) without spool failed", requeued, removed, nlost);
+    return 0;
+}
+
+int store_submit(store *s, const char *user, const char *label, int32_t priority,
+                 uint32_t total, const char *params, const void *frame, size_t len,
+                 uint64_t *id, char *err, size_t errsz)
+{
+    char dir[CONF_PATH + 64], tmp[CONF_PATH + 96], fin[CONF_PATH + 96], spool[CONF_PATH + 16];
+    int fd = -1, made_dir = 0;
+    uint64_t jid = 0;
+    if (exec_v(s, "BEGIN IMMEDIATE", NULL))
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "job database busy or failing");
+    if (exec_v(s, "INSERT INTO jobs(user, label, priority, state, submit_ms, params, total)"
+               " VALUES(?, ?, ?, 'PENDING', ?, ?, ?)", "ttiiti", user, label, (int64_t)priority,
+               store_now_ms(), params, (int64_t)total)) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "cannot insert the job row");
+        goto fail;
+    }
+    jid = (uint64_t)sqlite3_last_insert_rowid(s->db);
+    store_spool_path(s, jid, NULL, dir, sizeof dir);
+    snprintf(tmp, sizeof tmp, "%s/job.frame.tmp", dir);
+    snprintf(fin, sizeof fin, "%s/job.frame", dir);
+    snprintf(spool, sizeof spool, "%s/spool", s->dir);
+    if (mkdir(dir, 0700) != 0) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", dir, strerror(errno));
+        goto fail;
+    }
+    made_dir = 1;
+    fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", tmp, strerror(errno));
+        goto fail;
+    }
+    for (size_t off = 0; off < len;) {
+        ssize_t w = write(fd, (const char *)frame + off, len - off);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0) {
+            errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", tmp, strerror(w < 0 ? errno : EIO));
+            goto fail;
+        }
+        off += (size_t)w;
+    }
+    if (fsync(fd) != 0 || close(fd) != 0) {
+        fd = -1;
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: fsync: %s", tmp, strerror(errno));
+        goto fail;
+    }
+    fd = -1;
+    if (rename(tmp, fin) != 0 || fsync_path(dir) != 0 || fsync_path(spool) != 0) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", fin, strerror(errno));
+        goto fail;
+    }
+    if (exec_v(s, "COMMIT", NULL)) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "cannot commit the job row");
+        goto fail;
+    }
+    *id = jid;
+    return 0;
+fail:
+    if (fd >= 0)
+        close(fd);
+    exec_v(s, "ROLLBACK", NULL);
+    if (made_dir)
+        spool_remove(s, jid);
+    return PROTO_ESTORAGE;
+}
+
+static void read_job(sqlite3_stmt *st, store_job *j)
+{
+    memset(j, 0, sizeof *j);
+    j->id = (uint64_t)sqlite3_column_int64(st, 0);
+    snprintf(j->user, sizeof j->user, "%s", (const char *)sqlite3_column_text(st, 1));
+    snprintf(j->label, sizeof j->label, "%s", (const char *)sqlite3_column_text(st, 2));
+    j->priority = (int32_t)sqlite3_column_int64(st, 3);
+    j->state = state_from_name((const char *)sqlite3_column_text(st, 4));
+    snprintf(j->reason, sizeof j->reason, "%s", (const char *)sqlite3_column_text(st, 5));
+    j->submit_ms = sqlite3_column_int64(st, 6);
+    j->start_ms = sqlite3_column_int64(st, 7);
+    j->end_ms = sqlite3_column_int64(st, 8);
+    j->outer = (uint32_t)sqlite3_column_int64(st, 9);
+    j->total = (uint32_t)sqlite3_column_int64(st, 10);
+}
+
+int store_get(store *s, uint64_t id, store_job *out)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE id = ?", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, (int64_t)id);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        read_job(st, out);
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW ? 0 : rc == SQLITE_DONE ? PROTO_ENOT_FOUND : PROTO_ESTORAGE;
+}
+
+int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid)
+{
+    return exec_v(s, "UPDATE jobs SET state = 'RUNNING', start_ms = ?, pid = ?, reason = '' WHERE id = ?",
+                  "iii", start_ms, (int64_t)pid, (int64_t)id);
+}
+
+int store_set_state(store *s, uint64_t id, int state, const char *reason)
+{
+    if (!store_is_terminal(state))
+        return exec_v(s, "UPDATE jobs SET state = ?, reason = ?, start_ms = 0, end_ms = 0, pid = 0,"
+                      " outer_it = 0, energy = NULL WHERE id = ?", "tti",
+                      proto_state_name(state), reason ? reason : "", (int64_t)id);
+    const char *counter = state == PROTO_STATE_COMPLETED ? "completed"
+                        : state == PROTO_STATE_CANCELLED ? "cancelled" : "failed";
+    int rc = exec_v(s, "BEGIN", NULL);
+    if (!rc)
+        rc = exec_v(s, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0 WHERE id = ?", "ttii",
+                    proto_state_name(state), reason ? reason : "", store_now_ms(), (int64_t)id);
+    if (!rc)
+        rc = exec_v(s, "INSERT INTO counters(name, value) VALUES(?, 1)"
+                    " ON CONFLICT(name) DO UPDATE SET value = value + 1", "t", counter);
+    if (!rc)
+        rc = exec_v(s, "COMMIT", NULL);
+    if (rc)
+        exec_v(s, "ROLLBACK", NULL);
+    return rc;
+}
+
+int store_add_progress(store *s, uint64_t id, const proto_progress *p)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "INSERT INTO history(job, " HISTORY_COLS ") VALUES"
+                           "(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    int k = 1;
+    sqlite3_bind_int64(st, k++, (int64_t)id);
+    sqlite3_bind_int64(st, k++, p->stage);
+    sqlite3_bind_int64(st, k++, p->outer);
+    sqlite3_bind_int64(st, k++, p->total);
+    sqlite3_bind_int64(st, k++, p->inner[0]);
+    sqlite3_bind_int64(st, k++, p->inner[1]);
+    for (int d = 0; d < 2; d++)
+        for (int t = 0; t < PROTO_NTERMS; t++)
+            sqlite3_bind_double(st, k++, p->terms[d][t]);
+    sqlite3_bind_double(st, k++, p->beta);
+    sqlite3_bind_double(st, k++, p->gamma);
+    sqlite3_bind_double(st, k++, p->elapsed_s);
+    int rc = sqlite3_step(st);
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE)
+        return PROTO_ESTORAGE;
+    return exec_v(s, "UPDATE jobs SET outer_it = ?, total = ?, energy = ? WHERE id = ?", "iidi",
+                  (int64_t)p->outer, (int64_t)p->total,
+                  p->terms[0][PROTO_TERM_ENERGY] + p->terms[1][PROTO_TERM_ENERGY], (int64_t)id);
+}
+
+int store_clear_run(store *s, uint64_t id)
+{
+    char path[CONF_PATH + 96];
+    static const char *files[] = {"result.frame", "result.frame.tmp", "error.frame", "error.frame.tmp"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
+        unlink(store_spool_path(s, id, files[i], path, sizeof path));
+    return exec_v(s, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
+}
+
+static void read_progress(sqlite3_stmt *st, uint64_t id, proto_progress *p)
+{
+    int k = 0;
+    memset(p, 0, sizeof *p);
+    p->job_id = id;
+    p->stage = (uint8_t)sqlite3_column_int64(st, k++);
+    p->outer = (uint32_t)sqlite3_column_int64(st, k++);
+    p->total = (uint32_t)sqlite3_column_int64(st, k++);
+    p->inner[0] = (uint32_t)sqlite3_column_int64(st, k++);
+    p->inner[1] = (uint32_t)sqlite3_column_int64(st, k++);
+    for (int d = 0; d < 2; d++)
+        for (int t = 0; t < PROTO_NTERMS; t++)
+            p->terms[d][t] = sqlite3_column_double(st, k++);
+    p->beta = sqlite3_column_double(st, k++);
+    p->gamma = sqlite3_column_double(st, k++);
+    p->elapsed_s = sqlite3_column_double(st, k++);
+}
+
+int store_latest_progress(store *s, uint64_t id, proto_progress *out)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT " HISTORY_COLS " FROM history WHERE job = ?"
+                           " ORDER BY rowid DESC LIMIT 1", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, (int64_t)id);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        read_progress(st, id, out);
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW ? 0 : PROTO_ENOT_FOUND;
+}
+
+int store_history(store *s, uint64_t id, uint32_t from_outer, store_progress_fn fn, void *ctx)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT " HISTORY_COLS " FROM history WHERE job = ? AND outer_it >= ?"
+                           " ORDER BY rowid", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, (int64_t)id);
+    sqlite3_bind_int64(st, 2, from_outer);
+    int rc;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        proto_progress p;
+        read_progress(st, id, &p);
+        if (fn(ctx, &p))
+            break;
+    }
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW || rc == SQLITE_DONE ? 0 : PROTO_ESTORAGE;
+}
+
+static int each_job(store *s, sqlite3_stmt *st, store_job_fn fn, void *ctx)
+{
+    int rc;
+    store_job j;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        read_job(st, &j);
+        if (fn(ctx, &j))
+            break;
+    }
+    sqlite3_finalize(st);
+    (void)s;
+    return rc == SQLITE_ROW || rc == SQLITE_DONE ? 0 : PROTO_ESTORAGE;
+}
+
+int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_id,
+               uint32_t max, store_job_fn fn, void *ctx)
+{
+    char sql[512] = "SELECT " JOB_COLS " FROM jobs WHERE id > ?1 AND (?2 IS NULL OR user = ?2)";
+    if (state_mask) {
+        strcat(sql, " AND state IN (");
+        for (int i = 0, first = 1; i <= PROTO_STATE_LAST; i++)
+            if (state_mask & (1u << i)) {
+                strcat(sql, first ? "'" : ",'");
+                strcat(sql, proto_state_name(i));
+                strcat(sql, "'");
+                first = 0;
+            }
+        strcat(sql, ")");
+    }
+    strcat(sql, " ORDER BY id LIMIT ?3");
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, (int64_t)after_id);
+    if (user)
+        sqlite3_bind_text(st, 2, user, -1, SQLITE_TRANSIENT);
+    sqlite3_bind_int64(st, 3, max);
+    return each_job(s, st, fn, ctx);
+}
+
+int store_each_pending(store *s, store_job_fn fn, void *ctx)
+{
+    return store_list(s, NULL, 1u << PROTO_STATE_PENDING, 0, UINT32_MAX, fn, ctx);
+}
+
+int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state NOT IN ('PENDING', 'RUNNING')"
+                           " AND end_ms < ? ORDER BY id", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, before_ms);
+    return each_job(s, st, fn, ctx);
+}
+
+int store_delete(store *s, uint64_t id)
+{
+    int rc = exec_v(s, "BEGIN", NULL);
+    if (!rc)
+        rc = exec_v(s, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
+    if (!rc)
+        rc = exec_v(s, "DELETE FROM jobs WHERE id = ?", "i", (int64_t)id);
+    if (!rc)
+        rc = exec_v(s, "COMMIT", NULL);
+    if (rc) {
+        exec_v(s, "ROLLBACK", NULL);
+        return rc;
+    }
+    spool_remove(s, id);
+    return 0;
+}
+
+void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *cancelled)
+{
+    *completed = *failed = *cancelled = 0;
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT name, value FROM counters", -1, &st, NULL) != SQLITE_OK)
+        return;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+        const char *n = (const char *)sqlite3_column_text(st, 0);
+        uint64_t v = (uint64_t)sqlite3_column_int64(st, 1);
+        if (strcmp(n, "completed") == 0) *completed = v;
+        else if (strcmp(n, "failed") == 0) *failed = v;
+        else if (strcmp(n, "cancelled") == 0) *cancelled = v;
+    }
+    sqlite3_finalize(st);
+}

@@ -1,0 +1,429 @@
+/* wsup.c — worker supervision: --workers slots, each running at most one
+ * meshcorr-worker process (workers/WORKER.md is the contract: argv, spool
+ * files, progress frames on --progress-fd, exit codes).
+ *
+ * DESIGN: a job's end is decided from what the worker left, never from a
+ * guess: result.frame -> COMPLETED; our wall-time SIGTERM -> TIMEOUT;
+ * exit 3 or a cancel we sent -> CANCELLED; error.frame -> FAILED with its
+ * message (OUT_OF_MEMORY for NOMEM); a signal or a bare exit -> FAILED naming
+ * it. During a shutdown drain a job without result.frame goes back to
+ * PENDING, so it runs again on the next start: never lost. The worker is
+ * started with uv_spawn (fork + exec at once: nothing of the daemon's state
+ * runs in the child) and its progress pipe is read non-blocking in the loop.
+ * A slot is idle again only when the process and pipe handles are closed. */
+#include "mcd.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define WSUP_PROGRESS_FD 3
+#define WSUP_MAX_PROGRESS_FRAME 4096
+#define WSUP_EOF_GRACE_MS 2000      /* after exit, wait this long for the pipe's EOF */
+#define WSUP_MAX_ERROR_FRAME (1u << 20)
+
+struct wsup_slot {
+    mcd *d;
+    int index;
+    uint8_t state;                  /* PROTO_SLOT_* */
+    uint64_t job_id;
+    char user[AUTH_MAX_USER];
+    uv_process_t proc;
+    uv_pipe_t pipe;
+    uv_timer_t timer;               /* wall time, kill grace, EOF grace */
+    int open_handles;               /* this run's process + pipe not yet closed */
+    int exited, eof, finished;
+    int64_t exit_status;
+    int term_signal;
+    int term_sent, timed_out, cancel_requested, requeue;
+    int progress_bad;               /* a malformed frame: ignore the rest */
+    proto_buf in;
+};
+
+static void slot_finish(wsup_slot *s);
+
+static const char *worker_path(const mcd *d, char *buf, size_t sz)
+{
+    if (d->conf.worker[0])
+        return d->conf.worker;
+    /* meshcorr-worker next to meshcorrd */
+    static const char name[] = "meshcorr-worker";
+    ssize_t n = readlink("/proc/self/exe", buf, sz - sizeof name);
+    if (n <= 0)
+        return name;
+    buf[n] = '\0';
+    char *slash = strrchr(buf, '/');
+    memcpy(slash ? slash + 1 : buf, name, sizeof name);
+    return buf;
+}
+
+int wsup_init(mcd *d, char *err, size_t errsz)
+{
+    d->slots = calloc((size_t)d->conf.workers, sizeof *d->slots);
+    if (!d->slots) {
+        snprintf(err, errsz, "out of memory");
+        return -1;
+    }
+    for (int i = 0; i < d->conf.workers; i++) {
+        wsup_slot *s = &d->slots[i];
+        s->d = d;
+        s->index = i;
+        s->state = PROTO_SLOT_IDLE;
+        proto_buf_init(&s->in);
+        uv_timer_init(d->loop, &s->timer);
+        s->timer.data = s;
+    }
+    char buf[PATH_MAX];
+    const char *w = worker_path(d, buf, sizeof buf);
+    if (access(w, X_OK) != 0)
+        dlog(DLOG_WARN, "worker program %s is not executable: jobs will fail until it is", w);
+    return 0;
+}
+
+static void signal_worker(wsup_slot *s, int sig)
+{
+    if (!s->exited && s->open_handles) {
+        int rc = uv_process_kill(&s->proc, sig);
+        if (rc && rc != UV_ESRCH)
+            dlog(DLOG_WARN, "job %llu: kill(%d): %s", (unsigned long long)s->job_id, sig, uv_strerror(rc));
+    }
+}
+
+static void on_timer(uv_timer_t *t)
+{
+    wsup_slot *s = t->data;
+    if (s->exited) {                 /* exit seen, EOF never came: finish anyway */
+        dlog(DLOG_WARN, "job %llu: progress pipe still open after the worker exited", (unsigned long long)s->job_id);
+        slot_finish(s);
+    } else if (!s->term_sent) {      /* wall time is up */
+        dlog(DLOG_INFO, "job %llu: wall time %u s exceeded: SIGTERM", (unsigned long long)s->job_id,
+             s->d->conf.job_timeout_s);
+        s->timed_out = 1;
+        s->term_sent = 1;
+        signal_worker(s, SIGTERM);
+        uv_timer_start(&s->timer, on_timer, CONF_KILL_GRACE_S * 1000, 0);
+    } else {                         /* still alive after the grace period */
+        dlog(DLOG_WARN, "job %llu: worker alive %d s after SIGTERM: SIGKILL", (unsigned long long)s->job_id,
+             CONF_KILL_GRACE_S);
+        signal_worker(s, SIGKILL);
+    }
+}
+
+static void terminate(wsup_slot *s)
+{
+    if (s->term_sent || s->exited)
+        return;
+    s->term_sent = 1;
+    signal_worker(s, SIGTERM);
+    uv_timer_start(&s->timer, on_timer, CONF_KILL_GRACE_S * 1000, 0);
+}
+
+static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
+{
+    (void)h;
+    static char chunk[65536];     /* the loop is single-threaded: one read at a time */
+    (void)suggested;
+    *buf = uv_buf_init(chunk, sizeof chunk);
+}
+
+static void take_progress(wsup_slot *s)
+{
+    while (!s->progress_bad && s->in.len) {
+        proto_msg m;
+        size_t used = 0;
+        char err[256];
+        int rc = proto_decode(s->in.data, s->in.len, WSUP_MAX_PROGRESS_FRAME, &m, &used, err, sizeof err);
+        if (rc == PROTO_NEED_MORE)
+            return;
+        if (rc != PROTO_READY || m.type != PROTO_MSG_PROGRESS) {
+            dlog(DLOG_WARN, "job %llu: bad progress frame from the worker (%s): ignoring its progress",
+                 (unsigned long long)s->job_id, rc ? err : proto_type_name(m.type));
+            proto_msg_free(&m);
+            s->progress_bad = 1;
+            proto_buf_reset(&s->in);
+            return;
+        }
+        proto_progress p = m.u.progress;
+        proto_msg_free(&m);
+        proto_buf_consume(&s->in, used);
+        p.job_id = s->job_id;
+        if (s->state == PROTO_SLOT_STARTING)
+            s->state = PROTO_SLOT_BUSY;
+        if (store_add_progress(s->d->store, s->job_id, &p))
+            dlog(DLOG_ERROR, "job %llu: cannot store progress", (unsigned long long)s->job_id);
+        req_progress(s->d, &p);
+    }
+}
+
+static void on_read(uv_stream_t *st, ssize_t n, const uv_buf_t *buf)
+{
+    wsup_slot *s = st->data;
+    if (n > 0) {
+        if (!s->progress_bad) {
+            proto_buf_put(&s->in, buf->base, (size_t)n);
+            take_progress(s);
+        }
+        return;
+    }
+    if (n == 0)
+        return;
+    if (n != UV_EOF)
+        dlog(DLOG_WARN, "job %llu: progress pipe: %s", (unsigned long long)s->job_id, uv_strerror((int)n));
+    uv_read_stop(st);
+    s->eof = 1;
+    if (s->exited)
+        slot_finish(s);
+}
+
+static void on_exit_cb(uv_process_t *p, int64_t status, int sig)
+{
+    wsup_slot *s = p->data;
+    s->exited = 1;
+    s->exit_status = status;
+    s->term_signal = sig;
+    if (s->eof) {
+        slot_finish(s);
+    } else {
+        uv_timer_stop(&s->timer);
+        uv_timer_start(&s->timer, on_timer, WSUP_EOF_GRACE_MS, 0);
+    }
+}
+
+static void on_handle_closed(uv_handle_t *h)
+{
+    wsup_slot *s = h->data;
+    if (--s->open_handles > 0)
+        return;
+    s->state = PROTO_SLOT_IDLE;
+    s->job_id = 0;
+    mcd *d = s->d;
+    if (d->draining) {
+        if (!wsup_busy(d))
+            mcd_drained(d);
+    } else {
+        wsup_schedule(d);
+    }
+}
+
+/* Reads error.frame: its code and message; 0 when there is none. */
+static int read_error_frame(wsup_slot *s, char *msg, size_t msz)
+{
+    char path[CONF_PATH + 64];
+    store_spool_path(s->d->store, s->job_id, "error.frame", path, sizeof path);
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return 0;
+    static uint8_t buf[WSUP_MAX_ERROR_FRAME];
+    size_t n = fread(buf, 1, sizeof buf, fp);
+    fclose(fp);
+    proto_msg m;
+    size_t used;
+    char err[256];
+    int code = PROTO_EINTERNAL;
+    if (proto_decode(buf, n, sizeof buf, &m, &used, err, sizeof err) == PROTO_READY &&
+        m.type == PROTO_MSG_ERROR) {
+        code = m.u.error.code;
+        snprintf(msg, msz, "%s", m.u.error.message);
+    } else {
+        snprintf(msg, msz, "worker wrote an unreadable error.frame");
+    }
+    proto_msg_free(&m);
+    return code;
+}
+
+static void slot_finish(wsup_slot *s)
+{
+    if (s->finished)
+        return;
+    s->finished = 1;
+    mcd *d = s->d;
+    uv_timer_stop(&s->timer);
+    char path[CONF_PATH + 64], reason[PROTO_MAX_STRING + 1] = "", emsg[PROTO_MAX_STRING + 1] = "";
+    int state, ecode;
+    int has_result = access(store_spool_path(d->store, s->job_id, "result.frame", path, sizeof path), R_OK) == 0;
+    if (has_result) {
+        state = PROTO_STATE_COMPLETED;
+    } else if (s->requeue) {
+        state = PROTO_STATE_PENDING;
+        snprintf(reason, sizeof reason, "re-queued: the daemon shut down while it ran");
+    } else if (s->timed_out) {
+        state = PROTO_STATE_TIMEOUT;
+        snprintf(reason, sizeof reason, "wall time limit of %u s exceeded", d->conf.job_timeout_s);
+    } else if (s->cancel_requested || (s->term_signal == 0 && s->exit_status == 3)) {
+        state = PROTO_STATE_CANCELLED;
+        snprintf(reason, sizeof reason, "cancelled by request");
+    } else if ((ecode = read_error_frame(s, emsg, sizeof emsg)) != 0) {
+        state = ecode == PROTO_ENOMEM ? PROTO_STATE_OUT_OF_MEMORY : PROTO_STATE_FAILED;
+        snprintf(reason, sizeof reason, "%s: %s", proto_err_name(ecode), emsg);
+    } else if (s->term_signal) {
+        state = PROTO_STATE_FAILED;
+        snprintf(reason, sizeof reason, "worker killed by signal %d (%s)", s->term_signal,
+                 strsignal(s->term_signal));
+    } else {
+        state = PROTO_STATE_FAILED;
+        snprintf(reason, sizeof reason, "worker exited with status %lld without a result",
+                 (long long)s->exit_status);
+    }
+    dlog(DLOG_INFO, "job %llu: %s%s%s", (unsigned long long)s->job_id, proto_state_name(state),
+         reason[0] ? ": " : "", reason);
+    if (store_set_state(d->store, s->job_id, state, reason))
+        dlog(DLOG_ERROR, "job %llu: cannot record its end", (unsigned long long)s->job_id);
+    sched_done(d->sched, s->user);
+    store_job j;
+    if (state == PROTO_STATE_PENDING && store_get(d->store, s->job_id, &j) == 0)
+        sched_add(d->sched, s->job_id, s->user, j.priority);
+    else
+        req_job_ended(d, s->job_id);
+    if (!uv_is_closing((uv_handle_t *)&s->pipe))
+        uv_close((uv_handle_t *)&s->pipe, on_handle_closed);
+    if (!uv_is_closing((uv_handle_t *)&s->proc))
+        uv_close((uv_handle_t *)&s->proc, on_handle_closed);
+}
+
+static void slot_start(wsup_slot *s, uint64_t id, const char *user)
+{
+    mcd *d = s->d;
+    memset(&s->proc, 0, sizeof s->proc);
+    s->job_id = id;
+    snprintf(s->user, sizeof s->user, "%s", user);
+    s->state = PROTO_SLOT_STARTING;
+    s->exited = s->eof = s->finished = 0;
+    s->exit_status = 0;
+    s->term_signal = 0;
+    s->term_sent = s->timed_out = s->cancel_requested = s->requeue = s->progress_bad = 0;
+    proto_buf_reset(&s->in);
+    store_clear_run(d->store, id);
+
+    char wbuf[PATH_MAX], dir[CONF_PATH + 64], sid[32], fd[8], thr[16], maxv[16], maxf[16];
+    store_spool_path(d->store, id, NULL, dir, sizeof dir);
+    snprintf(sid, sizeof sid, "%llu", (unsigned long long)id);
+    snprintf(fd, sizeof fd, "%d", WSUP_PROGRESS_FD);
+    snprintf(thr, sizeof thr, "%d", d->conf.threads_per_worker);
+    snprintf(maxv, sizeof maxv, "%u", d->conf.max_vertices);
+    uint64_t mf = 4ull * d->conf.max_vertices;
+    snprintf(maxf, sizeof maxf, "%llu", (unsigned long long)(mf > 40000000 ? 40000000 : mf));
+    char *argv[16];
+    int k = 0;
+    argv[k++] = (char *)worker_path(d, wbuf, sizeof wbuf);
+    argv[k++] = "--job";         argv[k++] = dir;
+    argv[k++] = "--job-id";      argv[k++] = sid;
+    argv[k++] = "--progress-fd"; argv[k++] = fd;
+    argv[k++] = "--max-vertices"; argv[k++] = maxv;
+    argv[k++] = "--max-faces";   argv[k++] = maxf;
+    if (d->conf.threads_per_worker > 0) {
+        argv[k++] = "--threads";
+        argv[k++] = thr;
+    }
+    argv[k] = NULL;
+
+    uv_pipe_init(d->loop, &s->pipe, 0);
+    s->pipe.data = s;
+    s->proc.data = s;
+    s->open_handles = 2;
+    uv_stdio_container_t stdio[4];
+    stdio[0].flags = UV_IGNORE;
+    stdio[1].flags = UV_INHERIT_FD;    /* the worker's output joins our log */
+    stdio[1].data.fd = 2;
+    stdio[2].flags = UV_INHERIT_FD;
+    stdio[2].data.fd = 2;
+    stdio[3].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
+    stdio[3].data.stream = (uv_stream_t *)&s->pipe;
+    uv_process_options_t opt;
+    memset(&opt, 0, sizeof opt);
+    opt.file = argv[0];
+    opt.args = argv;
+    opt.exit_cb = on_exit_cb;
+    opt.stdio = stdio;
+    opt.stdio_count = 4;
+    int rc = uv_spawn(d->loop, &s->proc, &opt);
+    if (rc) {
+        dlog(DLOG_ERROR, "job %llu: cannot start %s: %s", (unsigned long long)id, argv[0], uv_strerror(rc));
+        store_set_running(d->store, id, store_now_ms(), 0);
+        /* finish as a crash with the reason below */
+        s->exited = s->eof = 1;
+        s->exit_status = 127;
+        s->finished = 1;
+        char reason[PROTO_MAX_STRING];
+        snprintf(reason, sizeof reason, "cannot start worker %s: %s", argv[0], uv_strerror(rc));
+        store_set_state(d->store, id, PROTO_STATE_FAILED, reason);
+        sched_done(d->sched, s->user);
+        req_job_ended(d, id);
+        uv_close((uv_handle_t *)&s->pipe, on_handle_closed);
+        uv_close((uv_handle_t *)&s->proc, on_handle_closed);
+        return;
+    }
+    dlog(DLOG_INFO, "job %llu: started on slot %d, worker pid %d", (unsigned long long)id, s->index, s->proc.pid);
+    store_set_running(d->store, id, store_now_ms(), s->proc.pid);
+    uv_read_start((uv_stream_t *)&s->pipe, on_alloc, on_read);
+    uv_timer_start(&s->timer, on_timer, (uint64_t)d->conf.job_timeout_s * 1000, 0);
+}
+
+void wsup_schedule(mcd *d)
+{
+    if (d->draining)
+        return;
+    for (int i = 0; i < d->conf.workers; i++) {
+        wsup_slot *s = &d->slots[i];
+        if (s->state != PROTO_SLOT_IDLE)
+            continue;
+        char user[AUTH_MAX_USER];
+        uint64_t id = sched_next(d->sched, user);
+        if (!id)
+            return;
+        slot_start(s, id, user);
+    }
+}
+
+int wsup_cancel(mcd *d, uint64_t id)
+{
+    for (int i = 0; i < d->conf.workers; i++) {
+        wsup_slot *s = &d->slots[i];
+        if (s->state != PROTO_SLOT_IDLE && s->job_id == id && !s->finished) {
+            s->cancel_requested = 1;
+            terminate(s);
+            return 0;
+        }
+    }
+    return -1;
+}
+
+void wsup_drain(mcd *d)
+{
+    for (int i = 0; i < d->conf.workers; i++) {
+        wsup_slot *s = &d->slots[i];
+        if (s->state != PROTO_SLOT_IDLE && !s->finished) {
+            s->requeue = 1;
+            s->state = PROTO_SLOT_DRAINING;
+            terminate(s);
+        }
+    }
+}
+
+int wsup_busy(const mcd *d)
+{
+    int n = 0;
+    for (int i = 0; i < d->conf.workers; i++)
+        n += d->slots[i].state != PROTO_SLOT_IDLE;
+    return n;
+}
+
+void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id)
+{
+    *state = d->slots[i].state;
+    *job_id = d->slots[i].job_id;
+}
+
+void wsup_close(mcd *d)
+{
+    if (!d->slots)
+        return;
+    for (int i = 0; i < d->conf.workers; i++) {
+        uv_close((uv_handle_t *)&d->slots[i].timer, NULL);
+        proto_buf_free(&d->slots[i].in);
+    }
+}

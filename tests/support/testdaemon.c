@@ -1,0 +1,242 @@
+/* testdaemon.c — starting, stopping and feeding the real meshcorrd in
+ * tests (see testdaemon.h). Test code only. */
+#include "support/testdaemon.h"
+#include "support/harness.h"
+#include "support/testmesh.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#define DAEMON "build/meshcorrd"
+#define WORKER "build/meshcorr-worker"
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+void testdaemon_need_worker(void)
+{
+    if (access(WORKER, X_OK) != 0)
+        SKIP("%s not built (the worker branch provides it)", WORKER);
+}
+
+void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
+{
+    snprintf(d->dir, sizeof d->dir, "%s/%s", harness_tmpdir(), name);
+    snprintf(d->state, sizeof d->state, "%s/state", d->dir);
+    snprintf(d->log, sizeof d->log, "%s/meshcorrd.log", d->dir);
+    snprintf(d->unix_addr, sizeof d->unix_addr, "unix:%s/sock", d->dir);
+    mkdir(d->dir, 0700);
+    char tokens[640], port[640], listen_unix[640];
+    snprintf(tokens, sizeof tokens, "%s/tokens", d->dir);
+    snprintf(port, sizeof port, "%s/port", d->dir);
+    snprintf(listen_unix, sizeof listen_unix, "%s", d->unix_addr);
+    FILE *fp = fopen(tokens, "w");
+    if (!fp)
+        FAILF("cannot write %s", tokens);
+    fprintf(fp, "# token user [admin]\n%s alice\n%s bob\n%s boss admin\n", TESTDAEMON_ALICE,
+            TESTDAEMON_BOB, TESTDAEMON_ADMIN);
+    fclose(fp);
+    unlink(port);
+    const char *argv[64];
+    int k = 0;
+    argv[k++] = DAEMON;
+    argv[k++] = "--state-dir"; argv[k++] = d->state;
+    argv[k++] = "--listen";    argv[k++] = listen_unix;
+    argv[k++] = "--listen";    argv[k++] = "tcp:127.0.0.1:0";
+    argv[k++] = "--port-file"; argv[k++] = port;
+    argv[k++] = "--tokens";    argv[k++] = tokens;
+    argv[k++] = "--log-level"; argv[k++] = "debug";
+    argv[k++] = "--threads-per-worker"; argv[k++] = "1";
+    for (int i = 0; args && args[i] && k < 62; i++)
+        argv[k++] = args[i];
+    argv[k] = NULL;
+    fflush(stdout);
+    fflush(stderr);
+    pid_t parent = getpid();
+    d->pid = fork();
+    if (d->pid < 0)
+        FAILF("fork: %s", strerror(errno));
+    if (d->pid == 0) {
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent)
+            _exit(127);
+        int fd = open(d->log, O_WRONLY | O_CREAT | O_APPEND, 0600);
+        if (fd >= 0) {
+            dup2(fd, 2);
+            close(fd);
+        }
+        execv(DAEMON, (char **)argv);
+        _exit(127);
+    }
+    for (int i = 0; i < 1000; i++) {      /* up to 10 s */
+        fp = fopen(port, "r");
+        if (fp) {
+            int ok = fscanf(fp, "%63s", d->tcp_addr) == 1;
+            fclose(fp);
+            if (ok)
+                return;
+        }
+        int st;
+        if (waitpid(d->pid, &st, WNOHANG) == d->pid)
+            FAILF("meshcorrd exited at start (status %d); log %s", st, d->log);
+        sleep_ms(10);
+    }
+    FAILF("meshcorrd did not write its port file; log %s", d->log);
+}
+
+int testdaemon_stop(testdaemon *d, int sig)
+{
+    int st = 0;
+    if (d->pid <= 0)
+        return -1;
+    kill(d->pid, sig);
+    for (int i = 0; i < 2000; i++) {
+        if (waitpid(d->pid, &st, WNOHANG) == d->pid) {
+            d->pid = 0;
+            return st;
+        }
+        sleep_ms(10);
+    }
+    kill(d->pid, SIGKILL);
+    waitpid(d->pid, &st, 0);
+    d->pid = 0;
+    FAILF("meshcorrd did not exit within 20 s of signal %d", sig);
+    return st;
+}
+
+mc_client *testdaemon_client(const testdaemon *d, const char *token)
+{
+    mc_client *c = NULL;
+    char err[1024];
+    int rc = mc_connect(token ? d->tcp_addr : d->unix_addr, token, &c, err, sizeof err);
+    if (rc)
+        FAILF("mc_connect(%s): %s (%s)", token ? d->tcp_addr : d->unix_addr, mc_strerror(rc), err);
+    mc_set_timeout(c, 20000);
+    return c;
+}
+
+static int cmdline_has_job(pid_t pid, uint64_t id)
+{
+    char path[64], cmd[8192], want[32];
+    snprintf(path, sizeof path, "/proc/%d/cmdline", (int)pid);
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return 0;
+    ssize_t n = read(fd, cmd, sizeof cmd - 1);
+    close(fd);
+    if (n <= 0)
+        return 0;
+    cmd[n] = '\0';
+    snprintf(want, sizeof want, "%llu", (unsigned long long)id);
+    for (ssize_t i = 0; i < n; i += (ssize_t)strlen(cmd + i) + 1)
+        if (strcmp(cmd + i, "--job-id") == 0 && i + 9 < n && strcmp(cmd + i + 9, want) == 0)
+            return 1;
+    return 0;
+}
+
+pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id)
+{
+    for (int tries = 0; tries < 1000; tries++) {
+        DIR *dp = opendir("/proc");
+        struct dirent *de;
+        while (dp && (de = readdir(dp))) {
+            pid_t pid = (pid_t)atoi(de->d_name);
+            char path[64], stat[512];
+            if (pid <= 0)
+                continue;
+            snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+            FILE *fp = fopen(path, "r");
+            if (!fp)
+                continue;
+            int ppid = -1;
+            if (fgets(stat, sizeof stat, fp)) {
+                char *rp = strrchr(stat, ')');
+                if (rp)
+                    sscanf(rp + 2, "%*c %d", &ppid);
+            }
+            fclose(fp);
+            if (ppid == d->pid && cmdline_has_job(pid, id)) {
+                closedir(dp);
+                return pid;
+            }
+        }
+        if (dp)
+            closedir(dp);
+        sleep_ms(10);
+    }
+    return -1;
+}
+
+int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s)
+{
+    mc_job_status s;
+    for (int i = 0; i < timeout_s * 50; i++) {
+        int rc = mc_status(c, id, &s);
+        if (rc)
+            FAILF("STATUS %llu: %s (%s)", (unsigned long long)id, mc_strerror(rc), mc_errmsg(c));
+        if (state >= 0 ? s.state == state : s.state >= MC_COMPLETED)
+            return s.state;
+        sleep_ms(20);
+    }
+    FAILF("job %llu still %s after %d s (wanted %s; reason '%s')", (unsigned long long)id,
+          mc_state_name(s.state), timeout_s, state >= 0 ? mc_state_name(state) : "a final state", s.reason);
+    return -1;
+}
+
+static unsigned char *encode(const mesh *m, size_t *len)
+{
+    unsigned char *buf = NULL;
+    char err[512];
+    if (dracob_encode(m->v, m->nv, m->f, m->nf, MESH_DRC_QUANTIZATION_BITS, &buf, len, err, sizeof err))
+        FAILF("dracob_encode: %s", err);
+    return buf;
+}
+
+uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc)
+{
+    mesh *S = testmesh_icosphere(long_job ? 3 : 2), *T = testmesh_icosphere(long_job ? 3 : 2);
+    if (!S || !T)
+        FAILF("testmesh_icosphere failed");
+    for (int i = 0; i < T->nv; i++) {           /* an ellipsoid, a little bent */
+        double *x = &T->v[3 * i];
+        x[0] *= 1.3;
+        x[2] += 0.15 * x[0] * x[0];
+    }
+    mc_job_spec spec;
+    mc_job_spec_init(&spec);
+    size_t sl, tl;
+    unsigned char *sb = encode(S, &sl), *tb = encode(T, &tl);
+    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5};
+    spec.source = sb;
+    spec.source_len = sl;
+    spec.target = tb;
+    spec.target_len = tl;
+    spec.landmarks = lm;
+    spec.nlandmarks = 6;
+    spec.iterations = (uint32_t)iterations;
+    spec.inner_iterations = long_job ? 50 : 10;
+    spec.beta_ramp = iterations > 1 ? iterations : 1;
+    spec.stop_change = 0;
+    spec.priority = priority;
+    spec.label = long_job ? "long icosphere job" : "quick icosphere job";
+    uint64_t id = 0;
+    *rc = mc_submit(c, &spec, &id);
+    free(sb);
+    free(tb);
+    mesh_free(S);
+    mesh_free(T);
+    return id;
+}

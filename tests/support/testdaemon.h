@@ -1,0 +1,50 @@
+/* testdaemon.h — the real build/meshcorrd for black-box tests: started with
+ * its own state directory under harness_tmpdir(), a Unix socket and a TCP
+ * listener on 127.0.0.1 (a free port the daemon picks and writes to its
+ * port file), and a tokens file with three users:
+ *   TESTDAEMON_ALICE (user alice), TESTDAEMON_BOB (user bob),
+ *   TESTDAEMON_ADMIN (user boss, admin).
+ * The daemon dies with the test process (PR_SET_PDEATHSIG). Jobs it runs:
+ * icosphere pairs, quick or long. Test code only. */
+#ifndef TESTDAEMON_H
+#define TESTDAEMON_H
+#include <sys/types.h>
+#include "meshcorr.h"
+
+#define TESTDAEMON_ALICE "tok-alice-0123456789"
+#define TESTDAEMON_BOB   "tok-bob-0123456789"
+#define TESTDAEMON_ADMIN "tok-boss-0123456789"
+
+typedef struct testdaemon {
+    pid_t pid;
+    char dir[512];             /* harness_tmpdir()/name */
+    char state[600];           /* dir/state */
+    char unix_addr[600];       /* "unix:dir/sock" */
+    char tcp_addr[64];         /* "tcp:127.0.0.1:PORT" */
+    char log[600];             /* the daemon's stderr (appended across restarts) */
+} testdaemon;
+
+/* SKIPs the test when build/meshcorr-worker has not been built. */
+void testdaemon_need_worker(void);
+/* Starts meshcorrd (args: extra options, NULL-terminated, or NULL) and waits
+ * until it listens; with the same name again, restarts on the same state.
+ * Fails the test when it cannot. */
+void testdaemon_start(testdaemon *d, const char *name, const char *const *args);
+/* Sends sig and waits for the daemon's exit (at most 20 s, then SIGKILL);
+ * returns its wait status. */
+int testdaemon_stop(testdaemon *d, int sig);
+/* A connected client: token NULL = the Unix socket (peer credentials), else
+ * TCP with that token. Fails the test when it cannot connect. */
+mc_client *testdaemon_client(const testdaemon *d, const char *token);
+/* Pid of the meshcorr-worker the daemon runs for job id, or -1 (waits up to
+ * 10 s for it to appear). */
+pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id);
+/* Polls STATUS until the job is in `state` (or, with state < 0, in any final
+ * state); fails the test after timeout_s. Returns the state. */
+int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s);
+/* Submits an icosphere job (level 2, 162 vertices; the target scaled and
+ * bent a little), 6 identity landmarks; iterations outer iterations, no
+ * early stop. long_job: level 3 (642 vertices), for jobs to cancel or kill. */
+uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc);
+
+#endif

@@ -1,0 +1,320 @@
+/* test_daemon_jobs.c — a job's life through the real meshcorrd, the real
+ * meshcorr-worker and libmeshcorr: submit, watch, result identical to the
+ * in-process pipeline, cancel (pending and running), worker crash, daemon
+ * SIGKILL and graceful shutdown (the job runs again and completes). */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "corr/corr.h"
+#include "map/bmap.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <signal.h>
+#include <sqlite3.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+typedef struct watch_log {
+    int n;
+    uint32_t outer[64];
+    double energy[64];
+} watch_log;
+
+static int on_progress(void *ctx, const mc_progress *p)
+{
+    watch_log *w = ctx;
+    if (w->n < 64) {
+        w->outer[w->n] = p->outer;
+        w->energy[w->n] = p->energy[0] + p->energy[1];
+        w->n++;
+    }
+    return 0;
+}
+
+static uint64_t submit_ok(mc_client *c, int iterations, int long_job, int32_t priority)
+{
+    int rc;
+    uint64_t id = testdaemon_submit(c, iterations, long_job, priority, &rc);
+    if (rc)
+        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
+    CHECK(id > 0);
+    return id;
+}
+
+TEST_T(submitted_job_streams_energies_and_completes, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "quick", NULL);
+    mc_client *c = testdaemon_client(&d, NULL);
+    uint64_t id = submit_ok(c, 3, 0, 0);
+    watch_log w = {0};
+    int state = -1;
+    char reason[1100];
+    int rc = mc_watch(c, id, 0, on_progress, &w, &state, reason, sizeof reason);
+    if (rc)
+        FAILF("WATCH: %s (%s)", mc_strerror(rc), mc_errmsg(c));
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+    int last = 0, ectm = 0;
+    for (int i = 0; i < w.n; i++) {
+        CHECK(w.outer[i] >= (uint32_t)last);
+        last = (int)w.outer[i];
+        if (w.outer[i] > 0) {
+            CHECK(isfinite(w.energy[i]) && w.energy[i] > 0);
+            ectm++;
+        }
+    }
+    CHECK_INT(ectm, 3);
+    CHECK_INT(last, 3);
+    /* a second watch from iteration 2 replays only the tail, then END */
+    watch_log tail = {0};
+    CHECK_INT(mc_watch(c, id, 2, on_progress, &tail, &state, reason, sizeof reason), 0);
+    CHECK_INT(state, MC_COMPLETED);
+    CHECK_INT(tail.n, 2);
+    CHECK_INT(tail.outer[0], 2);
+    mc_job_result r;
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q | MC_WANT_METRICS, &r), 0);
+    CHECK_INT(r.np, 162);
+    CHECK_INT(r.nq, 162);
+    CHECK(r.nmetrics > 0);
+    mc_result_free(&r);
+    mc_close(c);
+    CHECK(WIFEXITED(testdaemon_stop(&d, SIGTERM)));
+}
+
+/* The map the daemon returns is the in-process pipeline's map on the same
+ * Draco-decoded meshes, initial maps and parameters (the demo pair 381 -> 390,
+ * 3 outer iterations, one thread on both sides). */
+static mesh *decode(const unsigned char *b, size_t n)
+{
+    mesh *m = calloc(1, sizeof *m);
+    char err[512];
+    if (!m || dracob_decode(b, n, MESH_MAX_VERTICES, MESH_MAX_FACES, &m->v, &m->nv, &m->f, &m->nf, err,
+                            sizeof err))
+        FAILF("dracob_decode: %s", err);
+    return m;
+}
+
+static mc_map_row *rows_of(const bmap *P)
+{
+    mc_map_row *r = calloc((size_t)P->n, sizeof *r);
+    CHECK(r != NULL);
+    for (int i = 0; i < P->n; i++) {
+        r[i].face = (uint32_t)P->face[i];
+        memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
+    }
+    return r;
+}
+
+static void check_same_map(const mc_map_row *got, uint32_t n, const bmap *want)
+{
+    CHECK_INT(n, want->n);
+    for (int i = 0; i < want->n; i++) {
+        if (got[i].face != (uint32_t)want->face[i])
+            FAILF("row %d: face %u, in-process %d", i, got[i].face, want->face[i]);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(got[i].w[k], want->w[3 * i + k], 1e-12);
+    }
+}
+
+TEST_T(result_is_the_in_process_map_on_the_demo_pair, 120)
+{
+    testdaemon_need_worker();
+    const char *src = harness_data_path("shrec07_bim/Meshes/381.off");
+    char s381[512], s390[512], p0[512], q0[512], err[1024];
+    snprintf(s381, sizeof s381, "%s", src);
+    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
+    snprintf(p0, sizeof p0, "%s", harness_data_path("ectm_demo_381_390/init_381_to_390.map"));
+    snprintf(q0, sizeof q0, "%s", harness_data_path("ectm_demo_381_390/init_390_to_381.map"));
+    unsigned char *sb, *tb;
+    size_t sl, tl;
+    CHECK_INT(mc_encode_mesh_file(s381, &sb, &sl, err, sizeof err), 0);
+    CHECK_INT(mc_encode_mesh_file(s390, &tb, &tl, err, sizeof err), 0);
+    mesh *S = decode(sb, sl), *T = decode(tb, tl);
+    bmap *P0 = NULL, *Q0 = NULL;
+    if (bmap_read(p0, S, T, &P0, err, sizeof err) || bmap_read(q0, T, S, &Q0, err, sizeof err))
+        FAILF("%s", err);
+
+    testdaemon d;
+    testdaemon_start(&d, "demo", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_job_spec spec;
+    mc_job_spec_init(&spec);
+    spec.source = sb;
+    spec.source_len = sl;
+    spec.target = tb;
+    spec.target_len = tl;
+    mc_map_row *pr = rows_of(P0), *qr = rows_of(Q0);
+    spec.p = pr;
+    spec.np = (uint32_t)P0->n;
+    spec.q = qr;
+    spec.nq = (uint32_t)Q0->n;
+    spec.iterations = 3;
+    spec.label = "demo 381 -> 390";
+    uint64_t id;
+    int rc = mc_submit(c, &spec, &id);
+    if (rc)
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 3;
+    p.threads = 1;
+    ectm_result want = {0};
+    corr_input in = {S, T, "381", "390", NULL, P0, Q0};
+    if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
+        FAILF("corr_run: %s", err);
+
+    int state = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, NULL, NULL, &state, reason, sizeof reason), 0);
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+    mc_job_result r;
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q, &r), 0);
+    check_same_map(r.p, r.np, want.P);
+    check_same_map(r.q, r.nq, want.Q);
+    CHECK(r.deformed == NULL);   /* not asked */
+    mc_result_free(&r);
+    ectm_result_close(&want);
+    free(pr);
+    free(qr);
+    free(sb);
+    free(tb);
+    bmap_free(P0);
+    bmap_free(Q0);
+    mesh_free(S);
+    mesh_free(T);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* state of job id in the daemon's database, read directly (daemon stopped) */
+static int db_state(const testdaemon *d, uint64_t id, char *out, size_t n)
+{
+    char path[700];
+    snprintf(path, sizeof path, "%s/jobs.db", d->state);
+    sqlite3 *db;
+    sqlite3_stmt *st;
+    out[0] = '\0';
+    if (sqlite3_open(path, &db) != SQLITE_OK)
+        return -1;
+    int rc = -1;
+    if (sqlite3_prepare_v2(db, "SELECT state FROM jobs WHERE id = ?", -1, &st, NULL) == SQLITE_OK) {
+        sqlite3_bind_int64(st, 1, (sqlite3_int64)id);
+        if (sqlite3_step(st) == SQLITE_ROW) {
+            snprintf(out, n, "%s", (const char *)sqlite3_column_text(st, 0));
+            rc = 0;
+        }
+        sqlite3_finalize(st);
+    }
+    sqlite3_close(db);
+    return rc;
+}
+
+TEST_T(acknowledged_job_survives_daemon_sigkill_and_completes_after_restart, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "sigkill", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 200, 0, 0);
+    testdaemon_wait_state(c, id, MC_RUNNING, 10);
+    mc_close(c);
+    int st = testdaemon_stop(&d, SIGKILL);
+    CHECK(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    char state[32];
+    CHECK_INT(db_state(&d, id, state, sizeof state), 0);
+    CHECK(strcmp(state, "RUNNING") == 0 || strcmp(state, "COMPLETED") == 0);
+    testdaemon_start(&d, "sigkill", NULL);
+    c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    CHECK_INT(testdaemon_wait_state(c, id, -1, 40), MC_COMPLETED);
+    mc_job_result r;
+    CHECK_INT(mc_result(c, id, MC_WANT_P, &r), 0);
+    CHECK_INT(r.np, 162);
+    mc_result_free(&r);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(graceful_shutdown_requeues_the_running_job_and_next_start_completes_it, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "drain", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 1000, 0, 0);
+    testdaemon_wait_state(c, id, MC_RUNNING, 10);
+    mc_job_status s;
+    do {                                   /* let it get into the optimisation */
+        CHECK_INT(mc_status(c, id, &s), 0);
+    } while (!s.has_progress || s.progress.outer < 2);
+    int st = testdaemon_stop(&d, SIGTERM);
+    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    mc_close(c);
+    char state[32];
+    CHECK_INT(db_state(&d, id, state, sizeof state), 0);
+    CHECK_STR_HAS(state, "PENDING");
+    testdaemon_start(&d, "drain", NULL);
+    c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    int end = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, NULL, NULL, &end, reason, sizeof reason), 0);
+    if (end != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(end), reason);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(killed_worker_fails_its_job_naming_the_signal_and_daemon_keeps_serving, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "crash", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 1000, 1, 0);
+    uint64_t next = submit_ok(c, 3, 0, 0);
+    testdaemon_wait_state(c, id, MC_RUNNING, 10);
+    pid_t w = testdaemon_worker_pid(&d, id);
+    CHECK(w > 0);
+    CHECK_INT(kill(w, SIGKILL), 0);
+    CHECK_INT(testdaemon_wait_state(c, id, -1, 20), MC_FAILED);
+    mc_job_status s;
+    CHECK_INT(mc_status(c, id, &s), 0);
+    CHECK_STR_HAS(s.reason, "signal 9");
+    CHECK_INT(testdaemon_wait_state(c, next, -1, 30), MC_COMPLETED);
+    CHECK_INT(mc_ping(c), 0);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(cancel_ends_running_and_pending_jobs_cancelled, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "cancel", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t run = submit_ok(c, 1000, 1, 0);
+    uint64_t wait = submit_ok(c, 1000, 1, 0);
+    testdaemon_wait_state(c, run, MC_RUNNING, 10);
+    CHECK_INT(mc_cancel(c, wait), 0);          /* pending: at once */
+    mc_job_status s;
+    CHECK_INT(mc_status(c, wait, &s), 0);
+    CHECK_INT(s.state, MC_CANCELLED);
+    CHECK_INT(s.start_ms, 0);
+    CHECK_INT(mc_cancel(c, run), 0);           /* running: SIGTERM to its worker */
+    int end = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, run, 1u << 30, NULL, NULL, &end, reason, sizeof reason), 0);
+    CHECK_INT(end, MC_CANCELLED);
+    CHECK_STR_HAS(reason, "cancel");
+    CHECK_INT(mc_cancel(c, run), MC_EBAD_STATE);   /* nothing left to cancel */
+    CHECK_STR_HAS(mc_errmsg(c), "CANCELLED");
+    CHECK_INT(mc_delete(c, run), 0);
+    CHECK_INT(mc_status(c, run, &s), MC_ENOT_FOUND);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
