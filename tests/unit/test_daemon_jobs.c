@@ -164,7 +164,7 @@ TEST_T(result_is_the_in_process_map_on_the_demo_pair, 120)
     p.iterations = 3;
     p.threads = 1;
     ectm_result want = {0};
-    corr_input in = {S, T, "381", "390", NULL, P0, Q0};
+    corr_input in = {S, T, "381", "390", NULL, P0, Q0, NULL, CORR_STAGES_ALL};
     if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
         FAILF("corr_run: %s", err);
 
