@@ -355,6 +355,10 @@ int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
     p->inner_iterations = s->inner_iterations;
     p->tolerance = s->tolerance;
     p->stop_change = s->stop_change;
+    p->rhm_iterations = s->rhm_iterations;
+    p->rhm_dim = s->rhm_dim;
+    p->rhm_alpha = s->rhm_alpha;
+    p->rhm_landmark_weight = s->rhm_landmark_weight;
     p->backend = s->backend ? s->backend : "";
     m->priority = s->priority;
     m->label = s->label ? s->label : "";

@@ -81,7 +81,11 @@ typedef struct mc_job_spec {
     double gamma;              /* reverse-map weight */
     uint32_t iterations, inner_iterations;
     double tolerance, stop_change;
-    const char *backend;       /* NULL or "" = server default */
+    /* RHM, for landmark jobs; 0 = the server's default (200, 8, 5e-4, off) */
+    uint32_t rhm_iterations, rhm_dim;
+    double rhm_alpha, rhm_landmark_weight;
+    const char *backend;       /* NULL or "" = server default; "cpu", "opencl", "auto",
+                                  optionally ":DEVICE" (a platform or device name part) */
     int32_t priority;          /* higher runs first */
     const char *label;         /* NULL = "" */
 } mc_job_spec;
@@ -89,9 +93,13 @@ typedef struct mc_job_spec {
 /* The engine's defaults (those of `meshcorr match`); no meshes, no landmarks. */
 void mc_job_spec_init(mc_job_spec *s);
 
+enum { MC_STAGE_VORONOI = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
+
+/* For stages voronoi and rhm the five terms are RHM's (PROTOCOL.md,
+ * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */
 typedef struct mc_progress {
     uint64_t job_id;
-    int stage;                 /* 0 voronoi, 1 rhm, 2 ectm */
+    int stage;                 /* MC_STAGE_*: 0 voronoi, 1 rhm, 2 ectm, 3 init */
     uint32_t outer, total;     /* outer iteration, planned */
     uint32_t inner[2];         /* L-BFGS iterations: [0] source side, [1] target side */
     double membrane[2], bending[2], mismatch[2], reverse[2], energy[2];

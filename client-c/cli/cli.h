@@ -9,5 +9,14 @@ int cli_convert(int argc, char **argv);
 int cli_match(int argc, char **argv);
 int cli_eval(int argc, char **argv);
 int cli_devices(int argc, char **argv);
+/* cli_remote.c: through meshcorrd (libmeshcorr) */
+int cli_submit(int argc, char **argv);
+int cli_status(int argc, char **argv);
+int cli_watch(int argc, char **argv);
+int cli_result(int argc, char **argv);
+int cli_cancel(int argc, char **argv);
+int cli_delete(int argc, char **argv);
+int cli_list(int argc, char **argv);
+int cli_stats(int argc, char **argv);
 
 #endif

@@ -229,6 +229,7 @@ uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t p
     spec.iterations = (uint32_t)iterations;
     spec.inner_iterations = long_job ? 50 : 10;
     spec.beta_ramp = iterations > 1 ? iterations : 1;
+    spec.rhm_iterations = 3;
     spec.stop_change = 0;
     spec.priority = priority;
     spec.label = long_job ? "long icosphere job" : "quick icosphere job";

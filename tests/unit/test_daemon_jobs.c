@@ -18,6 +18,7 @@
 
 typedef struct watch_log {
     int n;
+    int stage[64];
     uint32_t outer[64];
     double energy[64];
 } watch_log;
@@ -26,6 +27,7 @@ static int on_progress(void *ctx, const mc_progress *p)
 {
     watch_log *w = ctx;
     if (w->n < 64) {
+        w->stage[w->n] = p->stage;
         w->outer[w->n] = p->outer;
         w->energy[w->n] = p->energy[0] + p->energy[1];
         w->n++;
@@ -58,23 +60,34 @@ TEST_T(submitted_job_streams_energies_and_completes, 60)
         FAILF("WATCH: %s (%s)", mc_strerror(rc), mc_errmsg(c));
     if (state != MC_COMPLETED)
         FAILF("job ended %s: %s", mc_state_name(state), reason);
-    int last = 0, ectm = 0;
+    /* stages in order (init, voronoi, rhm, ectm), iterations rising in each */
+    int last = 0, ectm = 0, rhm = 0;
     for (int i = 0; i < w.n; i++) {
+        if (i > 0 && w.stage[i] != w.stage[i - 1])
+            last = 0;
         CHECK(w.outer[i] >= (uint32_t)last);
         last = (int)w.outer[i];
-        if (w.outer[i] > 0) {
+        rhm += w.stage[i] == MC_STAGE_RHM;
+        if (w.stage[i] == MC_STAGE_ECTM) {
             CHECK(isfinite(w.energy[i]) && w.energy[i] > 0);
             ectm++;
         }
     }
+    CHECK_INT(rhm, 3);
     CHECK_INT(ectm, 3);
+    CHECK_INT(w.stage[w.n - 1], MC_STAGE_ECTM);
     CHECK_INT(last, 3);
-    /* a second watch from iteration 2 replays only the tail, then END */
+    /* a second watch from iteration 2 replays only the tail of each stage
+     * (RHM 2, 3 and ECTM 2, 3), then END */
     watch_log tail = {0};
     CHECK_INT(mc_watch(c, id, 2, on_progress, &tail, &state, reason, sizeof reason), 0);
     CHECK_INT(state, MC_COMPLETED);
-    CHECK_INT(tail.n, 2);
-    CHECK_INT(tail.outer[0], 2);
+    int tail_ectm = 0;
+    for (int i = 0; i < tail.n; i++) {
+        CHECK(tail.outer[i] >= 2);
+        tail_ectm += tail.stage[i] == MC_STAGE_ECTM;
+    }
+    CHECK_INT(tail_ectm, 2);
     mc_job_result r;
     CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q | MC_WANT_METRICS, &r), 0);
     CHECK_INT(r.np, 162);

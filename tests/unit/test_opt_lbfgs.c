@@ -118,3 +118,31 @@ TEST(lbfgs_refuses_bad_parameters)
     opt_stats st;
     CHECK_INT(opt_minimize(2, x, quad, NULL, NULL, &p, &st), OPT_EPARAM);
 }
+
+/* A gradient that turns NaN once (as a collapsing face's normal can): alone,
+ * liblbfgs 1.10 stops there "converged" (NaN gradient norm) or, with a NaN
+ * direction, accepts a NaN point. The driver rejects the point and goes on. */
+static double quad_nan_once(void *ctx, const double *x, double *g, int n)
+{
+    int *calls = ctx;
+    double f = quad(NULL, x, g, n);
+    if (++*calls == 3)
+        g[0] = NAN;
+    return f;
+}
+
+TEST(lbfgs_recovers_from_a_nan_gradient)
+{
+    double x[20] = {0};
+    opt_params p;
+    opt_params_init(&p);
+    opt_stats st;
+    int calls = 0;
+    CHECK_INT(opt_minimize(20, x, quad_nan_once, NULL, &calls, &p, &st), OPT_OK);
+    for (int i = 0; i < 20; i++)
+        CHECK(isfinite(x[i]));
+    CHECK(isfinite(st.f));
+    CHECK(st.converged);
+    double g[20];
+    CHECK(quad(NULL, x, g, 20) < 1e-6);
+}

@@ -4,6 +4,7 @@
 
 #include <lbfgs.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 const char *opt_strerror(int code)
@@ -34,6 +35,9 @@ typedef struct run {
     int wants_restart;
     int cancelled;
     int nonfinite;
+    int broken;         /* liblbfgs accepted a non-finite point */
+    double *good;       /* the last accepted point with a finite energy */
+    int n;
 } run;
 
 static lbfgsfloatval_t eval_cb(void *inst, const lbfgsfloatval_t *x, lbfgsfloatval_t *g,
@@ -43,8 +47,13 @@ static lbfgsfloatval_t eval_cb(void *inst, const lbfgsfloatval_t *x, lbfgsfloatv
     run *r = inst;
     r->st->evaluations++;
     double f = r->eval(r->ctx, x, g, n);
-    if (!isfinite(f)) {
-        /* Let the line search back off: an infinite energy is a rejected step. */
+    /* Let the line search back off: an infinite energy is a rejected step.
+     * A non-finite gradient is rejected too: liblbfgs 1.10 takes a NaN
+     * gradient norm for convergence and a NaN direction for a good step. */
+    int bad = !isfinite(f);
+    for (int i = 0; i < n && !bad; i++)
+        bad = !isfinite(g[i]);
+    if (bad) {
         r->nonfinite++;
         return INFINITY;
     }
@@ -58,6 +67,15 @@ static int progress_cb(void *inst, const lbfgsfloatval_t *x, const lbfgsfloatval
 {
     (void)g; (void)xnorm; (void)step; (void)n; (void)ls;
     run *r = inst;
+    /* liblbfgs 1.10's backtracking accepts a step when its Armijo test
+     * compares with NaN (a NaN search direction, after a zero curvature
+     * pair): the new point is NaN with f = +inf. Stop there; the driver goes
+     * back to the last good point and resets the memory. */
+    if (!isfinite(fx)) {
+        r->broken = 1;
+        return 1;
+    }
+    memcpy(r->good, x, sizeof *x * (size_t)r->n);
     r->st->iterations = r->iter_base + k;
     r->st->f = fx;
     if (r->iter) {
@@ -81,9 +99,14 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
         return OPT_EPARAM;
     memset(st, 0, sizeof *st);
     lbfgsfloatval_t *xx = lbfgs_malloc(n);
-    if (!xx)
+    double *good = malloc(sizeof *good * (size_t)n);
+    if (!xx || !good) {
+        lbfgs_free(xx);
+        free(good);
         return OPT_ENOMEM;
+    }
     memcpy(xx, x, sizeof *x * (size_t)n);
+    memcpy(good, x, sizeof *x * (size_t)n);
 
     lbfgs_parameter_t lp;
     lbfgs_parameter_init(&lp);
@@ -92,7 +115,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
     lp.linesearch = LBFGS_LINESEARCH_BACKTRACKING_ARMIJO;
     lp.max_linesearch = 40;
 
-    run r = { eval, iter, ctx, st, 0, 0, 0, 0, 0 };
+    run r = { eval, iter, ctx, st, 0, 0, 0, 0, 0, 0, good, n };
     int failures = 0, rc = OPT_OK;
     for (;;) {
         r.budget = p->max_iter - r.iter_base;
@@ -100,9 +123,17 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
             break;
         lp.max_iterations = r.budget;
         r.wants_restart = 0;
+        r.broken = 0;
         lbfgsfloatval_t fx = 0;
         int ret = lbfgs(n, xx, &fx, eval_cb, progress_cb, &r, &lp);
         r.iter_base = st->iterations;
+        if (r.broken) {
+            memcpy(xx, good, sizeof *x * (size_t)n);
+            if (failures++ >= p->max_restarts)
+                break;
+            st->restarts++;
+            continue;
+        }
         if (ret == LBFGS_SUCCESS || ret == LBFGS_ALREADY_MINIMIZED) {
             st->converged = 1;
             st->f = fx;
@@ -137,5 +168,6 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
     }
     memcpy(x, xx, sizeof *x * (size_t)n);
     lbfgs_free(xx);
+    free(good);
     return rc;
 }

@@ -1,0 +1,540 @@
+/* cli_remote.c — the `meshcorr` subcommands that talk to meshcorrd through
+ * libmeshcorr: submit, status, watch, result, cancel, delete, list, stats.
+ * They share the server options (--server ADDR, --token T; defaults
+ * $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock, and
+ * $MESHCORR_TOKEN) and print one line per fact. No numerics, no protocol
+ * details: meshcorr.h is the whole interface. */
+#include "cli/cli.h"
+#include "lmk/lmk.h"
+#include "map/bmap.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct remote {
+    const char *server, *token;
+    char def[4200];
+} remote;
+
+static void remote_defaults(remote *r)
+{
+    r->server = getenv("MESHCORR_SERVER");
+    r->token = getenv("MESHCORR_TOKEN");
+    if (!r->server || !*r->server) {
+        const char *xdg = getenv("XDG_RUNTIME_DIR");
+        snprintf(r->def, sizeof r->def, "unix:%s/meshcorr.sock", xdg && *xdg ? xdg : "/tmp");
+        r->server = r->def;
+    }
+}
+
+static mc_client *remote_connect(const char *cmd, const remote *r)
+{
+    mc_client *c = NULL;
+    char err[1200];
+    int rc = mc_connect(r->server, r->token, &c, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, r->server, err);
+        return NULL;
+    }
+    return c;
+}
+
+static int fail(const char *cmd, mc_client *c, int rc)
+{
+    fprintf(stderr, "meshcorr %s: %s\n", cmd, mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc));
+    mc_close(c);
+    return 1;
+}
+
+static int parse_id(const char *cmd, const char *s, uint64_t *id)
+{
+    char *e;
+    unsigned long long v = strtoull(s, &e, 10);
+    if (!*s || *e || v == 0) {
+        fprintf(stderr, "meshcorr %s: '%s' is not a job id\n", cmd, s);
+        return -1;
+    }
+    *id = v;
+    return 0;
+}
+
+/* Options every remote subcommand takes; 1 when handled. */
+enum { O_SERVER = 1000, O_TOKEN };
+#define REMOTE_OPTS {"server", required_argument, 0, O_SERVER}, {"token", required_argument, 0, O_TOKEN}
+
+static int remote_opt(remote *r, int c)
+{
+    if (c == O_SERVER) r->server = optarg;
+    else if (c == O_TOKEN) r->token = optarg;
+    else return 0;
+    return 1;
+}
+
+static void print_progress_text(const mc_progress *p)
+{
+    printf("job %llu stage %d iter %u/%u beta %.4g energy %.10g (source %.6g, target %.6g) %.1f s\n",
+           (unsigned long long)p->job_id, p->stage, p->outer, p->total, p->beta, p->energy[0] + p->energy[1],
+           p->energy[0], p->energy[1], p->elapsed_s);
+}
+
+static void print_progress_json(const mc_progress *p)
+{
+    printf("{\"job\":%llu,\"stage\":%d,\"outer\":%u,\"total\":%u,\"beta\":%.17g,\"gamma\":%.17g,"
+           "\"elapsed\":%.3f", (unsigned long long)p->job_id, p->stage, p->outer, p->total, p->beta,
+           p->gamma, p->elapsed_s);
+    static const char *names[2] = {"source", "target"};
+    for (int d = 0; d < 2; d++)
+        printf(",\"%s\":{\"membrane\":%.17g,\"bending\":%.17g,\"mismatch\":%.17g,\"reverse\":%.17g,"
+               "\"energy\":%.17g,\"inner\":%u}", names[d], p->membrane[d], p->bending[d], p->mismatch[d],
+               p->reverse[d], p->energy[d], p->inner[d]);
+    printf("}\n");
+}
+
+static mc_map_row *rows_of(const bmap *P)
+{
+    mc_map_row *r = malloc((size_t)P->n * sizeof *r + 1);
+    for (int i = 0; r && i < P->n; i++) {
+        r[i].face = (uint32_t)P->face[i];
+        memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
+    }
+    return r;
+}
+
+int cli_submit(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        REMOTE_OPTS,
+        {"landmarks", required_argument, 0, 'L'}, {"one-based", no_argument, 0, '1'},
+        {"init", required_argument, 0, 'i'}, {"init-reverse", required_argument, 0, 'I'},
+        {"model", required_argument, 0, 'm'}, {"alpha", required_argument, 0, 'a'},
+        {"eta", required_argument, 0, 'e'}, {"beta0", required_argument, 0, 'b'},
+        {"beta1", required_argument, 0, 'B'}, {"beta-ramp", required_argument, 0, 'R'},
+        {"gamma", required_argument, 0, 'g'}, {"iterations", required_argument, 0, 'k'},
+        {"inner-iterations", required_argument, 0, 'n'}, {"tolerance", required_argument, 0, 't'},
+        {"stop-change", required_argument, 0, 's'}, {"partial", no_argument, 0, 'P'},
+        {"priority", required_argument, 0, 'p'}, {"label", required_argument, 0, 'l'},
+        {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+    remote r;
+    remote_defaults(&r);
+    mc_job_spec spec;
+    mc_job_spec_init(&spec);
+    const char *lpath = NULL, *init = NULL, *init_rev = NULL;
+    int one_based = 0, c, bad = 0;
+    char *e;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        if (remote_opt(&r, c))
+            continue;
+        switch (c) {
+        case 'L': lpath = optarg; break;
+        case '1': one_based = 1; break;
+        case 'i': init = optarg; break;
+        case 'I': init_rev = optarg; break;
+        case 'm':
+            if (strcmp(optarg, "bijective") == 0) spec.model = MC_BIJECTIVE;
+            else if (strcmp(optarg, "injective") == 0) spec.model = MC_INJECTIVE;
+            else bad = 1;
+            break;
+        case 'a': spec.alpha = strtod(optarg, &e); bad |= *e != 0; break;
+        case 'e': spec.eta = strtod(optarg, &e); bad |= *e != 0; break;
+        case 'b': spec.beta0 = strtod(optarg, &e); bad |= *e != 0; break;
+        case 'B': spec.beta1 = strtod(optarg, &e); bad |= *e != 0; break;
+        case 'R': spec.beta_ramp = (int)strtol(optarg, &e, 10); bad |= *e != 0; break;
+        case 'g': spec.gamma = strtod(optarg, &e); bad |= *e != 0; break;
+        case 'k': spec.iterations = (uint32_t)strtoul(optarg, &e, 10); bad |= *e != 0; break;
+        case 'n': spec.inner_iterations = (uint32_t)strtoul(optarg, &e, 10); bad |= *e != 0; break;
+        case 't': spec.tolerance = strtod(optarg, &e); bad |= *e != 0; break;
+        case 's': spec.stop_change = strtod(optarg, &e); bad |= *e != 0; break;
+        case 'P': spec.partial = 1; break;
+        case 'p': spec.priority = (int32_t)strtol(optarg, &e, 10); bad |= *e != 0; break;
+        case 'l': spec.label = optarg; break;
+        case 'h':
+            printf("usage: meshcorr submit SOURCE TARGET (--landmarks PAIRS [--one-based] | --init P.map\n"
+                   "         [--init-reverse Q.map]) [--model M] [--alpha A] [--eta E] [--beta0 B]\n"
+                   "         [--beta1 B] [--beta-ramp K] [--gamma G] [--iterations K] [--inner-iterations N]\n"
+                   "         [--tolerance T] [--stop-change C] [--partial] [--priority N] [--label L]\n"
+                   "         [--server ADDR] [--token T]\nprints the job id\n");
+            return 0;
+        default: bad = 1;
+        }
+    }
+    if (bad || argc - optind != 2 || (!lpath && !init)) {
+        fprintf(stderr, "meshcorr submit: need SOURCE TARGET and --landmarks or --init (see --help)\n");
+        return 2;
+    }
+    const char *src = argv[optind], *tgt = argv[optind + 1];
+    char err[4096];
+    int status = 1;
+    mesh *S = NULL, *T = NULL;
+    lmk_set *L = NULL;
+    bmap *P0 = NULL, *Q0 = NULL;
+    mc_map_row *pr = NULL, *qr = NULL;
+    uint32_t *lm = NULL;
+    unsigned char *sb = NULL, *tb = NULL;
+    mc_client *cl = NULL;
+    if (mesh_read(src, &S, err, sizeof err) || mesh_read(tgt, &T, err, sizeof err) ||
+        (lpath && lmk_read_pairs(lpath, one_based, S, T, &L, err, sizeof err)) ||
+        (init && bmap_read(init, S, T, &P0, err, sizeof err)) ||
+        (init_rev && bmap_read(init_rev, T, S, &Q0, err, sizeof err)) ||
+        mc_encode_mesh_file(src, &sb, &spec.source_len, err, sizeof err) ||
+        mc_encode_mesh_file(tgt, &tb, &spec.target_len, err, sizeof err)) {
+        fprintf(stderr, "meshcorr submit: %s\n", err);
+        goto done;
+    }
+    spec.source = sb;
+    spec.target = tb;
+    if (L) {
+        lm = malloc(2 * sizeof *lm * (size_t)L->n + 1);
+        for (int i = 0; lm && i < L->n; i++) {
+            lm[2 * i] = (uint32_t)L->src[i];
+            lm[2 * i + 1] = (uint32_t)L->tgt[i];
+        }
+        spec.landmarks = lm;
+        spec.nlandmarks = (uint32_t)L->n;
+    }
+    if (P0) {
+        spec.p = pr = rows_of(P0);
+        spec.np = (uint32_t)P0->n;
+    }
+    if (Q0) {
+        spec.q = qr = rows_of(Q0);
+        spec.nq = (uint32_t)Q0->n;
+    }
+    if ((L && !lm) || (P0 && !pr) || (Q0 && !qr)) {
+        fprintf(stderr, "meshcorr submit: out of memory\n");
+        goto done;
+    }
+    if (!(cl = remote_connect("submit", &r)))
+        goto done;
+    uint64_t id;
+    int rc = mc_submit(cl, &spec, &id);
+    if (rc) {
+        fail("submit", cl, rc);
+        cl = NULL;
+        goto done;
+    }
+    printf("%llu\n", (unsigned long long)id);
+    status = 0;
+done:
+    mc_close(cl);
+    free(sb);
+    free(tb);
+    free(lm);
+    free(pr);
+    free(qr);
+    lmk_free(L);
+    bmap_free(P0);
+    bmap_free(Q0);
+    mesh_free(S);
+    mesh_free(T);
+    return status;
+}
+
+static void print_time(const char *what, int64_t ms)
+{
+    if (!ms)
+        return;
+    time_t t = (time_t)(ms / 1000);
+    struct tm tm;
+    char buf[64];
+    localtime_r(&t, &tm);
+    strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S", &tm);
+    printf("%-9s %s\n", what, buf);
+}
+
+/* Parses [--server A] [--token T] [extra...] ID for the one-id commands. */
+static int one_id(const char *cmd, int argc, char **argv, remote *r, uint64_t *id,
+                  const struct option *extra, void (*on_extra)(int, void *), void *ctx)
+{
+    struct option opts[16] = {REMOTE_OPTS};
+    int n = 2;
+    for (int i = 0; extra && extra[i].name && n < 15; i++)
+        opts[n++] = extra[i];
+    memset(&opts[n], 0, sizeof opts[n]);
+    remote_defaults(r);
+    int c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        if (remote_opt(r, c))
+            continue;
+        if (c == '?' || !on_extra)
+            return -1;
+        on_extra(c, ctx);
+    }
+    if (argc - optind != 1) {
+        fprintf(stderr, "meshcorr %s: need one job id\n", cmd);
+        return -1;
+    }
+    return parse_id(cmd, argv[optind], id);
+}
+
+int cli_status(int argc, char **argv)
+{
+    remote r;
+    uint64_t id;
+    if (one_id("status", argc, argv, &r, &id, NULL, NULL, NULL))
+        return 2;
+    mc_client *c = remote_connect("status", &r);
+    if (!c)
+        return 1;
+    mc_job_status s;
+    int rc = mc_status(c, id, &s);
+    if (rc)
+        return fail("status", c, rc);
+    printf("job       %llu\nstate     %s\nuser      %s\nlabel     %s\npriority  %d\n", (unsigned long long)s.job_id,
+           mc_state_name(s.state), s.user, s.label, s.priority);
+    if (s.reason[0])
+        printf("reason    %s\n", s.reason);
+    print_time("submitted", s.submit_ms);
+    print_time("started", s.start_ms);
+    print_time("ended", s.end_ms);
+    if (s.has_progress)
+        printf("progress  %u/%u, energy %.10g, %.1f s\n", s.progress.outer, s.progress.total,
+               s.progress.energy[0] + s.progress.energy[1], s.progress.elapsed_s);
+    mc_close(c);
+    return 0;
+}
+
+typedef struct watch_opts { long from; int json; int bad; } watch_opts;
+
+static void watch_opt(int c, void *ctx)
+{
+    watch_opts *w = ctx;
+    if (c == 'f')
+        w->from = strtol(optarg, NULL, 10);
+    else if (c == 'p')
+        w->json = strcmp(optarg, "json") == 0, w->bad |= strcmp(optarg, "json") && strcmp(optarg, "text");
+}
+
+static int on_progress(void *ctx, const mc_progress *p)
+{
+    if (((watch_opts *)ctx)->json)
+        print_progress_json(p);
+    else
+        print_progress_text(p);
+    fflush(stdout);
+    return 0;
+}
+
+int cli_watch(int argc, char **argv)
+{
+    static const struct option extra[] = {{"from", required_argument, 0, 'f'},
+                                          {"progress", required_argument, 0, 'p'}, {0, 0, 0, 0}};
+    remote r;
+    uint64_t id;
+    watch_opts w = {0, 0, 0};
+    if (one_id("watch", argc, argv, &r, &id, extra, watch_opt, &w) || w.bad || w.from < 0) {
+        fprintf(stderr, "usage: meshcorr watch ID [--from K] [--progress text|json]\n");
+        return 2;
+    }
+    mc_client *c = remote_connect("watch", &r);
+    if (!c)
+        return 1;
+    int state = -1;
+    char reason[1100];
+    int rc = mc_watch(c, id, (uint32_t)w.from, on_progress, &w, &state, reason, sizeof reason);
+    if (rc)
+        return fail("watch", c, rc);
+    printf("job %llu %s%s%s\n", (unsigned long long)id, mc_state_name(state), reason[0] ? ": " : "", reason);
+    mc_close(c);
+    return state == MC_COMPLETED ? 0 : 1;
+}
+
+typedef struct result_opts { const char *out, *out_rev, *out_def, *target; } result_opts;
+
+static void result_opt(int c, void *ctx)
+{
+    result_opts *o = ctx;
+    if (c == 'o') o->out = optarg;
+    else if (c == 'O') o->out_rev = optarg;
+    else if (c == 'd') o->out_def = optarg;
+    else if (c == 't') o->target = optarg;
+}
+
+static int write_map(const char *path, const mc_map_row *rows, uint32_t n, int nt, const char *comment)
+{
+    bmap *P = bmap_new((int)n, nt);
+    char err[1024];
+    if (!P) {
+        fprintf(stderr, "meshcorr result: out of memory\n");
+        return -1;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        P->face[i] = (int)rows[i].face;
+        memcpy(&P->w[3 * i], rows[i].w, sizeof rows[i].w);
+    }
+    int rc = bmap_write(path, P, comment, err, sizeof err);
+    if (rc)
+        fprintf(stderr, "meshcorr result: %s\n", err);
+    bmap_free(P);
+    return rc;
+}
+
+int cli_result(int argc, char **argv)
+{
+    static const struct option extra[] = {
+        {"out", required_argument, 0, 'o'}, {"out-reverse", required_argument, 0, 'O'},
+        {"out-deformed", required_argument, 0, 'd'}, {"target", required_argument, 0, 't'}, {0, 0, 0, 0}};
+    remote r;
+    uint64_t id;
+    result_opts o = {0};
+    if (one_id("result", argc, argv, &r, &id, extra, result_opt, &o) || (!o.out && !o.out_rev && !o.out_def)) {
+        fprintf(stderr, "usage: meshcorr result ID --out P.map [--out-reverse Q.map] [--out-deformed Y.ply]\n"
+                        "         [--target MESH (injective jobs: the target's vertex count for P.map)]\n");
+        return 2;
+    }
+    mc_client *c = remote_connect("result", &r);
+    if (!c)
+        return 1;
+    mc_job_result res;
+    unsigned what = MC_WANT_P | MC_WANT_Q | (o.out_def ? MC_WANT_DEFORMED : 0);
+    int rc = mc_result(c, id, what, &res), status = 1;
+    if (rc)
+        return fail("result", c, rc);
+    char comment[128], err[1024];
+    snprintf(comment, sizeof comment, "meshcorrd job %llu", (unsigned long long)id);
+    int nt = (int)res.nq;
+    mesh *T = NULL;
+    if (o.target) {
+        if (mesh_read(o.target, &T, err, sizeof err)) {
+            fprintf(stderr, "meshcorr result: %s\n", err);
+            goto done;
+        }
+        nt = T->nv;
+    }
+    if (o.out && !nt) {
+        fprintf(stderr, "meshcorr result: injective job: give --target MESH for the map's header\n");
+        goto done;
+    }
+    if (o.out && write_map(o.out, res.p, res.np, nt, comment))
+        goto done;
+    if (o.out_rev && (!res.nq || write_map(o.out_rev, res.q, res.nq, (int)res.np, comment))) {
+        if (!res.nq)
+            fprintf(stderr, "meshcorr result: job %llu has no reverse map (injective)\n", (unsigned long long)id);
+        goto done;
+    }
+    if (o.out_def) {
+        mesh Y = {0};
+        if (dracob_decode(res.deformed, res.deformed_len, MESH_MAX_VERTICES, MESH_MAX_FACES, &Y.v, &Y.nv,
+                          &Y.f, &Y.nf, err, sizeof err) || mesh_write(o.out_def, &Y, err, sizeof err)) {
+            fprintf(stderr, "meshcorr result: deformed mesh: %s\n", err);
+            free(Y.v);
+            free(Y.f);
+            goto done;
+        }
+        free(Y.v);
+        free(Y.f);
+    }
+    for (uint32_t i = 0; i < res.nmetrics; i++)
+        printf("%s %.10g\n", res.metric_keys[i], res.metric_values[i]);
+    status = 0;
+done:
+    mesh_free(T);
+    mc_result_free(&res);
+    mc_close(c);
+    return status;
+}
+
+static int simple(const char *cmd, int argc, char **argv, int (*fn)(mc_client *, uint64_t), const char *done)
+{
+    remote r;
+    uint64_t id;
+    if (one_id(cmd, argc, argv, &r, &id, NULL, NULL, NULL))
+        return 2;
+    mc_client *c = remote_connect(cmd, &r);
+    if (!c)
+        return 1;
+    int rc = fn(c, id);
+    if (rc)
+        return fail(cmd, c, rc);
+    printf("job %llu %s\n", (unsigned long long)id, done);
+    mc_close(c);
+    return 0;
+}
+
+int cli_cancel(int argc, char **argv) { return simple("cancel", argc, argv, mc_cancel, "cancelled"); }
+int cli_delete(int argc, char **argv) { return simple("delete", argc, argv, mc_delete, "deleted"); }
+
+int cli_list(int argc, char **argv)
+{
+    static const struct option opts[] = {REMOTE_OPTS, {"state", required_argument, 0, 's'},
+                                         {"user", required_argument, 0, 'u'}, {0, 0, 0, 0}};
+    remote r;
+    remote_defaults(&r);
+    uint32_t mask = 0;
+    const char *user = NULL;
+    int c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        if (remote_opt(&r, c))
+            continue;
+        if (c == 's') {
+            int s = mc_state_parse(optarg);
+            if (s < 0) {
+                fprintf(stderr, "meshcorr list: --state: '%s' is not a job state (PENDING, RUNNING, ...)\n", optarg);
+                return 2;
+            }
+            mask |= 1u << s;
+        } else if (c == 'u') {
+            user = optarg;
+        } else {
+            fprintf(stderr, "usage: meshcorr list [--state S]... [--user U]\n");
+            return 2;
+        }
+    }
+    mc_client *cl = remote_connect("list", &r);
+    if (!cl)
+        return 1;
+    mc_job_info *jobs;
+    uint32_t n;
+    int rc = mc_list(cl, user, mask, &jobs, &n);
+    if (rc)
+        return fail("list", cl, rc);
+    printf("%-8s %-13s %-10s %4s %11s  %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "LABEL");
+    for (uint32_t i = 0; i < n; i++) {
+        char it[32];
+        snprintf(it, sizeof it, "%u/%u", jobs[i].outer, jobs[i].total);
+        printf("%-8llu %-13s %-10s %4d %11s  %s\n", (unsigned long long)jobs[i].job_id,
+               mc_state_name(jobs[i].state), jobs[i].user, jobs[i].priority, it, jobs[i].label);
+    }
+    free(jobs);
+    mc_close(cl);
+    return 0;
+}
+
+int cli_stats(int argc, char **argv)
+{
+    static const struct option opts[] = {REMOTE_OPTS, {0, 0, 0, 0}};
+    remote r;
+    remote_defaults(&r);
+    int c;
+    optind = 1;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1)
+        if (!remote_opt(&r, c))
+            return 2;
+    mc_client *cl = remote_connect("stats", &r);
+    if (!cl)
+        return 1;
+    mc_server_stats s;
+    int rc = mc_stats(cl, &s);
+    if (rc)
+        return fail("stats", cl, rc);
+    printf("queued    %u\nrunning   %u\nworkers   %u\ncompleted %llu\nfailed    %llu\ncancelled %llu\n", s.queued,
+           s.running, s.workers, (unsigned long long)s.completed, (unsigned long long)s.failed,
+           (unsigned long long)s.cancelled);
+    static const char *slot[] = {"idle", "starting", "busy", "draining"};
+    for (uint32_t i = 0; i < s.nslots; i++)
+        printf("slot %u    %s%s%.0llu\n", i, slot[s.slot_state[i] & 3], s.slot_job[i] ? " job " : "",
+               (unsigned long long)s.slot_job[i]);
+    for (uint32_t i = 0; i < s.ndevices; i++)
+        printf("device    %s\n", s.devices[i]);
+    mc_stats_free(&s);
+    mc_close(cl);
+    return 0;
+}
