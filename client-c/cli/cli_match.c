@@ -4,6 +4,7 @@
  * progress (bar on a terminal, text lines, or JSON lines on stderr). Holds
  * no numerics. */
 #include "cli/cli.h"
+#include "cli/cli_job.h"
 #include "corr/corr.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
@@ -20,48 +21,12 @@ enum progress_mode { PROGRESS_AUTO, PROGRESS_TEXT, PROGRESS_JSON, PROGRESS_NONE 
 static void usage(FILE *fp)
 {
     fprintf(fp,
-        "usage: meshcorr match SOURCE TARGET (--init P.map [--init-reverse Q.map] | --landmarks PAIRS\n"
-        "         | --source-landmarks A --target-landmarks B) [--one-based]\n"
-        "         --out P.map [--out-reverse Q.map] [--out-deformed Y.ply] [--out-remeshed T.ply]\n"
-        "         [--model bijective|injective] [--preset release|paper]\n"
-        "         [--alpha A] [--eta E] [--beta0 B] [--beta1 B] [--beta-ramp K] [--gamma G]\n"
-        "         [--iterations K] [--inner-iterations N] [--tolerance T] [--stop-change C]\n"
-        "         [--log-eps E] [--backend cpu|opencl|auto] [--device NAME]\n"
-        "         [--stages all|rhm|ectm] [--rhm-alpha A] [--rhm-iterations K] [--rhm-dim M]\n"
-        "         [--rhm-landmark-weight G]\n"
-        "         [--partial] [--threads N] [--progress auto|text|json|none]\n"
-        "Defaults are the authors' released code's (--preset release): alpha 20, eta 6.667e-4,\n"
-        "beta 500 -> 1e5 over 200 iterations, gamma 1e4, 300 iterations, 50 L-BFGS steps.\n"
-        "Without --init, the initial maps come from the landmarks: a geodesic Voronoi map, then\n"
-        "Reversible Harmonic Maps (alpha 5e-4, beta 5e-3 min(k, 100), 8-D embedding, at most\n"
-        "200 iterations, landmark weight 0). --stages rhm stops there and writes RHM's maps;\n"
-        "--stages ectm runs ECTM alone and needs --init.\n"
-        "--backend opencl computes the elastic energy on an OpenCL device with fp64 whose\n"
-        "platform or device name contains NAME (see meshcorr devices); auto: a GPU, else the CPU.\n");
-}
-
-static int parse_double(const char *opt, const char *s, double *out)
-{
-    char *e;
-    double v = strtod(s, &e);
-    if (*s == '\0' || *e != '\0') {
-        fprintf(stderr, "meshcorr match: --%s: '%s' is not a number\n", opt, s);
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
-
-static int parse_int(const char *opt, const char *s, int *out)
-{
-    char *e;
-    long v = strtol(s, &e, 10);
-    if (*s == '\0' || *e != '\0' || v < -1000000000L || v > 1000000000L) {
-        fprintf(stderr, "meshcorr match: --%s: '%s' is not an integer\n", opt, s);
-        return -1;
-    }
-    *out = (int)v;
-    return 0;
+        "usage: meshcorr match SOURCE TARGET INPUTS --out P.map [--out-reverse Q.map]\n"
+        "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--stages all|rhm|ectm]\n"
+        "         [--log-eps E] [--threads N] [--progress auto|text|json|none] [job options]\n"
+        CLI_JOB_USAGE
+        "--stages rhm stops after RHM and writes its maps; --stages ectm runs ECTM alone\n"
+        "(needs --init).\n");
 }
 
 typedef struct progress_state {
@@ -172,148 +137,89 @@ static int write_mesh_with(const char *path, const mesh *faces_of, const double 
 
 int cli_match(int argc, char **argv)
 {
+    enum { O_OUT = 1, O_OUT_REVERSE, O_OUT_DEFORMED, O_OUT_REMESHED, O_STAGES, O_LOG_EPS,
+           O_THREADS, O_PROGRESS };
     static const struct option opts[] = {
-        {"init", required_argument, 0, 'i'},        {"init-reverse", required_argument, 0, 'I'},
-        {"out", required_argument, 0, 'o'},         {"out-reverse", required_argument, 0, 'O'},
-        {"out-deformed", required_argument, 0, 'd'}, {"out-remeshed", required_argument, 0, 'r'},
-        {"model", required_argument, 0, 'm'},       {"preset", required_argument, 0, 'p'},
-        {"alpha", required_argument, 0, 'a'},       {"eta", required_argument, 0, 'e'},
-        {"beta0", required_argument, 0, 'b'},       {"beta1", required_argument, 0, 'B'},
-        {"beta-ramp", required_argument, 0, 'R'},   {"gamma", required_argument, 0, 'g'},
-        {"iterations", required_argument, 0, 'k'},  {"inner-iterations", required_argument, 0, 'n'},
-        {"tolerance", required_argument, 0, 't'},   {"stop-change", required_argument, 0, 's'},
-        {"partial", no_argument, 0, 'P'},           {"threads", required_argument, 0, 'T'},
-        {"progress", required_argument, 0, 'G'},    {"help", no_argument, 0, 'h'},
-        {"landmarks", required_argument, 0, 'L'},   {"source-landmarks", required_argument, 0, 'x'},
-        {"target-landmarks", required_argument, 0, 'y'}, {"one-based", no_argument, 0, '1'},
-        {"log-eps", required_argument, 0, 'E'},
-        {"stages", required_argument, 0, 'S'},      {"rhm-alpha", required_argument, 0, 'A'},
-        {"rhm-iterations", required_argument, 0, 'K'}, {"rhm-dim", required_argument, 0, 'M'},
-        {"rhm-landmark-weight", required_argument, 0, 'W'},
-        {"backend", required_argument, 0, 'Z'},     {"device", required_argument, 0, 'D'},
-        {0, 0, 0, 0}};
-    const char *init = NULL, *init_rev = NULL, *out = NULL, *out_rev = NULL;
-    const char *out_def = NULL, *out_rem = NULL;
-    const char *lmk_pairs = NULL, *lmk_src = NULL, *lmk_tgt = NULL;
-    int one_based = 0;
+        CLI_JOB_OPTIONS,
+        {"out", required_argument, 0, O_OUT},        {"out-reverse", required_argument, 0, O_OUT_REVERSE},
+        {"out-deformed", required_argument, 0, O_OUT_DEFORMED},
+        {"out-remeshed", required_argument, 0, O_OUT_REMESHED},
+        {"stages", required_argument, 0, O_STAGES}, {"log-eps", required_argument, 0, O_LOG_EPS},
+        {"threads", required_argument, 0, O_THREADS}, {"progress", required_argument, 0, O_PROGRESS},
+        {"help", no_argument, 0, 'h'},              {0, 0, 0, 0}};
+    const char *out = NULL, *out_rev = NULL, *out_def = NULL, *out_rem = NULL;
     corr_stages stages = CORR_STAGES_ALL;
-    rhm_params rp;
-    rhm_params_init(&rp);
-    ectm_params p;
-    ectm_params_init(&p);
-    /* The preset is applied first, whatever its position: explicit weights win. */
-    for (int i = 1; i < argc; i++)
-        if (strcmp(argv[i], "--preset=paper") == 0 ||
-            (i + 1 < argc && strcmp(argv[i], "--preset") == 0 && strcmp(argv[i + 1], "paper") == 0))
-            ectm_params_paper(&p);
+    cli_job job;
+    cli_job_init(&job, argc, argv);
+    ectm_params *pp = &job.p;
     progress_state ps = { PROGRESS_AUTO };
     int c, bad = 0;
+    char *e;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        int r = cli_job_option(&job, "match", c, optarg);
+        if (r) {
+            bad |= r < 0;
+            continue;
+        }
         switch (c) {
-        case 'i': init = optarg; break;
-        case 'I': init_rev = optarg; break;
-        case 'o': out = optarg; break;
-        case 'O': out_rev = optarg; break;
-        case 'd': out_def = optarg; break;
-        case 'r': out_rem = optarg; break;
-        case 'm':
-            if (strcmp(optarg, "bijective") == 0) p.model = ECTM_BIJECTIVE;
-            else if (strcmp(optarg, "injective") == 0) p.model = ECTM_INJECTIVE;
-            else { fprintf(stderr, "meshcorr match: --model: '%s' is not bijective or injective\n", optarg); bad = 1; }
-            break;
-        case 'p':
-            if (strcmp(optarg, "paper") != 0 && strcmp(optarg, "release") != 0) {
-                fprintf(stderr, "meshcorr match: --preset: '%s' is not release or paper\n", optarg);
+        case O_OUT: out = optarg; break;
+        case O_OUT_REVERSE: out_rev = optarg; break;
+        case O_OUT_DEFORMED: out_def = optarg; break;
+        case O_OUT_REMESHED: out_rem = optarg; break;
+        case O_LOG_EPS:
+            pp->log_eps = strtod(optarg, &e);
+            if (!*optarg || *e) {
+                fprintf(stderr, "meshcorr match: --log-eps: '%s' is not a number\n", optarg);
                 bad = 1;
             }
             break;
-        case 'a': bad |= parse_double("alpha", optarg, &p.alpha) != 0; break;
-        case 'e': bad |= parse_double("eta", optarg, &p.eta) != 0; break;
-        case 'b': bad |= parse_double("beta0", optarg, &p.beta0) != 0; break;
-        case 'B': bad |= parse_double("beta1", optarg, &p.beta1) != 0; break;
-        case 'R': bad |= parse_int("beta-ramp", optarg, &p.beta_ramp) != 0; break;
-        case 'g': bad |= parse_double("gamma", optarg, &p.gamma) != 0; break;
-        case 'k': bad |= parse_int("iterations", optarg, &p.iterations) != 0; break;
-        case 'n': bad |= parse_int("inner-iterations", optarg, &p.inner_iterations) != 0; break;
-        case 't': bad |= parse_double("tolerance", optarg, &p.tolerance) != 0; break;
-        case 's': bad |= parse_double("stop-change", optarg, &p.stop_change) != 0; break;
-        case 'E': bad |= parse_double("log-eps", optarg, &p.log_eps) != 0; break;
-        case 'Z':
-            if (strcmp(optarg, "cpu") && strcmp(optarg, "opencl") && strcmp(optarg, "auto")) {
-                fprintf(stderr, "meshcorr match: --backend: '%s' is not cpu, opencl or auto\n", optarg);
+        case O_THREADS:
+            pp->threads = (int)strtol(optarg, &e, 10);
+            if (!*optarg || *e) {
+                fprintf(stderr, "meshcorr match: --threads: '%s' is not an integer\n", optarg);
                 bad = 1;
-            } else {
-                snprintf(p.backend, sizeof p.backend, "%s", optarg);
             }
             break;
-        case 'D':
-            if (strlen(optarg) >= sizeof p.device) {
-                fprintf(stderr, "meshcorr match: --device: name longer than %zu bytes\n",
-                        sizeof p.device - 1);
-                bad = 1;
-            } else {
-                snprintf(p.device, sizeof p.device, "%s", optarg);
-            }
-            break;
-        case 'P': p.partial = 1; break;
-        case 'T': bad |= parse_int("threads", optarg, &p.threads) != 0; break;
-        case 'G':
+        case O_PROGRESS:
             if (strcmp(optarg, "auto") == 0) ps.mode = PROGRESS_AUTO;
             else if (strcmp(optarg, "text") == 0) ps.mode = PROGRESS_TEXT;
             else if (strcmp(optarg, "json") == 0) ps.mode = PROGRESS_JSON;
             else if (strcmp(optarg, "none") == 0) ps.mode = PROGRESS_NONE;
             else { fprintf(stderr, "meshcorr match: --progress: '%s' is not auto, text, json or none\n", optarg); bad = 1; }
             break;
-        case 'L': lmk_pairs = optarg; break;
-        case 'x': lmk_src = optarg; break;
-        case 'y': lmk_tgt = optarg; break;
-        case '1': one_based = 1; break;
-        case 'S':
+        case O_STAGES:
             if (strcmp(optarg, "all") == 0) stages = CORR_STAGES_ALL;
             else if (strcmp(optarg, "rhm") == 0) stages = CORR_STAGES_RHM;
             else if (strcmp(optarg, "ectm") == 0) stages = CORR_STAGES_ECTM;
             else { fprintf(stderr, "meshcorr match: --stages: '%s' is not all, rhm or ectm\n", optarg); bad = 1; }
             break;
-        case 'A': bad |= parse_double("rhm-alpha", optarg, &rp.alpha) != 0; break;
-        case 'K': bad |= parse_int("rhm-iterations", optarg, &rp.iterations) != 0; break;
-        case 'M': bad |= parse_int("rhm-dim", optarg, &rp.dim) != 0; break;
-        case 'W': bad |= parse_double("rhm-landmark-weight", optarg, &rp.gamma) != 0; break;
         case 'h': usage(stdout); return 0;
         default: bad = 1;
         }
     }
-    int have_lmk = lmk_pairs || (lmk_src && lmk_tgt);
-    if (!bad && (argc - optind != 2 || !out || (!init && !have_lmk))) {
-        fprintf(stderr, "meshcorr match: need SOURCE TARGET, --out, and --init or landmarks\n");
+    if (!bad && (argc - optind != 2 || !out)) {
+        fprintf(stderr, "meshcorr match: need SOURCE TARGET and --out\n");
         bad = 1;
     }
-    if (!bad && !!lmk_src != !!lmk_tgt) {
-        fprintf(stderr, "meshcorr match: --source-landmarks and --target-landmarks go together\n");
-        bad = 1;
-    }
-    if (bad) {
+    if (bad || cli_job_check(&job, "match")) {
         usage(stderr);
         return 2;
     }
-    if (stages == CORR_STAGES_ECTM && !init) {
+    if (stages == CORR_STAGES_ECTM && !job.init) {
         fprintf(stderr, "meshcorr match: --stages ectm needs --init\n");
         return 2;
     }
-    if (stages == CORR_STAGES_RHM && (init || out_def)) {
+    if (stages == CORR_STAGES_RHM && (job.init || out_def)) {
         fprintf(stderr, "meshcorr match: --stages rhm starts from landmarks and has no deformation "
                 "(no --init, no --out-deformed)\n");
         return 2;
     }
-    if (p.model == ECTM_INJECTIVE && (init_rev || out_rev)) {
-        fprintf(stderr, "meshcorr match: --init-reverse/--out-reverse need the bijective model\n");
+    if (pp->model == ECTM_INJECTIVE && out_rev) {
+        fprintf(stderr, "meshcorr match: --out-reverse needs the bijective model\n");
         return 2;
     }
     char err[1024];
-    if (ectm_params_check(&p, err, sizeof err) || rhm_params_check(&rp, err, sizeof err)) {
-        fprintf(stderr, "meshcorr match: %s\n", err);
-        return 2;
-    }
     if (ps.mode == PROGRESS_AUTO && !isatty(STDERR_FILENO))
         ps.mode = PROGRESS_TEXT;
 
@@ -323,25 +229,11 @@ int cli_match(int argc, char **argv)
     lmk_set *L = NULL;
     ectm_result res = {0};
     const char *src = argv[optind], *tgt = argv[optind + 1];
-    if (!(S = load(src)) || !(T = load(tgt)))
+    if (!(S = load(src)) || !(T = load(tgt)) || cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
-    if (init) {
-        if (bmap_read(init, S, T, &P0, err, sizeof err)) {
-            fprintf(stderr, "meshcorr match: %s\n", err);
-            goto done;
-        }
-    } else if (lmk_pairs ? lmk_read_pairs(lmk_pairs, one_based, S, T, &L, err, sizeof err)
-                         : lmk_read_lists(lmk_src, lmk_tgt, one_based, S, T, &L, err, sizeof err)) {
-        fprintf(stderr, "meshcorr match: %s\n", err);
-        goto done;
-    }
-    if (init_rev && bmap_read(init_rev, T, S, &Q0, err, sizeof err)) {
-        fprintf(stderr, "meshcorr match: %s\n", err);
-        goto done;
-    }
-    rp.threads = p.threads;
-    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages };
-    if (corr_run(&in, &p, on_progress, &ps, &res, err, sizeof err)) {
+    job.rp.threads = pp->threads;
+    corr_input in = { S, T, src, tgt, L, P0, Q0, &job.rp, stages };
+    if (corr_run(&in, pp, on_progress, &ps, &res, err, sizeof err)) {
         fprintf(stderr, "\nmeshcorr match: %s\n", err);
         goto done;
     }
@@ -351,7 +243,7 @@ int cli_match(int argc, char **argv)
     else
         snprintf(comment, sizeof comment,
                  "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",
-                 src, tgt, p.model == ECTM_BIJECTIVE ? "bijective" : "injective",
+                 src, tgt, pp->model == ECTM_BIJECTIVE ? "bijective" : "injective",
                  res.last.outer, res.last.energy);
     if (bmap_write(out, res.P, comment, err, sizeof err) ||
         (out_rev && res.Q && bmap_write(out_rev, res.Q, comment, err, sizeof err))) {

@@ -5,6 +5,7 @@
  * $MESHCORR_TOKEN) and print one line per fact. No numerics, no protocol
  * details: meshcorr.h is the whole interface. */
 #include "cli/cli.h"
+#include "cli/cli_job.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/draco_bridge.h"
@@ -76,17 +77,24 @@ static int remote_opt(remote *r, int c)
     return 1;
 }
 
+static const char *stage_name(int stage)
+{
+    static const char *const names[] = {"voronoi", "rhm", "ectm", "init"};
+    return stage >= 0 && stage < 4 ? names[stage] : "?";
+}
+
 static void print_progress_text(const mc_progress *p)
 {
-    printf("job %llu stage %d iter %u/%u beta %.4g energy %.10g (source %.6g, target %.6g) %.1f s\n",
-           (unsigned long long)p->job_id, p->stage, p->outer, p->total, p->beta, p->energy[0] + p->energy[1],
+    printf("job %llu %s iter %u/%u beta %.4g energy %.10g (source %.6g, target %.6g) %.1f s\n",
+           (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total, p->beta,
+           p->energy[0] + p->energy[1],
            p->energy[0], p->energy[1], p->elapsed_s);
 }
 
 static void print_progress_json(const mc_progress *p)
 {
-    printf("{\"job\":%llu,\"stage\":%d,\"outer\":%u,\"total\":%u,\"beta\":%.17g,\"gamma\":%.17g,"
-           "\"elapsed\":%.3f", (unsigned long long)p->job_id, p->stage, p->outer, p->total, p->beta,
+    printf("{\"job\":%llu,\"stage\":\"%s\",\"outer\":%u,\"total\":%u,\"beta\":%.17g,\"gamma\":%.17g,"
+           "\"elapsed\":%.3f", (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total, p->beta,
            p->gamma, p->elapsed_s);
     static const char *names[2] = {"source", "target"};
     for (int d = 0; d < 2; d++)
@@ -106,68 +114,78 @@ static mc_map_row *rows_of(const bmap *P)
     return r;
 }
 
+/* The wire spec of a parsed job (meshes, landmarks and maps are added by the caller). */
+static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t bsz)
+{
+    const ectm_params *p = &j->p;
+    s->model = p->model == ECTM_INJECTIVE ? MC_INJECTIVE : MC_BIJECTIVE;
+    s->partial = p->partial;
+    s->alpha = p->alpha;
+    s->eta = p->eta;
+    s->beta0 = p->beta0;
+    s->beta1 = p->beta1;
+    s->beta_ramp = p->beta_ramp;
+    s->gamma = p->gamma;
+    s->iterations = (uint32_t)p->iterations;
+    s->inner_iterations = (uint32_t)p->inner_iterations;
+    s->tolerance = p->tolerance;
+    s->stop_change = p->stop_change;
+    s->rhm_iterations = (uint32_t)j->rp.iterations;
+    s->rhm_dim = (uint32_t)j->rp.dim;
+    s->rhm_alpha = j->rp.alpha;
+    s->rhm_landmark_weight = j->rp.gamma;
+    snprintf(backend, bsz, "%s%s%s", p->backend, p->device[0] ? ":" : "", p->device);
+    s->backend = backend;
+}
+
 int cli_submit(int argc, char **argv)
 {
+    enum { O_PRIORITY = 1, O_LABEL };
     static const struct option opts[] = {
-        REMOTE_OPTS,
-        {"landmarks", required_argument, 0, 'L'}, {"one-based", no_argument, 0, '1'},
-        {"init", required_argument, 0, 'i'}, {"init-reverse", required_argument, 0, 'I'},
-        {"model", required_argument, 0, 'm'}, {"alpha", required_argument, 0, 'a'},
-        {"eta", required_argument, 0, 'e'}, {"beta0", required_argument, 0, 'b'},
-        {"beta1", required_argument, 0, 'B'}, {"beta-ramp", required_argument, 0, 'R'},
-        {"gamma", required_argument, 0, 'g'}, {"iterations", required_argument, 0, 'k'},
-        {"inner-iterations", required_argument, 0, 'n'}, {"tolerance", required_argument, 0, 't'},
-        {"stop-change", required_argument, 0, 's'}, {"partial", no_argument, 0, 'P'},
-        {"priority", required_argument, 0, 'p'}, {"label", required_argument, 0, 'l'},
+        REMOTE_OPTS, CLI_JOB_OPTIONS,
+        {"priority", required_argument, 0, O_PRIORITY}, {"label", required_argument, 0, O_LABEL},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     remote r;
     remote_defaults(&r);
     mc_job_spec spec;
     mc_job_spec_init(&spec);
-    const char *lpath = NULL, *init = NULL, *init_rev = NULL;
-    int one_based = 0, c, bad = 0;
+    cli_job job;
+    cli_job_init(&job, argc, argv);
+    int c, bad = 0;
     char *e;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         if (remote_opt(&r, c))
             continue;
+        int jr = cli_job_option(&job, "submit", c, optarg);
+        if (jr) {
+            bad |= jr < 0;
+            continue;
+        }
         switch (c) {
-        case 'L': lpath = optarg; break;
-        case '1': one_based = 1; break;
-        case 'i': init = optarg; break;
-        case 'I': init_rev = optarg; break;
-        case 'm':
-            if (strcmp(optarg, "bijective") == 0) spec.model = MC_BIJECTIVE;
-            else if (strcmp(optarg, "injective") == 0) spec.model = MC_INJECTIVE;
-            else bad = 1;
+        case O_PRIORITY:
+            spec.priority = (int32_t)strtol(optarg, &e, 10);
+            if (!*optarg || *e) {
+                fprintf(stderr, "meshcorr submit: --priority: '%s' is not an integer\n", optarg);
+                bad = 1;
+            }
             break;
-        case 'a': spec.alpha = strtod(optarg, &e); bad |= *e != 0; break;
-        case 'e': spec.eta = strtod(optarg, &e); bad |= *e != 0; break;
-        case 'b': spec.beta0 = strtod(optarg, &e); bad |= *e != 0; break;
-        case 'B': spec.beta1 = strtod(optarg, &e); bad |= *e != 0; break;
-        case 'R': spec.beta_ramp = (int)strtol(optarg, &e, 10); bad |= *e != 0; break;
-        case 'g': spec.gamma = strtod(optarg, &e); bad |= *e != 0; break;
-        case 'k': spec.iterations = (uint32_t)strtoul(optarg, &e, 10); bad |= *e != 0; break;
-        case 'n': spec.inner_iterations = (uint32_t)strtoul(optarg, &e, 10); bad |= *e != 0; break;
-        case 't': spec.tolerance = strtod(optarg, &e); bad |= *e != 0; break;
-        case 's': spec.stop_change = strtod(optarg, &e); bad |= *e != 0; break;
-        case 'P': spec.partial = 1; break;
-        case 'p': spec.priority = (int32_t)strtol(optarg, &e, 10); bad |= *e != 0; break;
-        case 'l': spec.label = optarg; break;
+        case O_LABEL: spec.label = optarg; break;
         case 'h':
-            printf("usage: meshcorr submit SOURCE TARGET (--landmarks PAIRS [--one-based] | --init P.map\n"
-                   "         [--init-reverse Q.map]) [--model M] [--alpha A] [--eta E] [--beta0 B]\n"
-                   "         [--beta1 B] [--beta-ramp K] [--gamma G] [--iterations K] [--inner-iterations N]\n"
-                   "         [--tolerance T] [--stop-change C] [--partial] [--priority N] [--label L]\n"
-                   "         [--server ADDR] [--token T]\nprints the job id\n");
+            printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
+                   "         [--server ADDR] [--token T]\nprints the job id\n" CLI_JOB_USAGE);
             return 0;
         default: bad = 1;
         }
     }
-    if (bad || argc - optind != 2 || (!lpath && !init)) {
-        fprintf(stderr, "meshcorr submit: need SOURCE TARGET and --landmarks or --init (see --help)\n");
-        return 2;
+    if (!bad && argc - optind != 2) {
+        fprintf(stderr, "meshcorr submit: need SOURCE TARGET (see --help)\n");
+        bad = 1;
     }
+    if (bad || cli_job_check(&job, "submit"))
+        return 2;
+    char backend[160];
+    spec_of_job(&job, &spec, backend, sizeof backend);
     const char *src = argv[optind], *tgt = argv[optind + 1];
     char err[4096];
     int status = 1;
@@ -178,11 +196,13 @@ int cli_submit(int argc, char **argv)
     uint32_t *lm = NULL;
     unsigned char *sb = NULL, *tb = NULL;
     mc_client *cl = NULL;
-    if (mesh_read(src, &S, err, sizeof err) || mesh_read(tgt, &T, err, sizeof err) ||
-        (lpath && lmk_read_pairs(lpath, one_based, S, T, &L, err, sizeof err)) ||
-        (init && bmap_read(init, S, T, &P0, err, sizeof err)) ||
-        (init_rev && bmap_read(init_rev, T, S, &Q0, err, sizeof err)) ||
-        mc_encode_mesh_file(src, &sb, &spec.source_len, err, sizeof err) ||
+    if (mesh_read(src, &S, err, sizeof err) || mesh_read(tgt, &T, err, sizeof err)) {
+        fprintf(stderr, "meshcorr submit: %s\n", err);
+        goto done;
+    }
+    if (cli_job_load(&job, "submit", S, T, &L, &P0, &Q0))
+        goto done;
+    if (mc_encode_mesh_file(src, &sb, &spec.source_len, err, sizeof err) ||
         mc_encode_mesh_file(tgt, &tb, &spec.target_len, err, sizeof err)) {
         fprintf(stderr, "meshcorr submit: %s\n", err);
         goto done;
