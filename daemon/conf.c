@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG };
+enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT };
 
 #define OFF(f) offsetof(mcd_conf, f)
 static const struct option_def {
@@ -39,6 +39,8 @@ static const struct option_def {
     {"admin-uid", K_LONG, OFF(admin_uid), -1, INT_MAX, "UID treated as admin on the Unix socket (root always is)"},
     {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp:HOST:PORT addresses to"},
     {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
+    {"modbus", K_ENDPOINT, OFF(modbus), 0, 0, "[HOST:]PORT Modbus TCP status registers (off; 1502 suits; host 127.0.0.1)"},
+    {"metrics", K_ENDPOINT, OFF(metrics), 0, 0, "[HOST:]PORT Prometheus GET /metrics over HTTP (off; host 127.0.0.1)"},
 };
 #define NOPTIONS (sizeof options / sizeof options[0])
 
@@ -56,6 +58,7 @@ void conf_init(mcd_conf *c)
     c->max_output = CONF_DEFAULT_MAX_OUTPUT;
     c->admin_uid = -1;
     c->log_level = DLOG_INFO;
+    c->modbus.port = c->metrics.port = -1;
 }
 
 void conf_usage(FILE *fp)
@@ -70,6 +73,31 @@ static int set_path(char *dst, const char *name, const char *v, char *err, size_
     if (strlen(v) >= CONF_PATH)
         return errbuf_set(err, errsz, -1, "--%s: path longer than %d bytes", name, CONF_PATH - 1);
     strcpy(dst, v);
+    return 0;
+}
+
+/* "PORT", "HOST:PORT" or "[V6]:PORT"; HOST is kept as given. */
+static int set_endpoint(conf_endpoint *e, const char *name, const char *v, char *err, size_t errsz)
+{
+    const char *colon = strrchr(v, ':'), *port = colon ? colon + 1 : v;
+    const char *host = v;
+    size_t hlen = colon ? (size_t)(colon - v) : 0;
+    if (hlen >= 2 && host[0] == '[' && host[hlen - 1] == ']') {
+        host++;
+        hlen -= 2;
+    }
+    char *e2;
+    errno = 0;
+    long n = strtol(port, &e2, 10);
+    if (!*port || *e2 || errno || n < 1 || n > 65535 || (colon && hlen == 0) || hlen >= CONF_HOST)
+        return errbuf_set(err, errsz, -1, "--%s: '%s' is not PORT or HOST:PORT (PORT in [1, 65535])", name, v);
+    if (colon) {
+        memcpy(e->host, host, hlen);
+        e->host[hlen] = '\0';
+    } else {
+        strcpy(e->host, "127.0.0.1");
+    }
+    e->port = (int)n;
     return 0;
 }
 
@@ -93,6 +121,8 @@ int conf_set(mcd_conf *c, const char *key, const char *v, char *err, size_t errs
         return set_path(c->listen[c->nlisten++], o->name, v, err, errsz);
     case K_CONFIG:
         return conf_load_file(c, v, err, errsz);
+    case K_ENDPOINT:
+        return set_endpoint((conf_endpoint *)field, o->name, v, err, errsz);
     case K_LEVEL: {
         static const char *names[] = {"error", "warn", "info", "debug"};
         for (int i = 0; i < 4; i++)

@@ -2,7 +2,8 @@
  * queue rebuilt from the store, listeners, the result-expiry sweep and the
  * signal handlers, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
  * accepting, SIGTERM the workers, their jobs go back to PENDING, then close
- * every handle and the store. Holds no request or job logic. */
+ * every handle and the store; the dashboard threads (--modbus, --metrics)
+ * stop after the loop. Holds no request or job logic. */
 #include "mcd.h"
 
 #include <signal.h>
@@ -39,6 +40,7 @@ void mcd_drained(mcd *d)
     dlog(DLOG_INFO, "drained: no worker running; closing");
     srv_close_all(d);
     wsup_close(d);
+    snap_close(d);
     uv_close((uv_handle_t *)&d->sweep, NULL);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
     uv_close((uv_handle_t *)&d->sigint, NULL);
@@ -88,7 +90,9 @@ int main(int argc, char **argv)
         dlog(DLOG_ERROR, "cannot rebuild the queue from the store");
         goto done;
     }
-    if (wsup_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err)) {
+    if (wsup_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
+        (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
+        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.snap, &d.metrics, err, sizeof err))) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }
@@ -112,8 +116,12 @@ done:
         /* a start-up failure: close whatever was opened */
         srv_stop_listening(&d);
         wsup_close(&d);
+        snap_close(&d);
         uv_run(d.loop, UV_RUN_NOWAIT);
     }
+    mbus_stop(d.mbus);
+    metrics_stop(d.metrics);
+    snap_free(d.snap);
     uv_loop_close(d.loop);
     store_close(d.store);
     sched_free(d.sched);

@@ -9,6 +9,10 @@
  *   wsup.c   wsup_   worker processes: spawn, progress pipe, exit, timeouts
  *   srv.c    srv_    libuv loop, listeners, connections, bounded buffers
  *   req.c    req_    one handler per request type, WATCH fan-out
+ *   snap.c   snap_   the status snapshot: STATS and the dashboards read it
+ *   dash.c   dash_   listening sockets of the dashboard servers
+ *   mbus.c   mbus_   Modbus TCP input registers, in a thread of their own
+ *   metrics.c metrics_ Prometheus text over HTTP (libmicrohttpd's thread)
  *   main.c          main(): wires the above together
  *
  * The DESIGN rule every module keeps: an acknowledged job is never lost.
@@ -35,6 +39,13 @@
 #define CONF_HELLO_MAX_FRAME 65536           /* frame limit before HELLO succeeds */
 #define CONF_KILL_GRACE_S 5                  /* SIGTERM -> SIGKILL */
 
+#define CONF_HOST 256
+/* A dashboard server's address (--modbus, --metrics); port -1 = off. */
+typedef struct conf_endpoint {
+    char host[CONF_HOST];         /* as the user gave it; 127.0.0.1 when only a port was */
+    int port;
+} conf_endpoint;
+
 typedef struct mcd_conf {
     char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH" or "tcp:HOST:PORT" */
     int nlisten;
@@ -50,6 +61,8 @@ typedef struct mcd_conf {
     uint32_t max_output;          /* output bytes queued per connection */
     long admin_uid;               /* Unix-socket uid treated as admin; -1 none (root always) */
     int log_level;                /* DLOG_* */
+    conf_endpoint modbus;         /* Modbus TCP input registers (MODBUS.md) */
+    conf_endpoint metrics;        /* Prometheus text over HTTP, GET /metrics */
 } mcd_conf;
 
 void conf_init(mcd_conf *c);
@@ -141,12 +154,81 @@ uint32_t sched_queued(const sched *s);              /* pending, all users */
 uint32_t sched_user_pending(const sched *s, const char *user);
 uint32_t sched_user_running(const sched *s, const char *user);
 
+/* ---- snap_ ---------------------------------------------------------------- */
+/* The daemon's state in figures: the one place they are computed (STATS,
+ * the Modbus registers and /metrics all come from snap_collect). */
+typedef struct snap_slot {
+    uint64_t job_id;              /* 0 = idle */
+    uint8_t state;                /* PROTO_SLOT_* */
+    uint8_t has_progress;         /* the fields below are set */
+    uint8_t stage;                /* PROTO_STAGE_* of the latest progress record */
+    uint32_t outer, total;        /* outer iteration, planned */
+    double energy;                /* total energy: both directions summed */
+    double beta;                  /* mismatch weight */
+    uint32_t elapsed_s;           /* wall time since the job started */
+} snap_slot;
+
+typedef struct mcd_snapshot {
+    uint32_t seq;                 /* published snapshots so far (wraps) */
+    uint32_t uptime_s;            /* since the daemon started */
+    uint32_t queued, running, workers;
+    uint64_t completed, failed, cancelled;
+    uint32_t nslots;              /* = workers */
+    snap_slot *slots;             /* nslots, owned by whoever allocated the snapshot */
+} mcd_snapshot;
+
+typedef struct snap snap;
+typedef struct mcd mcd;
+#define SNAP_PERIOD_MS 200        /* the published snapshot's refresh */
+
+/* Loop thread: the snapshot state and a timer publishing every SNAP_PERIOD_MS. */
+int snap_init(mcd *d, char *err, size_t errsz);
+/* Loop thread: the figures now; out->slots holds conf.workers entries. */
+void snap_collect(mcd *d, mcd_snapshot *out);
+/* Loop thread: a worker's progress record (kept for its slot's figures). */
+void snap_progress(mcd *d, const proto_progress *p);
+void snap_close(mcd *d);          /* stops the timer (the loop can end) */
+void snap_free(snap *s);          /* after the readers are stopped; NULL ok */
+/* Any thread: a copy of the latest published snapshot; out->slots holds
+ * snap_nslots() entries. */
+void snap_read(snap *s, mcd_snapshot *out);
+uint32_t snap_nslots(const snap *s);
+mcd_snapshot *snap_alloc(uint32_t nslots);   /* zeroed; NULL on no memory */
+void snap_release(mcd_snapshot *m);          /* NULL ok */
+
+/* ---- dash_ ---------------------------------------------------------------- */
+/* A listening TCP socket (close-on-exec, non-blocking) on e: the fd, or -1
+ * with the detail in err. */
+int dash_listen(const conf_endpoint *e, const char *what, char *err, size_t errsz);
+
+/* ---- mbus_ ---------------------------------------------------------------- */
+/* MODBUS.md is the register map. 32-bit values: high word first. */
+#define MBUS_SLOT_BASE 16         /* slot i's block starts at 16 + 16 i */
+#define MBUS_SLOT_STRIDE 16
+#define MBUS_MAX_CLIENTS 8        /* more are accepted and closed at once */
+#define MBUS_FRAME_TIMEOUT_MS 500 /* a request must arrive whole within this */
+#define MBUS_IDLE_TIMEOUT_S 60    /* a connection without a request is closed */
+typedef struct mbus mbus;
+void mbus_put_u32(uint16_t r[2], uint32_t v);
+void mbus_put_f32(uint16_t r[2], float v);
+/* Registers for a snapshot: MBUS_SLOT_BASE + MBUS_SLOT_STRIDE * nslots of them. */
+size_t mbus_nregs(uint32_t nslots);
+void mbus_fill(const mcd_snapshot *s, uint16_t *regs);
+/* Binds conf.modbus and starts the server thread; 0, or -1 with err. */
+int mbus_start(const conf_endpoint *e, snap *s, mbus **out, char *err, size_t errsz);
+void mbus_stop(mbus *m);          /* joins the thread; NULL ok */
+
+/* ---- metrics_ ------------------------------------------------------------- */
+typedef struct metrics metrics;
+int metrics_start(const conf_endpoint *e, snap *s, metrics **out, char *err, size_t errsz);
+void metrics_stop(metrics *m);    /* NULL ok */
+
 /* ---- the daemon ------------------------------------------------------------ */
 typedef struct conn conn;
 typedef struct wsup_slot wsup_slot;
 typedef struct req_watch req_watch;
 
-typedef struct mcd {
+struct mcd {
     uv_loop_t *loop;
     mcd_conf conf;
     auth_tokens *tokens;
@@ -160,7 +242,10 @@ typedef struct mcd {
     uv_signal_t sigterm, sigint;
     uv_timer_t sweep;
     int draining;                 /* shutdown started: no new work */
-} mcd;
+    snap *snap;                   /* the status snapshot */
+    mbus *mbus;                   /* NULL unless --modbus */
+    metrics *metrics;             /* NULL unless --metrics */
+};
 
 /* ---- wsup_ ---------------------------------------------------------------- */
 int wsup_init(mcd *d, char *err, size_t errsz);

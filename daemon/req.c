@@ -351,6 +351,7 @@ static void on_watch(conn *c, const proto_msg *m)
 
 void req_progress(mcd *d, const proto_progress *p)
 {
+    snap_progress(d, p);
     iterating = 1;
     for (req_watch *w = d->watches; w; w = w->next)
         if (w->c && w->job_id == p->job_id && p->outer >= w->from_outer)
@@ -486,27 +487,31 @@ static void on_stats(conn *c, const proto_msg *m)
     memset(&r, 0, sizeof r);
     r.type = PROTO_MSG_STATS_OK;
     proto_stats_ok *s = &r.u.stats_ok;
-    int nslots = d->conf.workers > (int)PROTO_MAX_SLOTS ? (int)PROTO_MAX_SLOTS : d->conf.workers;
-    proto_slot *slots = calloc((size_t)nslots, sizeof *slots);
-    if (!slots) {
+    uint32_t nslots = (uint32_t)d->conf.workers > PROTO_MAX_SLOTS ? PROTO_MAX_SLOTS : (uint32_t)d->conf.workers;
+    mcd_snapshot *now = snap_alloc((uint32_t)d->conf.workers);
+    proto_slot *slots = calloc(nslots, sizeof *slots);
+    if (!now || !slots) {
         srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory");
-        return;
+        goto done;
     }
+    snap_collect(d, now);                   /* the figures the dashboards show too */
     uint32_t running = 0;
-    for (int i = 0; i < nslots; i++) {
-        wsup_slot_info(d, i, &slots[i].state, &slots[i].job_id);
+    for (uint32_t i = 0; i < nslots; i++) {
+        slots[i] = (proto_slot){now->slots[i].job_id, now->slots[i].state};
         store_job j;
         if (slots[i].job_id && !a->admin &&
             (store_get(d->store, slots[i].job_id, &j) || strcmp(j.user, a->user) != 0))
             slots[i].job_id = 0;
-        running += slots[i].state != PROTO_SLOT_IDLE && (a->admin || slots[i].job_id);
+        running += slots[i].state != PROTO_SLOT_IDLE && slots[i].job_id;
     }
-    s->queued = a->admin ? sched_queued(d->sched) : sched_user_pending(d->sched, a->user);
-    s->running = running;
-    s->workers = (uint32_t)d->conf.workers;
-    store_counters(d->store, &s->completed, &s->failed, &s->cancelled);
+    s->queued = a->admin ? now->queued : sched_user_pending(d->sched, a->user);
+    s->running = a->admin ? now->running : running;
+    s->workers = now->workers;
+    s->completed = now->completed;
+    s->failed = now->failed;
+    s->cancelled = now->cancelled;
     s->slots = slots;
-    s->nslots = (uint32_t)nslots;
+    s->nslots = nslots;
     char dev[64];
     long ncpu = d->conf.threads_per_worker ? d->conf.threads_per_worker : sysconf(_SC_NPROCESSORS_ONLN);
     snprintf(dev, sizeof dev, "cpu:%ld", ncpu);
@@ -514,6 +519,8 @@ static void on_stats(conn *c, const proto_msg *m)
     s->devices = devs;
     s->ndevices = 1;
     reply(c, &r, m->request_id);
+done:
+    snap_release(now);
     free(slots);
 }
 

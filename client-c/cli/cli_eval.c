@@ -14,6 +14,7 @@
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 #include "metric/metric.h"
+#include "viz/viz.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -24,16 +25,21 @@
 #define EVAL_CURVE_STEPS 26      /* t = 0, 0.01, ..., 0.25 */
 #define EVAL_CURVE_MAX 0.25
 #define EVAL_MAX_GT_LINES 100000000
+#define EVAL_MAX_MAPS 8
 
 static void usage(FILE *fp)
 {
     fprintf(fp,
-        "usage: meshcorr eval SOURCE TARGET P.map [--reverse Q.map]\n"
+        "usage: meshcorr eval SOURCE TARGET P.map [P2.map ...] [--reverse Q.map]\n"
         "         [--gt GT [--gt-target GT2] --gt-format vts-pair|vertex-list [--gt-base 0|1]]\n"
-        "         [--json]\n"
-        "Prints conformal and area distortion, flipped and collapsed triangles, mean-curvature\n"
-        "error, coverage of the target, the round trip with Q, and the geodesic error to a\n"
-        "ground truth (divided by sqrt(target area); mean and cumulative curve to 0.25).\n");
+        "         [--json] [--out-colors PREFIX] [--out-curve CURVES.svg] [--out-csv CURVES.csv]\n"
+        "Prints, for each map: conformal and area distortion, flipped and collapsed triangles,\n"
+        "mean-curvature error, coverage of the target, the round trip with Q (one map only),\n"
+        "and the geodesic error to a ground truth (divided by sqrt(target area); mean and\n"
+        "cumulative curve to 0.25). Pictures: --out-colors writes PREFIX.target.ply (the\n"
+        "target coloured by position) and PREFIX.source.ply (the source coloured through the\n"
+        "first map: same colour, same place); --out-curve and --out-csv write the cumulative\n"
+        "error curves of every map (with a ground truth).\n");
 }
 
 /* Reads the first column of every non-blank, non-'#' line of path as an
@@ -93,14 +99,85 @@ out:
     return rc;
 }
 
+/* PREFIX.target.ply coloured by position, PREFIX.source.ply through P. */
+static int write_colors(const char *prefix, const mesh *S, const mesh *T, const bmap *P)
+{
+    char path[4200], err[1024];
+    int rc = -1;
+    unsigned char *trgb = malloc(3 * (size_t)T->nv + 1), *srgb = malloc(3 * (size_t)S->nv + 1);
+    if (!trgb || !srgb) {
+        fprintf(stderr, "meshcorr eval: out of memory\n");
+        goto out;
+    }
+    viz_position_colors(T, trgb);
+    viz_pull_colors(P, T->f, trgb, srgb);
+    snprintf(path, sizeof path, "%s.target.ply", prefix);
+    if (mesh_write_ply_rgb(path, T, trgb, err, sizeof err))
+        goto fail;
+    snprintf(path, sizeof path, "%s.source.ply", prefix);
+    if (mesh_write_ply_rgb(path, S, srgb, err, sizeof err))
+        goto fail;
+    rc = 0;
+    goto out;
+fail:
+    fprintf(stderr, "meshcorr eval: %s\n", err);
+out:
+    free(trgb);
+    free(srgb);
+    return rc;
+}
+
+static int write_curves(const char *svg, const char *csv, const char *const *names,
+                        const double *const *curves, int n)
+{
+    if (svg) {
+        FILE *fp = fopen(svg, "w");
+        if (!fp) {
+            fprintf(stderr, "meshcorr eval: %s: cannot create\n", svg);
+            return -1;
+        }
+        viz_curves_svg(fp, "Cumulative geodesic error", names, curves, n, EVAL_CURVE_STEPS,
+                       EVAL_CURVE_MAX);
+        if (fclose(fp)) {
+            fprintf(stderr, "meshcorr eval: %s: write failed\n", svg);
+            return -1;
+        }
+    }
+    if (csv) {
+        FILE *fp = fopen(csv, "w");
+        if (!fp) {
+            fprintf(stderr, "meshcorr eval: %s: cannot create\n", csv);
+            return -1;
+        }
+        fprintf(fp, "error");
+        for (int a = 0; a < n; a++)
+            fprintf(fp, ",\"%s\"", names[a]);
+        fprintf(fp, "\n");
+        for (int k = 0; k < EVAL_CURVE_STEPS; k++) {
+            fprintf(fp, "%.4g", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1));
+            for (int a = 0; a < n; a++)
+                fprintf(fp, ",%.6g", curves[a][k]);
+            fprintf(fp, "\n");
+        }
+        if (fclose(fp)) {
+            fprintf(stderr, "meshcorr eval: %s: write failed\n", csv);
+            return -1;
+        }
+    }
+    return 0;
+}
+
 int cli_eval(int argc, char **argv)
 {
     static const struct option opts[] = {
         {"reverse", required_argument, 0, 'r'},  {"gt", required_argument, 0, 'g'},
         {"gt-target", required_argument, 0, 't'}, {"gt-format", required_argument, 0, 'f'},
         {"gt-base", required_argument, 0, 'b'},  {"json", no_argument, 0, 'j'},
-        {"help", no_argument, 0, 'h'},           {0, 0, 0, 0}};
+        {"out-colors", required_argument, 0, 'c'}, {"out-curve", required_argument, 0, 's'},
+        {"out-csv", required_argument, 0, 'v'},  {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
     const char *rev = NULL, *gt = NULL, *gt2 = NULL, *fmt = NULL;
+    const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL;
     int base = -1, json = 0, c, bad = 0;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
@@ -117,13 +194,25 @@ int cli_eval(int argc, char **argv)
             base = optarg[0] - '0';
             break;
         case 'j': json = 1; break;
+        case 'c': out_colors = optarg; break;
+        case 's': out_curve = optarg; break;
+        case 'v': out_csv = optarg; break;
         case 'h': usage(stdout); return 0;
         default: bad = 1;
         }
     }
     int pair = fmt && strcmp(fmt, "vts-pair") == 0, list = fmt && strcmp(fmt, "vertex-list") == 0;
-    if (!bad && argc - optind != 3) {
-        fprintf(stderr, "meshcorr eval: need SOURCE TARGET P.map\n");
+    int nmaps = argc - optind - 2;
+    if (!bad && (nmaps < 1 || nmaps > EVAL_MAX_MAPS)) {
+        fprintf(stderr, "meshcorr eval: need SOURCE TARGET and 1 to %d maps\n", EVAL_MAX_MAPS);
+        bad = 1;
+    }
+    if (!bad && rev && nmaps != 1) {
+        fprintf(stderr, "meshcorr eval: --reverse goes with a single map\n");
+        bad = 1;
+    }
+    if (!bad && (out_curve || out_csv) && !gt) {
+        fprintf(stderr, "meshcorr eval: --out-curve and --out-csv need a ground truth (--gt)\n");
         bad = 1;
     }
     if (!bad && gt && !pair && !list) {
@@ -140,20 +229,25 @@ int cli_eval(int argc, char **argv)
     }
     if (base < 0)
         base = pair ? 1 : 0;
-    const char *spath = argv[optind], *tpath = argv[optind + 1], *ppath = argv[optind + 2];
+    const char *spath = argv[optind], *tpath = argv[optind + 1];
+    char *const *ppaths = argv + optind + 2;
     char err[1024];
     int status = 1, ngt = 0, n2 = 0;
     mesh *S = NULL, *T = NULL;
-    bmap *P = NULL, *Q = NULL;
+    bmap *maps[EVAL_MAX_MAPS] = {0}, *Q = NULL;
     int *gsrc = NULL, *gtgt = NULL;
     double *gerr = NULL;
     geod_solver *gs = NULL;
     if (mesh_read(spath, &S, err, sizeof err) || mesh_read(tpath, &T, err, sizeof err) ||
-        bmap_read(ppath, S, T, &P, err, sizeof err) ||
         (rev && bmap_read(rev, T, S, &Q, err, sizeof err))) {
         fprintf(stderr, "meshcorr eval: %s\n", err);
         goto done;
     }
+    for (int a = 0; a < nmaps; a++)
+        if (bmap_read(ppaths[a], S, T, &maps[a], err, sizeof err)) {
+            fprintf(stderr, "meshcorr eval: %s\n", err);
+            goto done;
+        }
     if (gt && pair) {
         if (read_indices(gt, base, S->nv, &gsrc, &ngt) || read_indices(gt2, base, T->nv, &gtgt, &n2))
             goto done;
@@ -175,61 +269,78 @@ int cli_eval(int argc, char **argv)
         for (int k = 0; k < ngt; k++)
             gsrc[k] = k;
     }
-    metric_summary ms;
-    double curv, cover = metric_coverage(T, P, METRIC_COVER_RADIUS), trip = NAN;
-    if (metric_summarize(S, T, P, &ms) || metric_curvature_error(S, T, P, &curv) ||
-        (Q && metric_round_trip(S, T, P, Q, &trip)))
-        goto oom;
-    double gmean = NAN, curve[EVAL_CURVE_STEPS];
+    double curves[EVAL_MAX_MAPS][EVAL_CURVE_STEPS], gmean[EVAL_MAX_MAPS];
     if (gt) {
         if (!(gs = geod_solver_new(T, 0, err, sizeof err))) {
             fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);
             goto done;
         }
-        if (!(gerr = malloc(sizeof(double) * (size_t)ngt)))
+        if (!(gerr = malloc(sizeof(double) * (size_t)ngt * (size_t)nmaps)))
             goto oom;
-        const bmap *maps[1] = { P };
-        int rc = metric_geodesic_errors(gs, T, maps, 1, gsrc, gtgt, ngt, gerr);
+        int rc = metric_geodesic_errors(gs, T, (const bmap *const *)maps, nmaps, gsrc, gtgt, ngt, gerr);
         if (rc) {
             fprintf(stderr, "meshcorr eval: geodesic distances on %s failed: %s\n", tpath,
                     rc == -1 ? "out of memory" : geod_strerror(rc));
             goto done;
         }
-        gmean = 0;
-        for (int k = 0; k < ngt; k++)
-            gmean += gerr[k] / ngt;
-        metric_error_curve(gerr, ngt, EVAL_CURVE_MAX, EVAL_CURVE_STEPS, curve);
+        for (int a = 0; a < nmaps; a++) {
+            const double *e = gerr + (size_t)a * (size_t)ngt;
+            gmean[a] = 0;
+            for (int k = 0; k < ngt; k++)
+                gmean[a] += e[k] / ngt;
+            metric_error_curve(e, ngt, EVAL_CURVE_MAX, EVAL_CURVE_STEPS, curves[a]);
+        }
     }
-    if (json) {
-        printf("{\"map\":\"%s\",\"conformal_median\":%.9g,\"conformal_mean\":%.9g,"
-               "\"area_mean_abs_log\":%.9g,\"flipped\":%.9g,\"collapsed\":%.9g,"
-               "\"curvature_error\":%.9g,\"coverage\":%.9g", ppath, ms.median_conformal,
-               ms.mean_conformal, ms.mean_abs_log_area, ms.flipped_fraction,
-               ms.collapsed_fraction, curv, cover);
-        if (Q)
-            printf(",\"round_trip\":%.9g", trip);
-        if (gt) {
-            printf(",\"geodesic\":{\"points\":%d,\"mean\":%.9g,\"curve\":[", ngt, gmean);
-            for (int s = 0; s < EVAL_CURVE_STEPS; s++)
-                printf("%s[%.4g,%.6g]", s ? "," : "", EVAL_CURVE_MAX * s / (EVAL_CURVE_STEPS - 1), curve[s]);
-            printf("]}");
+    for (int a = 0; a < nmaps; a++) {
+        const bmap *P = maps[a];
+        const char *ppath = ppaths[a];
+        const double *curve = curves[a];
+        metric_summary ms;
+        double curv, cover = metric_coverage(T, P, METRIC_COVER_RADIUS), trip = NAN;
+        if (metric_summarize(S, T, P, &ms) || metric_curvature_error(S, T, P, &curv) ||
+            (Q && metric_round_trip(S, T, P, Q, &trip)))
+            goto oom;
+        if (json) {
+            printf("{\"map\":\"%s\",\"conformal_median\":%.9g,\"conformal_mean\":%.9g,"
+                   "\"area_mean_abs_log\":%.9g,\"flipped\":%.9g,\"collapsed\":%.9g,"
+                   "\"curvature_error\":%.9g,\"coverage\":%.9g", ppath, ms.median_conformal,
+                   ms.mean_conformal, ms.mean_abs_log_area, ms.flipped_fraction,
+                   ms.collapsed_fraction, curv, cover);
+            if (Q)
+                printf(",\"round_trip\":%.9g", trip);
+            if (gt) {
+                printf(",\"geodesic\":{\"points\":%d,\"mean\":%.9g,\"curve\":[", ngt, gmean[a]);
+                for (int k = 0; k < EVAL_CURVE_STEPS; k++)
+                    printf("%s[%.4g,%.6g]", k ? "," : "", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1), curve[k]);
+                printf("]}");
+            }
+            printf("}\n");
+        } else {
+            printf("%smap %s: %s (%d vertices) -> %s (%d vertices)\n", a ? "\n" : "", ppath,
+                   spath, S->nv, tpath, T->nv);
+            printf("conformal distortion: median %.4f, mean %.4f\n", ms.median_conformal, ms.mean_conformal);
+            printf("area distortion: mean |log area ratio| %.4f\n", ms.mean_abs_log_area);
+            printf("flipped triangles: %.2f %%\n", 100 * ms.flipped_fraction);
+            printf("collapsed triangles: %.2f %%\n", 100 * ms.collapsed_fraction);
+            printf("mean-curvature error: %.4f\n", curv);
+            printf("target area within %.2f of a mapped point: %.2f %%\n", METRIC_COVER_RADIUS, 100 * cover);
+            if (Q)
+                printf("round trip |QPX - X|: %.4f\n", trip);
+            if (gt) {
+                printf("geodesic error (/sqrt(area)): mean %.4f over %d points\n", gmean[a], ngt);
+                for (int k = 0; k < EVAL_CURVE_STEPS; k += 5)
+                    printf("  error <= %.2f: %.1f %%\n", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1), 100 * curve[k]);
+            }
         }
-        printf("}\n");
-    } else {
-        printf("map %s: %s (%d vertices) -> %s (%d vertices)\n", ppath, spath, S->nv, tpath, T->nv);
-        printf("conformal distortion: median %.4f, mean %.4f\n", ms.median_conformal, ms.mean_conformal);
-        printf("area distortion: mean |log area ratio| %.4f\n", ms.mean_abs_log_area);
-        printf("flipped triangles: %.2f %%\n", 100 * ms.flipped_fraction);
-        printf("collapsed triangles: %.2f %%\n", 100 * ms.collapsed_fraction);
-        printf("mean-curvature error: %.4f\n", curv);
-        printf("target area within %.2f of a mapped point: %.2f %%\n", METRIC_COVER_RADIUS, 100 * cover);
-        if (Q)
-            printf("round trip |QPX - X|: %.4f\n", trip);
-        if (gt) {
-            printf("geodesic error (/sqrt(area)): mean %.4f over %d points\n", gmean, ngt);
-            for (int s = 0; s < EVAL_CURVE_STEPS; s += 5)
-                printf("  error <= %.2f: %.1f %%\n", EVAL_CURVE_MAX * s / (EVAL_CURVE_STEPS - 1), 100 * curve[s]);
-        }
+    }
+    if (out_colors && write_colors(out_colors, S, T, maps[0]))
+        goto done;
+    if (out_curve || out_csv) {
+        const double *cv[EVAL_MAX_MAPS];
+        for (int a = 0; a < nmaps; a++)
+            cv[a] = curves[a];
+        if (write_curves(out_curve, out_csv, (const char *const *)ppaths, cv, nmaps))
+            goto done;
     }
     status = 0;
     goto done;
@@ -240,7 +351,8 @@ done:
     free(gerr);
     free(gsrc);
     free(gtgt);
-    bmap_free(P);
+    for (int a = 0; a < EVAL_MAX_MAPS; a++)
+        bmap_free(maps[a]);
     bmap_free(Q);
     mesh_free(S);
     mesh_free(T);

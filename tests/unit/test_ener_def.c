@@ -430,6 +430,48 @@ TEST(collapsing_a_face_makes_its_edges_inadmissible)
     fixture_close(&fx);
 }
 
+/* A sliver keeps its area but not its shape: stretching a face's third
+ * corner far along its first edge leaves the area above the area rule, yet
+ * its three edges must leave the bending term (ENER_SLIVER_MIN). */
+TEST(a_sliver_face_makes_its_edges_inadmissible)
+{
+    fixture fx;
+    fixture_open(&fx, testmesh_icosphere(2), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT});
+    const int all = fx.E.ne;
+    const int *f = fx.X->f;
+    const int t = 10;
+    double *y0 = fx.Y + 3 * f[3 * t], *y1 = fx.Y + 3 * f[3 * t + 1], *y2 = fx.Y + 3 * f[3 * t + 2];
+    /* y2 := y0 + 1e6·(y1 − y0) + 1e-6·(y2 − y0): area grows (×1), edges ×1e6 */
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = y1[k] - y0[k];
+        e2[k] = y2[k] - y0[k];
+    }
+    for (int k = 0; k < 3; k++)
+        y2[k] = y0[k] + 1e6 * e1[k] + e2[k];
+    /* neighbours of the stretched corner change too: count independently */
+    int want = 0;
+    for (int e = 0; e < fx.E.ne; e++) {
+        int ok = 1;
+        for (int side = 0; side < 2; side++) {
+            const int u = fx.E.ef[2 * e + side];
+            const double *a = fx.Y + 3 * f[3 * u], *b = fx.Y + 3 * f[3 * u + 1];
+            const double *c = fx.Y + 3 * f[3 * u + 2];
+            double p[3], q[3], r[3];
+            for (int k = 0; k < 3; k++) { p[k] = b[k] - a[k]; q[k] = c[k] - a[k]; r[k] = c[k] - b[k]; }
+            double n[3] = {p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]};
+            double s2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+            double l = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + q[0] * q[0] + q[1] * q[1] + q[2] * q[2]
+                     + r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            ok &= s2 > 1e-10 * l * l;
+        }
+        want += ok;
+    }
+    CHECK(want <= all - 3);
+    CHECK_INT(ener_def_update_admissible(fx.d, fx.Y), want);
+    fixture_close(&fx);
+}
+
 TEST(construction_refuses_degenerate_reference_and_bad_parameters)
 {
     char err[256];

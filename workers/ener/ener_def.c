@@ -245,10 +245,10 @@ int ener_def_update_admissible(ener_def *d, const double *Y)
     int count = 0;
 #pragma omp parallel
     {
-        /* area > ratio·â  ⟺  det g > 4·ratio²·â² */
 #pragma omp for schedule(static)
         for (int t = 0; t < nf; t++)
-            d->fok[t] = face_det(Y, d->f, t) > r2 * d->fr[t].ahat * d->fr[t].ahat;
+            d->fok[t] = (unsigned char)ener__face_admissible(corner(Y, d->f, t, 0), corner(Y, d->f, t, 1),
+                                                             corner(Y, d->f, t, 2), d->fr[t].ahat, r2);
 #pragma omp for schedule(static) reduction(+ : count)
         for (int e = 0; e < ne; e++) {
             d->adm[e] = d->fok[d->er[e].t[0]] && d->fok[d->er[e].t[1]];

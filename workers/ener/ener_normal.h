@@ -39,6 +39,29 @@ static inline double ener__unit_normal_of(const double e1[3], const double e2[3]
     return r;
 }
 
+/* Whether a face of Y counts as non-degenerate for the bending term (its
+ * edges are "admissible"): its area is above ENER_ADMISSIBLE_AREA_RATIO of
+ * its reference area âhat (r2 = 4·ratio², as |c|² = 4·area²), and it is no
+ * sliver: |c|² > ENER_SLIVER_MIN·(|e1|² + |e2|² + |e3|²)² (1/12 for an
+ * equilateral face). A sliver's normal turns so fast that no line-search step
+ * passes: on cow -> camel, tiny camel-ear faces shrunk to slivers in Ỹ left
+ * the reverse Y-step at 0 L-BFGS iterations from outer iteration ~60 on;
+ * with the sliver rule it runs its 50. */
+#define ENER_SLIVER_MIN 1e-10
+static inline int ener__face_admissible(const double *y0, const double *y1, const double *y2,
+                                        double ahat, double r2)
+{
+    const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+    const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+    const double e3[3] = {y2[0] - y1[0], y2[1] - y1[1], y2[2] - y1[2]};
+    const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+    const double s = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    const double l = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] + e2[0] * e2[0]
+                   + e2[1] * e2[1] + e2[2] * e2[2] + e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2];
+    return s > r2 * ahat * ahat && s > ENER_SLIVER_MIN * l * l;
+}
+
 /* The same from the corners (y0, y1, y2). */
 static inline double ener__unit_normal(const double *y0, const double *y1,
                                        const double *y2, double n[3])

@@ -167,13 +167,7 @@ __kernel void ener_k_face_ok(__global const double *Y, __global const int *f,
     ener__load3(Y, f[3 * t], y0);
     ener__load3(Y, f[3 * t + 1], y1);
     ener__load3(Y, f[3 * t + 2], y2);
-    const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
-    const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
-    const double n0 = e1[1] * e2[2] - e1[2] * e2[1];
-    const double n1 = e1[2] * e2[0] - e1[0] * e2[2];
-    const double n2 = e1[0] * e2[1] - e1[1] * e2[0];
-    const double ahat = fref[4 * t + 3];
-    fok[t] = n0 * n0 + n1 * n1 + n2 * n2 > r2 * ahat * ahat;
+    fok[t] = (uchar)ener__face_admissible(y0, y1, y2, fref[4 * t + 3], r2);
 }
 
 /* Admissibility, step 2: edge e is admissible when both faces are; the

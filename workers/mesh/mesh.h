@@ -75,6 +75,9 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz);
 int mesh_write_obj(const char *path, const mesh *m, char *err, size_t errsz);
 int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz);
 int mesh_write_ply(const char *path, const mesh *m, char *err, size_t errsz);
+/* Binary PLY with per-vertex colours (rgb: nv by 3 bytes; NULL: none). */
+int mesh_write_ply_rgb(const char *path, const mesh *m, const unsigned char *rgb,
+                       char *err, size_t errsz);
 int mesh_read_drc(const char *path, mesh **out, char *err, size_t errsz);
 int mesh_write_drc(const char *path, const mesh *m, char *err, size_t errsz);
 

@@ -353,15 +353,26 @@ static void put_le(FILE *fp, const void *src, int size)
 
 int mesh_write_ply(const char *path, const mesh *m, char *err, size_t errsz)
 {
+    return mesh_write_ply_rgb(path, m, NULL, err, errsz);
+}
+
+int mesh_write_ply_rgb(const char *path, const mesh *m, const unsigned char *rgb,
+                       char *err, size_t errsz)
+{
     FILE *fp = fopen(path, "wb");
     if (!fp)
         return errbuf_set(err, errsz, MESH_EIO, "%s: cannot create: %s", path, strerror(errno));
     fprintf(fp, "ply\nformat binary_little_endian 1.0\ncomment written by meshcorr\n"
-                "element vertex %d\nproperty double x\nproperty double y\nproperty double z\n"
+                "element vertex %d\nproperty double x\nproperty double y\nproperty double z\n%s"
                 "element face %d\nproperty list uchar int vertex_indices\nend_header\n",
-            m->nv, m->nf);
-    for (long i = 0; i < 3L * m->nv; i++)
-        put_le(fp, &m->v[i], 8);
+            m->nv, rgb ? "property uchar red\nproperty uchar green\nproperty uchar blue\n" : "",
+            m->nf);
+    for (int i = 0; i < m->nv; i++) {
+        for (int k = 0; k < 3; k++)
+            put_le(fp, &m->v[3 * i + k], 8);
+        if (rgb)
+            fwrite(rgb + 3 * i, 1, 3, fp);
+    }
     for (int i = 0; i < m->nf; i++) {
         fputc(3, fp);
         for (int k = 0; k < 3; k++)

@@ -1,0 +1,173 @@
+/* metrics.c — --metrics: the status snapshot in Prometheus text format
+ * (version 0.0.4) at GET /metrics, served by libmicrohttpd's own polling
+ * thread. Other paths are 404, other methods 405. Each request formats the
+ * latest published snapshot (snap_read); nothing here touches the daemon's
+ * state. MHD bounds what a client can hold: MHD_OPTION_CONNECTION_LIMIT
+ * connections, each closed after MHD_OPTION_CONNECTION_TIMEOUT idle seconds. */
+#include "mcd.h"
+#include "util/errbuf.h"
+
+#include <microhttpd.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#define METRICS_MAX_CONNECTIONS 16
+#define METRICS_TIMEOUT_S 10
+
+struct metrics {
+    struct MHD_Daemon *mhd;
+    snap *snap;
+    mcd_snapshot *copy;          /* used by MHD's one polling thread only */
+};
+
+static void family(FILE *fp, const char *name, const char *type, const char *help)
+{
+    fprintf(fp, "# HELP %s %s\n# TYPE %s %s\n", name, help, name, type);
+}
+
+/* Per-slot gauges: field selects which figure; slots without progress are
+ * left out of the progress gauges. */
+enum slot_field { F_STATE, F_STAGE, F_OUTER, F_TOTAL, F_ENERGY, F_BETA, F_ELAPSED, F_PROGRESS };
+
+static void slot_family(FILE *fp, const mcd_snapshot *s, const char *name, const char *help, enum slot_field f)
+{
+    family(fp, name, "gauge", help);
+    for (uint32_t i = 0; i < s->nslots; i++) {
+        const snap_slot *o = &s->slots[i];
+        if (f != F_STATE && f != F_ELAPSED && !o->has_progress)
+            continue;
+        double v = 0;
+        switch (f) {
+        case F_STATE:    v = o->state; break;
+        case F_STAGE:    v = o->stage; break;
+        case F_OUTER:    v = o->outer; break;
+        case F_TOTAL:    v = o->total; break;
+        case F_ENERGY:   v = o->energy; break;
+        case F_BETA:     v = o->beta; break;
+        case F_ELAPSED:  v = o->elapsed_s; break;
+        case F_PROGRESS: v = o->total ? (double)(o->outer < o->total ? o->outer : o->total) / o->total : 0; break;
+        }
+        fprintf(fp, "%s{slot=\"%u\",job=\"%llu\"} %.17g\n", name, i, (unsigned long long)o->job_id, v);
+    }
+}
+
+static void format(FILE *fp, const mcd_snapshot *s)
+{
+    family(fp, "meshcorr_queue_depth", "gauge", "Jobs pending in the queue.");
+    fprintf(fp, "meshcorr_queue_depth %u\n", s->queued);
+    family(fp, "meshcorr_running_jobs", "gauge", "Worker slots running a job.");
+    fprintf(fp, "meshcorr_running_jobs %u\n", s->running);
+    family(fp, "meshcorr_jobs_total", "counter", "Jobs ended, by final state, since the job store was created.");
+    fprintf(fp, "meshcorr_jobs_total{state=\"completed\"} %llu\n", (unsigned long long)s->completed);
+    fprintf(fp, "meshcorr_jobs_total{state=\"failed\"} %llu\n", (unsigned long long)s->failed);
+    fprintf(fp, "meshcorr_jobs_total{state=\"cancelled\"} %llu\n", (unsigned long long)s->cancelled);
+    family(fp, "meshcorr_workers", "gauge", "Worker slots configured.");
+    fprintf(fp, "meshcorr_workers %u\n", s->workers);
+    family(fp, "meshcorr_uptime_seconds", "gauge", "Seconds since meshcorrd started.");
+    fprintf(fp, "meshcorr_uptime_seconds %u\n", s->uptime_s);
+    family(fp, "meshcorr_snapshots_total", "counter", "Status snapshots published (one every 200 ms).");
+    fprintf(fp, "meshcorr_snapshots_total %u\n", s->seq);
+    slot_family(fp, s, "meshcorr_slot_state", "Worker slot state: 0 idle, 1 starting, 2 busy, 3 draining (job 0: none).", F_STATE);
+    slot_family(fp, s, "meshcorr_slot_elapsed_seconds", "Wall time since the slot's job started.", F_ELAPSED);
+    slot_family(fp, s, "meshcorr_slot_stage", "Stage of the latest progress: 0 voronoi, 1 rhm, 2 ectm, 3 init.", F_STAGE);
+    slot_family(fp, s, "meshcorr_slot_outer_iteration", "Outer iteration of the latest progress.", F_OUTER);
+    slot_family(fp, s, "meshcorr_slot_total_iterations", "Outer iterations planned.", F_TOTAL);
+    slot_family(fp, s, "meshcorr_slot_progress_ratio", "Outer iteration over iterations planned (0 to 1).", F_PROGRESS);
+    slot_family(fp, s, "meshcorr_slot_energy", "Total energy of the latest progress (both directions summed).", F_ENERGY);
+    slot_family(fp, s, "meshcorr_slot_beta", "Mismatch weight beta of the latest progress.", F_BETA);
+}
+
+static enum MHD_Result reply(struct MHD_Connection *conn, unsigned status, const char *body, size_t len,
+                             int must_free)
+{
+    struct MHD_Response *r = MHD_create_response_from_buffer(
+        len, (void *)body, must_free ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
+    if (!r) {
+        if (must_free)
+            free((void *)body);
+        return MHD_NO;
+    }
+    MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE,
+                            status == MHD_HTTP_OK ? "text/plain; version=0.0.4; charset=utf-8" : "text/plain");
+    if (status == MHD_HTTP_METHOD_NOT_ALLOWED)
+        MHD_add_response_header(r, MHD_HTTP_HEADER_ALLOW, "GET");
+    enum MHD_Result rc = MHD_queue_response(conn, status, r);
+    MHD_destroy_response(r);
+    return rc;
+}
+
+static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url, const char *method,
+                                  const char *version, const char *upload, size_t *upload_size, void **state)
+{
+    (void)version;
+    (void)upload;
+    (void)state;
+    metrics *m = cls;
+    if (*upload_size) {            /* a body we do not want: drop it, answer at the end */
+        *upload_size = 0;
+        return MHD_YES;
+    }
+    if (strcmp(url, "/metrics") != 0) {
+        static const char nf[] = "not found: the metrics are at /metrics\n";
+        return reply(conn, MHD_HTTP_NOT_FOUND, nf, sizeof nf - 1, 0);
+    }
+    if (strcmp(method, MHD_HTTP_METHOD_GET) != 0) {
+        static const char na[] = "method not allowed: GET only\n";
+        return reply(conn, MHD_HTTP_METHOD_NOT_ALLOWED, na, sizeof na - 1, 0);
+    }
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *fp = open_memstream(&buf, &len);
+    if (!fp)
+        return MHD_NO;
+    snap_read(m->snap, m->copy);
+    format(fp, m->copy);
+    if (fclose(fp) != 0) {
+        free(buf);
+        return MHD_NO;
+    }
+    return reply(conn, MHD_HTTP_OK, buf, len, 1);
+}
+
+int metrics_start(const conf_endpoint *e, snap *s, metrics **out, char *err, size_t errsz)
+{
+    *out = NULL;
+    metrics *m = calloc(1, sizeof *m);
+    if (!m || !(m->copy = snap_alloc(snap_nslots(s)))) {
+        free(m);
+        return errbuf_set(err, errsz, -1, "metrics: out of memory");
+    }
+    m->snap = s;
+    int fd = dash_listen(e, "metrics", err, errsz);
+    if (fd < 0) {
+        metrics_stop(m);
+        return -1;
+    }
+    struct sockaddr_storage sa;
+    socklen_t sl = sizeof sa;
+    getsockname(fd, (struct sockaddr *)&sa, &sl);
+    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | (sa.ss_family == AF_INET6 ? MHD_USE_IPv6 : 0);
+    m->mhd = MHD_start_daemon(flags, 0, NULL, NULL, on_request, m, MHD_OPTION_LISTEN_SOCKET, fd,
+                              MHD_OPTION_CONNECTION_LIMIT, (unsigned)METRICS_MAX_CONNECTIONS,
+                              MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)METRICS_TIMEOUT_S, MHD_OPTION_END);
+    if (!m->mhd) {
+        close(fd);
+        metrics_stop(m);
+        return errbuf_set(err, errsz, -1, "--metrics %s:%d: libmicrohttpd did not start", e->host, e->port);
+    }
+    *out = m;
+    return 0;
+}
+
+void metrics_stop(metrics *m)
+{
+    if (!m)
+        return;
+    if (m->mhd)
+        MHD_stop_daemon(m->mhd);   /* joins its thread, closes the listening socket */
+    snap_release(m->copy);
+    free(m);
+}

@@ -1,0 +1,192 @@
+/* snap.c — the status snapshot: queue depth, running jobs, end counters,
+ * worker slots and each running job's latest progress, computed in one
+ * place (snap_collect) for STATS and for the dashboards (mbus.c, metrics.c).
+ *
+ * DESIGN: the loop thread owns the daemon's state; the dashboard servers run
+ * in threads of their own and must never touch it. Every SNAP_PERIOD_MS the
+ * loop collects a snapshot and publishes a copy under a mutex (seq + 1); the
+ * other threads copy the published one out under the same mutex (snap_read)
+ * and answer from their copy, so a slow client never holds the lock, and the
+ * loop never waits on anything but a memcpy. The latest progress record of
+ * each slot's job is kept here from the records wsup passes through req, so
+ * a snapshot reads the store only when a slot changes job (and once for the
+ * end counters). Nothing here talks to clients. */
+#include "mcd.h"
+#include "util/errbuf.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct slot_cache {
+    uint64_t job_id;              /* the job the entries below belong to */
+    int64_t start_ms;
+    int has_progress;
+    proto_progress p;
+} slot_cache;
+
+struct snap {
+    /* loop thread only */
+    slot_cache *cache;            /* conf.workers */
+    mcd_snapshot *scratch;
+    uv_timer_t timer;
+    int timer_open;
+    struct timespec t0;
+    uint32_t seq;
+    /* shared: under mu */
+    pthread_mutex_t mu;
+    mcd_snapshot *board;
+};
+
+mcd_snapshot *snap_alloc(uint32_t nslots)
+{
+    mcd_snapshot *m = calloc(1, sizeof *m);
+    if (!m || !(m->slots = calloc(nslots ? nslots : 1, sizeof *m->slots))) {
+        free(m);
+        return NULL;
+    }
+    m->nslots = nslots;
+    return m;
+}
+
+void snap_release(mcd_snapshot *m)
+{
+    if (!m)
+        return;
+    free(m->slots);
+    free(m);
+}
+
+/* Brings slot i's cache to the job wsup runs there now. */
+static slot_cache *sync_slot(mcd *d, int i, uint8_t *state)
+{
+    slot_cache *c = &d->snap->cache[i];
+    uint64_t job;
+    wsup_slot_info(d, i, state, &job);
+    if (c->job_id != job) {
+        memset(c, 0, sizeof *c);
+        c->job_id = job;
+        store_job j;
+        if (job && store_get(d->store, job, &j) == 0)
+            c->start_ms = j.start_ms;
+        if (job && store_latest_progress(d->store, job, &c->p) == 0)
+            c->has_progress = 1;
+    }
+    return c;
+}
+
+void snap_progress(mcd *d, const proto_progress *p)
+{
+    for (int i = 0; i < d->conf.workers; i++) {
+        uint8_t state;
+        slot_cache *c = sync_slot(d, i, &state);
+        if (c->job_id == p->job_id) {
+            c->p = *p;
+            c->has_progress = 1;
+        }
+    }
+}
+
+void snap_collect(mcd *d, mcd_snapshot *out)
+{
+    int64_t now = store_now_ms();
+    uint32_t running = 0;
+    for (int i = 0; i < d->conf.workers; i++) {
+        snap_slot *o = &out->slots[i];
+        slot_cache *c = sync_slot(d, i, &o->state);
+        o->job_id = c->job_id;
+        running += o->state != PROTO_SLOT_IDLE;
+        o->has_progress = (uint8_t)c->has_progress;
+        o->stage = c->has_progress ? c->p.stage : 0;
+        o->outer = c->has_progress ? c->p.outer : 0;
+        o->total = c->has_progress ? c->p.total : 0;
+        o->energy = c->has_progress ? c->p.terms[0][PROTO_TERM_ENERGY] + c->p.terms[1][PROTO_TERM_ENERGY] : 0;
+        o->beta = c->has_progress ? c->p.beta : 0;
+        o->elapsed_s = c->job_id && c->start_ms && now > c->start_ms ? (uint32_t)((now - c->start_ms) / 1000) : 0;
+    }
+    out->nslots = (uint32_t)d->conf.workers;
+    out->workers = (uint32_t)d->conf.workers;
+    out->running = running;
+    out->queued = sched_queued(d->sched);
+    store_counters(d->store, &out->completed, &out->failed, &out->cancelled);
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    out->uptime_s = (uint32_t)(t.tv_sec - d->snap->t0.tv_sec);
+    out->seq = d->snap->seq;
+}
+
+static void copy_snapshot(mcd_snapshot *dst, const mcd_snapshot *src)
+{
+    snap_slot *slots = dst->slots;
+    uint32_t n = dst->nslots < src->nslots ? dst->nslots : src->nslots;
+    *dst = *src;
+    dst->slots = slots;
+    dst->nslots = n;
+    memcpy(slots, src->slots, n * sizeof *slots);
+}
+
+static void publish(mcd *d)
+{
+    snap *s = d->snap;
+    s->seq++;
+    snap_collect(d, s->scratch);
+    pthread_mutex_lock(&s->mu);
+    copy_snapshot(s->board, s->scratch);
+    pthread_mutex_unlock(&s->mu);
+}
+
+static void on_timer(uv_timer_t *t)
+{
+    publish(t->data);
+}
+
+int snap_init(mcd *d, char *err, size_t errsz)
+{
+    snap *s = calloc(1, sizeof *s);
+    if (!s)
+        return errbuf_set(err, errsz, -1, "out of memory");
+    d->snap = s;
+    pthread_mutex_init(&s->mu, NULL);
+    clock_gettime(CLOCK_MONOTONIC, &s->t0);
+    uint32_t n = (uint32_t)d->conf.workers;
+    if (!(s->cache = calloc(n, sizeof *s->cache)) || !(s->scratch = snap_alloc(n)) || !(s->board = snap_alloc(n)))
+        return errbuf_set(err, errsz, -1, "out of memory for the snapshot");
+    publish(d);
+    uv_timer_init(d->loop, &s->timer);
+    s->timer.data = d;
+    s->timer_open = 1;
+    uv_timer_start(&s->timer, on_timer, SNAP_PERIOD_MS, SNAP_PERIOD_MS);
+    return 0;
+}
+
+void snap_close(mcd *d)
+{
+    if (d->snap && d->snap->timer_open) {
+        d->snap->timer_open = 0;
+        uv_close((uv_handle_t *)&d->snap->timer, NULL);
+    }
+}
+
+void snap_free(snap *s)
+{
+    if (!s)
+        return;
+    pthread_mutex_destroy(&s->mu);
+    free(s->cache);
+    snap_release(s->scratch);
+    snap_release(s->board);
+    free(s);
+}
+
+void snap_read(snap *s, mcd_snapshot *out)
+{
+    pthread_mutex_lock(&s->mu);
+    copy_snapshot(out, s->board);
+    pthread_mutex_unlock(&s->mu);
+}
+
+uint32_t snap_nslots(const snap *s)
+{
+    return s->board->nslots;
+}
