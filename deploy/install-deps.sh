@@ -14,6 +14,7 @@ libcgal-demo
 ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd
 libuv1-dev
 libsqlite3-dev
+slurmctld slurmd slurm-client munge
 "
 
 SUDO=""
