@@ -652,6 +652,9 @@ int mc_stats(mc_client *c, mc_server_stats *out)
     for (uint32_t i = 0; i < s->ndevices && i < 8; i++)
         snprintf(out->devices[i], sizeof out->devices[i], "%s", s->devices[i]);
     out->ndevices = s->ndevices < 8 ? s->ndevices : 8;
+    snprintf(out->backend, sizeof out->backend, "%s", s->backend ? s->backend : "");
+    out->backend_ok = s->backend_ok;
+    snprintf(out->backend_status, sizeof out->backend_status, "%s", s->backend_status ? s->backend_status : "");
     proto_msg_free(&rep);
     return 0;
 }

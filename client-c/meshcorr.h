@@ -143,6 +143,9 @@ typedef struct mc_server_stats {
     uint64_t *slot_job;                  /* nslots job ids (0 = idle or not yours) */
     int *slot_state;                     /* 0 idle, 1 starting, 2 busy, 3 draining */
     char devices[8][128]; uint32_t ndevices;
+    char backend[16];                    /* "local" or "slurm" */
+    int backend_ok;                      /* 0: jobs stay PENDING; backend_status says why */
+    char backend_status[1024];
 } mc_server_stats;
 void mc_stats_free(mc_server_stats *s);
 

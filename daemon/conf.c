@@ -41,6 +41,19 @@ static const struct option_def {
     {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
     {"modbus", K_ENDPOINT, OFF(modbus), 0, 0, "[HOST:]PORT Modbus TCP status registers (off; 1502 suits; host 127.0.0.1)"},
     {"metrics", K_ENDPOINT, OFF(metrics), 0, 0, "[HOST:]PORT Prometheus GET /metrics over HTTP (off; host 127.0.0.1)"},
+    {"backend", K_PATH, OFF(backend), 0, 0, "local|slurm: where jobs run (default local)"},
+    {"slurm-partition", K_PATH, OFF(slurm_partition), 0, 0, "NAME sbatch --partition (default: Slurm's)"},
+    {"slurm-account", K_PATH, OFF(slurm_account), 0, 0, "NAME sbatch --account"},
+    {"slurm-time", K_PATH, OFF(slurm_time), 0, 0, "LIMIT sbatch --time, e.g. 2:00:00"},
+    {"slurm-cpus", K_INT, OFF(slurm_cpus), 1, 4096, "N sbatch --cpus-per-task and worker threads (default 1)"},
+    {"slurm-mem", K_PATH, OFF(slurm_mem), 0, 0, "SIZE sbatch --mem, e.g. 8G"},
+    {"slurm-max-jobs", K_INT, OFF(slurm_max_jobs), 1, 1000000, "N jobs handed to Slurm at once (default 100)"},
+    {"slurm-extra", K_PATH, OFF(slurm_extra), 0, 0, "ARGS more sbatch arguments, split on blanks"},
+    {"slurm-spool", K_PATH, OFF(slurm_spool), 0, 0, "DIR <state-dir>/spool as the nodes see it"},
+    {"slurm-worker", K_PATH, OFF(slurm_worker), 0, 0, "PATH of meshcorr-worker on the nodes"},
+    {"slurm-progress", K_PATH, OFF(slurm_progress), 0, 0, "HOST:PORT the workers' progress listener binds (default 0.0.0.0:0)"},
+    {"slurm-progress-host", K_PATH, OFF(slurm_progress_host), 0, 0, "HOST the workers connect to (default: the bind host, or this host's name)"},
+    {"slurm-poll-ms", K_U32, OFF(slurm_poll_ms), 50, 3600000, "MS between squeue polls (default 5000)"},
 };
 #define NOPTIONS (sizeof options / sizeof options[0])
 
@@ -59,6 +72,11 @@ void conf_init(mcd_conf *c)
     c->admin_uid = -1;
     c->log_level = DLOG_INFO;
     c->modbus.port = c->metrics.port = -1;
+    strcpy(c->backend, "local");
+    c->slurm_cpus = 1;
+    c->slurm_max_jobs = CONF_DEFAULT_SLURM_MAX_JOBS;
+    strcpy(c->slurm_progress, "0.0.0.0:0");
+    c->slurm_poll_ms = CONF_DEFAULT_SLURM_POLL_MS;
 }
 
 void conf_usage(FILE *fp)
@@ -217,5 +235,7 @@ int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
         return errbuf_set(err, errsz, -1, "--state-dir is required");
     if (c->nlisten == 0)
         return errbuf_set(err, errsz, -1, "at least one --listen address is required");
+    if (strcmp(c->backend, "local") != 0 && strcmp(c->backend, "slurm") != 0)
+        return errbuf_set(err, errsz, -1, "--backend: '%s' is not local or slurm", c->backend);
     return 0;
 }

@@ -1,9 +1,10 @@
 /* main.c — meshcorrd's main(): options, store recovery, the scheduler's
- * queue rebuilt from the store, listeners, the result-expiry sweep and the
+ * queue rebuilt from the store, the backend (backend.h), listeners, the result-expiry sweep and the
  * signal handlers, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
  * accepting, SIGTERM the workers, their jobs go back to PENDING, then close
  * every handle and the store; the dashboard threads (--modbus, --metrics)
  * stop after the loop. Holds no request or job logic. */
+#include "backend.h"
 #include "mcd.h"
 
 #include <signal.h>
@@ -39,7 +40,7 @@ void mcd_drained(mcd *d)
 {
     dlog(DLOG_INFO, "drained: no worker running; closing");
     srv_close_all(d);
-    wsup_close(d);
+    bk_close(d);
     snap_close(d);
     uv_close((uv_handle_t *)&d->sweep, NULL);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
@@ -54,10 +55,10 @@ static void on_signal(uv_signal_t *h, int sig)
         return;
     }
     d->draining = 1;
-    dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, wsup_busy(d));
+    dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, bk_busy(d));
     srv_stop_listening(d);
-    wsup_drain(d);
-    if (!wsup_busy(d))
+    bk_drain(d);
+    if (!bk_busy(d))
         mcd_drained(d);
 }
 
@@ -82,7 +83,7 @@ int main(int argc, char **argv)
     d.loop = uv_default_loop();
     if (auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
         store_open(d.conf.state_dir, &d.store, err, sizeof err) ||
-        store_recover(d.store, err, sizeof err)) {
+        store_recover(d.store, strcmp(d.conf.backend, "slurm") == 0, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }
@@ -90,7 +91,7 @@ int main(int argc, char **argv)
         dlog(DLOG_ERROR, "cannot rebuild the queue from the store");
         goto done;
     }
-    if (wsup_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
+    if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
         (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.snap, &d.metrics, err, sizeof err))) {
         dlog(DLOG_ERROR, "%s", err);
@@ -105,9 +106,9 @@ int main(int argc, char **argv)
     d.sigterm.data = d.sigint.data = &d;
     uv_signal_start(&d.sigterm, on_signal, SIGTERM);
     uv_signal_start(&d.sigint, on_signal, SIGINT);
-    dlog(DLOG_INFO, "meshcorrd ready: %d worker slot(s), %u job(s) pending, state in %s", d.conf.workers,
+    dlog(DLOG_INFO, "meshcorrd ready: %s backend, %u job(s) pending, state in %s", bk_name(&d),
          sched_queued(d.sched), d.conf.state_dir);
-    wsup_schedule(&d);
+    bk_schedule(&d);
     uv_run(d.loop, UV_RUN_DEFAULT);
     status = 0;
     dlog(DLOG_INFO, "stopped");
@@ -115,7 +116,7 @@ done:
     if (status) {
         /* a start-up failure: close whatever was opened */
         srv_stop_listening(&d);
-        wsup_close(&d);
+        bk_close(&d);
         snap_close(&d);
         uv_run(d.loop, UV_RUN_NOWAIT);
     }

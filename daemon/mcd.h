@@ -6,7 +6,11 @@
  *   auth.c   auth_   tokens file (TCP) and peer credentials (Unix socket)
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
- *   wsup.c   wsup_   worker processes: spawn, progress pipe, exit, timeouts
+ *   backend.c bk_    where jobs run (backend.h): `local` or `slurm`
+ *   wsup.c   wsup_   the local backend: worker processes, progress pipe, exit
+ *   bk_slurm.c       the slurm backend: sbatch/squeue/scancel, re-attach
+ *   bk_prog.c        progress connections from workers on Slurm nodes
+ *   bk_cmd.c         external commands run without blocking the loop
  *   srv.c    srv_    libuv loop, listeners, connections, bounded buffers
  *   req.c    req_    one handler per request type, WATCH fan-out
  *   snap.c   snap_   the status snapshot: STATS and the dashboards read it
@@ -38,6 +42,8 @@
 #define CONF_DEFAULT_MAX_OUTPUT (8u << 20)   /* bytes queued to one slow client */
 #define CONF_HELLO_MAX_FRAME 65536           /* frame limit before HELLO succeeds */
 #define CONF_KILL_GRACE_S 5                  /* SIGTERM -> SIGKILL */
+#define CONF_DEFAULT_SLURM_MAX_JOBS 100
+#define CONF_DEFAULT_SLURM_POLL_MS 5000
 
 #define CONF_HOST 256
 /* A dashboard server's address (--modbus, --metrics); port -1 = off. */
@@ -63,6 +69,19 @@ typedef struct mcd_conf {
     int log_level;                /* DLOG_* */
     conf_endpoint modbus;         /* Modbus TCP input registers (MODBUS.md) */
     conf_endpoint metrics;        /* Prometheus text over HTTP, GET /metrics */
+    /* where jobs run (backend.h): "local" worker slots or "slurm" */
+    char backend[CONF_PATH];
+    char slurm_partition[CONF_PATH], slurm_account[CONF_PATH];
+    char slurm_time[CONF_PATH];   /* sbatch --time ("" = the partition's default) */
+    int slurm_cpus;               /* --cpus-per-task (also the worker's --threads) */
+    char slurm_mem[CONF_PATH];    /* --mem, e.g. "4G" ("" = the partition's default) */
+    int slurm_max_jobs;           /* meshcorr jobs in Slurm at once */
+    char slurm_extra[CONF_PATH];  /* more sbatch arguments, split on blanks */
+    char slurm_spool[CONF_PATH];  /* <state-dir>/spool as the nodes see it ("" = same path) */
+    char slurm_worker[CONF_PATH]; /* meshcorr-worker on the nodes ("" = --worker's path) */
+    char slurm_progress[CONF_PATH];   /* HOST:PORT the progress listener binds */
+    char slurm_progress_host[CONF_PATH]; /* host the workers connect to ("" = bind host) */
+    uint32_t slurm_poll_ms;       /* squeue/progress-file period */
 } mcd_conf;
 
 void conf_init(mcd_conf *c);
@@ -103,6 +122,8 @@ typedef struct store_job {
     int state;                    /* enum proto_state */
     int64_t submit_ms, start_ms, end_ms;
     uint32_t outer, total;        /* latest outer iteration, planned */
+    char slurm_id[32];            /* Slurm job of the current run; "" none */
+    int64_t progress_off;         /* bytes of spool/<id>/progress.frames already taken */
 } store_job;
 typedef int (*store_job_fn)(void *ctx, const store_job *j);          /* non-zero stops */
 typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zero stops */
@@ -113,8 +134,10 @@ int store_open(const char *dir, store **out, char *err, size_t errsz);
 void store_close(store *s);
 /* After a restart: RUNNING jobs go back to PENDING (a leftover worker of the
  * previous daemon is killed), spool dirs without a row are removed, unfinished
- * rows without job.frame become FAILED. */
-int store_recover(store *s, char *err, size_t errsz);
+ * rows without job.frame become FAILED. Unfinished jobs with a Slurm job id
+ * are left as they are with keep_slurm (the Slurm backend re-attaches), else
+ * they go back to PENDING too. */
+int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
 /* Durable insert: row and spool/<id>/job.frame (fsynced) in one transaction. */
 int store_submit(store *s, const char *user, const char *label, int32_t priority,
                  uint32_t total, const char *params, const void *frame, size_t len,
@@ -124,6 +147,9 @@ int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid);
 /* PENDING clears the run's times; a terminal state sets end_ms and counts it. */
 int store_set_state(store *s, uint64_t id, int state, const char *reason);
 int store_add_progress(store *s, uint64_t id, const proto_progress *p);
+/* The Slurm job running it ("" none) and how much of progress.frames is read. */
+int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progress_off);
+int store_set_reason(store *s, uint64_t id, const char *reason);
 /* Drops a previous run's history and result files before a (re)run. */
 int store_clear_run(store *s, uint64_t id);
 int store_latest_progress(store *s, uint64_t id, proto_progress *out); /* 0 or NOT_FOUND */
@@ -131,7 +157,10 @@ int store_history(store *s, uint64_t id, uint32_t from_outer, store_progress_fn 
 /* user NULL = every user; jobs with id > after_id in id order, at most max. */
 int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_id,
                uint32_t max, store_job_fn fn, void *ctx);
+/* PENDING jobs not handed to Slurm yet. */
 int store_each_pending(store *s, store_job_fn fn, void *ctx);
+/* PENDING or RUNNING jobs that have a Slurm job id. */
+int store_each_slurm(store *s, store_job_fn fn, void *ctx);
 /* Terminal jobs that ended before before_ms. */
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx);
 int store_delete(store *s, uint64_t id);
@@ -227,6 +256,7 @@ void metrics_stop(metrics *m);    /* NULL ok */
 typedef struct conn conn;
 typedef struct wsup_slot wsup_slot;
 typedef struct req_watch req_watch;
+typedef struct bk_ops bk_ops;
 
 struct mcd {
     uv_loop_t *loop;
@@ -245,9 +275,10 @@ struct mcd {
     snap *snap;                   /* the status snapshot */
     mbus *mbus;                   /* NULL unless --modbus */
     metrics *metrics;             /* NULL unless --metrics */
+    const bk_ops *bk;             /* the backend (backend.h) */
 };
 
-/* ---- wsup_ ---------------------------------------------------------------- */
+/* ---- wsup_: the local backend (called through bk_, backend.h) ------------- */
 int wsup_init(mcd *d, char *err, size_t errsz);
 /* Starts pending jobs on idle slots while both exist. */
 void wsup_schedule(mcd *d);
@@ -259,6 +290,10 @@ int wsup_busy(const mcd *d);    /* slots not idle */
 /* Slot i's state (PROTO_SLOT_*) and job (0 = none). */
 void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
 void wsup_close(mcd *d);
+/* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
+const char *wsup_worker_path(const mcd *d, char *buf, size_t sz);
+/* The worker's --max-faces for the configured --max-vertices. */
+unsigned long long wsup_max_faces(const mcd *d);
 
 /* ---- srv_ ----------------------------------------------------------------- */
 int srv_listen(mcd *d, char *err, size_t errsz);

@@ -1,6 +1,6 @@
 /* req.c — one handler per request type (PROTOCOL.md, Messages) and the
  * WATCH registry. Handlers check the session, the job's visibility and state,
- * act through store_/sched_/wsup_, and answer through srv_send. Never reads a
+ * act through store_/sched_/bk_, and answer through srv_send. Never reads a
  * socket, never blocks on a client.
  *
  * DESIGN: visibility — a non-admin session sees only its user's jobs, and
@@ -8,7 +8,7 @@
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
  * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
  * anything is stored. Draco bytes are never decoded here (only workers do). */
-#include "mcd.h"
+#include "backend.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -207,7 +207,7 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', %s", (unsigned long long)id, a->user,
          s->priority, s->label, params);
     reply_id(c, PROTO_MSG_SUBMIT_OK, m->request_id, id);
-    wsup_schedule(d);
+    bk_schedule(d);
 }
 
 static void on_status(conn *c, const proto_msg *m)
@@ -382,7 +382,10 @@ static void on_cancel(conn *c, const proto_msg *m)
     store_job j;
     if (visible_job(c, m->request_id, m->u.cancel.job_id, &j))
         return;
-    if (j.state == PROTO_STATE_PENDING) {
+    if (!store_is_terminal(j.state) && bk_cancel(d, j.id) == 0) {
+        /* the backend has it (running, or queued in Slurm) and stops it */
+        dlog(DLOG_INFO, "job %llu: cancel requested from the %s backend", (unsigned long long)j.id, bk_name(d));
+    } else if (j.state == PROTO_STATE_PENDING) {
         sched_remove(d->sched, j.id);
         if (store_set_state(d->store, j.id, PROTO_STATE_CANCELLED, "cancelled by request before it ran")) {
             srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure cancelling job %llu",
@@ -391,12 +394,10 @@ static void on_cancel(conn *c, const proto_msg *m)
         }
         dlog(DLOG_INFO, "job %llu: CANCELLED while pending", (unsigned long long)j.id);
         req_job_ended(d, j.id);
-    } else if (j.state != PROTO_STATE_RUNNING || wsup_cancel(d, j.id) != 0) {
+    } else {
         srv_send_error(c, m->request_id, PROTO_EBAD_STATE, "job %llu is %s: nothing to cancel",
                        (unsigned long long)j.id, proto_state_name(j.state));
         return;
-    } else {
-        dlog(DLOG_INFO, "job %llu: cancel requested: SIGTERM to its worker", (unsigned long long)j.id);
     }
     reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
 }
@@ -487,9 +488,9 @@ static void on_stats(conn *c, const proto_msg *m)
     memset(&r, 0, sizeof r);
     r.type = PROTO_MSG_STATS_OK;
     proto_stats_ok *s = &r.u.stats_ok;
-    uint32_t nslots = (uint32_t)d->conf.workers > PROTO_MAX_SLOTS ? PROTO_MAX_SLOTS : (uint32_t)d->conf.workers;
-    mcd_snapshot *now = snap_alloc((uint32_t)d->conf.workers);
-    proto_slot *slots = calloc(nslots, sizeof *slots);
+    uint32_t nslots = (uint32_t)bk_nslots(d) > PROTO_MAX_SLOTS ? PROTO_MAX_SLOTS : (uint32_t)bk_nslots(d);
+    mcd_snapshot *now = snap_alloc((uint32_t)bk_nslots(d));
+    proto_slot *slots = calloc((size_t)nslots + 1, sizeof *slots);
     if (!now || !slots) {
         srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory");
         goto done;
@@ -518,6 +519,10 @@ static void on_stats(conn *c, const proto_msg *m)
     const char *devs[1] = {dev};
     s->devices = devs;
     s->ndevices = 1;
+    char health[PROTO_MAX_STRING + 1];
+    s->backend = bk_name(d);
+    s->backend_ok = (uint8_t)bk_health(d, health, sizeof health);
+    s->backend_status = health;
     reply(c, &r, m->request_id);
 done:
     snap_release(now);

@@ -11,6 +11,7 @@
  * each slot's job is kept here from the records wsup passes through req, so
  * a snapshot reads the store only when a slot changes job (and once for the
  * end counters). Nothing here talks to clients. */
+#include "backend.h"
 #include "mcd.h"
 #include "util/errbuf.h"
 
@@ -28,7 +29,7 @@ typedef struct slot_cache {
 
 struct snap {
     /* loop thread only */
-    slot_cache *cache;            /* conf.workers */
+    slot_cache *cache;            /* bk_nslots */
     mcd_snapshot *scratch;
     uv_timer_t timer;
     int timer_open;
@@ -63,7 +64,7 @@ static slot_cache *sync_slot(mcd *d, int i, uint8_t *state)
 {
     slot_cache *c = &d->snap->cache[i];
     uint64_t job;
-    wsup_slot_info(d, i, state, &job);
+    bk_slot_info(d, i, state, &job);
     if (c->job_id != job) {
         memset(c, 0, sizeof *c);
         c->job_id = job;
@@ -78,7 +79,7 @@ static slot_cache *sync_slot(mcd *d, int i, uint8_t *state)
 
 void snap_progress(mcd *d, const proto_progress *p)
 {
-    for (int i = 0; i < d->conf.workers; i++) {
+    for (int i = 0; i < bk_nslots(d); i++) {
         uint8_t state;
         slot_cache *c = sync_slot(d, i, &state);
         if (c->job_id == p->job_id) {
@@ -92,7 +93,7 @@ void snap_collect(mcd *d, mcd_snapshot *out)
 {
     int64_t now = store_now_ms();
     uint32_t running = 0;
-    for (int i = 0; i < d->conf.workers; i++) {
+    for (int i = 0; i < bk_nslots(d); i++) {
         snap_slot *o = &out->slots[i];
         slot_cache *c = sync_slot(d, i, &o->state);
         o->job_id = c->job_id;
@@ -105,8 +106,8 @@ void snap_collect(mcd *d, mcd_snapshot *out)
         o->beta = c->has_progress ? c->p.beta : 0;
         o->elapsed_s = c->job_id && c->start_ms && now > c->start_ms ? (uint32_t)((now - c->start_ms) / 1000) : 0;
     }
-    out->nslots = (uint32_t)d->conf.workers;
-    out->workers = (uint32_t)d->conf.workers;
+    out->nslots = (uint32_t)bk_nslots(d);
+    out->workers = (uint32_t)bk_nslots(d);
     out->running = running;
     out->queued = sched_queued(d->sched);
     store_counters(d->store, &out->completed, &out->failed, &out->cancelled);
@@ -149,7 +150,7 @@ int snap_init(mcd *d, char *err, size_t errsz)
     d->snap = s;
     pthread_mutex_init(&s->mu, NULL);
     clock_gettime(CLOCK_MONOTONIC, &s->t0);
-    uint32_t n = (uint32_t)d->conf.workers;
+    uint32_t n = (uint32_t)bk_nslots(d);
     if (!(s->cache = calloc(n, sizeof *s->cache)) || !(s->scratch = snap_alloc(n)) || !(s->board = snap_alloc(n)))
         return errbuf_set(err, errsz, -1, "out of memory for the snapshot");
     publish(d);

@@ -11,7 +11,9 @@
  *
  * Tables: jobs (one row per job; state as its Slurm name; the latest outer
  * iteration and energy), history (one row per PROGRESS record), counters
- * (jobs ended per final state since the store was created). Runs in the
+ * (jobs ended per final state since the store was created). A job handed
+ * to Slurm keeps its Slurm job id in its row until it ends, so a restarted
+ * daemon re-attaches to it instead of running it again. Runs in the
  * event loop thread only; it never talks to clients or workers. */
 #include "mcd.h"
 #include "util/errbuf.h"
@@ -44,7 +46,9 @@ static const char schema[] =
     " total INTEGER NOT NULL,"             /* planned outer iterations */
     " outer_it INTEGER NOT NULL DEFAULT 0," /* latest progress */
     " energy REAL,"
-    " pid INTEGER NOT NULL DEFAULT 0);"    /* worker of the current run */
+    " pid INTEGER NOT NULL DEFAULT 0,"     /* worker of the current run */
+    " slurm_id TEXT NOT NULL DEFAULT '',"  /* Slurm job of the current run ('' none) */
+    " progress_off INTEGER NOT NULL DEFAULT 0);" /* bytes of progress.frames taken */
     "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
     "CREATE TABLE IF NOT EXISTS history("
     " job INTEGER NOT NULL, stage INTEGER NOT NULL, outer_it INTEGER NOT NULL,"
@@ -57,7 +61,8 @@ static const char schema[] =
 
 #define HISTORY_COLS "stage, outer_it, total, inner0, inner1, membrane0, bending0, mismatch0," \
     " reverse0, energy0, membrane1, bending1, mismatch1, reverse1, energy1, beta, gamma, elapsed_s"
-#define JOB_COLS "id, user, label, priority, state, reason, submit_ms, start_ms, end_ms, outer_it, total"
+#define JOB_COLS "id, user, label, priority, state, reason, submit_ms, start_ms, end_ms, outer_it, total," \
+    " slurm_id, progress_off"
 
 int64_t store_now_ms(void)
 {
@@ -177,6 +182,10 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
         sqlite3_free(msg);
         goto fail;
     }
+    /* stores made before the Slurm backend: add its columns (an error here
+     * only says the column exists) */
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN slurm_id TEXT NOT NULL DEFAULT ''", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN progress_off INTEGER NOT NULL DEFAULT 0", NULL, NULL, NULL);
     *out = s;
     return 0;
 fail:
@@ -220,18 +229,30 @@ static void kill_leftover_worker(long pid, uint64_t id)
         }
 }
 
-int store_recover(store *s, char *err, size_t errsz)
+int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
 {
     sqlite3_stmt *st;
     int rc = 0;
-    /* 1. RUNNING -> PENDING (the run was cut off by the daemon's end). */
-    if (sqlite3_prepare_v2(s->db, "SELECT id, pid FROM jobs WHERE state = 'RUNNING'", -1, &st, NULL) != SQLITE_OK)
+    /* 0. Slurm runs without the Slurm backend: they run here again. */
+    if (!keep_slurm) {
+        if ((rc = exec_v(s, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
+                         " energy = NULL, slurm_id = '', progress_off = 0"
+                         " WHERE state IN ('PENDING', 'RUNNING') AND slurm_id != ''", NULL)))
+            return errbuf_set(err, errsz, rc, "recover: cannot re-queue Slurm jobs");
+        if (sqlite3_changes(s->db))
+            dlog(DLOG_WARN, "store: %d job(s) handed to Slurm by an earlier run go back to the queue"
+                 " (backend is not slurm)", sqlite3_changes(s->db));
+    }
+    /* 1. RUNNING -> PENDING (the run was cut off by the daemon's end);
+     * Slurm runs go on without us and are re-attached by the backend. */
+    if (sqlite3_prepare_v2(s->db, "SELECT id, pid FROM jobs WHERE state = 'RUNNING' AND slurm_id = ''",
+                           -1, &st, NULL) != SQLITE_OK)
         return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
     while (sqlite3_step(st) == SQLITE_ROW)
         kill_leftover_worker((long)sqlite3_column_int64(st, 1), (uint64_t)sqlite3_column_int64(st, 0));
     sqlite3_finalize(st);
     if ((rc = exec_v(s, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
-                     " energy = NULL WHERE state = 'RUNNING'", NULL)))
+                     " energy = NULL WHERE state = 'RUNNING' AND slurm_id = ''", NULL)))
         return errbuf_set(err, errsz, rc, "recover: cannot re-queue running jobs");
     int requeued = sqlite3_changes(s->db);
     /* 2. spool directories without a committed row. */
@@ -360,6 +381,8 @@ static void read_job(sqlite3_stmt *st, store_job *j)
     j->end_ms = sqlite3_column_int64(st, 8);
     j->outer = (uint32_t)sqlite3_column_int64(st, 9);
     j->total = (uint32_t)sqlite3_column_int64(st, 10);
+    snprintf(j->slurm_id, sizeof j->slurm_id, "%s", (const char *)sqlite3_column_text(st, 11));
+    j->progress_off = sqlite3_column_int64(st, 12);
 }
 
 int store_get(store *s, uint64_t id, store_job *out)
@@ -381,17 +404,29 @@ int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid)
                   "iii", start_ms, (int64_t)pid, (int64_t)id);
 }
 
+int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progress_off)
+{
+    return exec_v(s, "UPDATE jobs SET slurm_id = ?, progress_off = ? WHERE id = ?", "tii", slurm_id,
+                  progress_off, (int64_t)id);
+}
+
+int store_set_reason(store *s, uint64_t id, const char *reason)
+{
+    return exec_v(s, "UPDATE jobs SET reason = ? WHERE id = ?", "ti", reason, (int64_t)id);
+}
+
 int store_set_state(store *s, uint64_t id, int state, const char *reason)
 {
     if (!store_is_terminal(state))
         return exec_v(s, "UPDATE jobs SET state = ?, reason = ?, start_ms = 0, end_ms = 0, pid = 0,"
-                      " outer_it = 0, energy = NULL WHERE id = ?", "tti",
+                      " outer_it = 0, energy = NULL, slurm_id = '', progress_off = 0 WHERE id = ?", "tti",
                       proto_state_name(state), reason ? reason : "", (int64_t)id);
     const char *counter = state == PROTO_STATE_COMPLETED ? "completed"
                         : state == PROTO_STATE_CANCELLED ? "cancelled" : "failed";
     int rc = exec_v(s, "BEGIN", NULL);
     if (!rc)
-        rc = exec_v(s, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0 WHERE id = ?", "ttii",
+        rc = exec_v(s, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0, slurm_id = '' WHERE id = ?",
+                    "ttii",
                     proto_state_name(state), reason ? reason : "", store_now_ms(), (int64_t)id);
     if (!rc)
         rc = exec_v(s, "INSERT INTO counters(name, value) VALUES(?, 1)"
@@ -434,7 +469,8 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p)
 int store_clear_run(store *s, uint64_t id)
 {
     char path[CONF_PATH + 96];
-    static const char *files[] = {"result.frame", "result.frame.tmp", "error.frame", "error.frame.tmp"};
+    static const char *files[] = {"result.frame", "result.frame.tmp", "error.frame", "error.frame.tmp",
+                                  "progress.frames", "progress.secret", "slurm.out"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         unlink(store_spool_path(s, id, files[i], path, sizeof path));
     return exec_v(s, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
@@ -533,7 +569,20 @@ int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_i
 
 int store_each_pending(store *s, store_job_fn fn, void *ctx)
 {
-    return store_list(s, NULL, 1u << PROTO_STATE_PENDING, 0, UINT32_MAX, fn, ctx);
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state = 'PENDING' AND slurm_id = ''"
+                           " ORDER BY id", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    return each_job(s, st, fn, ctx);
+}
+
+int store_each_slurm(store *s, store_job_fn fn, void *ctx)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state IN ('PENDING', 'RUNNING')"
+                           " AND slurm_id != '' ORDER BY id", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    return each_job(s, st, fn, ctx);
 }
 
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx)

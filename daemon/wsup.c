@@ -10,8 +10,9 @@
  * PENDING, so it runs again on the next start: never lost. The worker is
  * started with uv_spawn (fork + exec at once: nothing of the daemon's state
  * runs in the child) and its progress pipe is read non-blocking in the loop.
- * A slot is idle again only when the process and pipe handles are closed. */
-#include "mcd.h"
+ * A slot is idle again only when the process and pipe handles are closed.
+ * This is the `local` backend (backend.h); bk_local at the end is its table. */
+#include "backend.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -23,7 +24,6 @@
 #include <unistd.h>
 
 #define WSUP_PROGRESS_FD 3
-#define WSUP_MAX_PROGRESS_FRAME 4096
 #define WSUP_EOF_GRACE_MS 2000      /* after exit, wait this long for the pipe's EOF */
 #define WSUP_MAX_ERROR_FRAME (1u << 20)
 
@@ -47,7 +47,7 @@ struct wsup_slot {
 
 static void slot_finish(wsup_slot *s);
 
-static const char *worker_path(const mcd *d, char *buf, size_t sz)
+const char *wsup_worker_path(const mcd *d, char *buf, size_t sz)
 {
     if (d->conf.worker[0])
         return d->conf.worker;
@@ -60,6 +60,12 @@ static const char *worker_path(const mcd *d, char *buf, size_t sz)
     char *slash = strrchr(buf, '/');
     memcpy(slash ? slash + 1 : buf, name, sizeof name);
     return buf;
+}
+
+unsigned long long wsup_max_faces(const mcd *d)
+{
+    unsigned long long mf = 4ull * d->conf.max_vertices;
+    return mf > 40000000 ? 40000000 : mf;
 }
 
 int wsup_init(mcd *d, char *err, size_t errsz)
@@ -79,7 +85,7 @@ int wsup_init(mcd *d, char *err, size_t errsz)
         s->timer.data = s;
     }
     char buf[PATH_MAX];
-    const char *w = worker_path(d, buf, sizeof buf);
+    const char *w = wsup_worker_path(d, buf, sizeof buf);
     if (access(w, X_OK) != 0)
         dlog(DLOG_WARN, "worker program %s is not executable: jobs will fail until it is", w);
     return 0;
@@ -133,31 +139,13 @@ static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
 
 static void take_progress(wsup_slot *s)
 {
-    while (!s->progress_bad && s->in.len) {
-        proto_msg m;
-        size_t used = 0;
-        char err[256];
-        int rc = proto_decode(s->in.data, s->in.len, WSUP_MAX_PROGRESS_FRAME, &m, &used, err, sizeof err);
-        if (rc == PROTO_NEED_MORE)
-            return;
-        if (rc != PROTO_READY || m.type != PROTO_MSG_PROGRESS) {
-            dlog(DLOG_WARN, "job %llu: bad progress frame from the worker (%s): ignoring its progress",
-                 (unsigned long long)s->job_id, rc ? err : proto_type_name(m.type));
-            proto_msg_free(&m);
-            s->progress_bad = 1;
-            proto_buf_reset(&s->in);
-            return;
-        }
-        proto_progress p = m.u.progress;
-        proto_msg_free(&m);
-        proto_buf_consume(&s->in, used);
-        p.job_id = s->job_id;
-        if (s->state == PROTO_SLOT_STARTING)
-            s->state = PROTO_SLOT_BUSY;
-        if (store_add_progress(s->d->store, s->job_id, &p))
-            dlog(DLOG_ERROR, "job %llu: cannot store progress", (unsigned long long)s->job_id);
-        req_progress(s->d, &p);
-    }
+    if (s->progress_bad)
+        return;
+    int n = bk_progress_take(s->d, s->job_id, &s->in);
+    if (n < 0)
+        s->progress_bad = 1;
+    else if (n > 0 && s->state == PROTO_SLOT_STARTING)
+        s->state = PROTO_SLOT_BUSY;
 }
 
 static void on_read(uv_stream_t *st, ssize_t n, const uv_buf_t *buf)
@@ -305,11 +293,10 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     snprintf(fd, sizeof fd, "%d", WSUP_PROGRESS_FD);
     snprintf(thr, sizeof thr, "%d", d->conf.threads_per_worker);
     snprintf(maxv, sizeof maxv, "%u", d->conf.max_vertices);
-    uint64_t mf = 4ull * d->conf.max_vertices;
-    snprintf(maxf, sizeof maxf, "%llu", (unsigned long long)(mf > 40000000 ? 40000000 : mf));
+    snprintf(maxf, sizeof maxf, "%llu", wsup_max_faces(d));
     char *argv[16];
     int k = 0;
-    argv[k++] = (char *)worker_path(d, wbuf, sizeof wbuf);
+    argv[k++] = (char *)wsup_worker_path(d, wbuf, sizeof wbuf);
     argv[k++] = "--job";         argv[k++] = dir;
     argv[k++] = "--job-id";      argv[k++] = sid;
     argv[k++] = "--progress-fd"; argv[k++] = fd;
@@ -427,3 +414,25 @@ void wsup_close(mcd *d)
         proto_buf_free(&d->slots[i].in);
     }
 }
+
+static int wsup_nslots(const mcd *d)
+{
+    return d->conf.workers;
+}
+
+static int wsup_health(const mcd *d, char *msg, size_t sz)
+{
+    char buf[PATH_MAX];
+    const char *w = wsup_worker_path(d, buf, sizeof buf);
+    if (access(w, X_OK) != 0) {
+        snprintf(msg, sz, "worker program %s is not executable", w);
+        return 0;
+    }
+    snprintf(msg, sz, "%d worker slot(s), %d busy", d->conf.workers, wsup_busy(d));
+    return 1;
+}
+
+const bk_ops bk_local = {
+    "local", wsup_init, wsup_schedule, wsup_cancel, wsup_drain, wsup_busy,
+    wsup_nslots, wsup_slot_info, wsup_health, wsup_close,
+};

@@ -299,6 +299,9 @@ typedef struct proto_stats_ok {
     uint64_t completed, failed, cancelled;
     proto_slot *slots; uint32_t nslots;
     const char **devices; uint32_t ndevices;
+    const char *backend;              /* "local", "slurm" */
+    uint8_t backend_ok;               /* 1 jobs can start; 0 see backend_status */
+    const char *backend_status;       /* e.g. "sbatch not found in PATH" */
 } proto_stats_ok;
 typedef struct proto_error_msg { int32_t code; const char *message; } proto_error_msg;
 

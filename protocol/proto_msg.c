@@ -483,6 +483,9 @@ static void io_payload(io *c, proto_msg *m)
             s->devices = io_alloc(c, s->ndevices, sizeof *s->devices);
         for (uint32_t i = 0; i < s->ndevices && !c->err; i++)
             io_str(c, &s->devices[i], "device name");
+        io_str(c, &s->backend, "backend name");
+        io_u8(c, &s->backend_ok);
+        io_str(c, &s->backend_status, "backend status");
         break;
     }
     case PROTO_MSG_ERROR:

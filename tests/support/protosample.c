@@ -165,7 +165,8 @@ void protosample_fill(int type, int v, proto_msg *m)
     }
     case PROTO_MSG_STATS_OK: {
         proto_stats_ok *u = &m->u.stats_ok;
-        *u = (proto_stats_ok){ 12, 2, 3, 1000000, 7, UINT64_MAX, NULL, 0, NULL, 0 };
+        *u = (proto_stats_ok){ 12, 2, 3, 1000000, 7, UINT64_MAX, NULL, 0, NULL, 0, "slurm", 0,
+                               "squeue failed: slurm_load_jobs error: Unable to contact slurm controller" };
         if (!v) {
             slots[0] = (proto_slot){ 0, PROTO_SLOT_IDLE };
             slots[1] = (proto_slot){ 31, PROTO_SLOT_BUSY };
@@ -328,6 +329,8 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
                  "stats_ok slot");
         for (uint32_t i = 0; i < x->ndevices; i++)
             DIFF(str_ne(x->devices[i], y->devices[i]), "stats_ok device");
+        DIFF(str_ne(x->backend, y->backend) || x->backend_ok != y->backend_ok ||
+             str_ne(x->backend_status, y->backend_status), "stats_ok backend");
         return NULL;
     }
     case PROTO_MSG_ERROR:

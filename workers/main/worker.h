@@ -55,14 +55,24 @@ void wrk_job_close(wrk_job *job);
 int wrk_frame_read(const char *path, unsigned char **buf, proto_msg *m, char *err, size_t errsz);
 int wrk_frame_write(const char *dir, const char *name, const proto_msg *m, char *err, size_t errsz);
 
-/* worker_progress.c — PROGRESS frames (request id 0) on a pipe. fd < 0: no
- * progress. The first write error closes the channel for good (the daemon
- * is gone); the job carries on. */
+/* worker_progress.c — PROGRESS frames (request id 0) on a pipe, or on a TCP
+ * connection to meshcorrd (Slurm nodes, --progress-tcp) that falls back to
+ * appending them to DIR/progress.frames when it cannot be made or breaks.
+ * fd < 0 and no file: no progress. A pipe's first write error closes it for
+ * good (the daemon is gone); the job always carries on. */
+#define WRK_PROGRESS_FILE "progress.frames"
+#define WRK_PROGRESS_HELLO "MCPROGRESS"      /* daemon/backend.h, bk_prog_ */
+#define WRK_SECRET_MAX 128
 typedef struct wrk_progress {
     int fd;
     uint64_t job_id;
     int total;                     /* planned outer iterations */
+    char file[4096];               /* fallback: "" none, else DIR/progress.frames */
 } wrk_progress;
+/* Connects to host:port (a TCP stream, send timeout set) and sends the hello
+ * line with job_id and the secret read from secret_file; on any failure
+ * pg->fd stays -1 and the frames go to pg->file. Reasons go to stderr. */
+void wrk_progress_connect(wrk_progress *pg, const char *hostport, const char *secret_file);
 void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, double elapsed,
                        proto_progress *out);
 void wrk_progress_send(wrk_progress *pg, const corr_progress *cp, double elapsed);

@@ -37,6 +37,7 @@ static void usage(void)
     fprintf(stderr,
         "usage: meshcorr-worker --job DIR --job-id ID [--progress-fd N] [--threads N]\n"
         "                       [--max-vertices N] [--max-faces N]\n"
+        "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage. See workers/WORKER.md.\n");
 }
@@ -118,7 +119,9 @@ int main(int argc, char **argv)
         {"job", required_argument, 0, 'j'},          {"job-id", required_argument, 0, 'i'},
         {"progress-fd", required_argument, 0, 'p'},  {"threads", required_argument, 0, 't'},
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
+        {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
         {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
+    const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
     uint64_t job_id = 0;
     int have_id = 0, progress_fd = -1, bad = 0;
@@ -150,6 +153,8 @@ int main(int argc, char **argv)
             if (!(bad |= parse_num("max-faces", optarg, 1, MESH_MAX_FACES, &v) != 0))
                 lim.max_faces = (int)v;
             break;
+        case 'c': progress_tcp = optarg; break;
+        case 's': secret_file = optarg; break;
         case 'h': usage(); return WRK_EXIT_USAGE;
         default: bad = 1;
         }
@@ -161,6 +166,10 @@ int main(int argc, char **argv)
     struct stat st;
     if (!bad && (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
         fprintf(stderr, "meshcorr-worker: --job %s: not a directory\n", dir);
+        bad = 1;
+    }
+    if (!bad && (!progress_tcp != !secret_file || (progress_tcp && progress_fd >= 0))) {
+        fprintf(stderr, "meshcorr-worker: --progress-tcp needs --secret-file, and excludes --progress-fd\n");
         bad = 1;
     }
     if (!bad && progress_fd >= 0 && fcntl(progress_fd, F_GETFD) < 0) {
@@ -188,6 +197,9 @@ int main(int argc, char **argv)
     wrk_job job;
     ectm_result res;
     wrk_result out;
+    run_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.pg.fd = -1;
     memset(&job, 0, sizeof job);
     memset(&res, 0, sizeof res);
     memset(&out, 0, sizeof out);
@@ -201,7 +213,14 @@ int main(int argc, char **argv)
         status = fail(dir, job_id, rc, err);
         goto done;
     }
-    run_ctx ctx = { { progress_fd, job_id, job.params.iterations }, t0, 0 };
+    ctx.pg.fd = progress_fd;
+    ctx.pg.job_id = job_id;
+    ctx.pg.total = job.params.iterations;
+    ctx.t0 = t0;
+    if (progress_tcp) {
+        snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, WRK_PROGRESS_FILE);
+        wrk_progress_connect(&ctx.pg, progress_tcp, secret_file);
+    }
     corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0,
                       &job.rhm, CORR_STAGES_ALL };
     if (cancel_requested)
@@ -224,6 +243,8 @@ int main(int argc, char **argv)
     }
     status = WRK_EXIT_OK;
 done:
+    if (progress_tcp && ctx.pg.fd >= 0)
+        close(ctx.pg.fd);
     wrk_result_close(&out);
     ectm_result_close(&res);
     wrk_job_close(&job);

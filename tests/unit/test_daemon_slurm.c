@@ -1,0 +1,363 @@
+/* test_daemon_slurm.c — meshcorrd's slurm backend against a real Slurm
+ * (Debian's slurmctld, slurmd and munge), through libmeshcorr: progress
+ * streamed back over TCP and, when the worker cannot connect, through the
+ * spool's progress.frames; the demo pair's map identical to the local
+ * backend's; CANCEL as scancel; Slurm's time limit as TIMEOUT; meshcorrd
+ * SIGKILLed and restarted while Slurm runs its jobs re-attaches without
+ * submitting anything twice; a missing sbatch or an unreachable controller is
+ * in STATS and the job stays PENDING.
+ *
+ * The binary re-executes itself inside a private pid + network namespace
+ * where tests/slurm/run-in-slurm.sh starts ONE single-node Slurm that all
+ * tests below share, run one after the other in that namespace (Slurm takes
+ * seconds to start; one per test would cost more than the tests). Each test
+ * still runs in its own process with its own meshcorrd and state directory.
+ * Without the privileges for the namespace, or without Slurm installed,
+ * every test SKIPs with the reason. */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "support/testslurm.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+__attribute__((constructor(101))) static void enter_slurm(int argc, char **argv)
+{
+    testslurm_enter(argc, argv);
+}
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+typedef struct watch_log {
+    int n;
+    uint32_t last_outer;
+    int monotone, finite;
+} watch_log;
+
+static int on_progress(void *ctx, const mc_progress *p)
+{
+    watch_log *w = ctx;
+    if (w->n && p->outer < w->last_outer)
+        w->monotone = 0;
+    if (!isfinite(p->energy[0] + p->energy[1]))
+        w->finite = 0;
+    w->last_outer = p->outer;
+    w->n++;
+    return 0;
+}
+
+static uint64_t submit_ok(mc_client *c, int iterations, int long_job)
+{
+    int rc;
+    uint64_t id = testdaemon_submit(c, iterations, long_job, 0, &rc);
+    if (rc)
+        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
+    return id;
+}
+
+static int log_has(const testdaemon *d, const char *what)
+{
+    FILE *fp = fopen(d->log, "r");
+    char line[4096];
+    int found = 0;
+    while (fp && !found && fgets(line, sizeof line, fp))
+        found = strstr(line, what) != NULL;
+    if (fp)
+        fclose(fp);
+    return found;
+}
+
+/* The demo pair 381 -> 390 with its initial maps (no landmarks: ECTM only,
+ * so the outer iterations only grow), no early stop. */
+static uint64_t submit_demo(mc_client *c, uint32_t iterations)
+{
+    char err[1024];
+    const char *f[4] = {"shrec07_bim/Meshes/381.off", "shrec07_bim/Meshes/390.off",
+                        "ectm_demo_381_390/init_381_to_390.map", "ectm_demo_381_390/init_390_to_381.map"};
+    char path[4][600];
+    for (int i = 0; i < 4; i++)
+        snprintf(path[i], sizeof path[i], "%s", harness_data_path(f[i]));
+    unsigned char *sb, *tb;
+    size_t sl, tl;
+    CHECK_INT(mc_encode_mesh_file(path[0], &sb, &sl, err, sizeof err), 0);
+    CHECK_INT(mc_encode_mesh_file(path[1], &tb, &tl, err, sizeof err), 0);
+    mesh *S = NULL, *T = NULL;
+    bmap *P0 = NULL, *Q0 = NULL;
+    if (mesh_read(path[0], &S, err, sizeof err) || mesh_read(path[1], &T, err, sizeof err) ||
+        bmap_read(path[2], S, T, &P0, err, sizeof err) || bmap_read(path[3], T, S, &Q0, err, sizeof err))
+        FAILF("%s", err);
+    uint32_t np = (uint32_t)P0->n, nq = (uint32_t)Q0->n;
+    mc_map_row *p = calloc(np, sizeof *p), *q = calloc(nq, sizeof *q);
+    CHECK(p && q);
+    for (uint32_t i = 0; i < np; i++) {
+        p[i].face = (uint32_t)P0->face[i];
+        memcpy(p[i].w, &P0->w[3 * i], sizeof p[i].w);
+    }
+    for (uint32_t i = 0; i < nq; i++) {
+        q[i].face = (uint32_t)Q0->face[i];
+        memcpy(q[i].w, &Q0->w[3 * i], sizeof q[i].w);
+    }
+    bmap_free(P0);
+    bmap_free(Q0);
+    mesh_free(S);
+    mesh_free(T);
+    mc_job_spec spec;
+    mc_job_spec_init(&spec);
+    spec.source = sb;
+    spec.source_len = sl;
+    spec.target = tb;
+    spec.target_len = tl;
+    spec.p = p;
+    spec.np = np;
+    spec.q = q;
+    spec.nq = nq;
+    spec.iterations = iterations;
+    spec.stop_change = 0;
+    spec.label = "demo 381 -> 390";
+    uint64_t id = 0;
+    if (mc_submit(c, &spec, &id))
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+    free(sb);
+    free(tb);
+    free(p);
+    free(q);
+    return id;
+}
+
+static void demo_result(mc_client *c, uint64_t id, watch_log *w, mc_job_result *r)
+{
+    int state = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, on_progress, w, &state, reason, sizeof reason), 0);
+    if (state != MC_COMPLETED)
+        FAILF("job %llu ended %s: %s", (unsigned long long)id, mc_state_name(state), reason);
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q, r), 0);
+}
+
+TEST_T(slurm_job_streams_energies_and_gives_the_local_backends_map, 150)
+{
+    testslurm_need();
+    testdaemon sd, ld;
+    const char *local_args[] = {"--workers", "1", NULL};
+    testslurm_daemon(&sd, "demo-slurm", NULL);
+    testdaemon_start(&ld, "demo-local", local_args);
+    mc_client *sc = testdaemon_client(&sd, TESTDAEMON_ALICE), *lc = testdaemon_client(&ld, TESTDAEMON_ALICE);
+    uint64_t sid = submit_demo(sc, 2), lid = submit_demo(lc, 2);
+    watch_log sw = {0, 0, 1, 1}, lw = {0, 0, 1, 1};
+    mc_job_result sr, lr;
+    demo_result(sc, sid, &sw, &sr);
+    demo_result(lc, lid, &lw, &lr);
+    CHECK(sw.n >= 2);                  /* both outer iterations */
+    CHECK_INT(sw.n, lw.n);
+    CHECK(sw.monotone && sw.finite);
+    CHECK_INT(sw.last_outer, 2);
+    /* the stream came over the authenticated TCP connection, not the file */
+    CHECK(log_has(&sd, "progress connection from its worker"));
+    char path[1200];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/spool/%llu/progress.frames", sd.state, (unsigned long long)sid);
+    CHECK(stat(path, &st) != 0);
+    snprintf(path, sizeof path, "%s/spool/%llu/progress.secret", sd.state, (unsigned long long)sid);
+    CHECK_INT(stat(path, &st), 0);
+    CHECK_INT(st.st_mode & 0777, 0600);
+    /* the same map, bit for bit, as the local backend's worker */
+    CHECK_INT(sr.np, lr.np);
+    CHECK_INT(sr.nq, lr.nq);
+    CHECK(sr.np > 1000);
+    for (uint32_t i = 0; i < sr.np; i++)
+        if (sr.p[i].face != lr.p[i].face || memcmp(sr.p[i].w, lr.p[i].w, sizeof sr.p[i].w) != 0)
+            FAILF("P row %u differs: face %u vs %u", i, sr.p[i].face, lr.p[i].face);
+    for (uint32_t i = 0; i < sr.nq; i++)
+        if (sr.q[i].face != lr.q[i].face || memcmp(sr.q[i].w, lr.q[i].w, sizeof sr.q[i].w) != 0)
+            FAILF("Q row %u differs", i);
+    CHECK_INT(testslurm_count(&sd, sid), 1);
+    mc_server_stats stats;
+    CHECK_INT(mc_stats(sc, &stats), 0);
+    CHECK_STR_HAS(stats.backend, "slurm");
+    CHECK_INT(stats.backend_ok, 1);
+    CHECK_INT(stats.completed, 1);
+    mc_stats_free(&stats);
+    mc_result_free(&sr);
+    mc_result_free(&lr);
+    mc_close(sc);
+    mc_close(lc);
+    testdaemon_stop(&sd, SIGTERM);
+    testdaemon_stop(&ld, SIGTERM);
+}
+
+TEST_T(worker_that_cannot_reach_the_daemon_reports_through_the_progress_file, 90)
+{
+    testslurm_need();
+    testdaemon d;
+    /* the workers are told 127.0.0.2, where nothing listens */
+    const char *args[] = {"--slurm-progress-host", "127.0.0.2", NULL};
+    testslurm_daemon(&d, "file", args);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 4, 0);
+    watch_log w = {0, 0, 1, 1};
+    int state = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, on_progress, &w, &state, reason, sizeof reason), 0);
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+    CHECK(w.n >= 4);                   /* (landmark jobs: RHM's records, then ECTM's) */
+    CHECK_INT(w.last_outer, 4);
+    CHECK(w.finite);
+    CHECK(!log_has(&d, "progress connection from its worker"));
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(cancel_of_a_running_slurm_job_is_scancel_and_ends_cancelled, 90)
+{
+    testslurm_need();
+    testdaemon d;
+    testslurm_daemon(&d, "cancel", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 100000, 1);
+    testdaemon_wait_state(c, id, MC_RUNNING, 30);
+    char st[64];
+    CHECK_STR_HAS(testslurm_state(&d, id, st, sizeof st), "RUNNING");
+    CHECK_INT(mc_cancel(c, id), 0);
+    int end = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 1u << 30, NULL, NULL, &end, reason, sizeof reason), 0);
+    CHECK_INT(end, MC_CANCELLED);
+    CHECK_STR_HAS(reason, "scancel");
+    CHECK_STR_HAS(testslurm_state(&d, id, st, sizeof st), "CANCELLED");
+    CHECK_INT(mc_cancel(c, id), MC_EBAD_STATE);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(job_over_its_slurm_time_limit_ends_timeout_with_slurms_reason, 150)
+{
+    testslurm_need();
+    testdaemon d;
+    /* one minute is Slurm's smallest limit; slurmctld checks limits every 30 s */
+    const char *args[] = {"--slurm-time", "1", NULL};
+    testslurm_daemon(&d, "timeout", args);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_demo(c, 100000);     /* hours */
+    testdaemon_wait_state(c, id, MC_RUNNING, 30);
+    int end = testdaemon_wait_state(c, id, -1, 130);
+    mc_job_status s;
+    CHECK_INT(mc_status(c, id, &s), 0);
+    if (end != MC_TIMEOUT)
+        FAILF("job ended %s: %s", mc_state_name(end), s.reason);
+    CHECK_STR_HAS(s.reason, "time limit");
+    CHECK_STR_HAS(s.reason, "TIMEOUT");
+    char st[64];
+    CHECK_STR_HAS(testslurm_state(&d, id, st, sizeof st), "TIMEOUT");
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 120)
+{
+    testslurm_need();
+    testdaemon d;
+    testslurm_daemon(&d, "restart", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t a = submit_demo(c, 25), b = submit_demo(c, 25);   /* seconds each */
+    testdaemon_wait_state(c, a, MC_RUNNING, 30);
+    testdaemon_wait_state(c, b, MC_RUNNING, 30);
+    sleep_ms(500);
+    mc_close(c);
+    testdaemon_stop(&d, SIGKILL);
+    /* the Slurm jobs run on without meshcorrd */
+    char st[64];
+    CHECK_STR_HAS(testslurm_state(&d, a, st, sizeof st), "RUNNING");
+    testslurm_daemon(&d, "restart", NULL);
+    c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    CHECK(log_has(&d, "re-attached to Slurm job"));
+    for (int i = 0; i < 2; i++) {
+        uint64_t id = i ? b : a;
+        watch_log w = {0, 0, 1, 1};
+        int end = -1;
+        char reason[1100];
+        CHECK_INT(mc_watch(c, id, 0, on_progress, &w, &end, reason, sizeof reason), 0);
+        if (end != MC_COMPLETED)
+            FAILF("job %llu ended %s: %s", (unsigned long long)id, mc_state_name(end), reason);
+        CHECK_INT(w.last_outer, 25);
+        CHECK(w.monotone && w.finite);
+        mc_job_result r;
+        CHECK_INT(mc_result(c, id, MC_WANT_P, &r), 0);
+        CHECK_INT(r.np, 6938);
+        mc_result_free(&r);
+        CHECK_INT(testslurm_count(&d, id), 1);   /* one sbatch per job */
+    }
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(missing_sbatch_is_in_stats_and_the_job_stays_pending, 60)
+{
+    testslurm_need();
+    const char *path = getenv("PATH");
+    char saved[4096];
+    snprintf(saved, sizeof saved, "%s", path ? path : "");
+    setenv("PATH", "/nonexistent", 1);        /* the daemon inherits it */
+    testdaemon d;
+    testslurm_daemon(&d, "nosbatch", NULL);
+    setenv("PATH", saved, 1);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 2, 0);
+    sleep_ms(1500);                            /* five polls */
+    mc_job_status s;
+    CHECK_INT(mc_status(c, id, &s), 0);
+    CHECK_INT(s.state, MC_PENDING);
+    mc_server_stats stats;
+    CHECK_INT(mc_stats(c, &stats), 0);
+    CHECK_STR_HAS(stats.backend, "slurm");
+    CHECK_INT(stats.backend_ok, 0);
+    CHECK_STR_HAS(stats.backend_status, "not found in PATH");
+    mc_stats_free(&stats);
+    CHECK(log_has(&d, "not found in PATH"));
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(unreachable_controller_is_in_stats_and_the_job_stays_pending, 90)
+{
+    testslurm_need();
+    /* the same cluster, but a controller port nothing listens on */
+    char conf[1200], line[1024];
+    snprintf(conf, sizeof conf, "%s/unreachable.conf", harness_tmpdir());
+    FILE *in = fopen(getenv("SLURM_CONF"), "r"), *out = fopen(conf, "w");
+    CHECK(in && out);
+    while (fgets(line, sizeof line, in))
+        fputs(strncmp(line, "SlurmctldPort=", 14) == 0 ? "SlurmctldPort=6999\n" : line, out);
+    fclose(in);
+    fclose(out);
+    setenv("SLURM_CONF", conf, 1);
+    testdaemon d;
+    testslurm_daemon(&d, "noctld", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 2, 0);
+    mc_server_stats stats = {0};
+    for (int i = 0; i < 600 && !strstr(stats.backend_status, "squeue failed"); i++) {
+        mc_stats_free(&stats);
+        CHECK_INT(mc_stats(c, &stats), 0);
+        sleep_ms(100);
+    }
+    CHECK_INT(stats.backend_ok, 0);
+    CHECK_STR_HAS(stats.backend_status, "squeue failed");
+    mc_stats_free(&stats);
+    mc_job_status s;
+    CHECK_INT(mc_status(c, id, &s), 0);
+    CHECK_INT(s.state, MC_PENDING);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
