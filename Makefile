@@ -41,7 +41,7 @@ CLIENT_LIB := $(BUILD)/libmeshcorr.a
 DAEMON_C    := $(wildcard daemon/*.c)
 DAEMON_OBJ  := $(DAEMON_C:%.c=$(BUILD)/obj/%.o)
 DAEMON_LIB  := $(BUILD)/libmcdaemon.a
-DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3 -lmodbus -lmicrohttpd
+DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3 -lmodbus -lmicrohttpd -lsystemd
 
 CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)

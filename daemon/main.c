@@ -1,6 +1,7 @@
 /* main.c — meshcorrd's main(): options, store recovery, the scheduler's
  * queue rebuilt from the store, listeners, the result-expiry sweep and the
- * signal handlers, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
+ * signal handlers (SIGHUP: reload.c), READY=1 to the service manager, then
+ * the loop. Shutdown (SIGTERM/SIGINT) drains: stop
  * accepting, SIGTERM the workers, their jobs go back to PENDING, then close
  * every handle and the store; the dashboard threads (--modbus, --metrics)
  * stop after the loop. Holds no request or job logic. */
@@ -44,6 +45,8 @@ void mcd_drained(mcd *d)
     uv_close((uv_handle_t *)&d->sweep, NULL);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
     uv_close((uv_handle_t *)&d->sigint, NULL);
+    reload_close(d);
+    notify_close(d);
 }
 
 static void on_signal(uv_signal_t *h, int sig)
@@ -55,6 +58,7 @@ static void on_signal(uv_signal_t *h, int sig)
     }
     d->draining = 1;
     dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, wsup_busy(d));
+    notify_stopping(d);
     srv_stop_listening(d);
     wsup_drain(d);
     if (!wsup_busy(d))
@@ -105,9 +109,11 @@ int main(int argc, char **argv)
     d.sigterm.data = d.sigint.data = &d;
     uv_signal_start(&d.sigterm, on_signal, SIGTERM);
     uv_signal_start(&d.sigint, on_signal, SIGINT);
+    reload_init(&d, argc, argv);
     dlog(DLOG_INFO, "meshcorrd ready: %d worker slot(s), %u job(s) pending, state in %s", d.conf.workers,
          sched_queued(d.sched), d.conf.state_dir);
     wsup_schedule(&d);
+    notify_ready(&d);
     uv_run(d.loop, UV_RUN_DEFAULT);
     status = 0;
     dlog(DLOG_INFO, "stopped");

@@ -44,7 +44,8 @@ static const char schema[] =
     " total INTEGER NOT NULL,"             /* planned outer iterations */
     " outer_it INTEGER NOT NULL DEFAULT 0," /* latest progress */
     " energy REAL,"
-    " pid INTEGER NOT NULL DEFAULT 0);"    /* worker of the current run */
+    " pid INTEGER NOT NULL DEFAULT 0,"     /* worker of the current run */
+    " crashes INTEGER NOT NULL DEFAULT 0);" /* runs whose worker crashed */
     "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
     "CREATE TABLE IF NOT EXISTS history("
     " job INTEGER NOT NULL, stage INTEGER NOT NULL, outer_it INTEGER NOT NULL,"
@@ -174,6 +175,16 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
                      "PRAGMA busy_timeout=5000;", NULL, NULL, &msg) != SQLITE_OK ||
         sqlite3_exec(s->db, schema, NULL, NULL, &msg) != SQLITE_OK) {
         errbuf_set(err, errsz, rc, "%s: %s", path, msg ? msg : "cannot set up");
+        sqlite3_free(msg);
+        goto fail;
+    }
+    /* a jobs.db from before the crash count gains the column */
+    sqlite3_stmt *probe;
+    if (sqlite3_prepare_v2(s->db, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, NULL) == SQLITE_OK) {
+        sqlite3_finalize(probe);
+    } else if (sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN crashes INTEGER NOT NULL DEFAULT 0",
+                            NULL, NULL, &msg) != SQLITE_OK) {
+        errbuf_set(err, errsz, rc, "%s: %s", path, msg ? msg : "cannot add the crashes column");
         sqlite3_free(msg);
         goto fail;
     }
@@ -379,6 +390,22 @@ int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid)
 {
     return exec_v(s, "UPDATE jobs SET state = 'RUNNING', start_ms = ?, pid = ?, reason = '' WHERE id = ?",
                   "iii", start_ms, (int64_t)pid, (int64_t)id);
+}
+
+int store_add_crash(store *s, uint64_t id, uint32_t *crashes)
+{
+    int rc = exec_v(s, "UPDATE jobs SET crashes = crashes + 1 WHERE id = ?", "i", (int64_t)id);
+    if (rc)
+        return rc;
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT crashes FROM jobs WHERE id = ?", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, (int64_t)id);
+    rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        *crashes = (uint32_t)sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW ? 0 : rc == SQLITE_DONE ? PROTO_ENOT_FOUND : PROTO_ESTORAGE;
 }
 
 int store_set_state(store *s, uint64_t id, int state, const char *reason)

@@ -15,6 +15,7 @@ ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd
 libuv1-dev
 libsqlite3-dev
 libmodbus-dev libmicrohttpd-dev mbpoll
+libsystemd-dev
 "
 
 SUDO=""
