@@ -128,8 +128,11 @@ demo:
 	sh deploy/demo.sh $(BUILD)
 
 install: $(PROGRAMS)
-	install -d $(DESTDIR)$(PREFIX)/bin
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/systemd/system $(DESTDIR)/etc/meshcorr
 	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
+	sed 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
+	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
+	test -e $(DESTDIR)/etc/meshcorr/meshcorrd.conf || install -m 644 deploy/meshcorrd.conf $(DESTDIR)/etc/meshcorr/meshcorrd.conf
 
 clean:
 	rm -rf $(BUILD)
