@@ -384,6 +384,7 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     dlog(DLOG_INFO, "job %llu: started on slot %d, worker pid %d", (unsigned long long)id, s->index, s->proc.pid);
     store_set_running(d->store, id, store_now_ms(), s->proc.pid);
     uv_read_start((uv_stream_t *)&s->pipe, on_alloc, on_read);
+    uv_update_time(d->loop);     /* the wall time counts from now, not the loop's cached time */
     uv_timer_start(&s->timer, on_timer, (uint64_t)d->conf.job_timeout_s * 1000, 0);
 }
 
