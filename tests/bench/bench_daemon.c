@@ -53,6 +53,9 @@ TEST_T(submit_round_trip_of_a_10k_vertex_pair, 300)
         spec.source_len = sl;
         spec.target = tb;
         spec.target_len = tl;
+        static const uint32_t lm[] = {0, 0, 100, 100, 200, 200, 300, 300};
+        spec.landmarks = lm;
+        spec.nlandmarks = 4;
         spec.iterations = 3;
         spec.label = "bench submit";
         uint64_t id;
