@@ -41,7 +41,7 @@ CLIENT_LIB := $(BUILD)/libmeshcorr.a
 DAEMON_C    := $(wildcard daemon/*.c)
 DAEMON_OBJ  := $(DAEMON_C:%.c=$(BUILD)/obj/%.o)
 DAEMON_LIB  := $(BUILD)/libmcdaemon.a
-DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3 -lmodbus -lmicrohttpd
+DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3 -lmodbus -lmicrohttpd -lsystemd
 
 CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
@@ -128,8 +128,11 @@ demo:
 	sh deploy/demo.sh $(BUILD)
 
 install: $(PROGRAMS)
-	install -d $(DESTDIR)$(PREFIX)/bin
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/systemd/system $(DESTDIR)/etc/meshcorr
 	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
+	sed 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
+	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
+	test -e $(DESTDIR)/etc/meshcorr/meshcorrd.conf || install -m 644 deploy/meshcorrd.conf $(DESTDIR)/etc/meshcorr/meshcorrd.conf
 
 clean:
 	rm -rf $(BUILD)

@@ -28,6 +28,7 @@ static const struct option_def {
     {"tokens", K_PATH, OFF(tokens), 0, 0, "FILE of `token user [admin]` lines (TCP users)"},
     {"worker", K_PATH, OFF(worker), 0, 0, "PATH of meshcorr-worker (default: next to meshcorrd)"},
     {"threads-per-worker", K_INT, OFF(threads_per_worker), 0, 4096, "N OpenMP threads per worker (0: all)"},
+    {"worker-memory-mb", K_U32, OFF(worker_memory_mb), 0, 1u << 24, "MB of address space per worker (0: no limit)"},
     {"max-frame", K_U32, OFF(max_frame), PROTO_HDR_SIZE + 1, PROTO_MAX_FRAME, "BYTES largest request frame"},
     {"max-vertices", K_U32, OFF(max_vertices), 3, 20000000, "N vertices per mesh"},
     {"max-landmarks", K_U32, OFF(max_landmarks), 0, PROTO_MAX_LANDMARKS, "N landmark pairs per job"},

@@ -1,9 +1,13 @@
-/* dlog.c — meshcorrd's log: one line per event on stderr, with the time and
- * a level; lines above the configured level are dropped. No other output. */
+/* dlog.c — meshcorrd's log: one line per event on stderr, lines above the
+ * configured level dropped. Each line starts with its syslog priority in the
+ * sd-daemon convention (`<3>` error, `<4>` warning, `<6>` info, `<7>` debug)
+ * that journald reads; the UTC time follows unless stderr is the journal's
+ * stream ($JOURNAL_STREAM), which stamps lines itself. No other output. */
 #include "mcd.h"
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <time.h>
 
 static int level_max = DLOG_INFO;
@@ -16,18 +20,24 @@ void dlog_set_level(int level)
 void dlog(int level, const char *fmt, ...)
 {
     static const char *names[] = {"error", "warn", "info", "debug"};
+    static const int prio[] = {3, 4, 6, 7};
     if (level > level_max)
         return;
+    char line[2048];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (getenv("JOURNAL_STREAM")) {
+        fprintf(stderr, "<%d>%s: %s\n", prio[level], names[level], line);
+        return;
+    }
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     struct tm tm;
     gmtime_r(&ts.tv_sec, &tm);
     char when[32];
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%S", &tm);
-    char line[2048];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "%s.%03ldZ meshcorrd %s: %s\n", when, ts.tv_nsec / 1000000, names[level], line);
+    fprintf(stderr, "<%d>%s.%03ldZ meshcorrd %s: %s\n", prio[level], when, ts.tv_nsec / 1000000,
+            names[level], line);
 }

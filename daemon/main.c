@@ -1,6 +1,7 @@
 /* main.c — meshcorrd's main(): options, store recovery, the scheduler's
- * queue rebuilt from the store, the backend (backend.h), listeners, the result-expiry sweep and the
- * signal handlers, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
+ * queue rebuilt from the store, the backend (backend.h), listeners, the
+ * result-expiry sweep and the signal handlers (SIGHUP: reload.c), READY=1 to
+ * the service manager, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
  * accepting, SIGTERM the workers, their jobs go back to PENDING, then close
  * every handle and the store; the dashboard threads (--modbus, --metrics)
  * stop after the loop. Holds no request or job logic. */
@@ -45,6 +46,8 @@ void mcd_drained(mcd *d)
     uv_close((uv_handle_t *)&d->sweep, NULL);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
     uv_close((uv_handle_t *)&d->sigint, NULL);
+    reload_close(d);
+    notify_close(d);
 }
 
 static void on_signal(uv_signal_t *h, int sig)
@@ -56,6 +59,7 @@ static void on_signal(uv_signal_t *h, int sig)
     }
     d->draining = 1;
     dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, bk_busy(d));
+    notify_stopping(d);
     srv_stop_listening(d);
     bk_drain(d);
     if (!bk_busy(d))
@@ -106,9 +110,11 @@ int main(int argc, char **argv)
     d.sigterm.data = d.sigint.data = &d;
     uv_signal_start(&d.sigterm, on_signal, SIGTERM);
     uv_signal_start(&d.sigint, on_signal, SIGINT);
+    reload_init(&d, argc, argv);
     dlog(DLOG_INFO, "meshcorrd ready: %s backend, %u job(s) pending, state in %s", bk_name(&d),
          sched_queued(d.sched), d.conf.state_dir);
     bk_schedule(&d);
+    notify_ready(&d);
     uv_run(d.loop, UV_RUN_DEFAULT);
     status = 0;
     dlog(DLOG_INFO, "stopped");

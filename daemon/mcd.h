@@ -17,6 +17,8 @@
  *   dash.c   dash_   listening sockets of the dashboard servers
  *   mbus.c   mbus_   Modbus TCP input registers, in a thread of their own
  *   metrics.c metrics_ Prometheus text over HTTP (libmicrohttpd's thread)
+ *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
+ *   reload.c reload_ SIGHUP: options and tokens read again
  *   main.c          main(): wires the above together
  *
  * The DESIGN rule every module keeps: an acknowledged job is never lost.
@@ -61,6 +63,7 @@ typedef struct mcd_conf {
     char port_file[CONF_PATH];    /* "" = none; else bound TCP addresses, one a line */
     int workers;                  /* worker slots (>= 1) */
     int threads_per_worker;       /* 0 = the worker's default */
+    uint32_t worker_memory_mb;    /* address-space limit per worker; 0 = none */
     uint32_t max_frame, max_vertices, max_landmarks;
     uint32_t max_jobs_per_user, max_queue;
     uint32_t job_timeout_s, result_ttl_s;
@@ -150,6 +153,8 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p);
 /* The Slurm job running it ("" none) and how much of progress.frames is read. */
 int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progress_off);
 int store_set_reason(store *s, uint64_t id, const char *reason);
+/* One more run of job id ended in a worker crash: the count after it. */
+int store_add_crash(store *s, uint64_t id, uint32_t *crashes);
 /* Drops a previous run's history and result files before a (re)run. */
 int store_clear_run(store *s, uint64_t id);
 int store_latest_progress(store *s, uint64_t id, proto_progress *out); /* 0 or NOT_FOUND */
@@ -276,7 +281,22 @@ struct mcd {
     mbus *mbus;                   /* NULL unless --modbus */
     metrics *metrics;             /* NULL unless --metrics */
     const bk_ops *bk;             /* the backend (backend.h) */
+    int argc;                     /* the command line, parsed again on SIGHUP */
+    char **argv;
+    uv_signal_t sighup;
+    uv_timer_t notify_timer;      /* STATUS= updates */
 };
+
+/* ---- notify_ -------------------------------------------------------------- */
+void notify_ready(mcd *d);        /* READY=1 and the first STATUS=; starts the timer */
+void notify_reloading(void);
+void notify_reloaded(void);
+void notify_stopping(mcd *d);
+void notify_close(mcd *d);        /* stops the STATUS= timer */
+
+/* ---- reload_ -------------------------------------------------------------- */
+void reload_init(mcd *d, int argc, char **argv);  /* SIGHUP handler */
+void reload_close(mcd *d);
 
 /* ---- wsup_: the local backend (called through bk_, backend.h) ------------- */
 int wsup_init(mcd *d, char *err, size_t errsz);

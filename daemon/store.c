@@ -48,7 +48,8 @@ static const char schema[] =
     " energy REAL,"
     " pid INTEGER NOT NULL DEFAULT 0,"     /* worker of the current run */
     " slurm_id TEXT NOT NULL DEFAULT '',"  /* Slurm job of the current run ('' none) */
-    " progress_off INTEGER NOT NULL DEFAULT 0);" /* bytes of progress.frames taken */
+    " progress_off INTEGER NOT NULL DEFAULT 0," /* bytes of progress.frames taken */
+    " crashes INTEGER NOT NULL DEFAULT 0);" /* runs whose worker crashed */
     "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
     "CREATE TABLE IF NOT EXISTS history("
     " job INTEGER NOT NULL, stage INTEGER NOT NULL, outer_it INTEGER NOT NULL,"
@@ -186,6 +187,16 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
      * only says the column exists) */
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN slurm_id TEXT NOT NULL DEFAULT ''", NULL, NULL, NULL);
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN progress_off INTEGER NOT NULL DEFAULT 0", NULL, NULL, NULL);
+    /* a jobs.db from before the crash count gains the column */
+    sqlite3_stmt *probe;
+    if (sqlite3_prepare_v2(s->db, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, NULL) == SQLITE_OK) {
+        sqlite3_finalize(probe);
+    } else if (sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN crashes INTEGER NOT NULL DEFAULT 0",
+                            NULL, NULL, &msg) != SQLITE_OK) {
+        errbuf_set(err, errsz, rc, "%s: %s", path, msg ? msg : "cannot add the crashes column");
+        sqlite3_free(msg);
+        goto fail;
+    }
     *out = s;
     return 0;
 fail:
@@ -413,6 +424,22 @@ int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progres
 int store_set_reason(store *s, uint64_t id, const char *reason)
 {
     return exec_v(s, "UPDATE jobs SET reason = ? WHERE id = ?", "ti", reason, (int64_t)id);
+}
+
+int store_add_crash(store *s, uint64_t id, uint32_t *crashes)
+{
+    int rc = exec_v(s, "UPDATE jobs SET crashes = crashes + 1 WHERE id = ?", "i", (int64_t)id);
+    if (rc)
+        return rc;
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT crashes FROM jobs WHERE id = ?", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    sqlite3_bind_int64(st, 1, (int64_t)id);
+    rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        *crashes = (uint32_t)sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW ? 0 : rc == SQLITE_DONE ? PROTO_ENOT_FOUND : PROTO_ESTORAGE;
 }
 
 int store_set_state(store *s, uint64_t id, int state, const char *reason)

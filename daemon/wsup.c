@@ -5,12 +5,13 @@
  * DESIGN: a job's end is decided from what the worker left, never from a
  * guess: result.frame -> COMPLETED; our wall-time SIGTERM -> TIMEOUT;
  * exit 3 or a cancel we sent -> CANCELLED; error.frame -> FAILED with its
- * message (OUT_OF_MEMORY for NOMEM); a signal or a bare exit -> FAILED naming
- * it. During a shutdown drain a job without result.frame goes back to
- * PENDING, so it runs again on the next start: never lost. The worker is
- * started with uv_spawn (fork + exec at once: nothing of the daemon's state
- * runs in the child) and its progress pipe is read non-blocking in the loop.
- * A slot is idle again only when the process and pipe handles are closed.
+ * message (OUT_OF_MEMORY for NOMEM); a signal or a bare exit is a crash: the
+ * job runs once more, a second crash fails it ("worker crashed twice").
+ * During a shutdown drain a job without result.frame goes back to PENDING,
+ * so it runs again on the next start: never lost. The worker is started
+ * with uv_spawn (fork + exec at once: nothing of the daemon's state runs in
+ * the child) and its progress pipe is read non-blocking in the loop. A slot
+ * is idle again only when the process and pipe handles are closed.
  * This is the `local` backend (backend.h); bk_local at the end is its table. */
 #include "backend.h"
 
@@ -26,6 +27,7 @@
 #define WSUP_PROGRESS_FD 3
 #define WSUP_EOF_GRACE_MS 2000      /* after exit, wait this long for the pipe's EOF */
 #define WSUP_MAX_ERROR_FRAME (1u << 20)
+#define WSUP_MAX_CRASHES 2          /* worker crashes that fail a job */
 
 struct wsup_slot {
     mcd *d;
@@ -224,6 +226,29 @@ static int read_error_frame(wsup_slot *s, char *msg, size_t msz)
     return code;
 }
 
+/* The worker died without result.frame or error.frame: the first crash of a
+ * job re-queues it, the second fails it (a poison job must not take the
+ * slots down forever). The count lives in the job row. */
+static int crashed(wsup_slot *s, char *reason, size_t rsz)
+{
+    char what[160];
+    if (s->term_signal)
+        snprintf(what, sizeof what, "worker killed by signal %d (%s)", s->term_signal,
+                 strsignal(s->term_signal));
+    else
+        snprintf(what, sizeof what, "worker exited with status %lld without a result",
+                 (long long)s->exit_status);
+    uint32_t crashes = WSUP_MAX_CRASHES;
+    if (store_add_crash(s->d->store, s->job_id, &crashes))
+        dlog(DLOG_ERROR, "job %llu: cannot count its crash", (unsigned long long)s->job_id);
+    if (crashes < WSUP_MAX_CRASHES) {
+        snprintf(reason, rsz, "re-queued after crash %u of %d: %s", crashes, WSUP_MAX_CRASHES, what);
+        return PROTO_STATE_PENDING;
+    }
+    snprintf(reason, rsz, "worker crashed twice: %s", what);
+    return PROTO_STATE_FAILED;
+}
+
 static void slot_finish(wsup_slot *s)
 {
     if (s->finished)
@@ -248,14 +273,8 @@ static void slot_finish(wsup_slot *s)
     } else if ((ecode = read_error_frame(s, emsg, sizeof emsg)) != 0) {
         state = ecode == PROTO_ENOMEM ? PROTO_STATE_OUT_OF_MEMORY : PROTO_STATE_FAILED;
         snprintf(reason, sizeof reason, "%s: %s", proto_err_name(ecode), emsg);
-    } else if (s->term_signal) {
-        state = PROTO_STATE_FAILED;
-        snprintf(reason, sizeof reason, "worker killed by signal %d (%s)", s->term_signal,
-                 strsignal(s->term_signal));
     } else {
-        state = PROTO_STATE_FAILED;
-        snprintf(reason, sizeof reason, "worker exited with status %lld without a result",
-                 (long long)s->exit_status);
+        state = crashed(s, reason, sizeof reason);
     }
     dlog(DLOG_INFO, "job %llu: %s%s%s", (unsigned long long)s->job_id, proto_state_name(state),
          reason[0] ? ": " : "", reason);
@@ -287,7 +306,7 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     proto_buf_reset(&s->in);
     store_clear_run(d->store, id);
 
-    char wbuf[PATH_MAX], dir[CONF_PATH + 64], sid[32], fd[8], thr[16], maxv[16], maxf[16];
+    char wbuf[PATH_MAX], dir[CONF_PATH + 64], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16];
     store_spool_path(d->store, id, NULL, dir, sizeof dir);
     snprintf(sid, sizeof sid, "%llu", (unsigned long long)id);
     snprintf(fd, sizeof fd, "%d", WSUP_PROGRESS_FD);
@@ -305,6 +324,11 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     if (d->conf.threads_per_worker > 0) {
         argv[k++] = "--threads";
         argv[k++] = thr;
+    }
+    if (d->conf.worker_memory_mb > 0) {
+        snprintf(mem, sizeof mem, "%u", d->conf.worker_memory_mb);
+        argv[k++] = "--max-memory-mb";
+        argv[k++] = mem;
     }
     argv[k] = NULL;
 
@@ -347,6 +371,7 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     dlog(DLOG_INFO, "job %llu: started on slot %d, worker pid %d", (unsigned long long)id, s->index, s->proc.pid);
     store_set_running(d->store, id, store_now_ms(), s->proc.pid);
     uv_read_start((uv_stream_t *)&s->pipe, on_alloc, on_read);
+    uv_update_time(d->loop);     /* the wall time counts from now, not the loop's cached time */
     uv_timer_start(&s->timer, on_timer, (uint64_t)d->conf.job_timeout_s * 1000, 0);
 }
 

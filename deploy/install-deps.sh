@@ -16,6 +16,7 @@ libuv1-dev
 libsqlite3-dev
 libmodbus-dev libmicrohttpd-dev mbpoll
 slurmctld slurmd slurm-client munge
+libsystemd-dev
 "
 
 SUDO=""

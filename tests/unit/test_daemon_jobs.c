@@ -282,7 +282,8 @@ TEST_T(graceful_shutdown_requeues_the_running_job_and_next_start_completes_it, 6
     testdaemon_stop(&d, SIGTERM);
 }
 
-TEST_T(killed_worker_fails_its_job_naming_the_signal_and_daemon_keeps_serving, 60)
+/* A poison job: the first crash re-queues it, the second fails it. */
+TEST_T(job_whose_worker_is_killed_twice_fails_as_crashed_twice_and_daemon_keeps_serving, 60)
 {
     testdaemon_need_worker();
     testdaemon d;
@@ -294,9 +295,15 @@ TEST_T(killed_worker_fails_its_job_naming_the_signal_and_daemon_keeps_serving, 6
     pid_t w = testdaemon_worker_pid(&d, id);
     CHECK(w > 0);
     CHECK_INT(kill(w, SIGKILL), 0);
+    pid_t w2 = -1;                      /* the job runs again in a new worker */
+    for (int i = 0; i < 50 && (w2 < 0 || w2 == w); i++)
+        w2 = testdaemon_worker_pid(&d, id);
+    CHECK(w2 > 0 && w2 != w);
+    CHECK_INT(kill(w2, SIGKILL), 0);
     CHECK_INT(testdaemon_wait_state(c, id, -1, 20), MC_FAILED);
     mc_job_status s;
     CHECK_INT(mc_status(c, id, &s), 0);
+    CHECK_STR_HAS(s.reason, "worker crashed twice");
     CHECK_STR_HAS(s.reason, "signal 9");
     CHECK_INT(testdaemon_wait_state(c, next, -1, 30), MC_COMPLETED);
     CHECK_INT(mc_ping(c), 0);

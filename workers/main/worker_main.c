@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -36,7 +37,7 @@ static void usage(void)
 {
     fprintf(stderr,
         "usage: meshcorr-worker --job DIR --job-id ID [--progress-fd N] [--threads N]\n"
-        "                       [--max-vertices N] [--max-faces N]\n"
+        "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage. See workers/WORKER.md.\n");
@@ -120,11 +121,13 @@ int main(int argc, char **argv)
         {"progress-fd", required_argument, 0, 'p'},  {"threads", required_argument, 0, 't'},
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
+        {"max-memory-mb", required_argument, 0, 'm'},
         {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
     uint64_t job_id = 0;
     int have_id = 0, progress_fd = -1, bad = 0;
+    unsigned long long max_memory_mb = 0;
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
     unsigned long long v;
     int c;
@@ -155,6 +158,9 @@ int main(int argc, char **argv)
             break;
         case 'c': progress_tcp = optarg; break;
         case 's': secret_file = optarg; break;
+        case 'm':
+            bad |= parse_num("max-memory-mb", optarg, 1, 1ull << 24, &max_memory_mb) != 0;
+            break;
         case 'h': usage(); return WRK_EXIT_USAGE;
         default: bad = 1;
         }
@@ -175,6 +181,15 @@ int main(int argc, char **argv)
     if (!bad && progress_fd >= 0 && fcntl(progress_fd, F_GETFD) < 0) {
         fprintf(stderr, "meshcorr-worker: --progress-fd %d: not an open descriptor\n", progress_fd);
         bad = 1;
+    }
+    if (!bad && max_memory_mb) {
+        /* allocations past the limit fail (NOMEM) instead of waking the OOM killer */
+        struct rlimit rl = { (rlim_t)max_memory_mb << 20, (rlim_t)max_memory_mb << 20 };
+        if (setrlimit(RLIMIT_AS, &rl) != 0) {
+            fprintf(stderr, "meshcorr-worker: --max-memory-mb %llu: setrlimit: %s\n", max_memory_mb,
+                    strerror(errno));
+            bad = 1;
+        }
     }
     if (bad) {
         usage();

@@ -1,0 +1,242 @@
+/* bench_daemon.c — what the daemon costs a client: SUBMIT of a 10K-vertex
+ * pair (Draco encoding and the round trip to SUBMIT_OK, timed apart),
+ * PROGRESS fan-out to 20 watchers of one job, and one small job through the
+ * daemon against the same job run in process (corr_run). Prints figures,
+ * never fails on time. */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "corr/corr.h"
+#include "map/bmap.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <pthread.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+#define NSUBMIT 5
+
+/* The worker is /bin/true, so the jobs end at once and take no CPU from the
+ * submit path being timed. */
+TEST_T(submit_round_trip_of_a_10k_vertex_pair, 300)
+{
+    char s390[512], s381[512], err[1024];
+    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
+    snprintf(s381, sizeof s381, "%s", harness_data_path("shrec07_bim/Meshes/381.off"));
+    testdaemon d;
+    const char *args[] = {"--worker", "/bin/true", NULL};
+    testdaemon_start(&d, "bench-submit", args);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    double enc = 0, rt = 0, rt_min = 1e30;
+    size_t bytes = 0;
+    for (int k = 0; k < NSUBMIT; k++) {
+        unsigned char *sb, *tb;
+        size_t sl, tl;
+        double t0 = now();
+        if (mc_encode_mesh_file(s390, &sb, &sl, err, sizeof err) ||
+            mc_encode_mesh_file(s381, &tb, &tl, err, sizeof err))
+            FAILF("encode: %s", err);
+        double t1 = now();
+        mc_job_spec spec;
+        mc_job_spec_init(&spec);
+        spec.source = sb;
+        spec.source_len = sl;
+        spec.target = tb;
+        spec.target_len = tl;
+        static const uint32_t lm[] = {0, 0, 100, 100, 200, 200, 300, 300};
+        spec.landmarks = lm;
+        spec.nlandmarks = 4;
+        spec.iterations = 3;
+        spec.label = "bench submit";
+        uint64_t id;
+        if (mc_submit(c, &spec, &id))
+            FAILF("SUBMIT: %s", mc_errmsg(c));
+        double t2 = now();
+        enc += t1 - t0;
+        rt += t2 - t1;
+        if (t2 - t1 < rt_min)
+            rt_min = t2 - t1;
+        bytes = sl + tl;
+        free(sb);
+        free(tb);
+    }
+    printf("SUBMIT 390 -> 381 (both Draco: %zu bytes): encode %.1f ms, "
+           "round trip to SUBMIT_OK %.1f ms (min %.1f ms), mean of %d\n",
+           bytes, 1e3 * enc / NSUBMIT, 1e3 * rt / NSUBMIT, 1e3 * rt_min, NSUBMIT);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+#define NWATCHERS 20
+
+typedef struct watcher {
+    const testdaemon *d;
+    uint64_t id;
+    int frames, end_state, rc;
+    double t_end;
+} watcher;
+
+static int count_frame(void *ctx, const mc_progress *p)
+{
+    (void)p;
+    ((watcher *)ctx)->frames++;
+    return 0;
+}
+
+static void *watch_thread(void *arg)
+{
+    watcher *w = arg;
+    mc_client *c = NULL;
+    char err[512];
+    if ((w->rc = mc_connect(w->d->unix_addr, NULL, &c, err, sizeof err)) != 0)
+        return NULL;
+    mc_set_timeout(c, 120000);
+    w->rc = mc_watch(c, w->id, 0, count_frame, w, &w->end_state, NULL, 0);
+    w->t_end = now();
+    mc_close(c);
+    return NULL;
+}
+
+TEST_T(progress_fan_out_to_20_watchers_of_one_job, 300)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "bench-fanout", NULL);
+    mc_client *c = testdaemon_client(&d, NULL);
+    int rc;
+    double t0 = now();
+    uint64_t id = testdaemon_submit(c, 200, 0, 0, &rc);
+    if (rc)
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+    static watcher w[NWATCHERS];
+    pthread_t th[NWATCHERS];
+    for (int i = 0; i < NWATCHERS; i++) {
+        w[i] = (watcher){&d, id, 0, -1, 0, 0};
+        CHECK_INT(pthread_create(&th[i], NULL, watch_thread, &w[i]), 0);
+    }
+    long total = 0;
+    double first = 1e30, last = 0;
+    for (int i = 0; i < NWATCHERS; i++) {
+        pthread_join(th[i], NULL);
+        if (w[i].rc || w[i].end_state != MC_COMPLETED)
+            FAILF("watcher %d: rc %d, end %s", i, w[i].rc, mc_state_name(w[i].end_state));
+        total += w[i].frames;
+        first = w[i].t_end < first ? w[i].t_end : first;
+        last = w[i].t_end > last ? w[i].t_end : last;
+    }
+    double secs = last - t0;
+    printf("fan-out: %d watchers of one 200-iteration job: %ld PROGRESS frames in %.2f s "
+           "(%.0f frames/s delivered, %d per watcher), END reached every watcher within %.1f ms\n",
+           NWATCHERS, total, secs, (double)total / secs, w[0].frames, 1e3 * (last - first));
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+static mesh *decode(const unsigned char *b, size_t n)
+{
+    mesh *m = calloc(1, sizeof *m);
+    char err[512];
+    if (!m || dracob_decode(b, n, MESH_MAX_VERTICES, MESH_MAX_FACES, &m->v, &m->nv, &m->f, &m->nf, err,
+                            sizeof err))
+        FAILF("dracob_decode: %s", err);
+    return m;
+}
+
+static mc_map_row *rows_of(const bmap *P)
+{
+    mc_map_row *r = calloc((size_t)P->n, sizeof *r);
+    CHECK(r != NULL);
+    for (int i = 0; i < P->n; i++) {
+        r[i].face = (uint32_t)P->face[i];
+        memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
+    }
+    return r;
+}
+
+/* The demo pair 381 -> 390 from its initial maps, 3 outer iterations, one
+ * thread on both sides: submit-to-END through the daemon against corr_run. */
+TEST_T(daemon_overhead_against_the_in_process_run, 600)
+{
+    testdaemon_need_worker();
+    char s381[512], s390[512], p0[512], q0[512], err[1024];
+    snprintf(s381, sizeof s381, "%s", harness_data_path("shrec07_bim/Meshes/381.off"));
+    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
+    snprintf(p0, sizeof p0, "%s", harness_data_path("ectm_demo_381_390/init_381_to_390.map"));
+    snprintf(q0, sizeof q0, "%s", harness_data_path("ectm_demo_381_390/init_390_to_381.map"));
+    unsigned char *sb, *tb;
+    size_t sl, tl;
+    CHECK_INT(mc_encode_mesh_file(s381, &sb, &sl, err, sizeof err), 0);
+    CHECK_INT(mc_encode_mesh_file(s390, &tb, &tl, err, sizeof err), 0);
+    mesh *S = decode(sb, sl), *T = decode(tb, tl);
+    bmap *P0 = NULL, *Q0 = NULL;
+    if (bmap_read(p0, S, T, &P0, err, sizeof err) || bmap_read(q0, T, S, &Q0, err, sizeof err))
+        FAILF("%s", err);
+
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 3;
+    p.threads = 1;
+    ectm_result want = {0};
+    corr_input in = {S, T, "381", "390", NULL, P0, Q0, NULL, CORR_STAGES_ALL};
+    double t0 = now();
+    if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
+        FAILF("corr_run: %s", err);
+    double t_local = now() - t0;
+    ectm_result_close(&want);
+
+    testdaemon d;
+    testdaemon_start(&d, "bench-overhead", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_set_timeout(c, 600000);
+    mc_job_spec spec;
+    mc_job_spec_init(&spec);
+    spec.source = sb;
+    spec.source_len = sl;
+    spec.target = tb;
+    spec.target_len = tl;
+    mc_map_row *pr = rows_of(P0), *qr = rows_of(Q0);
+    spec.p = pr;
+    spec.np = (uint32_t)P0->n;
+    spec.q = qr;
+    spec.nq = (uint32_t)Q0->n;
+    spec.iterations = 3;
+    spec.label = "bench overhead";
+    uint64_t id;
+    t0 = now();
+    if (mc_submit(c, &spec, &id))
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+    int state = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, NULL, NULL, &state, reason, sizeof reason), 0);
+    double t_daemon = now() - t0;
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+    mc_job_result r;
+    t0 = now();
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q, &r), 0);
+    double t_fetch = now() - t0;
+    mc_result_free(&r);
+    printf("381 -> 390, 3 iterations, 1 thread: in process %.2f s, through the daemon %.2f s "
+           "(submit to END; ratio %.3f, overhead %.2f s); RESULT fetch of both maps %.1f ms\n",
+           t_local, t_daemon, t_daemon / t_local, t_daemon - t_local, 1e3 * t_fetch);
+    free(pr);
+    free(qr);
+    free(sb);
+    free(tb);
+    bmap_free(P0);
+    bmap_free(Q0);
+    mesh_free(S);
+    mesh_free(T);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
