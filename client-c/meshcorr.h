@@ -68,7 +68,7 @@ typedef struct mc_map_row {    /* a point on face `face` of the other mesh */
 } mc_map_row;
 
 typedef struct mc_job_spec {
-    const unsigned char *source; size_t source_len;   /* Draco bytes (mc_encode_mesh_file) */
+    const unsigned char *source; size_t source_len;   /* Draco bytes (mc_encode_mesh[_file]) */
     const unsigned char *target; size_t target_len;
     const uint32_t *landmarks; uint32_t nlandmarks;   /* nlandmarks (src, tgt) pairs, 2n ids */
     const mc_map_row *p; uint32_t np;                 /* optional initial map, np = source vertices */
@@ -184,6 +184,14 @@ int mc_send_raw(mc_client *c, const void *bytes, size_t len);
  * the user's vertex order kept (the engine's order-preserving encoder).
  * *bytes is malloc()ed. */
 int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz);
+/* The same from arrays in memory: v is nv by 3 doubles (x y z per vertex),
+ * f is nf by 3 0-based vertex indices (counter-clockwise), both read only and
+ * still the caller's. The Draco bytes keep vertex i as vertex i (landmark
+ * ids and maps refer to it), positions quantized to 16 bits over the
+ * bounding box (as the files). *bytes is malloc()ed: free() it once
+ * mc_submit has returned. Bad sizes or indices: MC_EARG. */
+int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
+                   char *err, size_t errsz);
 
 #ifdef __cplusplus
 }
