@@ -2,8 +2,8 @@
 # demo.sh BUILD — the main job through a real meshcorrd, on meshes every
 # Debian machine with libcgal-demo has: cow -> camel. Extracts the two meshes
 # from Debian's CGAL data archive into BUILD/demo/, starts BUILD/meshcorrd
-# (state in BUILD/demo/state, Unix socket BUILD/demo/meshcorrd.sock, one
-# local worker), submits the job with the landmark pairs in deploy/demo/,
+# (a fresh state in BUILD/demo/state, Unix socket BUILD/demo/meshcorrd.sock,
+# one local worker), submits the job with the landmark pairs in deploy/demo/,
 # watches it, fetches the maps and the deformed cow, evaluates them with
 # coloured PLYs, and stops the daemon (also when a step fails). Installs
 # nothing.
@@ -14,7 +14,7 @@ archive=/usr/share/doc/libcgal-dev/data.tar.gz
 out="$build/demo"
 sock="$out/meshcorrd.sock"
 server="unix:$sock"
-mkdir -p "$out/state"
+mkdir -p "$out"
 if [ ! -f "$archive" ]; then
     echo "demo: $archive is missing: run deploy/install-deps.sh (package libcgal-demo)" >&2
     exit 1
@@ -35,8 +35,12 @@ stop_daemon() {
 trap stop_daemon EXIT
 trap 'exit 130' INT TERM
 
-rm -f "$sock"
-"$build/meshcorrd" --state-dir "$out/state" --listen "$server" --workers 1 2>"$out/meshcorrd.log" &
+# A fresh state each run (an interrupted demo leaves its job queued there);
+# the daemon in its own session, so that a Ctrl-C reaches this script, which
+# stops the daemon, and not the daemon alone.
+rm -rf "$out/state" "$sock"
+mkdir -p "$out/state"
+setsid "$build/meshcorrd" --state-dir "$out/state" --listen "$server" --workers 1 2>"$out/meshcorrd.log" &
 daemon=$!
 tries=0
 until "$build/meshcorr" stats --server "$server" >/dev/null 2>&1; do

@@ -281,6 +281,10 @@ int cli_submit(int argc, char **argv)
         fprintf(stderr, "meshcorr submit: need SOURCE TARGET (see --help)\n");
         bad = 1;
     }
+    if (!watch && w.json) {
+        fprintf(stderr, "meshcorr submit: --progress goes with --watch\n");
+        bad = 1;
+    }
     if (bad || w.bad || cli_job_check(&job, "submit"))
         return 2;
     char backend[160];
