@@ -15,8 +15,12 @@ PKGS     = draco liblbfgs
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
 CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(BUILD)/gen
-CFLAGS   += -std=c11 $(OPT) $(WARN) -fopenmp -pthread
-CXXFLAGS += -std=c++17 $(OPT) $(WARN) -pthread $(shell pkg-config --cflags draco)
+# -fPIC everywhere so libmeshcorr.so can take engine objects from the same
+# archives; Debian's gcc builds PIE by default, so with
+# -fno-semantic-interposition the code is the same as before.
+PIC      = -fPIC -fno-semantic-interposition
+CFLAGS   += -std=c11 $(OPT) $(WARN) $(PIC) -fopenmp -pthread
+CXXFLAGS += -std=c++17 $(OPT) $(WARN) $(PIC) -pthread $(shell pkg-config --cflags draco)
 LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lcholmod -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
 
 # The engine library: everything under workers/ except the worker main.
@@ -35,6 +39,10 @@ PROTO_LIB := $(BUILD)/libmcproto.a
 CLIENT_C   := $(wildcard client-c/*.c)
 CLIENT_OBJ := $(CLIENT_C:%.c=$(BUILD)/obj/%.o)
 CLIENT_LIB := $(BUILD)/libmeshcorr.a
+# The shared libmeshcorr.so.1: the client objects plus the engine and codec
+# members they need (the linker takes only those from the archives); it
+# exports mc_* only (client-c/meshcorr.map).
+CLIENT_SO  := $(BUILD)/libmeshcorr.so.1
 
 # meshcorrd: daemon/*.c; every file but main.c also goes into libmcdaemon.a
 # so tests can drive a module (the scheduler) directly.
@@ -60,7 +68,7 @@ WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
 
-.PHONY: all test bench demo install clean
+.PHONY: all test bench demo install install-lib clean
 all: $(PROGRAMS)
 
 $(BUILD)/obj/%.o: %.c
@@ -90,6 +98,11 @@ $(PROTO_LIB): $(PROTO_OBJ)
 $(CLIENT_LIB): $(CLIENT_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
+
+$(CLIENT_SO): $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) client-c/meshcorr.map
+	$(CC) $(CFLAGS) -shared -Wl,-soname,libmeshcorr.so.1 -Wl,--no-undefined \
+	  -Wl,--version-script=client-c/meshcorr.map -o $@ $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+	ln -sf libmeshcorr.so.1 $(BUILD)/libmeshcorr.so
 
 $(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
 	@mkdir -p $(dir $@)
@@ -133,6 +146,19 @@ install: $(PROGRAMS)
 	sed 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	test -e $(DESTDIR)/etc/meshcorr/meshcorrd.conf || install -m 644 deploy/meshcorrd.conf $(DESTDIR)/etc/meshcorr/meshcorrd.conf
+
+# libmeshcorr: header, static and shared libraries, pkg-config file (the
+# engine and codec archives too: static users link them, see Libs.private).
+all: $(CLIENT_SO)
+install: install-lib
+install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_LIB) $(PROTO_LIB)
+	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 client-c/meshcorr.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(CLIENT_SO) $(DESTDIR)$(PREFIX)/lib/
+	ln -sf libmeshcorr.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(strip $(LDLIBS))|' client-c/meshcorr.pc.in \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/meshcorr.pc
 
 clean:
 	rm -rf $(BUILD)

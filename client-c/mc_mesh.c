@@ -1,5 +1,5 @@
-/* mc_mesh.c — libmeshcorr's mesh helper: a mesh file as the Draco bytes a
- * job carries, with the engine's order-preserving encoder (landmarks and
+/* mc_mesh.c — libmeshcorr's mesh helpers: a mesh file, or vertex and face
+ * arrays in memory, as the Draco bytes a job carries, with the engine's order-preserving encoder (landmarks and
  * maps use the file's vertex order). A .drc file is sent as it is. */
 #include "meshcorr.h"
 #include "mesh/draco_bridge.h"
@@ -38,6 +38,25 @@ static int read_whole(const char *path, unsigned char **bytes, size_t *len, char
     return 0;
 }
 
+int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
+                   char *err, size_t errsz)
+{
+    *bytes = NULL;
+    *len = 0;
+    if (!v || !f || nv < 3 || nf < 1 || nv > MESH_MAX_VERTICES || nf > MESH_MAX_FACES) {
+        snprintf(err, errsz, "need 3 to %d vertices and 1 to %d faces (got %d and %d)", MESH_MAX_VERTICES,
+                 MESH_MAX_FACES, nv, nf);
+        return MC_EARG;
+    }
+    char derr[512];
+    int rc = dracob_encode(v, nv, f, nf, MESH_DRC_QUANTIZATION_BITS, bytes, len, derr, sizeof derr);
+    if (rc) {
+        snprintf(err, errsz, "%s", derr);
+        return rc == DRACOB_ENOMEM ? MC_ENOMEM : rc == DRACOB_EARG ? MC_EARG : MC_EFILE;
+    }
+    return 0;
+}
+
 int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
 {
     *bytes = NULL;
@@ -48,13 +67,10 @@ int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, ch
     mesh *m = NULL;
     if (mesh_read(path, &m, err, errsz))
         return MC_EFILE;
-    char derr[512];
-    int rc = dracob_encode(m->v, m->nv, m->f, m->nf, MESH_DRC_QUANTIZATION_BITS, bytes, len,
-                           derr, sizeof derr);
+    char merr[600];
+    int rc = mc_encode_mesh(m->v, m->nv, m->f, m->nf, bytes, len, merr, sizeof merr);
     mesh_free(m);
-    if (rc) {
-        snprintf(err, errsz, "%s: %s", path, derr);
-        return rc == DRACOB_ENOMEM ? MC_ENOMEM : MC_EFILE;
-    }
-    return 0;
+    if (rc)
+        snprintf(err, errsz, "%s: %s", path, merr);
+    return rc == MC_EARG ? MC_EFILE : rc;
 }

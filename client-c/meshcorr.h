@@ -1,6 +1,8 @@
-/* meshcorr.h — libmeshcorr, the C client of meshcorrd (build/libmeshcorr.a;
- * link it with build/libmcengine.a, build/libmcproto.a and the engine's
- * libraries: see the Makefile's LDLIBS).
+/* meshcorr.h — libmeshcorr, the C client of meshcorrd. Shared:
+ * libmeshcorr.so.1 (`pkg-config --cflags --libs meshcorr` after make
+ * install), which exports mc_* only. Static: libmeshcorr.a, then
+ * libmcengine.a, libmcproto.a and the libraries in meshcorr.pc's
+ * Libs.private (the Makefile's LDLIBS).
  *
  * One mc_client is one connection (Unix socket or TCP), authenticated at
  * mc_connect, used by one thread at a time. Every call is blocking: requests
@@ -14,9 +16,11 @@
  * client's last failed call (the server's message, or the system error).
  *
  * Ownership: mc_connect returns a client freed by mc_close (NULL ok).
- * Arrays a call fills (mc_list's jobs, mc_result's maps and mesh, mc_stats's
- * slots) are malloc()ed and released by the matching _free function, which
- * accepts NULL and zeroed structs. Inputs (mc_job_spec) stay the caller's. */
+ * Arrays a call fills are malloc()ed and released with one call each:
+ * mc_result_free(&r) for everything in an mc_job_result, mc_stats_free(&s)
+ * for an mc_server_stats (both accept zeroed structs), free(jobs) for
+ * mc_list. Draco bytes from mc_encode_mesh[_file] are free()d by the caller.
+ * Inputs (mc_job_spec and what it points to) stay the caller's. */
 #ifndef MESHCORR_H
 #define MESHCORR_H
 #include <stddef.h>
@@ -68,7 +72,7 @@ typedef struct mc_map_row {    /* a point on face `face` of the other mesh */
 } mc_map_row;
 
 typedef struct mc_job_spec {
-    const unsigned char *source; size_t source_len;   /* Draco bytes (mc_encode_mesh_file) */
+    const unsigned char *source; size_t source_len;   /* Draco bytes (mc_encode_mesh[_file]) */
     const unsigned char *target; size_t target_len;
     const uint32_t *landmarks; uint32_t nlandmarks;   /* nlandmarks (src, tgt) pairs, 2n ids */
     const mc_map_row *p; uint32_t np;                 /* optional initial map, np = source vertices */
@@ -187,6 +191,14 @@ int mc_send_raw(mc_client *c, const void *bytes, size_t len);
  * the user's vertex order kept (the engine's order-preserving encoder).
  * *bytes is malloc()ed. */
 int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz);
+/* The same from arrays in memory: v is nv by 3 doubles (x y z per vertex),
+ * f is nf by 3 0-based vertex indices (counter-clockwise), both read only and
+ * still the caller's. The Draco bytes keep vertex i as vertex i (landmark
+ * ids and maps refer to it), positions quantized to 16 bits over the
+ * bounding box (as the files). *bytes is malloc()ed: free() it once
+ * mc_submit has returned. Bad sizes or indices: MC_EARG. */
+int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
+                   char *err, size_t errsz);
 
 #ifdef __cplusplus
 }

@@ -1,9 +1,9 @@
 /* cli_remote.c — the `meshcorr` subcommands that talk to meshcorrd through
  * libmeshcorr: submit, status, watch, result, cancel, delete, list, stats.
- * They share the server options (--server ADDR, --token T; defaults
- * $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock, and
- * $MESHCORR_TOKEN) and print one line per fact. No numerics, no protocol
- * details: meshcorr.h is the whole interface. */
+ * They share the server options (--server ADDR, --token T, --token-file F;
+ * defaults $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock, and
+ * $MESHCORR_TOKEN) and print one line per fact, or JSON where asked. No
+ * numerics, no protocol details: meshcorr.h is the whole interface. */
 #include "cli/cli.h"
 #include "cli/cli_job.h"
 #include "lmk/lmk.h"
@@ -20,6 +20,7 @@
 
 typedef struct remote {
     const char *server, *token;
+    const char *token_file;    /* when set, the token is this file's first line */
     char def[4200];
 } remote;
 
@@ -27,6 +28,7 @@ static void remote_defaults(remote *r)
 {
     r->server = getenv("MESHCORR_SERVER");
     r->token = getenv("MESHCORR_TOKEN");
+    r->token_file = NULL;
     if (!r->server || !*r->server) {
         const char *xdg = getenv("XDG_RUNTIME_DIR");
         snprintf(r->def, sizeof r->def, "unix:%s/meshcorr.sock", xdg && *xdg ? xdg : "/tmp");
@@ -34,13 +36,41 @@ static void remote_defaults(remote *r)
     }
 }
 
+/* The token in a --token-file: its first line, without the line end. */
+static int read_token_file(const char *cmd, const char *path, char *tok, size_t toksz)
+{
+    FILE *fp = fopen(path, "r");
+    if (!fp) {
+        fprintf(stderr, "meshcorr %s: --token-file %s: cannot open\n", cmd, path);
+        return -1;
+    }
+    if (!fgets(tok, (int)toksz, fp))
+        tok[0] = '\0';
+    fclose(fp);
+    tok[strcspn(tok, "\r\n")] = '\0';
+    if (!tok[0]) {
+        fprintf(stderr, "meshcorr %s: --token-file %s: no token on the first line\n", cmd, path);
+        return -1;
+    }
+    return 0;
+}
+
 static mc_client *remote_connect(const char *cmd, const remote *r)
 {
     mc_client *c = NULL;
-    char err[1200];
-    int rc = mc_connect(r->server, r->token, &c, err, sizeof err);
+    char err[1200], tok[1024];
+    const char *token = r->token;
+    if (r->token_file) {
+        if (read_token_file(cmd, r->token_file, tok, sizeof tok))
+            return NULL;
+        token = tok;
+    }
+    int rc = mc_connect(r->server, token, &c, err, sizeof err);
     if (rc) {
         fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, r->server, err);
+        if (rc == MC_EUNAUTHORIZED)
+            fprintf(stderr, "meshcorr %s: the server refused the token (from %s)\n", cmd,
+                    r->token_file ? "--token-file" : token && *token ? "--token or $MESHCORR_TOKEN" : "nowhere: none given");
         return NULL;
     }
     return c;
@@ -66,15 +96,35 @@ static int parse_id(const char *cmd, const char *s, uint64_t *id)
 }
 
 /* Options every remote subcommand takes; 1 when handled. */
-enum { O_SERVER = 1000, O_TOKEN };
-#define REMOTE_OPTS {"server", required_argument, 0, O_SERVER}, {"token", required_argument, 0, O_TOKEN}
+enum { O_SERVER = 1000, O_TOKEN, O_TOKEN_FILE };
+#define REMOTE_OPTS {"server", required_argument, 0, O_SERVER}, {"token", required_argument, 0, O_TOKEN}, \
+                    {"token-file", required_argument, 0, O_TOKEN_FILE}
+#define REMOTE_NOPTS 3
+#define REMOTE_USAGE "         [--server ADDR] [--token T | --token-file F]\n"
 
+/* The last of --token and --token-file wins; either overrides $MESHCORR_TOKEN. */
 static int remote_opt(remote *r, int c)
 {
     if (c == O_SERVER) r->server = optarg;
-    else if (c == O_TOKEN) r->token = optarg;
+    else if (c == O_TOKEN) r->token = optarg, r->token_file = NULL;
+    else if (c == O_TOKEN_FILE) r->token_file = optarg;
     else return 0;
     return 1;
+}
+
+/* s as a JSON string, quotes included. */
+static void json_str(const char *s)
+{
+    putchar('"');
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            printf("\\%c", *p);
+        else if (*p < 0x20)
+            printf("\\u%04x", *p);
+        else
+            putchar(*p);
+    }
+    putchar('"');
 }
 
 static const char *stage_name(int stage)
@@ -83,12 +133,14 @@ static const char *stage_name(int stage)
     return stage >= 0 && stage < 4 ? names[stage] : "?";
 }
 
+/* One line per iteration; every term is the sum of both directions
+ * (source -> target and target -> source; --progress json has each). */
 static void print_progress_text(const mc_progress *p)
 {
-    printf("job %llu %s iter %u/%u beta %.4g energy %.10g (source %.6g, target %.6g) %.1f s\n",
-           (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total, p->beta,
-           p->energy[0] + p->energy[1],
-           p->energy[0], p->energy[1], p->elapsed_s);
+    printf("job %llu %s iter %u/%u energy %.3e membrane %.2e bending %.2e mismatch %.2e reverse %.2e "
+           "beta %.2e %.1f s\n", (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total,
+           p->energy[0] + p->energy[1], p->membrane[0] + p->membrane[1], p->bending[0] + p->bending[1],
+           p->mismatch[0] + p->mismatch[1], p->reverse[0] + p->reverse[1], p->beta, p->elapsed_s);
 }
 
 static void print_progress_json(const mc_progress *p)
@@ -112,6 +164,47 @@ static mc_map_row *rows_of(const bmap *P)
         memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
     }
     return r;
+}
+
+typedef struct watch_opts { long from; int json; int bad; } watch_opts;
+
+static void watch_opt(int c, void *ctx)
+{
+    watch_opts *w = ctx;
+    if (c == 'f')
+        w->from = strtol(optarg, NULL, 10);
+    else if (c == 'p')
+        w->json = strcmp(optarg, "json") == 0, w->bad |= strcmp(optarg, "json") && strcmp(optarg, "text");
+}
+
+static int on_progress(void *ctx, const mc_progress *p)
+{
+    if (((watch_opts *)ctx)->json)
+        print_progress_json(p);
+    else
+        print_progress_text(p);
+    fflush(stdout);
+    return 0;
+}
+
+/* Follows job id on c to its end (c is closed); exit status 0 when it
+ * COMPLETED, 1 otherwise with the state and reason on stderr. */
+static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
+{
+    int state = -1;
+    char reason[1100];
+    int rc = mc_watch(c, id, (uint32_t)w->from, on_progress, w, &state, reason, sizeof reason);
+    if (rc)
+        return fail(cmd, c, rc);
+    mc_close(c);
+    if (state == MC_COMPLETED) {
+        printf("job %llu COMPLETED\n", (unsigned long long)id);
+        return 0;
+    }
+    fflush(stdout);
+    fprintf(stderr, "meshcorr %s: job %llu %s%s%s\n", cmd, (unsigned long long)id,
+            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", reason);
+    return 1;
 }
 
 /* The wire spec of a parsed job (meshes, landmarks and maps are added by the caller). */
@@ -140,10 +233,11 @@ static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t 
 
 int cli_submit(int argc, char **argv)
 {
-    enum { O_PRIORITY = 1, O_LABEL };
+    enum { O_PRIORITY = 1, O_LABEL, O_WATCH, O_PROGRESS };
     static const struct option opts[] = {
         REMOTE_OPTS, CLI_JOB_OPTIONS,
         {"priority", required_argument, 0, O_PRIORITY}, {"label", required_argument, 0, O_LABEL},
+        {"watch", no_argument, 0, O_WATCH}, {"progress", required_argument, 0, O_PROGRESS},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     remote r;
     remote_defaults(&r);
@@ -151,7 +245,8 @@ int cli_submit(int argc, char **argv)
     mc_job_spec_init(&spec);
     cli_job job;
     cli_job_init(&job, argc, argv);
-    int c, bad = 0;
+    int c, bad = 0, watch = 0;
+    watch_opts w = {0, 0, 0};
     char *e;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
@@ -171,9 +266,13 @@ int cli_submit(int argc, char **argv)
             }
             break;
         case O_LABEL: spec.label = optarg; break;
+        case O_WATCH: watch = 1; break;
+        case O_PROGRESS: watch_opt('p', &w); break;
         case 'h':
             printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
-                   "         [--server ADDR] [--token T]\nprints the job id\n" CLI_JOB_USAGE);
+                   "         [--watch [--progress text|json]]\n" REMOTE_USAGE
+                   "prints the job id; with --watch then follows the job as `meshcorr watch` does\n"
+                   "(and exits as it: 0 when the job COMPLETED)\n" CLI_JOB_USAGE);
             return 0;
         default: bad = 1;
         }
@@ -182,7 +281,11 @@ int cli_submit(int argc, char **argv)
         fprintf(stderr, "meshcorr submit: need SOURCE TARGET (see --help)\n");
         bad = 1;
     }
-    if (bad || cli_job_check(&job, "submit"))
+    if (!watch && w.json) {
+        fprintf(stderr, "meshcorr submit: --progress goes with --watch\n");
+        bad = 1;
+    }
+    if (bad || w.bad || cli_job_check(&job, "submit"))
         return 2;
     char backend[160];
     spec_of_job(&job, &spec, backend, sizeof backend);
@@ -240,7 +343,12 @@ int cli_submit(int argc, char **argv)
         goto done;
     }
     printf("%llu\n", (unsigned long long)id);
+    fflush(stdout);
     status = 0;
+    if (watch) {
+        status = watch_job("submit", cl, id, &w);
+        cl = NULL;
+    }
 done:
     mc_close(cl);
     free(sb);
@@ -273,7 +381,7 @@ static int one_id(const char *cmd, int argc, char **argv, remote *r, uint64_t *i
                   const struct option *extra, void (*on_extra)(int, void *), void *ctx)
 {
     struct option opts[16] = {REMOTE_OPTS};
-    int n = 2;
+    int n = REMOTE_NOPTS;
     for (int i = 0; extra && extra[i].name && n < 15; i++)
         opts[n++] = extra[i];
     memset(&opts[n], 0, sizeof opts[n]);
@@ -321,27 +429,6 @@ int cli_status(int argc, char **argv)
     return 0;
 }
 
-typedef struct watch_opts { long from; int json; int bad; } watch_opts;
-
-static void watch_opt(int c, void *ctx)
-{
-    watch_opts *w = ctx;
-    if (c == 'f')
-        w->from = strtol(optarg, NULL, 10);
-    else if (c == 'p')
-        w->json = strcmp(optarg, "json") == 0, w->bad |= strcmp(optarg, "json") && strcmp(optarg, "text");
-}
-
-static int on_progress(void *ctx, const mc_progress *p)
-{
-    if (((watch_opts *)ctx)->json)
-        print_progress_json(p);
-    else
-        print_progress_text(p);
-    fflush(stdout);
-    return 0;
-}
-
 int cli_watch(int argc, char **argv)
 {
     static const struct option extra[] = {{"from", required_argument, 0, 'f'},
@@ -350,20 +437,15 @@ int cli_watch(int argc, char **argv)
     uint64_t id;
     watch_opts w = {0, 0, 0};
     if (one_id("watch", argc, argv, &r, &id, extra, watch_opt, &w) || w.bad || w.from < 0) {
-        fprintf(stderr, "usage: meshcorr watch ID [--from K] [--progress text|json]\n");
+        fprintf(stderr, "usage: meshcorr watch ID [--from K] [--progress text|json]\n" REMOTE_USAGE
+                        "one line per iteration, each term summed over both directions;\n"
+                        "exit 0 when the job COMPLETED, 1 otherwise\n");
         return 2;
     }
     mc_client *c = remote_connect("watch", &r);
     if (!c)
         return 1;
-    int state = -1;
-    char reason[1100];
-    int rc = mc_watch(c, id, (uint32_t)w.from, on_progress, &w, &state, reason, sizeof reason);
-    if (rc)
-        return fail("watch", c, rc);
-    printf("job %llu %s%s%s\n", (unsigned long long)id, mc_state_name(state), reason[0] ? ": " : "", reason);
-    mc_close(c);
-    return state == MC_COMPLETED ? 0 : 1;
+    return watch_job("watch", c, id, &w);
 }
 
 typedef struct result_opts { const char *out, *out_rev, *out_def, *target; } result_opts;
@@ -484,9 +566,11 @@ int cli_delete(int argc, char **argv) { return simple("delete", argc, argv, mc_d
 int cli_list(int argc, char **argv)
 {
     static const struct option opts[] = {REMOTE_OPTS, {"state", required_argument, 0, 's'},
-                                         {"user", required_argument, 0, 'u'}, {0, 0, 0, 0}};
+                                         {"user", required_argument, 0, 'u'}, {"json", no_argument, 0, 'j'},
+                                         {0, 0, 0, 0}};
     remote r;
     remote_defaults(&r);
+    int json = 0;
     uint32_t mask = 0;
     const char *user = NULL;
     int c;
@@ -503,8 +587,11 @@ int cli_list(int argc, char **argv)
             mask |= 1u << s;
         } else if (c == 'u') {
             user = optarg;
+        } else if (c == 'j') {
+            json = 1;
         } else {
-            fprintf(stderr, "usage: meshcorr list [--state S]... [--user U]\n");
+            fprintf(stderr, "usage: meshcorr list [--state S]... [--user U] [--json]\n" REMOTE_USAGE
+                            "--json: one array of job objects\n");
             return 2;
         }
     }
@@ -516,6 +603,22 @@ int cli_list(int argc, char **argv)
     int rc = mc_list(cl, user, mask, &jobs, &n);
     if (rc)
         return fail("list", cl, rc);
+    if (json) {
+        printf("[");
+        for (uint32_t i = 0; i < n; i++) {
+            printf("%s{\"id\":%llu,\"state\":\"%s\",\"user\":", i ? ",\n " : "",
+                   (unsigned long long)jobs[i].job_id, mc_state_name(jobs[i].state));
+            json_str(jobs[i].user);
+            printf(",\"priority\":%d,\"submit_ms\":%lld,\"outer\":%u,\"total\":%u,\"label\":", jobs[i].priority,
+                   (long long)jobs[i].submit_ms, jobs[i].outer, jobs[i].total);
+            json_str(jobs[i].label);
+            printf("}");
+        }
+        printf("]\n");
+        free(jobs);
+        mc_close(cl);
+        return 0;
+    }
     printf("%-8s %-13s %-10s %4s %11s  %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "LABEL");
     for (uint32_t i = 0; i < n; i++) {
         char it[32];
@@ -530,14 +633,20 @@ int cli_list(int argc, char **argv)
 
 int cli_stats(int argc, char **argv)
 {
-    static const struct option opts[] = {REMOTE_OPTS, {0, 0, 0, 0}};
+    static const struct option opts[] = {REMOTE_OPTS, {"json", no_argument, 0, 'j'}, {0, 0, 0, 0}};
     remote r;
     remote_defaults(&r);
-    int c;
+    int c, json = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1)
-        if (!remote_opt(&r, c))
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        if (remote_opt(&r, c))
+            continue;
+        if (c != 'j') {
+            fprintf(stderr, "usage: meshcorr stats [--json]\n" REMOTE_USAGE);
             return 2;
+        }
+        json = 1;
+    }
     mc_client *cl = remote_connect("stats", &r);
     if (!cl)
         return 1;
@@ -545,10 +654,27 @@ int cli_stats(int argc, char **argv)
     int rc = mc_stats(cl, &s);
     if (rc)
         return fail("stats", cl, rc);
+    static const char *slot[] = {"idle", "starting", "busy", "draining"};
+    if (json) {
+        printf("{\"queued\":%u,\"running\":%u,\"workers\":%u,\"completed\":%llu,\"failed\":%llu,"
+               "\"cancelled\":%llu,\"slots\":[", s.queued, s.running, s.workers, (unsigned long long)s.completed,
+               (unsigned long long)s.failed, (unsigned long long)s.cancelled);
+        for (uint32_t i = 0; i < s.nslots; i++)
+            printf("%s{\"state\":\"%s\",\"job\":%llu}", i ? "," : "", slot[s.slot_state[i] & 3],
+                   (unsigned long long)s.slot_job[i]);
+        printf("],\"devices\":[");
+        for (uint32_t i = 0; i < s.ndevices; i++) {
+            printf("%s", i ? "," : "");
+            json_str(s.devices[i]);
+        }
+        printf("]}\n");
+        mc_stats_free(&s);
+        mc_close(cl);
+        return 0;
+    }
     printf("queued    %u\nrunning   %u\nworkers   %u\ncompleted %llu\nfailed    %llu\ncancelled %llu\n", s.queued,
            s.running, s.workers, (unsigned long long)s.completed, (unsigned long long)s.failed,
            (unsigned long long)s.cancelled);
-    static const char *slot[] = {"idle", "starting", "busy", "draining"};
     for (uint32_t i = 0; i < s.nslots; i++)
         printf("slot %u    %s%s%.0llu\n", i, slot[s.slot_state[i] & 3], s.slot_job[i] ? " job " : "",
                (unsigned long long)s.slot_job[i]);

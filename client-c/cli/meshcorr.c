@@ -15,14 +15,14 @@ static const struct {
     { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
     { "eval",    cli_eval,    "SOURCE TARGET P.map .. quality of a map (see meshcorr eval --help)" },
     { "devices", cli_devices, "                 list OpenCL devices for --backend opencl|auto" },
-    { "submit",  cli_submit,  "SOURCE TARGET .. send a job to meshcorrd; prints its id" },
+    { "submit",  cli_submit,  "SOURCE TARGET .. send a job to meshcorrd; prints its id (--watch: then follow it)" },
     { "status",  cli_status,  "ID               a job's state, times and latest progress" },
-    { "watch",   cli_watch,   "ID [--from K]    follow a job's energies until it ends" },
+    { "watch",   cli_watch,   "ID [--from K]    follow a job's energies; exit 0 if it COMPLETED" },
     { "result",  cli_result,  "ID --out P.map   fetch a finished job's maps (and deformed mesh)" },
     { "cancel",  cli_cancel,  "ID               cancel a pending or running job" },
     { "delete",  cli_delete,  "ID               remove a finished job and its result" },
-    { "list",    cli_list,    "[--state S]      your jobs" },
-    { "stats",   cli_stats,   "                 queue, workers, counters" },
+    { "list",    cli_list,    "[--state S]      your jobs (--json: a JSON array)" },
+    { "stats",   cli_stats,   "[--json]         queue, workers, counters" },
 };
 
 static void usage(FILE *fp)
@@ -31,8 +31,8 @@ static void usage(FILE *fp)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         fprintf(fp, "  %-8s %s\n", commands[i].name, commands[i].help);
     fprintf(fp, "\nserver commands take --server ADDR (unix:PATH or tcp:HOST:PORT; default\n"
-                "$MESHCORR_SERVER, else unix:$XDG_RUNTIME_DIR/meshcorr.sock) and --token T\n"
-                "(default $MESHCORR_TOKEN; not needed on the Unix socket)\n");
+                "$MESHCORR_SERVER, else unix:$XDG_RUNTIME_DIR/meshcorr.sock) and --token T or\n"
+                "--token-file F (default $MESHCORR_TOKEN; not needed on the Unix socket)\n");
 }
 
 int main(int argc, char **argv)

@@ -3,7 +3,6 @@
 #include "support/testdaemon.h"
 #include "support/harness.h"
 #include "support/testmesh.h"
-#include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
 
 #include <dirent.h>
@@ -200,8 +199,8 @@ static unsigned char *encode(const mesh *m, size_t *len)
 {
     unsigned char *buf = NULL;
     char err[512];
-    if (dracob_encode(m->v, m->nv, m->f, m->nf, MESH_DRC_QUANTIZATION_BITS, &buf, len, err, sizeof err))
-        FAILF("dracob_encode: %s", err);
+    if (mc_encode_mesh(m->v, m->nv, m->f, m->nf, &buf, len, err, sizeof err))
+        FAILF("mc_encode_mesh: %s", err);
     return buf;
 }
 

@@ -3,25 +3,14 @@
  * is one object per outer iteration. */
 #include "support/harness.h"
 #include "support/testfile.h"
+#include "support/testrun.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 
 #include <string.h>
-#include <sys/wait.h>
 
-/* Runs cmd through the shell; returns its exit status and its stdout+stderr
- * in out (truncated). */
-static int run(const char *cmd, char *out, size_t outsz)
-{
-    char full[4096];
-    snprintf(full, sizeof full, "%s 2>&1", cmd);
-    FILE *p = popen(full, "r");
-    CHECK(p);
-    size_t n = fread(out, 1, outsz - 1, p);
-    out[n] = '\0';
-    int st = pclose(p);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+/* Runs cmd; its exit status, and its stdout+stderr in out (truncated). */
+static int run(const char *cmd, char *out, size_t outsz) { return testrunf(out, outsz, "%s 2>&1", cmd); }
 
 static const char *mesh381(void) { return harness_data_path("shrec07_bim/Meshes/381.off"); }
 

@@ -1,0 +1,221 @@
+/* test_cli_remote.c — the real build/meshcorr's remote subcommands against a
+ * real meshcorrd (tests/support/testdaemon): submit prints the id alone,
+ * watch prints one line per iteration and exits 0 only for a COMPLETED job,
+ * result writes the maps mc_result returns, list/stats --json are JSON,
+ * --token-file works over TCP and a bad token is refused in words. */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "support/testfile.h"
+#include "support/testjson.h"
+#include "support/testmesh.h"
+#include "support/testrun.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+
+static char src[600], tgt[600], lmk[600], out[1 << 16];
+
+/* Icosphere pair (the target an ellipsoid, a little bent) and 6 identity
+ * landmarks in this test's directory. */
+static void write_inputs(void)
+{
+    mesh *S = testmesh_icosphere(2), *T = testmesh_icosphere(2);
+    CHECK(S && T);
+    for (int i = 0; i < T->nv; i++) {
+        double *x = &T->v[3 * i];
+        x[0] *= 1.3;
+        x[2] += 0.15 * x[0] * x[0];
+    }
+    char err[512];
+    snprintf(src, sizeof src, "%s/s.off", harness_tmpdir());
+    snprintf(tgt, sizeof tgt, "%s/t.off", harness_tmpdir());
+    CHECK_INT(mesh_write(src, S, err, sizeof err), 0);
+    CHECK_INT(mesh_write(tgt, T, err, sizeof err), 0);
+    snprintf(lmk, sizeof lmk, "%s", testfile_text("pairs.lmk", "0 0\n1 1\n2 2\n3 3\n4 4\n5 5\n"));
+    mesh_free(S);
+    mesh_free(T);
+}
+
+#define JOB_OPTS "--iterations 4 --beta-ramp 4 --inner-iterations 10 --rhm-iterations 3"
+
+/* `meshcorr submit` of the quick pair; returns the id it printed (stdout
+ * must be the id and a newline, nothing else). */
+static uint64_t submit(const testdaemon *d, const char *extra)
+{
+    int rc = testrunf(out, sizeof out, "build/meshcorr submit %s %s --landmarks %s " JOB_OPTS " --server %s %s",
+                      src, tgt, lmk, d->unix_addr, extra);
+    CHECK_INT(rc, 0);
+    char *e;
+    unsigned long long id = strtoull(out, &e, 10);
+    if (id == 0 || strcmp(e, "\n") != 0)
+        FAILF("submit printed \"%s\", not an id alone", out);
+    return id;
+}
+
+TEST_T(submit_prints_the_id_watch_prints_energies_and_exits_0_and_result_writes_mc_results_maps, 90)
+{
+    testdaemon_need_worker();
+    write_inputs();
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    uint64_t id = submit(&d, "");
+
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s", (unsigned long long)id,
+                       d.unix_addr), 0);
+    char last[64];
+    snprintf(last, sizeof last, "job %llu COMPLETED\n", (unsigned long long)id);
+    CHECK(strlen(out) > strlen(last) && strcmp(out + strlen(out) - strlen(last), last) == 0);
+    int nectm = 0;
+    double e4 = 0;
+    for (char *l = out; *l; l = strchr(l, '\n') + 1) {
+        unsigned long long jid;
+        char stage[16];
+        unsigned k, total;
+        double e, mem, ben, mis, rev, beta;
+        if (sscanf(l, "job %llu %15s iter %u/%u energy %lf membrane %lf bending %lf mismatch %lf reverse %lf "
+                      "beta %lf", &jid, stage, &k, &total, &e, &mem, &ben, &mis, &rev, &beta) == 10) {
+            CHECK_INT(jid, id);
+            if (strcmp(stage, "ectm") == 0) {
+                nectm++;
+                CHECK_INT(total, 4);
+                CHECK(isfinite(e) && e > 0 && mem >= 0 && ben >= 0 && mis >= 0 && rev >= 0 && beta > 0);
+                if (k == 4)
+                    e4 = e;
+            }
+        } else if (strcmp(l, last) != 0) {
+            FAILF("watch line is not in the documented format: %.*s", (int)strcspn(l, "\n"), l);
+        }
+    }
+    CHECK(nectm >= 4);
+    /* the text line's energy is the sum of both directions of the JSON record */
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr watch %llu --progress json --server %s",
+                       (unsigned long long)id, d.unix_addr), 0);
+    char *rec = strstr(out, "\"stage\":\"ectm\",\"outer\":4,");
+    CHECK(rec);
+    char *es = strstr(rec, "\"energy\":"), *et = es ? strstr(es + 1, "\"energy\":") : NULL;
+    CHECK(es && et);
+    double sum = strtod(es + 9, NULL) + strtod(et + 9, NULL);
+    CHECK_NEAR(e4, sum, 1e-3 * sum);
+
+    char P[700], Q[700], Y[700], err[512];
+    snprintf(P, sizeof P, "%s/p.map", harness_tmpdir());
+    snprintf(Q, sizeof Q, "%s/q.map", harness_tmpdir());
+    snprintf(Y, sizeof Y, "%s/y.ply", harness_tmpdir());
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr result %llu --out %s --out-reverse %s --out-deformed %s "
+                       "--server %s 2>&1", (unsigned long long)id, P, Q, Y, d.unix_addr), 0);
+    mesh *S = NULL, *T = NULL, *D = NULL;
+    CHECK_INT(mesh_read(src, &S, err, sizeof err), 0);
+    CHECK_INT(mesh_read(tgt, &T, err, sizeof err), 0);
+    CHECK_INT(mesh_read(Y, &D, err, sizeof err), 0);
+    CHECK_INT(D->nv, S->nv);
+    bmap *Pm = NULL, *Qm = NULL;
+    if (bmap_read(P, S, T, &Pm, err, sizeof err) || bmap_read(Q, T, S, &Qm, err, sizeof err))
+        FAILF("bmap_read: %s", err);
+    mc_client *c = testdaemon_client(&d, NULL);
+    mc_job_result res;
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q, &res), 0);
+    CHECK_INT(res.np, Pm->n);
+    CHECK_INT(res.nq, Qm->n);
+    for (uint32_t i = 0; i < res.np; i++) {
+        CHECK_INT(res.p[i].face, Pm->face[i]);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(res.p[i].w[k], Pm->w[3 * i + k], 1e-15);
+    }
+    for (uint32_t i = 0; i < res.nq; i++)
+        CHECK_INT(res.q[i].face, Qm->face[i]);
+    mc_result_free(&res);
+    mc_close(c);
+    bmap_free(Pm);
+    bmap_free(Qm);
+    mesh_free(S);
+    mesh_free(T);
+    mesh_free(D);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_1_saying_why, 90)
+{
+    testdaemon_need_worker();
+    write_inputs();
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    int rc = testrunf(out, sizeof out, "build/meshcorr submit %s %s --landmarks %s " JOB_OPTS
+                      " --server %s --watch", src, tgt, lmk, d.unix_addr);
+    CHECK_INT(rc, 0);
+    char *e;
+    unsigned long long id = strtoull(out, &e, 10);
+    CHECK(id > 0 && *e == '\n');
+    CHECK_STR_HAS(out, " ectm iter 4/4 energy ");
+    CHECK_STR_HAS(out, " COMPLETED\n");
+
+    mc_client *c = testdaemon_client(&d, NULL);
+    uint64_t long_id = testdaemon_submit(c, 100000, 1, 0, &rc);
+    CHECK_INT(rc, 0);
+    testdaemon_wait_state(c, long_id, MC_RUNNING, 30);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr cancel %llu --server %s", (unsigned long long)long_id,
+                       d.unix_addr), 0);
+    rc = testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s 2>&1 >/dev/null",
+                  (unsigned long long)long_id, d.unix_addr);
+    CHECK_INT(rc, 1);
+    CHECK_STR_HAS(out, "CANCELLED");
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
+{
+    testdaemon_need_worker();
+    write_inputs();
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    uint64_t id = submit(&d, "--label 'a \"quoted\" label'");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s", (unsigned long long)id,
+                       d.unix_addr), 0);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --json --server %s", d.unix_addr), 0);
+    if (!testjson_valid(out))
+        FAILF("list --json is not JSON:\n%s", out);
+    CHECK(out[0] == '[');
+    char want[128];
+    snprintf(want, sizeof want, "{\"id\":%llu,\"state\":\"COMPLETED\",", (unsigned long long)id);
+    CHECK_STR_HAS(out, want);
+    CHECK_STR_HAS(out, "\"outer\":4,\"total\":4");
+    CHECK_STR_HAS(out, "\"label\":\"a \\\"quoted\\\" label\"");
+
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr stats --json --server %s", d.unix_addr), 0);
+    if (!testjson_valid(out))
+        FAILF("stats --json is not JSON:\n%s", out);
+    CHECK_STR_HAS(out, "\"completed\":1,");
+    CHECK_STR_HAS(out, "\"queued\":0,");
+    CHECK_STR_HAS(out, "\"slots\":[{\"state\":\"");
+    CHECK(!testjson_valid("[{\"id\":1,}]") && !testjson_valid("{\"a\":1} x"));
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(token_file_authenticates_over_tcp_and_a_bad_token_fails_with_a_clear_message, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    const char *good = testfile_text("good.token", TESTDAEMON_BOB "\n");
+    char goodp[700];
+    snprintf(goodp, sizeof goodp, "%s", good);
+    /* the file wins over a wrong $MESHCORR_TOKEN */
+    CHECK_INT(testrunf(out, sizeof out, "MESHCORR_TOKEN=wrong build/meshcorr stats --json --server %s "
+                       "--token-file %s 2>&1", d.tcp_addr, goodp), 0);
+    CHECK(testjson_valid(out));
+    const char *bad = testfile_text("bad.token", "not-a-token\n");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s --token-file %s 2>&1", d.tcp_addr, bad),
+              1);
+    CHECK_STR_HAS(out, "refused the token (from --token-file)");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s --token wrong 2>&1", d.tcp_addr), 1);
+    CHECK_STR_HAS(out, "refused the token");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s --token-file %s/none 2>&1", d.tcp_addr,
+                       harness_tmpdir()), 1);
+    CHECK_STR_HAS(out, "cannot open");
+    testdaemon_stop(&d, SIGTERM);
+}

@@ -1,0 +1,139 @@
+/* test_client_lib.c — libmeshcorr as a user gets it: in-memory meshes encoded
+ * with their vertex order kept, and `make install` (the library part, into a
+ * temporary DESTDIR) giving a header, static and shared libraries and a
+ * pkg-config file that a small program builds with and talks to a real
+ * meshcorrd through. */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "support/testfile.h"
+#include "support/testmesh.h"
+#include "support/testrun.h"
+#include "mesh/draco_bridge.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <math.h>
+#include <signal.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+TEST(in_memory_mesh_encodes_to_draco_keeping_vertex_order_and_faces)
+{
+    mesh *m = testmesh_icosphere(2);
+    CHECK(m);
+    unsigned long long seed = 7;
+    for (int i = 0; i < 3 * m->nv; i++)
+        m->v[i] += 0.05 * testmesh_rand(&seed);
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    char err[512];
+    CHECK_INT(mc_encode_mesh(m->v, m->nv, m->f, m->nf, &buf, &len, err, sizeof err), 0);
+    CHECK(buf && len > 0);
+    double *v = NULL;
+    int *f = NULL, nv = 0, nf = 0;
+    CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf, err, sizeof err), 0);
+    CHECK_INT(nv, m->nv);
+    CHECK_INT(nf, m->nf);
+    double ext = 0;
+    for (int i = 0; i < 3 * nv; i++)
+        ext = fmax(ext, fabs(m->v[i]));
+    for (int i = 0; i < 3 * nv; i++)
+        CHECK_NEAR(v[i], m->v[i], 2 * ext / 65535.0 * 2);
+    for (int t = 0; t < nf; t++) {     /* the same triangle, possibly rotated */
+        int r = 0;
+        while (r < 3 && f[3 * t] != m->f[3 * t + r])
+            r++;
+        CHECK(r < 3);
+        for (int k = 0; k < 3; k++)
+            CHECK_INT(f[3 * t + k], m->f[3 * t + (r + k) % 3]);
+    }
+    free(v);
+    free(f);
+    free(buf);
+    mesh_free(m);
+}
+
+TEST(in_memory_mesh_with_a_bad_index_is_refused_with_a_message)
+{
+    static const double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const int f[] = {0, 1, 3};
+    unsigned char *buf = (unsigned char *)"x";
+    size_t len = 9;
+    char err[512] = "";
+    CHECK_INT(mc_encode_mesh(v, 3, f, 1, &buf, &len, err, sizeof err), MC_EARG);
+    CHECK(buf == NULL && len == 0);
+    CHECK_STR_HAS(err, "out of range");
+    CHECK_INT(mc_encode_mesh(v, 2, f, 1, &buf, &len, err, sizeof err), MC_EARG);
+}
+
+static const char prog[] =
+    "#include <meshcorr.h>\n"
+    "#include <stdio.h>\n"
+    "#include <stdlib.h>\n"
+    "int main(int argc, char **argv)\n"
+    "{\n"
+    "    static const double v[] = {0,0,0, 1,0,0, 0,1,0, 0,0,1};\n"
+    "    static const int f[] = {0,2,1, 0,1,3, 0,3,2, 1,2,3};\n"
+    "    unsigned char *b; size_t n; char err[256];\n"
+    "    if (mc_encode_mesh(v, 4, f, 4, &b, &n, err, sizeof err)) return 3;\n"
+    "    free(b);\n"
+    "    printf(\"strerror %s\\n\", mc_strerror(MC_ENOT_FOUND));\n"
+    "    mc_client *c;\n"
+    "    int rc = mc_connect(argc > 1 ? argv[1] : \"unix:/nonexistent\", NULL, &c, err, sizeof err);\n"
+    "    if (rc) { printf(\"connect %s\\n\", mc_strerror(rc)); return 1; }\n"
+    "    rc = mc_ping(c);\n"
+    "    printf(\"user %s ping %d\\n\", mc_user(c), rc);\n"
+    "    mc_close(c);\n"
+    "    return rc != 0;\n"
+    "}\n";
+
+TEST_T(installed_library_builds_a_program_with_pkg_config_that_talks_to_meshcorrd, 240)
+{
+    testdaemon_need_worker();
+    char dest[600], out[8192], path[800];
+    snprintf(dest, sizeof dest, "%s/dest", harness_tmpdir());
+    CHECK_INT(testrunf(out, sizeof out, "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s install-lib "
+                       "DESTDIR=%s PREFIX=/opt/mc 2>&1", dest), 0);
+    static const char *const files[] = {"include/meshcorr.h", "lib/libmeshcorr.a", "lib/libmeshcorr.so.1",
+                                        "lib/libmeshcorr.so", "lib/pkgconfig/meshcorr.pc"};
+    struct stat st;
+    for (int i = 0; i < 5; i++) {
+        snprintf(path, sizeof path, "%s/opt/mc/%s", dest, files[i]);
+        if (stat(path, &st))
+            FAILF("make install-lib did not install %s", path);
+    }
+    snprintf(path, sizeof path, "%s/opt/mc/lib/pkgconfig/meshcorr.pc", dest);
+    char *pc = (char *)testfile_read(path, &(size_t){0});
+    CHECK_STR_HAS(pc, "prefix=/opt/mc\n");
+    free(pc);
+    CHECK_INT(testrunf(out, sizeof out, "readelf -d %s/opt/mc/lib/libmeshcorr.so.1", dest), 0);
+    CHECK_STR_HAS(out, "Library soname: [libmeshcorr.so.1]");
+
+    const char *src = testfile_text("prog.c", prog);
+    char bin[700];
+    snprintf(bin, sizeof bin, "%s/prog", harness_tmpdir());
+    int rc = testrunf(out, sizeof out,
+                      "export PKG_CONFIG_PATH=%s/opt/mc/lib/pkgconfig PKG_CONFIG_SYSROOT_DIR=%s; "
+                      "cc -std=c11 -Wall -Werror -o %s %s $(pkg-config --cflags --libs meshcorr) 2>&1",
+                      dest, dest, bin, src);
+    if (rc)
+        FAILF("building against the installed library failed:\n%s", out);
+    CHECK_INT(testrunf(out, sizeof out, "readelf -d %s", bin), 0);
+    CHECK_STR_HAS(out, "Shared library: [libmeshcorr.so.1]");
+
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    rc = testrunf(out, sizeof out, "LD_LIBRARY_PATH=%s/opt/mc/lib %s %s 2>&1", dest, bin, d.unix_addr);
+    if (rc)
+        FAILF("the program failed (%d):\n%s", rc, out);
+    char want[256];
+    snprintf(want, sizeof want, "strerror %s\n", mc_strerror(MC_ENOT_FOUND));
+    CHECK_STR_HAS(out, want);
+    CHECK_STR_HAS(out, " ping 0");
+    CHECK(strstr(out, "user ") && !strstr(out, "user  "));
+    CHECK_INT(testrunf(out, sizeof out, "LD_LIBRARY_PATH=%s/opt/mc/lib %s unix:%s/none.sock", dest, bin,
+                       harness_tmpdir()), 1);
+    CHECK_STR_HAS(out, "connect ");
+    testdaemon_stop(&d, SIGTERM);
+}
