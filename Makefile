@@ -69,6 +69,9 @@ WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
 
 .PHONY: all test bench demo install install-lib clean
+# Objects built through pattern chains are kept (make would otherwise delete
+# them after the run and print that as the last line of `make test`).
+.SECONDARY:
 all: $(PROGRAMS)
 
 $(BUILD)/obj/%.o: %.c

@@ -1,0 +1,146 @@
+/* test_daemon_input.c — bad input through the real daemon and client: a
+ * frame of another protocol version, a SUBMIT whose mesh blob fails its
+ * checksum (refused, nothing stored), a Draco buffer that is no mesh and a
+ * landmark index out of range (accepted — only the worker decodes meshes —
+ * then FAILED with the worker's message). Each time the daemon keeps
+ * serving the other clients. */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "support/testjob.h"
+#include "support/testmesh.h"
+#include "proto.h"
+
+#include <signal.h>
+#include <string.h>
+
+TEST_T(frame_of_another_version_is_refused_and_others_are_served, 30)
+{
+    testdaemon d;
+    testdaemon_start(&d, "version", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE), *other = testdaemon_client(&d, NULL);
+    proto_hdr h = {PROTO_VERSION + 7, PROTO_MSG_PING, 0, 9, 0};
+    uint8_t frame[PROTO_HDR_SIZE];
+    proto_frame_put_header(frame, &h);
+    CHECK_INT(mc_send_raw(c, frame, sizeof frame), PROTO_EBAD_VERSION);
+    CHECK_STR_HAS(mc_errmsg(c), "BAD_VERSION");
+    CHECK_INT(mc_ping(other), 0);
+    mc_close(c);
+    mc_close(other);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(submit_whose_mesh_fails_its_checksum_is_refused_and_nothing_is_stored, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "checksum", NULL);
+    char src[512], tgt[512], err[512];
+    snprintf(src, sizeof src, "%s", harness_data_path("shrec07_bim/Meshes/386.off"));
+    snprintf(tgt, sizeof tgt, "%s", harness_data_path("shrec07_bim/Meshes/52.off"));
+    proto_landmark L[4] = {{0, 0}, {10, 10}, {20, 20}, {30, 30}};
+    testjob j;
+    if (testjob_build(&j, src, tgt, L, 4, NULL, NULL, NULL, err, sizeof err))
+        FAILF("%s", err);
+    j.msg.request_id = 41;
+    proto_buf b;
+    proto_buf_init(&b);
+    CHECK_INT(proto_msg_encode(&b, &j.msg, err, sizeof err), 0);
+    /* flip one byte in the middle of the source mesh's Draco bytes */
+    const unsigned char *blob = j.msg.u.submit.source.data;
+    size_t len = j.msg.u.submit.source.len;
+    unsigned char *at = memmem(b.data, b.len, blob, len);
+    CHECK(at != NULL);
+    at[len / 2] ^= 0x5a;
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    CHECK_INT(mc_send_raw(c, b.data, b.len), PROTO_EBAD_CHECKSUM);
+    CHECK_STR_HAS(mc_errmsg(c), "BAD_CHECKSUM");
+    mc_close(c);
+    c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_job_info *jobs = NULL;
+    uint32_t n = 99;
+    CHECK_INT(mc_list(c, NULL, 0, &jobs, &n), 0);
+    CHECK_INT(n, 0);                                  /* nothing was stored */
+    free(jobs);
+    mc_close(c);
+    proto_buf_free(&b);
+    testjob_close(&j);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* A spec for the icosphere pair with the given landmark pairs (2n ids). */
+static void sphere_spec(mc_job_spec *s, unsigned char **sb, unsigned char **tb,
+                        const uint32_t *lm, uint32_t n)
+{
+    mesh *S = testmesh_icosphere(2);
+    char err[256];
+    mc_job_spec_init(s);
+    CHECK_INT(mc_encode_mesh(S->v, S->nv, S->f, S->nf, sb, &s->source_len, err, sizeof err), 0);
+    CHECK_INT(mc_encode_mesh(S->v, S->nv, S->f, S->nf, tb, &s->target_len, err, sizeof err), 0);
+    s->source = *sb;
+    s->target = *tb;
+    s->landmarks = lm;
+    s->nlandmarks = n;
+    s->iterations = 2;
+    s->beta_ramp = 2;
+    s->rhm_iterations = 2;
+    mesh_free(S);
+}
+
+TEST_T(draco_bytes_that_are_no_mesh_fail_the_job_naming_the_source_mesh, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "draco", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3};
+    mc_job_spec s;
+    unsigned char *sb, *tb;
+    sphere_spec(&s, &sb, &tb, lm, 4);
+    unsigned char junk[200];
+    unsigned long long st = 12345;
+    for (size_t i = 0; i < sizeof junk; i++)
+        junk[i] = (unsigned char)(testmesh_rand(&st) * 256);
+    memcpy(junk, "DRACO", 5);                  /* looks like a header, is not a mesh */
+    s.source = junk;
+    s.source_len = sizeof junk;
+    uint64_t id = 0;
+    CHECK_INT(mc_submit(c, &s, &id), 0);       /* accepted: the daemon never decodes Draco */
+    CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_FAILED);
+    mc_job_status js;
+    CHECK_INT(mc_status(c, id, &js), 0);
+    CHECK_STR_HAS(js.reason, "BAD_MESH");
+    CHECK_STR_HAS(js.reason, "source mesh");
+    uint64_t ok;                               /* the next job runs as usual */
+    int rc;
+    ok = testdaemon_submit(c, 2, 0, 0, &rc);
+    CHECK_INT(rc, 0);
+    CHECK_INT(testdaemon_wait_state(c, ok, -1, 60), MC_COMPLETED);
+    free(sb);
+    free(tb);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+TEST_T(landmark_index_out_of_range_fails_the_job_naming_landmark_and_range, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "landmark", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 162};   /* 162 vertices: 0..161 */
+    mc_job_spec s;
+    unsigned char *sb, *tb;
+    sphere_spec(&s, &sb, &tb, lm, 4);
+    uint64_t id = 0;
+    CHECK_INT(mc_submit(c, &s, &id), 0);
+    CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_FAILED);
+    mc_job_status js;
+    CHECK_INT(mc_status(c, id, &js), 0);
+    CHECK_STR_HAS(js.reason, "BAD_LANDMARKS");
+    CHECK_STR_HAS(js.reason, "landmark 4");
+    CHECK_STR_HAS(js.reason, "162 out of range");
+    free(sb);
+    free(tb);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
