@@ -68,3 +68,26 @@ int bk_progress_take(mcd *d, uint64_t id, proto_buf *in)
     }
     return n;
 }
+
+int bk_error_frame(const char *path, char *msg, size_t msz)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return 0;
+    static uint8_t buf[BK_MAX_ERROR_FRAME];
+    size_t n = fread(buf, 1, sizeof buf, fp);
+    fclose(fp);
+    proto_msg m;
+    size_t used;
+    char err[256];
+    int code = PROTO_EINTERNAL;
+    if (proto_decode(buf, n, sizeof buf, &m, &used, err, sizeof err) == PROTO_READY &&
+        m.type == PROTO_MSG_ERROR) {
+        code = m.u.error.code;
+        snprintf(msg, msz, "%s", m.u.error.message);
+    } else {
+        snprintf(msg, msz, "worker wrote an unreadable error.frame");
+    }
+    proto_msg_free(&m);
+    return code;
+}

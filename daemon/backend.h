@@ -46,6 +46,11 @@ void bk_close(mcd *d);
  * frame that is not a valid PROGRESS (in is then reset; the caller ignores
  * the rest of that stream). */
 #define BK_MAX_PROGRESS_FRAME 4096
+/* A worker's error.frame at path: its protocol error code and message
+ * (msg); 0 when there is none, PROTO_EINTERNAL when it does not decode.
+ * Loop thread only (one static buffer). */
+#define BK_MAX_ERROR_FRAME (1 << 20)
+int bk_error_frame(const char *path, char *msg, size_t msz);
 int bk_progress_take(mcd *d, uint64_t id, proto_buf *in);
 
 /* ---- bk_cmd.c: one external command, asynchronously ---------------------- */

@@ -208,24 +208,7 @@ static void read_progress_file(sjob *j)
 static int read_error_frame(uint64_t id, char *msg, size_t msz)
 {
     char path[CONF_PATH + 64];
-    FILE *fp = fopen(spool_file(id, "error.frame", path, sizeof path), "rb");
-    if (!fp)
-        return 0;
-    static uint8_t buf[1 << 20];
-    size_t n = fread(buf, 1, sizeof buf, fp);
-    fclose(fp);
-    proto_msg m;
-    size_t used;
-    char err[256];
-    int code = PROTO_EINTERNAL;
-    if (proto_decode(buf, n, sizeof buf, &m, &used, err, sizeof err) == PROTO_READY && m.type == PROTO_MSG_ERROR) {
-        code = m.u.error.code;
-        snprintf(msg, msz, "%s", m.u.error.message);
-    } else {
-        snprintf(msg, msz, "worker wrote an unreadable error.frame");
-    }
-    proto_msg_free(&m);
-    return code;
+    return bk_error_frame(spool_file(id, "error.frame", path, sizeof path), msg, msz);
 }
 
 static int is_terminal_slurm(const char *st)

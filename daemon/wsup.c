@@ -26,7 +26,6 @@
 
 #define WSUP_PROGRESS_FD 3
 #define WSUP_EOF_GRACE_MS 2000      /* after exit, wait this long for the pipe's EOF */
-#define WSUP_MAX_ERROR_FRAME (1u << 20)
 #define WSUP_MAX_CRASHES 2          /* worker crashes that fail a job */
 
 struct wsup_slot {
@@ -205,25 +204,7 @@ static int read_error_frame(wsup_slot *s, char *msg, size_t msz)
 {
     char path[CONF_PATH + 64];
     store_spool_path(s->d->store, s->job_id, "error.frame", path, sizeof path);
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return 0;
-    static uint8_t buf[WSUP_MAX_ERROR_FRAME];
-    size_t n = fread(buf, 1, sizeof buf, fp);
-    fclose(fp);
-    proto_msg m;
-    size_t used;
-    char err[256];
-    int code = PROTO_EINTERNAL;
-    if (proto_decode(buf, n, sizeof buf, &m, &used, err, sizeof err) == PROTO_READY &&
-        m.type == PROTO_MSG_ERROR) {
-        code = m.u.error.code;
-        snprintf(msg, msz, "%s", m.u.error.message);
-    } else {
-        snprintf(msg, msz, "worker wrote an unreadable error.frame");
-    }
-    proto_msg_free(&m);
-    return code;
+    return bk_error_frame(path, msg, msz);
 }
 
 /* The worker died without result.frame or error.frame: the first crash of a
