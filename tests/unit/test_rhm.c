@@ -298,3 +298,68 @@ TEST(refuses_too_few_landmarks_and_bad_parameters)
     CHECK_STR_HAS(err, "alpha");
     mesh_free(m);
 }
+
+/* A known answer: the unit icosphere (level 3) mapped to the same sphere
+ * with its vertices slid along the surface (a different tessellation;
+ * vertex i moves by at most 0.03 of a radius), from 8 farthest-point
+ * landmarks. The true map sends vertex i near vertex i: the mean geodesic
+ * error stays close to the slide (0.03 / √(4π) ≈ 0.0085 at most), with no
+ * flipped or collapsed triangle. */
+TEST_T(sphere_to_retessellated_sphere_is_found_from_eight_landmarks, 120)
+{
+    mesh *S = testmesh_icosphere(3), *T = testmesh_icosphere(3);
+    for (int i = 0; i < T->nv; i++) {
+        double *x = T->v + 3 * i, t = 0.03 * sin(7 * x[0] + 3 * x[1]);
+        double a = cos(t) * x[0] - sin(t) * x[1], b = sin(t) * x[0] + cos(t) * x[1];
+        x[0] = a;
+        x[1] = b;
+    }
+    int src[8], tgt[8];
+    double *d = malloc(sizeof(double) * (size_t)S->nv);
+    src[0] = 0;
+    for (int i = 0; i < S->nv; i++)
+        d[i] = INFINITY;
+    for (int k = 1; k < 8; k++) {       /* farthest-point sample, Euclidean */
+        const double *p = S->v + 3 * src[k - 1];
+        int best = 0;
+        for (int i = 0; i < S->nv; i++) {
+            const double *q = S->v + 3 * i;
+            double e = hypot(hypot(p[0] - q[0], p[1] - q[1]), p[2] - q[2]);
+            d[i] = fmin(d[i], e);
+            if (d[i] > d[best])
+                best = i;
+        }
+        src[k] = best;
+    }
+    memcpy(tgt, src, sizeof src);
+    lmk_set L = {8, src, tgt};
+    rhm_params p;
+    rhm_params_init(&p);
+    rhm_result r;
+    char err[256];
+    if (rhm_run(S, T, &L, &p, NULL, NULL, &r, err, sizeof err))
+        FAILF("%s", err);
+    int *id = malloc(sizeof(int) * (size_t)S->nv);
+    double *ge = malloc(sizeof(double) * (size_t)S->nv);
+    for (int i = 0; i < S->nv; i++)
+        id[i] = i;
+    geod_solver *gs = geod_solver_new(T, 0, err, sizeof err);
+    CHECK(gs != NULL);
+    const bmap *maps[1] = {r.P12};
+    CHECK_INT(metric_geodesic_errors(gs, T, maps, 1, id, id, S->nv, ge), 0);
+    metric_summary ms;
+    CHECK_INT(metric_summarize(S, T, r.P12, &ms), 0);
+    double g = mean(ge, S->nv);
+    printf("  mean geodesic error %.4f, median conformal %.4f, flipped %.2f %%, collapsed %.2f %%\n",
+           g, ms.median_conformal, 100 * ms.flipped_fraction, 100 * ms.collapsed_fraction);
+    CHECK(g < 0.03);
+    CHECK(ms.flipped_fraction == 0 && ms.collapsed_fraction == 0);
+    CHECK(ms.median_conformal < 0.05);
+    geod_solver_free(gs);
+    rhm_result_close(&r);
+    free(id);
+    free(ge);
+    free(d);
+    mesh_free(S);
+    mesh_free(T);
+}
