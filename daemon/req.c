@@ -154,8 +154,15 @@ static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t m
         p->inner_iterations < 1 || p->inner_iterations > REQ_MAX_ITERATIONS)
         return snprintf(msg, msz, "iterations %u / inner_iterations %u: must be in [1, %u]", p->iterations,
                         p->inner_iterations, REQ_MAX_ITERATIONS), PROTO_EBAD_PARAMS;
-    if (p->backend[0] && strcmp(p->backend, "cpu") != 0)
-        return snprintf(msg, msz, "backend '%s': this server runs \"cpu\" only", p->backend), PROTO_EBAD_PARAMS;
+    /* backend: "" (the server's default, cpu), "cpu", "opencl" or "auto", with an
+     * optional ":DEVICE" the worker matches against OpenCL platform/device names */
+    if (p->backend[0]) {
+        size_t k = strcspn(p->backend, ":");
+        if (!((k == 3 && !strncmp(p->backend, "cpu", 3)) || (k == 6 && !strncmp(p->backend, "opencl", 6)) ||
+              (k == 4 && !strncmp(p->backend, "auto", 4))))
+            return snprintf(msg, msz, "backend '%s': not cpu, opencl or auto (optionally :DEVICE)",
+                            p->backend), PROTO_EBAD_PARAMS;
+    }
     return 0;
 }
 

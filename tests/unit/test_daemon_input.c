@@ -144,3 +144,32 @@ TEST_T(landmark_index_out_of_range_fails_the_job_naming_landmark_and_range, 60)
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
+
+TEST_T(backend_is_chosen_per_job_and_an_unknown_one_is_refused, 120)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "backend", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3};
+    mc_job_spec s;
+    unsigned char *sb, *tb;
+    sphere_spec(&s, &sb, &tb, lm, 4);
+    uint64_t id = 0;
+    s.backend = "gpu-please";
+    CHECK_INT(mc_submit(c, &s, &id), PROTO_EBAD_PARAMS);
+    CHECK_STR_HAS(mc_errmsg(c), "not cpu, opencl or auto");
+    s.backend = "opencl";
+    CHECK_INT(mc_submit(c, &s, &id), 0);
+    int st = testdaemon_wait_state(c, id, -1, 90);
+    mc_job_status js;
+    CHECK_INT(mc_status(c, id, &js), 0);
+    if (st == MC_FAILED && strstr(js.reason, "OpenCL"))
+        SKIP("no OpenCL device with fp64 here: %s", js.reason);
+    if (st != MC_COMPLETED)
+        FAILF("the OpenCL job ended %s: %s", mc_state_name(st), js.reason);
+    free(sb);
+    free(tb);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
