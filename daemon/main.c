@@ -114,6 +114,7 @@ int main(int argc, char **argv)
     dlog(DLOG_INFO, "meshcorrd ready: %s backend, %u job(s) pending, state in %s", bk_name(&d),
          sched_queued(d.sched), d.conf.state_dir);
     bk_schedule(&d);
+    dev_probe(&d);
     notify_ready(&d);
     uv_run(d.loop, UV_RUN_DEFAULT);
     status = 0;

@@ -212,6 +212,7 @@ typedef struct mcd_snapshot {
 } mcd_snapshot;
 
 typedef struct snap snap;
+#define MCD_MAX_DEVICES 16
 typedef struct mcd mcd;
 #define SNAP_PERIOD_MS 200        /* the published snapshot's refresh */
 
@@ -285,7 +286,17 @@ struct mcd {
     char **argv;
     uv_signal_t sighup;
     uv_timer_t notify_timer;      /* STATUS= updates */
+    /* compute devices a worker can use (devices.c), for STATS */
+    char devices[MCD_MAX_DEVICES][192];
+    int ndevices;
 };
+
+/* ---- dev_: the devices a worker sees, asked once of the worker program ---- */
+/* Runs `meshcorr-worker --list-devices` in the background; until it answers
+ * (or if it fails) STATS shows "cpu:N". */
+void dev_probe(mcd *d);
+/* The device lines into out (at most max); their number. */
+int dev_list(const mcd *d, const char **out, int max);
 
 /* ---- notify_ -------------------------------------------------------------- */
 void notify_ready(mcd *d);        /* READY=1 and the first STATUS=; starts the timer */

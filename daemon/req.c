@@ -521,11 +521,16 @@ static void on_stats(conn *c, const proto_msg *m)
     s->slots = slots;
     s->nslots = nslots;
     char dev[64];
-    long ncpu = d->conf.threads_per_worker ? d->conf.threads_per_worker : sysconf(_SC_NPROCESSORS_ONLN);
-    snprintf(dev, sizeof dev, "cpu:%ld", ncpu);
-    const char *devs[1] = {dev};
+    const char *devs[MCD_MAX_DEVICES];
+    int nd = dev_list(d, devs, MCD_MAX_DEVICES);
+    if (nd == 0) {                          /* the worker has not answered (yet) */
+        long ncpu = d->conf.threads_per_worker ? d->conf.threads_per_worker : sysconf(_SC_NPROCESSORS_ONLN);
+        snprintf(dev, sizeof dev, "cpu:%ld", ncpu);
+        devs[0] = dev;
+        nd = 1;
+    }
     s->devices = devs;
-    s->ndevices = 1;
+    s->ndevices = (uint32_t)nd;
     char health[PROTO_MAX_STRING + 1];
     s->backend = bk_name(d);
     s->backend_ok = (uint8_t)bk_health(d, health, sizeof health);

@@ -12,6 +12,7 @@
 
 #include <signal.h>
 #include <string.h>
+#include <unistd.h>
 
 TEST_T(frame_of_another_version_is_refused_and_others_are_served, 30)
 {
@@ -170,6 +171,43 @@ TEST_T(backend_is_chosen_per_job_and_an_unknown_one_is_refused, 120)
         FAILF("the OpenCL job ended %s: %s", mc_state_name(st), js.reason);
     free(sb);
     free(tb);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* STATS lists the devices a worker can use: "cpu:N" at once, then what the
+ * worker program reports (OpenCL devices with fp64 when there are any). */
+TEST_T(stats_lists_the_devices_the_worker_reports, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "devices", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    /* testdaemon runs its workers with one thread each */
+    FILE *p = popen("build/meshcorr-worker --list-devices --threads 1 2>/dev/null", "r");
+    CHECK(p);
+    char want[8][256];
+    int nwant = 0;
+    while (nwant < 8 && fgets(want[nwant], sizeof want[nwant], p)) {
+        want[nwant][strcspn(want[nwant], "\n")] = '\0';
+        nwant++;
+    }
+    CHECK_INT(pclose(p), 0);
+    CHECK(nwant >= 1 && strncmp(want[0], "cpu:", 4) == 0);
+    mc_server_stats s;
+    int same = 0;
+    for (int tries = 0; tries < 100 && !same; tries++) {   /* the probe runs at start */
+        CHECK_INT(mc_stats(c, &s), 0);
+        CHECK(s.ndevices >= 1);
+        CHECK(strncmp(s.devices[0], "cpu:", 4) == 0);
+        same = (int)s.ndevices == nwant;
+        for (int i = 0; same && i < nwant; i++)
+            same = strncmp(s.devices[i], want[i], sizeof s.devices[i] - 1) == 0;
+        mc_stats_free(&s);
+        if (!same)
+            usleep(100000);
+    }
+    CHECK(same);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }

@@ -90,4 +90,8 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
                      double elapsed, wrk_result *r, char *err, size_t errsz);
 void wrk_result_close(wrk_result *r);
 
+/* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with
+ * fp64, one per line on stdout; 0 when printed. */
+int wrk_list_devices(int threads);
+
 #endif

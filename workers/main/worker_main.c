@@ -39,6 +39,7 @@ static void usage(void)
         "usage: meshcorr-worker --job DIR --job-id ID [--progress-fd N] [--threads N]\n"
         "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
+        "       meshcorr-worker --list-devices [--threads N]\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage. See workers/WORKER.md.\n");
 }
@@ -121,12 +122,12 @@ int main(int argc, char **argv)
         {"progress-fd", required_argument, 0, 'p'},  {"threads", required_argument, 0, 't'},
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
-        {"max-memory-mb", required_argument, 0, 'm'},
+        {"max-memory-mb", required_argument, 0, 'm'}, {"list-devices", no_argument, 0, 'L'},
         {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
     uint64_t job_id = 0;
-    int have_id = 0, progress_fd = -1, bad = 0;
+    int have_id = 0, progress_fd = -1, bad = 0, list_devices = 0;
     unsigned long long max_memory_mb = 0;
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
     unsigned long long v;
@@ -161,10 +162,13 @@ int main(int argc, char **argv)
         case 'm':
             bad |= parse_num("max-memory-mb", optarg, 1, 1ull << 24, &max_memory_mb) != 0;
             break;
+        case 'L': list_devices = 1; break;
         case 'h': usage(); return WRK_EXIT_USAGE;
         default: bad = 1;
         }
     }
+    if (!bad && list_devices)
+        return wrk_list_devices(lim.threads) ? WRK_EXIT_USAGE : 0;
     if (!bad && (!dir || !have_id || optind != argc)) {
         fprintf(stderr, "meshcorr-worker: --job and --job-id are required, nothing else\n");
         bad = 1;
