@@ -7,7 +7,6 @@
 #include "support/testdaemon.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
-#include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
 #include "meshcorr.h"
 
@@ -142,52 +141,21 @@ TEST_T(progress_fan_out_to_20_watchers_of_one_job, 300)
     testdaemon_stop(&d, SIGTERM);
 }
 
-static mesh *decode(const unsigned char *b, size_t n)
-{
-    mesh *m = calloc(1, sizeof *m);
-    char err[512];
-    if (!m || dracob_decode(b, n, MESH_MAX_VERTICES, MESH_MAX_FACES, &m->v, &m->nv, &m->f, &m->nf, err,
-                            sizeof err))
-        FAILF("dracob_decode: %s", err);
-    return m;
-}
-
-static mc_map_row *rows_of(const bmap *P)
-{
-    mc_map_row *r = calloc((size_t)P->n, sizeof *r);
-    CHECK(r != NULL);
-    for (int i = 0; i < P->n; i++) {
-        r[i].face = (uint32_t)P->face[i];
-        memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
-    }
-    return r;
-}
-
 /* The demo pair 381 -> 390 from its initial maps, 3 outer iterations, one
  * thread on both sides: submit-to-END through the daemon against corr_run. */
 TEST_T(daemon_overhead_against_the_in_process_run, 600)
 {
     testdaemon_need_worker();
-    char s381[512], s390[512], p0[512], q0[512], err[1024];
-    snprintf(s381, sizeof s381, "%s", harness_data_path("shrec07_bim/Meshes/381.off"));
-    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
-    snprintf(p0, sizeof p0, "%s", harness_data_path("ectm_demo_381_390/init_381_to_390.map"));
-    snprintf(q0, sizeof q0, "%s", harness_data_path("ectm_demo_381_390/init_390_to_381.map"));
-    unsigned char *sb, *tb;
-    size_t sl, tl;
-    CHECK_INT(mc_encode_mesh_file(s381, &sb, &sl, err, sizeof err), 0);
-    CHECK_INT(mc_encode_mesh_file(s390, &tb, &tl, err, sizeof err), 0);
-    mesh *S = decode(sb, sl), *T = decode(tb, tl);
-    bmap *P0 = NULL, *Q0 = NULL;
-    if (bmap_read(p0, S, T, &P0, err, sizeof err) || bmap_read(q0, T, S, &Q0, err, sizeof err))
-        FAILF("%s", err);
+    testdaemon_demo dm;
+    testdaemon_demo_open(&dm, 3);
+    char err[1024];
 
     ectm_params p;
     ectm_params_init(&p);
     p.iterations = 3;
     p.threads = 1;
     ectm_result want = {0};
-    corr_input in = {S, T, "381", "390", NULL, P0, Q0, NULL, CORR_STAGES_ALL};
+    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_STAGES_ALL};
     double t0 = now();
     if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
         FAILF("corr_run: %s", err);
@@ -198,22 +166,10 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
     testdaemon_start(&d, "bench-overhead", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
     mc_set_timeout(c, 600000);
-    mc_job_spec spec;
-    mc_job_spec_init(&spec);
-    spec.source = sb;
-    spec.source_len = sl;
-    spec.target = tb;
-    spec.target_len = tl;
-    mc_map_row *pr = rows_of(P0), *qr = rows_of(Q0);
-    spec.p = pr;
-    spec.np = (uint32_t)P0->n;
-    spec.q = qr;
-    spec.nq = (uint32_t)Q0->n;
-    spec.iterations = 3;
-    spec.label = "bench overhead";
+    dm.spec.label = "bench overhead";
     uint64_t id;
     t0 = now();
-    if (mc_submit(c, &spec, &id))
+    if (mc_submit(c, &dm.spec, &id))
         FAILF("SUBMIT: %s", mc_errmsg(c));
     int state = -1;
     char reason[1100];
@@ -229,14 +185,7 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
     printf("381 -> 390, 3 iterations, 1 thread: in process %.2f s, through the daemon %.2f s "
            "(submit to END; ratio %.3f, overhead %.2f s); RESULT fetch of both maps %.1f ms\n",
            t_local, t_daemon, t_daemon / t_local, t_daemon - t_local, 1e3 * t_fetch);
-    free(pr);
-    free(qr);
-    free(sb);
-    free(tb);
-    bmap_free(P0);
-    bmap_free(Q0);
-    mesh_free(S);
-    mesh_free(T);
+    testdaemon_demo_close(&dm);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }

@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
@@ -239,4 +240,59 @@ uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t p
     mesh_free(S);
     mesh_free(T);
     return id;
+}
+
+static mc_map_row *rows_of(const bmap *P)
+{
+    mc_map_row *r = calloc((size_t)P->n + 1, sizeof *r);
+    CHECK(r != NULL);
+    for (int i = 0; i < P->n; i++) {
+        r[i].face = (uint32_t)P->face[i];
+        memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
+    }
+    return r;
+}
+
+void testdaemon_demo_open(testdaemon_demo *dm, uint32_t iterations)
+{
+    static const char *const rel[4] = {
+        "shrec07_bim/Meshes/381.off", "shrec07_bim/Meshes/390.off",
+        "ectm_demo_381_390/init_381_to_390.map", "ectm_demo_381_390/init_390_to_381.map"};
+    char path[4][600], err[1024];
+    for (int i = 0; i < 4; i++)
+        snprintf(path[i], sizeof path[i], "%s", harness_data_path(rel[i]));
+    memset(dm, 0, sizeof *dm);
+    mc_job_spec *s = &dm->spec;
+    mc_job_spec_init(s);
+    if (mc_encode_mesh_file(path[0], &dm->sb, &s->source_len, err, sizeof err) ||
+        mc_encode_mesh_file(path[1], &dm->tb, &s->target_len, err, sizeof err) ||
+        mesh_read_drc_mem(dm->sb, s->source_len, MESH_MAX_VERTICES, MESH_MAX_FACES, "381", &dm->S,
+                          err, sizeof err) ||
+        mesh_read_drc_mem(dm->tb, s->target_len, MESH_MAX_VERTICES, MESH_MAX_FACES, "390", &dm->T,
+                          err, sizeof err) ||
+        bmap_read(path[2], dm->S, dm->T, &dm->P0, err, sizeof err) ||
+        bmap_read(path[3], dm->T, dm->S, &dm->Q0, err, sizeof err))
+        FAILF("%s", err);
+    s->source = dm->sb;
+    s->target = dm->tb;
+    s->p = dm->pr = rows_of(dm->P0);
+    s->np = (uint32_t)dm->P0->n;
+    s->q = dm->qr = rows_of(dm->Q0);
+    s->nq = (uint32_t)dm->Q0->n;
+    s->iterations = iterations;
+    s->stop_change = 0;
+    s->label = "demo 381 -> 390";
+}
+
+void testdaemon_demo_close(testdaemon_demo *dm)
+{
+    free(dm->sb);
+    free(dm->tb);
+    free(dm->pr);
+    free(dm->qr);
+    bmap_free(dm->P0);
+    bmap_free(dm->Q0);
+    mesh_free(dm->S);
+    mesh_free(dm->T);
+    memset(dm, 0, sizeof *dm);
 }

@@ -10,6 +10,8 @@
 #define TESTDAEMON_H
 #include <sys/types.h>
 #include "meshcorr.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
 
 #define TESTDAEMON_ALICE "tok-alice-0123456789"
 #define TESTDAEMON_BOB   "tok-bob-0123456789"
@@ -46,5 +48,20 @@ int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s);
  * bent a little), 6 identity landmarks; iterations outer iterations, no
  * early stop. long_job: level 3 (642 vertices), for jobs to cancel or kill. */
 uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc);
+
+/* The authors' demo pair 381 -> 390 with its HOT initial maps, as a client
+ * sends it (spec: Draco bytes, maps P and Q, `iterations` outer iterations,
+ * no early stop) and as the worker sees it (S, T decoded from those Draco
+ * bytes; P0, Q0 read against them), to compare a daemon's job with corr_run
+ * in process. SKIPs the test without the data folder. */
+typedef struct testdaemon_demo {
+    mc_job_spec spec;
+    mesh *S, *T;
+    bmap *P0, *Q0;
+    unsigned char *sb, *tb;     /* owned by the struct, as are the map rows */
+    mc_map_row *pr, *qr;
+} testdaemon_demo;
+void testdaemon_demo_open(testdaemon_demo *dm, uint32_t iterations);
+void testdaemon_demo_close(testdaemon_demo *dm);
 
 #endif

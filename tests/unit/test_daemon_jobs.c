@@ -6,7 +6,6 @@
 #include "support/testdaemon.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
-#include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
 #include "meshcorr.h"
 
@@ -101,27 +100,6 @@ TEST_T(submitted_job_streams_energies_and_completes, 60)
 /* The map the daemon returns is the in-process pipeline's map on the same
  * Draco-decoded meshes, initial maps and parameters (the demo pair 381 -> 390,
  * 3 outer iterations, one thread on both sides). */
-static mesh *decode(const unsigned char *b, size_t n)
-{
-    mesh *m = calloc(1, sizeof *m);
-    char err[512];
-    if (!m || dracob_decode(b, n, MESH_MAX_VERTICES, MESH_MAX_FACES, &m->v, &m->nv, &m->f, &m->nf, err,
-                            sizeof err))
-        FAILF("dracob_decode: %s", err);
-    return m;
-}
-
-static mc_map_row *rows_of(const bmap *P)
-{
-    mc_map_row *r = calloc((size_t)P->n, sizeof *r);
-    CHECK(r != NULL);
-    for (int i = 0; i < P->n; i++) {
-        r[i].face = (uint32_t)P->face[i];
-        memcpy(r[i].w, &P->w[3 * i], sizeof r[i].w);
-    }
-    return r;
-}
-
 static void check_same_map(const mc_map_row *got, uint32_t n, const bmap *want)
 {
     CHECK_INT(n, want->n);
@@ -136,39 +114,14 @@ static void check_same_map(const mc_map_row *got, uint32_t n, const bmap *want)
 TEST_T(result_is_the_in_process_map_on_the_demo_pair, 120)
 {
     testdaemon_need_worker();
-    const char *src = harness_data_path("shrec07_bim/Meshes/381.off");
-    char s381[512], s390[512], p0[512], q0[512], err[1024];
-    snprintf(s381, sizeof s381, "%s", src);
-    snprintf(s390, sizeof s390, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
-    snprintf(p0, sizeof p0, "%s", harness_data_path("ectm_demo_381_390/init_381_to_390.map"));
-    snprintf(q0, sizeof q0, "%s", harness_data_path("ectm_demo_381_390/init_390_to_381.map"));
-    unsigned char *sb, *tb;
-    size_t sl, tl;
-    CHECK_INT(mc_encode_mesh_file(s381, &sb, &sl, err, sizeof err), 0);
-    CHECK_INT(mc_encode_mesh_file(s390, &tb, &tl, err, sizeof err), 0);
-    mesh *S = decode(sb, sl), *T = decode(tb, tl);
-    bmap *P0 = NULL, *Q0 = NULL;
-    if (bmap_read(p0, S, T, &P0, err, sizeof err) || bmap_read(q0, T, S, &Q0, err, sizeof err))
-        FAILF("%s", err);
-
+    testdaemon_demo dm;
+    testdaemon_demo_open(&dm, 3);
+    char err[1024];
     testdaemon d;
     testdaemon_start(&d, "demo", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    mc_job_spec spec;
-    mc_job_spec_init(&spec);
-    spec.source = sb;
-    spec.source_len = sl;
-    spec.target = tb;
-    spec.target_len = tl;
-    mc_map_row *pr = rows_of(P0), *qr = rows_of(Q0);
-    spec.p = pr;
-    spec.np = (uint32_t)P0->n;
-    spec.q = qr;
-    spec.nq = (uint32_t)Q0->n;
-    spec.iterations = 3;
-    spec.label = "demo 381 -> 390";
     uint64_t id;
-    int rc = mc_submit(c, &spec, &id);
+    int rc = mc_submit(c, &dm.spec, &id);
     if (rc)
         FAILF("SUBMIT: %s", mc_errmsg(c));
 
@@ -177,7 +130,7 @@ TEST_T(result_is_the_in_process_map_on_the_demo_pair, 120)
     p.iterations = 3;
     p.threads = 1;
     ectm_result want = {0};
-    corr_input in = {S, T, "381", "390", NULL, P0, Q0, NULL, CORR_STAGES_ALL};
+    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_STAGES_ALL};
     if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
         FAILF("corr_run: %s", err);
 
@@ -193,14 +146,7 @@ TEST_T(result_is_the_in_process_map_on_the_demo_pair, 120)
     CHECK(r.deformed == NULL);   /* not asked */
     mc_result_free(&r);
     ectm_result_close(&want);
-    free(pr);
-    free(qr);
-    free(sb);
-    free(tb);
-    bmap_free(P0);
-    bmap_free(Q0);
-    mesh_free(S);
-    mesh_free(T);
+    testdaemon_demo_close(&dm);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }

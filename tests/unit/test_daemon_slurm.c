@@ -82,56 +82,12 @@ static int log_has(const testdaemon *d, const char *what)
  * so the outer iterations only grow), no early stop. */
 static uint64_t submit_demo(mc_client *c, uint32_t iterations)
 {
-    char err[1024];
-    const char *f[4] = {"shrec07_bim/Meshes/381.off", "shrec07_bim/Meshes/390.off",
-                        "ectm_demo_381_390/init_381_to_390.map", "ectm_demo_381_390/init_390_to_381.map"};
-    char path[4][600];
-    for (int i = 0; i < 4; i++)
-        snprintf(path[i], sizeof path[i], "%s", harness_data_path(f[i]));
-    unsigned char *sb, *tb;
-    size_t sl, tl;
-    CHECK_INT(mc_encode_mesh_file(path[0], &sb, &sl, err, sizeof err), 0);
-    CHECK_INT(mc_encode_mesh_file(path[1], &tb, &tl, err, sizeof err), 0);
-    mesh *S = NULL, *T = NULL;
-    bmap *P0 = NULL, *Q0 = NULL;
-    if (mesh_read(path[0], &S, err, sizeof err) || mesh_read(path[1], &T, err, sizeof err) ||
-        bmap_read(path[2], S, T, &P0, err, sizeof err) || bmap_read(path[3], T, S, &Q0, err, sizeof err))
-        FAILF("%s", err);
-    uint32_t np = (uint32_t)P0->n, nq = (uint32_t)Q0->n;
-    mc_map_row *p = calloc(np, sizeof *p), *q = calloc(nq, sizeof *q);
-    CHECK(p && q);
-    for (uint32_t i = 0; i < np; i++) {
-        p[i].face = (uint32_t)P0->face[i];
-        memcpy(p[i].w, &P0->w[3 * i], sizeof p[i].w);
-    }
-    for (uint32_t i = 0; i < nq; i++) {
-        q[i].face = (uint32_t)Q0->face[i];
-        memcpy(q[i].w, &Q0->w[3 * i], sizeof q[i].w);
-    }
-    bmap_free(P0);
-    bmap_free(Q0);
-    mesh_free(S);
-    mesh_free(T);
-    mc_job_spec spec;
-    mc_job_spec_init(&spec);
-    spec.source = sb;
-    spec.source_len = sl;
-    spec.target = tb;
-    spec.target_len = tl;
-    spec.p = p;
-    spec.np = np;
-    spec.q = q;
-    spec.nq = nq;
-    spec.iterations = iterations;
-    spec.stop_change = 0;
-    spec.label = "demo 381 -> 390";
+    testdaemon_demo dm;
+    testdaemon_demo_open(&dm, iterations);
     uint64_t id = 0;
-    if (mc_submit(c, &spec, &id))
+    if (mc_submit(c, &dm.spec, &id))
         FAILF("SUBMIT: %s", mc_errmsg(c));
-    free(sb);
-    free(tb);
-    free(p);
-    free(q);
+    testdaemon_demo_close(&dm);
     return id;
 }
 
