@@ -63,29 +63,37 @@ TEST(farthest_points_are_spread_and_keep_their_fields)
     CHECK(s != NULL);
     enum { K = 12 };
     int pts[K];
-    double *F = malloc((size_t)K * m->nv * sizeof *F);
+    double *F = malloc((size_t)K * K * sizeof *F);
     CHECK_INT(embed_farthest_points(s, 7, K, pts, F, NULL, 0), EMBED_OK);
     CHECK_INT(pts[0], 7);
     for (int j = 0; j < K; j++) {
-        CHECK(F[(size_t)j * m->nv + pts[j]] == 0);
-        for (int i = 0; i < j; i++)
+        CHECK(F[(size_t)j * K + j] == 0);
+        for (int i = 0; i < j; i++) {
             CHECK(pts[i] != pts[j]);
+            CHECK(F[(size_t)i * K + j] == F[(size_t)j * K + i]);
+        }
     }
     /* pts[1] is the farthest vertex from pts[0]: near the antipode */
-    CHECK(F[pts[1]] > 0.95 * M_PI);
-    /* pts[j] maximises the distance to the earlier points */
+    CHECK(F[1] > 0.95 * M_PI);
+    /* pts[j] maximises the distance to the earlier points, and D holds the
+     * distance fields at the sample */
+    double *all = malloc((size_t)K * m->nv * sizeof *all);
+    CHECK_INT(geod_all_pairs_from(s, pts, K, all), GEOD_OK);
     for (int j = 1; j < K; j++) {
         double best = 0, got = INFINITY;
         for (int x = 0; x < m->nv; x++) {
             double d = INFINITY;
             for (int i = 0; i < j; i++)
-                d = fmin(d, F[(size_t)i * m->nv + x]);
+                d = fmin(d, all[(size_t)i * m->nv + x]);
             best = fmax(best, d);
             if (x == pts[j])
                 got = d;
         }
-        CHECK_NEAR(got, best, 0);
+        CHECK_NEAR(got, best, 1e-12);
+        for (int i = 0; i < j; i++)
+            CHECK_NEAR(F[(size_t)i * K + j], all[(size_t)j * m->nv + pts[i]], 1e-12);
     }
+    free(all);
     char err[256] = "";
     CHECK_INT(embed_farthest_points(s, m->nv, 3, pts, F, err, sizeof err), EMBED_EINVAL);
     free(F);
@@ -96,11 +104,10 @@ TEST(farthest_points_are_spread_and_keep_their_fields)
 /* Great-circle distance is not Euclidean: classical MDS of the EXACT
  * distances of 400 random sphere points gives corr 0.978 and stress 0.16
  * (3-D), 0.23 (8-D), 0.31 (64-D) (the negative eigenvalues are dropped and
- * more dimensions only stretch distances), so a correlation above 0.99 is
- * out of reach of (L)MDS on a sphere. Measured here (level 4, dim 8, k 50):
- * landmarks corr 0.980, stress 0.234; sample corr 0.978, stress 0.227:
- * the exact-distance figures, i.e. the heat-method error adds nothing
- * visible. */
+ * more dimensions only stretch distances). SMACOF does better. Measured
+ * here (level 4, dim 8, k 300): landmark stress 0.230 classical -> 0.099
+ * after 80 SMACOF steps, corr 0.9825; sample corr 0.9805, stress 0.103
+ * (classical landmark MDS alone had sample stress 0.227). */
 TEST(sphere_embedding_reproduces_geodesic_distances)
 {
     mesh *m = testmesh_icosphere(4);
@@ -111,13 +118,15 @@ TEST(sphere_embedding_reproduces_geodesic_distances)
     double *Z = malloc((size_t)m->nv * EMBED_DIM_DEFAULT * sizeof *Z);
     embed_quality q;
     CHECK_INT(embed_lmds(s, 0, 0, 0, Z, &q, err, sizeof err), EMBED_OK);
-    printf("  k %d: landmarks corr %.4f stress %.4f; sample (%d pairs) corr %.4f stress %.4f; "
-           "eigen kept %.3f\n", q.landmarks, q.corr_landmarks, q.stress_landmarks,
-           q.pairs_sample, q.corr_sample, q.stress_sample, q.eigen_kept);
-    CHECK_INT(q.landmarks, EMBED_MIN_LANDMARKS);
+    printf("  k %d: landmarks corr %.4f stress %.4f (classical %.4f, %d SMACOF steps); sample (%d "
+           "pairs) corr %.4f stress %.4f; eigen kept %.3f\n", q.landmarks, q.corr_landmarks,
+           q.stress_landmarks, q.stress_classical, q.smacof_iterations, q.pairs_sample,
+           q.corr_sample, q.stress_sample, q.eigen_kept);
+    CHECK_INT(q.landmarks, EMBED_LANDMARKS_DEFAULT);
     CHECK(q.pairs_sample > 0.9 * EMBED_QUALITY_SOURCES * EMBED_QUALITY_TARGETS);
-    CHECK(q.corr_landmarks > 0.975 && q.corr_sample > 0.975);
-    CHECK(q.stress_landmarks < 0.25 && q.stress_sample < 0.25);
+    CHECK(q.corr_landmarks > 0.98 && q.corr_sample > 0.975);
+    CHECK(q.stress_landmarks < 0.12 && q.stress_sample < 0.12);
+    CHECK(q.stress_landmarks < 0.5 * q.stress_classical);
     for (int i = 0; i < m->nv * EMBED_DIM_DEFAULT; i++)
         CHECK(isfinite(Z[i]));
     free(Z);
@@ -151,8 +160,9 @@ static double procrustes_2d(const double *Z, const double *P3, int n)
     return sqrt(fmax(res, 0) / pp);
 }
 
-/* Measured (817 vertices, k 50): Procrustes 0.0078 of the disk's size;
- * landmarks corr 0.99960, stress 0.0175; sample corr 0.99988, stress 0.0173. */
+/* Measured (817 vertices, k 300): Procrustes 0.0123 of the disk's size;
+ * landmarks corr 0.99985, stress 0.0086 (classical 0.0126); sample corr
+ * 0.99986, stress 0.0080. */
 TEST(disk_embedding_in_2d_recovers_the_disk)
 {
     mesh *m = testmesh_disk(16);
@@ -164,13 +174,13 @@ TEST(disk_embedding_in_2d_recovers_the_disk)
     embed_quality q;
     CHECK_INT(embed_lmds(s, 2, 0, 0, Z, &q, err, sizeof err), EMBED_OK);
     double pe = procrustes_2d(Z, m->v, m->nv);
-    printf("  Procrustes %.5f; landmarks corr %.5f stress %.4f; sample corr %.5f stress %.4f; "
-           "eigen kept %.3f\n", pe, q.corr_landmarks, q.stress_landmarks, q.corr_sample,
-           q.stress_sample, q.eigen_kept);
-    CHECK(pe < 0.015);
+    printf("  Procrustes %.5f; landmarks corr %.5f stress %.4f (classical %.4f); sample corr %.5f "
+           "stress %.4f; eigen kept %.3f\n", pe, q.corr_landmarks, q.stress_landmarks,
+           q.stress_classical, q.corr_sample, q.stress_sample, q.eigen_kept);
+    CHECK(pe < 0.02);
     CHECK(q.corr_landmarks > 0.999 && q.corr_sample > 0.999);
-    CHECK(q.stress_landmarks < 0.025 && q.stress_sample < 0.025);
-    CHECK(q.eigen_kept > 0.9); /* measured 0.944 */
+    CHECK(q.stress_landmarks < 0.015 && q.stress_sample < 0.015);
+    CHECK(q.eigen_kept > 0.85); /* measured 0.896 */
     /* a 1-D embedding of a disk must fit worse: the report is not constant */
     embed_quality q1;
     CHECK_INT(embed_lmds(s, 1, 0, 0, Z, &q1, err, sizeof err), EMBED_OK);
@@ -196,6 +206,83 @@ TEST(bad_embedding_arguments_are_refused)
     /* the default k is capped at nv (42 vertices) */
     CHECK_INT(embed_lmds(s, 3, 0, 0, Z, NULL, err, sizeof err), EMBED_OK);
     CHECK(strcmp(embed_strerror(EMBED_EDISCONNECTED), "mesh not connected") == 0);
+    free(Z);
+    geod_solver_free(s);
+    mesh_free(m);
+}
+
+/* SMACOF from a perturbed start recovers points whose distances are
+ * Euclidean (stress to round-off), and never raises the stress. */
+TEST(smacof_recovers_euclidean_configurations)
+{
+    enum { K = 40, DIM = 3 };
+    double P[K * DIM], Y[K * DIM], D[K * K];
+    unsigned long long st = 11;
+    for (int i = 0; i < K * DIM; i++)
+        P[i] = testmesh_rand(&st);
+    for (int i = 0; i < K; i++)
+        for (int j = 0; j < K; j++) {
+            double d2 = 0;
+            for (int c = 0; c < DIM; c++)
+                d2 += (P[i * DIM + c] - P[j * DIM + c]) * (P[i * DIM + c] - P[j * DIM + c]);
+            D[i * K + j] = sqrt(d2);
+        }
+    for (int i = 0; i < K * DIM; i++)
+        Y[i] = P[i] + 0.1 * (testmesh_rand(&st) - 0.5);
+    double g[K * (K - 1) / 2], e[K * (K - 1) / 2], stress[4], corr;
+    int its[4] = {0, 1, 5, 2000};
+    for (int r = 0; r < 4; r++) {
+        double Yr[K * DIM];
+        memcpy(Yr, Y, sizeof Y);
+        CHECK_INT(embed_smacof(D, K, DIM, its[r], 0, Yr, NULL), EMBED_OK);
+        int n = 0;
+        for (int i = 0; i < K; i++)
+            for (int j = i + 1; j < K; j++, n++) {
+                double d2 = 0;
+                for (int c = 0; c < DIM; c++)
+                    d2 += (Yr[i * DIM + c] - Yr[j * DIM + c]) * (Yr[i * DIM + c] - Yr[j * DIM + c]);
+                g[n] = D[i * K + j];
+                e[n] = sqrt(d2);
+            }
+        embed_distance_fit(g, e, n, &stress[r], &corr);
+    }
+    printf("  stress after 0/1/5/2000 steps: %.3g %.3g %.3g %.3g\n", stress[0], stress[1],
+           stress[2], stress[3]);
+    CHECK(stress[1] <= stress[0] && stress[2] <= stress[1] && stress[3] <= stress[2]);
+    CHECK(stress[3] < 1e-6);
+}
+
+/* The biharmonic extension keeps the fixed rows and, from every fourth
+ * vertex of a level-4 sphere with its true coordinates, rebuilds the rest
+ * closely. Measured: max error 0.0004 on the unit sphere. */
+TEST(biharmonic_extension_interpolates_and_rebuilds_a_sphere)
+{
+    mesh *m = testmesh_icosphere(4);
+    char err[256] = "";
+    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    if (!s)
+        FAILF("%s", err);
+    int k = 0, *fixed = malloc(m->nv * sizeof *fixed);
+    double *Y = malloc((size_t)m->nv * 3 * sizeof *Y), *Z = malloc((size_t)m->nv * 3 * sizeof *Z);
+    for (int v = 0; v < m->nv; v += 4, k++) {
+        fixed[k] = v;
+        memcpy(Y + 3 * k, m->v + 3 * v, 3 * sizeof *Y);
+    }
+    CHECK_INT(embed_biharmonic(geod_solver_laplacian(s), geod_solver_mass(s), fixed, k, Y, 3, Z,
+                               err, sizeof err), EMBED_OK);
+    double worst = 0;
+    for (int v = 0; v < m->nv; v++) {
+        double d2 = 0;
+        for (int c = 0; c < 3; c++)
+            d2 += (Z[3 * v + c] - m->v[3 * v + c]) * (Z[3 * v + c] - m->v[3 * v + c]);
+        if (v % 4 == 0)
+            CHECK(d2 == 0);
+        worst = fmax(worst, sqrt(d2));
+    }
+    printf("  %d of %d vertices fixed; max error %.4f\n", k, m->nv, worst);
+    CHECK(worst < 0.002);
+    free(fixed);
+    free(Y);
     free(Z);
     geod_solver_free(s);
     mesh_free(m);

@@ -34,9 +34,12 @@ static int print_progress(void *ctx, const rhm_report *r)
 /* Landmarks -> Voronoi -> RHM -> ECTM (30 outer iterations, as corr_run
  * chains them) on FAUST tr_reg_000 -> tr_reg_001 with 12 landmarks, scored
  * against the 5000-point ground truth. Measured (mean geodesic error /
- * sqrt(area)): Voronoi 0.1335, RHM 0.0417, RHM + ECTM 0.0407; mean |log
- * area| RHM 0.627 -> ECTM 0.452; collapsed triangles Voronoi 99.96 %, RHM
- * 14.1 %, ECTM 10.7 %; median conformal RHM 0.111, ECTM 0.053. */
+ * sqrt(area)): Voronoi 0.1335, RHM 0.0377, RHM + ECTM 0.0368; mean |log
+ * area| RHM 0.548 -> ECTM 0.523; collapsed triangles Voronoi 99.96 %, RHM
+ * 14.4 %, ECTM 9.0 %; median conformal RHM 0.064, ECTM 0.061; flipped RHM
+ * 14.3 %, ECTM 16.8 % (whole limb segments mapped twisted: see rhm.h).
+ * Before the SMACOF embedding and the intrinsic Delaunay geodesics: RHM
+ * 0.0417, median conformal 0.111, flipped 29.7 %. */
 TEST_T(rhm_then_ectm_from_faust_landmarks_against_ground_truth, 150)
 {
     testgt g;
@@ -79,9 +82,11 @@ TEST_T(rhm_then_ectm_from_faust_landmarks_against_ground_truth, 150)
      * distortion); RHM's is finite on most and low in the median */
     CHECK(ms[0].collapsed_fraction > 0.99);
     CHECK(ms[1].collapsed_fraction < 0.2);
-    CHECK(ms[1].median_conformal < 0.2);
-    /* ECTM: less area distortion, no worse geodesic error */
-    CHECK(ms[2].mean_abs_log_area < 0.85 * ms[1].mean_abs_log_area);
+    CHECK(ms[1].median_conformal < 0.1);
+    CHECK(ms[1].flipped_fraction < 0.2);
+    /* ECTM: less area and conformal distortion, no worse geodesic error */
+    CHECK(ms[2].mean_abs_log_area < ms[1].mean_abs_log_area);
+    CHECK(ms[2].median_conformal < ms[1].median_conformal);
     CHECK(ms[2].collapsed_fraction < ms[1].collapsed_fraction);
     CHECK(ge[2] <= ge[1] * 1.02);
     free(e);
@@ -304,7 +309,9 @@ TEST(refuses_too_few_landmarks_and_bad_parameters)
  * vertex i moves by at most 0.03 of a radius), from 8 farthest-point
  * landmarks. The true map sends vertex i near vertex i: the mean geodesic
  * error stays close to the slide (0.03 / √(4π) ≈ 0.0085 at most), with no
- * flipped or collapsed triangle. */
+ * flipped or collapsed triangle. Measured: mean geodesic error 0.0039,
+ * median conformal 0.0002 (with the classical landmark-MDS embedding:
+ * 0.0048 and 0.0073). */
 TEST_T(sphere_to_retessellated_sphere_is_found_from_eight_landmarks, 120)
 {
     mesh *S = testmesh_icosphere(3), *T = testmesh_icosphere(3);
@@ -354,7 +361,7 @@ TEST_T(sphere_to_retessellated_sphere_is_found_from_eight_landmarks, 120)
            g, ms.median_conformal, 100 * ms.flipped_fraction, 100 * ms.collapsed_fraction);
     CHECK(g < 0.03);
     CHECK(ms.flipped_fraction == 0 && ms.collapsed_fraction == 0);
-    CHECK(ms.median_conformal < 0.05);
+    CHECK(ms.median_conformal < 0.01);
     geod_solver_free(gs);
     rhm_result_close(&r);
     free(id);

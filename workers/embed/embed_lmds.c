@@ -1,6 +1,7 @@
-/* embed_lmds.c — landmark MDS of geodesic distances and its quality report;
- * see embed.h. Sampling, eigenpairs and the fit measure live in their own
- * files; this one assembles the centred matrix and triangulates. */
+/* embed_lmds.c — the embedding of embed.h assembled: classical MDS start,
+ * SMACOF, principal axes, biharmonic extension, and the quality report.
+ * Sampling, eigenpairs, SMACOF, the extension and the fit measure live in
+ * their own files. */
 #include "embed/embed.h"
 #include "util/errbuf.h"
 
@@ -75,113 +76,167 @@ out:
     return rc;
 }
 
+/* Classical MDS of the k by k distances D into Y (k by dim); the share of
+ * the kept eigenvalues in *kept. */
+static int classical(const double *D, int k, int dim, double *Y, double *kept,
+                     char *err, size_t errsz)
+{
+    int rc = EMBED_ENOMEM;
+    double *B = malloc((size_t)k * k * sizeof *B), *mu = malloc((size_t)k * sizeof *mu);
+    double *w = malloc((size_t)dim * sizeof *w), *V = malloc((size_t)k * dim * sizeof *V);
+    double *all_w = malloc((size_t)k * sizeof *all_w);
+    if (!B || !mu || !w || !V || !all_w) {
+        errbuf_set(err, errsz, rc, "out of memory for %d landmarks", k);
+        goto out;
+    }
+    double tot = 0;
+    for (int a = 0; a < k; a++) {
+        mu[a] = 0;
+        for (int b = 0; b < k; b++)
+            mu[a] += D[(size_t)a * k + b] * D[(size_t)a * k + b];
+        mu[a] /= k;
+        tot += mu[a];
+    }
+    tot /= k;
+    for (int a = 0; a < k; a++)
+        for (int b = 0; b < k; b++) {
+            double d = D[(size_t)a * k + b];
+            B[(size_t)a * k + b] = -0.5 * (d * d - mu[a] - mu[b] + tot);
+        }
+    if ((rc = embed_top_eigenpairs(B, k, dim, w, V, all_w)) != EMBED_OK) {
+        errbuf_set(err, errsz, rc, "eigenpairs of the %d by %d centred matrix", k, k);
+        goto out;
+    }
+    double sum_kept = 0, sum_all = 0;
+    for (int i = 0; i < dim; i++) {
+        double sc = w[i] > 0 ? sqrt(w[i]) : 0;
+        sum_kept += w[i] > 0 ? w[i] : 0;
+        for (int a = 0; a < k; a++)
+            Y[(size_t)a * dim + i] = sc * V[(size_t)a * dim + i];
+    }
+    for (int a = 0; a < k; a++)
+        sum_all += fabs(all_w[a]);
+    *kept = sum_all > 0 ? sum_kept / sum_all : 0;
+out:
+    free(B);
+    free(mu);
+    free(w);
+    free(V);
+    free(all_w);
+    return rc;
+}
+
+/* Y (k by dim) centred and rotated onto its principal axes, variance
+ * descending, each axis' sign fixed by its largest-magnitude entry. */
+static int principal_axes(double *Y, int k, int dim)
+{
+    double *C = calloc((size_t)dim * dim, sizeof *C), *w = malloc((size_t)dim * sizeof *w);
+    double *R = malloc((size_t)dim * dim * sizeof *R), *y = malloc((size_t)dim * sizeof *y);
+    int rc = EMBED_ENOMEM;
+    if (!C || !w || !R || !y)
+        goto out;
+    for (int c = 0; c < dim; c++) {
+        double m = 0;
+        for (int a = 0; a < k; a++)
+            m += Y[(size_t)a * dim + c];
+        m /= k;
+        for (int a = 0; a < k; a++)
+            Y[(size_t)a * dim + c] -= m;
+    }
+    for (int a = 0; a < k; a++)
+        for (int i = 0; i < dim; i++)
+            for (int j = 0; j < dim; j++)
+                C[(size_t)i * dim + j] += Y[(size_t)a * dim + i] * Y[(size_t)a * dim + j];
+    if ((rc = embed_top_eigenpairs(C, dim, dim, w, R, NULL)) != EMBED_OK)
+        goto out;
+    for (int a = 0; a < k; a++) {
+        double *row = Y + (size_t)a * dim;
+        for (int j = 0; j < dim; j++) {
+            y[j] = 0;
+            for (int i = 0; i < dim; i++)
+                y[j] += row[i] * R[(size_t)i * dim + j];
+        }
+        memcpy(row, y, (size_t)dim * sizeof *y);
+    }
+    for (int j = 0; j < dim; j++) {
+        int big = 0;
+        for (int a = 1; a < k; a++)
+            if (fabs(Y[(size_t)a * dim + j]) > fabs(Y[(size_t)big * dim + j]))
+                big = a;
+        if (Y[(size_t)big * dim + j] < 0)
+            for (int a = 0; a < k; a++)
+                Y[(size_t)a * dim + j] = -Y[(size_t)a * dim + j];
+    }
+out:
+    free(C);
+    free(w);
+    free(R);
+    free(y);
+    return rc;
+}
+
+static void landmark_fit(const double *D, const double *Y, int k, int dim, double *stress,
+                         double *corr, double *dg, double *de)
+{
+    size_t n = 0;
+    for (int a = 0; a < k; a++)
+        for (int b = a + 1; b < k; b++, n++) {
+            dg[n] = D[(size_t)a * k + b];
+            de[n] = dist_rows(Y, dim, a, b);
+        }
+    embed_distance_fit(dg, de, (int)n, stress, corr);
+}
+
 int embed_lmds(geod_solver *s, int dim, int k, int start, double *Z,
                embed_quality *q, char *err, size_t errsz)
 {
     int nv = geod_solver_nv(s);
     if (dim <= 0)
         dim = EMBED_DIM_DEFAULT;
-    if (k <= 0) {
-        k = 3 * dim > EMBED_MIN_LANDMARKS ? 3 * dim : EMBED_MIN_LANDMARKS;
-        k = k < nv ? k : nv;
-    }
+    if (k <= 0)
+        k = EMBED_LANDMARKS_DEFAULT < nv ? EMBED_LANDMARKS_DEFAULT : nv;
     if (dim > EMBED_MAX_DIM || k < dim + 1 || k > nv || start < 0 || start >= nv)
         return errbuf_set(err, errsz, EMBED_EINVAL,
                           "dim %d (max %d), landmarks %d (need dim+1..%d), start %d", dim,
                           EMBED_MAX_DIM, k, nv, start);
     int rc = EMBED_ENOMEM;
+    size_t np = (size_t)k * (k - 1) / 2;
     int *pts = malloc((size_t)k * sizeof *pts);
-    double *F = malloc((size_t)k * nv * sizeof *F), *D2 = malloc((size_t)k * k * sizeof *D2);
-    double *mu = malloc((size_t)k * sizeof *mu), *w = malloc((size_t)dim * sizeof *w);
-    double *V = malloc((size_t)k * dim * sizeof *V), *all_w = malloc((size_t)k * sizeof *all_w);
-    double *dg = NULL, *de = NULL;
-    if (!pts || !F || !D2 || !mu || !w || !V || !all_w) {
+    double *D = malloc((size_t)k * k * sizeof *D), *Y = malloc((size_t)k * dim * sizeof *Y);
+    double *dg = q ? malloc(np * sizeof *dg) : NULL, *de = q ? malloc(np * sizeof *de) : NULL;
+    if (!pts || !D || !Y || (q && (!dg || !de))) {
         errbuf_set(err, errsz, rc, "out of memory for %d landmarks", k);
         goto out;
     }
-    if ((rc = embed_farthest_points(s, start, k, pts, F, err, errsz)) != EMBED_OK)
+    if ((rc = embed_farthest_points(s, start, k, pts, D, err, errsz)) != EMBED_OK)
         goto out;
-
-    /* D2 = squared symmetrised distances; B = -1/2 J D2 J into V's eigen call */
-    for (int a = 0; a < k; a++)
-        for (int b = 0; b < k; b++) {
-            double d = 0.5 * (F[(size_t)a * nv + pts[b]] + F[(size_t)b * nv + pts[a]]);
-            D2[(size_t)a * k + b] = d * d;
-        }
-    double tot = 0;
-    for (int a = 0; a < k; a++) {
-        mu[a] = 0;
-        for (int b = 0; b < k; b++)
-            mu[a] += D2[(size_t)a * k + b];
-        mu[a] /= k;
-        tot += mu[a];
-    }
-    tot /= k;
-    double *B = malloc((size_t)k * k * sizeof *B);
-    if (!B) {
-        rc = errbuf_set(err, errsz, EMBED_ENOMEM, "out of memory");
+    double kept, stress0 = 0, corr0;
+    if ((rc = classical(D, k, dim, Y, &kept, err, errsz)) != EMBED_OK)
+        goto out;
+    if (q)
+        landmark_fit(D, Y, k, dim, &stress0, &corr0, dg, de);
+    int iters = 0;
+    if ((rc = embed_smacof(D, k, dim, EMBED_SMACOF_MAX_ITER, EMBED_SMACOF_TOL, Y, &iters)) ||
+        (rc = principal_axes(Y, k, dim))) {
+        errbuf_set(err, errsz, rc, "stress majorisation of %d landmarks", k);
         goto out;
     }
-    for (int a = 0; a < k; a++)
-        for (int b = 0; b < k; b++)
-            B[(size_t)a * k + b] = -0.5 * (D2[(size_t)a * k + b] - mu[a] - mu[b] + tot);
-    rc = embed_top_eigenpairs(B, k, dim, w, V, all_w);
-    free(B);
-    if (rc != EMBED_OK) {
-        errbuf_set(err, errsz, rc, "eigenpairs of the %d by %d centred matrix", k, k);
+    if ((rc = embed_biharmonic(geod_solver_laplacian(s), geod_solver_mass(s), pts, k, Y, dim, Z,
+                               err, errsz)))
         goto out;
-    }
-
-    /* pseudo-inverse columns v_i / sqrt(lambda_i), 0 for lambda_i <= 0 */
-    for (int i = 0; i < dim; i++) {
-        double sc = w[i] > 0 ? 1 / sqrt(w[i]) : 0;
-        for (int a = 0; a < k; a++)
-            V[(size_t)a * dim + i] *= sc;
-    }
-#pragma omp parallel for schedule(static)
-    for (int x = 0; x < nv; x++) {
-        double *z = Z + (size_t)x * dim;
-        for (int i = 0; i < dim; i++)
-            z[i] = 0;
-        for (int a = 0; a < k; a++) {
-            double d = F[(size_t)a * nv + x], r = -0.5 * (d * d - mu[a]);
-            for (int i = 0; i < dim; i++)
-                z[i] += r * V[(size_t)a * dim + i];
-        }
-    }
-
     if (q) {
-        double kept = 0, all = 0;
-        for (int i = 0; i < dim; i++)
-            kept += w[i] > 0 ? w[i] : 0;
-        for (int a = 0; a < k; a++)
-            all += fabs(all_w[a]);
         memset(q, 0, sizeof *q);
         q->landmarks = k;
-        q->eigen_kept = all > 0 ? kept / all : 0;
-        size_t np = (size_t)k * (k - 1) / 2, n = 0;
-        dg = malloc(np * sizeof *dg);
-        de = malloc(np * sizeof *de);
-        if (!dg || !de) {
-            rc = errbuf_set(err, errsz, EMBED_ENOMEM, "out of memory for the report");
-            goto out;
-        }
-        for (int a = 0; a < k; a++)
-            for (int b = a + 1; b < k; b++, n++) {
-                dg[n] = sqrt(D2[(size_t)a * k + b]);
-                de[n] = dist_rows(Z, dim, pts[a], pts[b]);
-            }
-        embed_distance_fit(dg, de, (int)np, &q->stress_landmarks, &q->corr_landmarks);
+        q->eigen_kept = kept;
+        q->stress_classical = stress0;
+        q->smacof_iterations = iters;
+        landmark_fit(D, Y, k, dim, &q->stress_landmarks, &q->corr_landmarks, dg, de);
         rc = sample_quality(s, Z, dim, q, err, errsz);
     }
 out:
     free(pts);
-    free(F);
-    free(D2);
-    free(mu);
-    free(w);
-    free(V);
-    free(all_w);
+    free(D);
+    free(Y);
     free(dg);
     free(de);
     return rc;

@@ -2,12 +2,17 @@
  * Weischedel, Wardetzky 2013), with the two sparse factorisations made once
  * per mesh and reused for any number of sources.
  *
- * Method, per call: with M the lumped mass (geo_area.h) and L the cotan
- * Laplacian (geo_cotan.h, positive semi-definite), one backward-Euler heat
- * step (M + t L) u = delta_sources, t = t_factor * h^2 with h the mean edge
- * length; per face X = -grad u / |grad u|; per vertex the integrated
- * divergence of X; then the Poisson problem L phi = -div X, shifted so that
- * the sources sit at 0 (see geod_distances for the exact rule).
+ * Method: the mesh's triangulation is first flipped to its intrinsic
+ * Delaunay triangulation (same vertices, edges kept as lengths; see
+ * geod__idt.h for why: on meshes with obtuse triangles the plain cotan
+ * operators made distances collapse far from the source). On it, with M
+ * the lumped mass and L the cotan Laplacian (positive semi-definite, every
+ * edge weight >= 0), per call: one backward-Euler heat step
+ * (M + t L) u = delta_sources, t = t_factor * h^2 with h the mesh's mean
+ * edge length; per triangle X = -grad u / |grad u|; per vertex the
+ * integrated divergence of X; then the Poisson problem L phi = -div X,
+ * shifted so that the sources sit at 0 (see geod_distances for the exact
+ * rule).
  *
  * Numerical choices:
  *  - Poisson regularisation: L is singular (constants per connected
@@ -43,6 +48,7 @@
  * in a fixed order). Double precision throughout. */
 #ifndef GEOD_H
 #define GEOD_H
+#include "geo/geo_csr.h"
 #include "mesh/mesh.h"
 
 #include <stddef.h>
@@ -76,6 +82,15 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
 void geod_solver_free(geod_solver *s);
 
 int geod_solver_nv(const geod_solver *s);
+/* The operators the distances are computed with, borrowed (valid while s
+ * lives): the cotan Laplacian of the intrinsic Delaunay triangulation (nv
+ * by nv, both triangles, positive semi-definite, every off-diagonal entry
+ * <= 0) and its lumped mass (nv). Other modules may build on them (the
+ * embedding's biharmonic extension). */
+const geo_csr *geod_solver_laplacian(const geod_solver *s);
+const double *geod_solver_mass(const geod_solver *s);
+/* Edges flipped to make that triangulation Delaunay (0: the mesh was). */
+int geod_solver_flips(const geod_solver *s);
 /* The heat time t actually used. */
 double geod_solver_time(const geod_solver *s);
 

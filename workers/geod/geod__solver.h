@@ -4,15 +4,20 @@
 #ifndef GEOD__SOLVER_H
 #define GEOD__SOLVER_H
 #include "geod/geod.h"
+#include "geo/geo_csr.h"
 
 #include <suitesparse/cholmod.h>
 
 struct geod_solver {
-    const mesh *m;           /* borrowed */
     int nv, nf;
     double t;                /* heat time */
-    double *grad;            /* nf by 9: gradients of the 3 hat functions, 0 on degenerate faces */
+    int *f;                  /* nf by 3: the intrinsic Delaunay triangles (geod__idt.h) */
+    double *grad;            /* nf by 6: gradients of the 3 hat functions in each
+                                triangle's own plane frame, 0 on degenerate faces */
     double *area;            /* nf */
+    int flips;               /* edges flipped to make the triangulation Delaunay */
+    geo_csr *L;              /* its cotan Laplacian (both triangles) */
+    double *mass;            /* nv: its lumped mass */
     int *comp;               /* nv: connected component of each vertex */
     int ncomp;
     int n_interior;          /* vertices not on the boundary (all when closed) */

@@ -13,20 +13,19 @@
  * over faces in order: deterministic. */
 static void divergence(const geod_solver *s, const double *u, double *b)
 {
-    const int *f = s->m->f;
     memset(b, 0, (size_t)s->nv * sizeof *b);
     for (int t = 0; t < s->nf; t++) {
-        const double *g = s->grad + 9 * (size_t)t;
-        const int *c = f + 3 * (size_t)t;
-        double X[3];
-        for (int d = 0; d < 3; d++)
-            X[d] = -(u[c[0]] * g[d] + u[c[1]] * g[3 + d] + u[c[2]] * g[6 + d]);
-        double n = sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]);
+        const double *g = s->grad + 6 * (size_t)t;
+        const int *c = s->f + 3 * (size_t)t;
+        double X[2];
+        for (int d = 0; d < 2; d++)
+            X[d] = -(u[c[0]] * g[d] + u[c[1]] * g[2 + d] + u[c[2]] * g[4 + d]);
+        double n = sqrt(X[0] * X[0] + X[1] * X[1]);
         if (!(n > 0) || !isfinite(n))
             continue; /* flat heat (no source in reach) or degenerate face */
         double w = s->area[t] / n;
         for (int k = 0; k < 3; k++)
-            b[c[k]] += w * (g[3 * k] * X[0] + g[3 * k + 1] * X[1] + g[3 * k + 2] * X[2]);
+            b[c[k]] += w * (g[2 * k] * X[0] + g[2 * k + 1] * X[1]);
     }
 }
 

@@ -3,8 +3,8 @@
  * interior block (meshes with boundary) and L + eps M; see geod.h. Solving
  * lives in geod_distances.c. */
 #include "geod/geod__solver.h"
-#include "geo/geo_area.h"
-#include "geo/geo_cotan.h"
+#include "geod/geod__idt.h"
+#include "geo/geo_csr.h"
 #include "geo/geo_edges.h"
 #include "geo/geo_tri.h"
 #include "util/errbuf.h"
@@ -24,6 +24,9 @@ const char *geod_strerror(int code)
 }
 
 int geod_solver_nv(const geod_solver *s) { return s->nv; }
+int geod_solver_flips(const geod_solver *s) { return s->flips; }
+const geo_csr *geod_solver_laplacian(const geod_solver *s) { return s->L; }
+const double *geod_solver_mass(const geod_solver *s) { return s->mass; }
 double geod_solver_time(const geod_solver *s) { return s->t; }
 
 void geod_solver_free(geod_solver *s)
@@ -36,6 +39,9 @@ void geod_solver_free(geod_solver *s)
         cholmod_free_factor(&s->poisson, &s->cc);
         cholmod_finish(&s->cc);
     }
+    free(s->f);
+    geo_csr_free(s->L);
+    free(s->mass);
     free(s->grad);
     free(s->area);
     free(s->comp);
@@ -43,30 +49,121 @@ void geod_solver_free(geod_solver *s)
     free(s);
 }
 
-/* g_k = (c x e_k) / |c|^2 with c = (p1-p0) x (p2-p0) and e_k the edge
- * opposite corner k, p_{k+2} - p_{k+1}: the gradient of corner k's hat. */
-static void face_gradients(const mesh *m, double *grad, double *area)
+/* Per intrinsic triangle, in its own plane frame (corner 0 at the origin,
+ * corner 1 on the x axis, corner 2 above): the hat gradients
+ * g_k = J (p_{k+2} - p_{k+1}) / (2 A), J the quarter turn, and the area.
+ * Degenerate triangles get zero gradients and area. */
+static void face_gradients(const geod__idt *T, double *grad, double *area)
 {
-    for (int t = 0; t < m->nf; t++) {
-        double c[3];
-        double *g = grad + 9 * (size_t)t;
-        if (geo__face_cross(m, t, c)) {
-            memset(g, 0, 9 * sizeof *g);
+    for (int t = 0; t < T->nf; t++) {
+        const double *l = T->len + 3 * (size_t)t;
+        double *g = grad + 6 * (size_t)t, a2 = geod__double_area(l[0], l[1], l[2]);
+        if (!(a2 > GEO__DEGENERATE_REL * (l[1] * l[1] + l[2] * l[2]))) {
+            memset(g, 0, 6 * sizeof *g);
             area[t] = 0;
             continue;
         }
-        const double *p[3];
-        geo__corners(m, t, p);
-        double cc = geo__dot(c, c);
+        /* |p0 p1| = l[2], |p2 p0| = l[1] */
+        double x2 = (l[2] * l[2] + l[1] * l[1] - l[0] * l[0]) / (2 * l[2]);
+        double p[3][2] = {{0, 0}, {l[2], 0}, {x2, a2 / l[2]}};
         for (int k = 0; k < 3; k++) {
-            double e[3];
-            geo__sub(p[(k + 2) % 3], p[(k + 1) % 3], e);
-            geo__cross(c, e, g + 3 * k);
-            for (int d = 0; d < 3; d++)
-                g[3 * k + d] /= cc;
+            const double *q = p[(k + 2) % 3], *r = p[(k + 1) % 3];
+            g[2 * k] = -(q[1] - r[1]) / a2;
+            g[2 * k + 1] = (q[0] - r[0]) / a2;
         }
-        area[t] = 0.5 * sqrt(cc);
+        area[t] = 0.5 * a2;
     }
+}
+
+/* The cotan Laplacian L (positive semi-definite, weight (cot a + cot b) / 2
+ * per edge) and the lumped mass (a third of each incident triangle's area)
+ * of the intrinsic triangulation. L as CSR with both triangles, duplicate
+ * edges summed, loops (an edge from a vertex to itself) dropped: they add
+ * nothing to x^T L x. */
+static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass)
+{
+    size_t nt = 3 * (size_t)T->nf;
+    int *cnt = calloc((size_t)nv + 1, sizeof *cnt);
+    int *tr = malloc(2 * nt * sizeof *tr), *tc = malloc(2 * nt * sizeof *tc);
+    double *tv = malloc(2 * nt * sizeof *tv), *diag = calloc((size_t)nv, sizeof *diag);
+    geo_csr *L = NULL;
+    if (!cnt || !tr || !tc || !tv || !diag)
+        goto out;
+    memset(mass, 0, (size_t)nv * sizeof *mass);
+    size_t n = 0;
+    for (int t = 0; t < T->nf; t++)
+        for (int k = 0; k < 3; k++) {
+            const double *l = T->len + 3 * (size_t)t;
+            mass[T->f[3 * t + k]] += area[t] / 3;
+            int i = T->f[3 * t + (k + 1) % 3], j = T->f[3 * t + (k + 2) % 3];
+            double w = area[t] > 0 ? 0.5 * geod__cot(l[k], l[(k + 1) % 3], l[(k + 2) % 3]) : 0;
+            if (i == j || w == 0)
+                continue;
+            diag[i] += w;
+            diag[j] += w;
+            tr[n] = i, tc[n] = j, tv[n++] = -w;
+            tr[n] = j, tc[n] = i, tv[n++] = -w;
+        }
+    /* CSR by counting sort on rows, then per row sort columns and merge */
+    for (size_t q = 0; q < n; q++)
+        cnt[tr[q] + 1]++;
+    for (int i = 0; i < nv; i++)
+        cnt[i + 1] += cnt[i];
+    int *pos = malloc((size_t)nv * sizeof *pos), *col = malloc((n + (size_t)nv) * sizeof *col);
+    double *val = malloc((n + (size_t)nv) * sizeof *val);
+    if (!pos || !col || !val) {
+        free(pos);
+        free(col);
+        free(val);
+        goto out;
+    }
+    for (int i = 0; i < nv; i++)
+        pos[i] = cnt[i] + i;                /* room for the diagonal in each row */
+    for (int i = 0; i < nv; i++) {
+        col[pos[i]] = i;
+        val[pos[i]++] = diag[i];
+    }
+    for (size_t q = 0; q < n; q++) {
+        col[pos[tr[q]]] = tc[q];
+        val[pos[tr[q]]++] = tv[q];
+    }
+    size_t nnz = 0;
+    for (int i = 0; i < nv; i++) {       /* insertion sort: rows are short */
+        int lo = cnt[i] + i, hi = cnt[i + 1] + i + 1;
+        for (int a = lo + 1; a < hi; a++)
+            for (int b = a; b > lo && col[b - 1] > col[b]; b--) {
+                int c = col[b]; col[b] = col[b - 1]; col[b - 1] = c;
+                double v = val[b]; val[b] = val[b - 1]; val[b - 1] = v;
+            }
+        for (int a = lo; a < hi; a++)
+            nnz += a == lo || col[a] != col[a - 1];
+    }
+    if ((L = geo_csr_new(nv, (int)nnz))) {
+        size_t at = 0;
+        for (int i = 0; i < nv; i++) {
+            L->row_start[i] = (int)at;
+            int lo = cnt[i] + i, hi = cnt[i + 1] + i + 1;
+            for (int a = lo; a < hi; a++) {
+                if (a > lo && col[a] == col[a - 1]) {
+                    L->val[at - 1] += val[a];
+                    continue;
+                }
+                L->col[at] = col[a];
+                L->val[at++] = val[a];
+            }
+        }
+        L->row_start[nv] = (int)at;
+    }
+    free(pos);
+    free(col);
+    free(val);
+out:
+    free(cnt);
+    free(tr);
+    free(tc);
+    free(tv);
+    free(diag);
+    return L;
 }
 
 static int find_root(int *parent, int i)
@@ -157,6 +254,7 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
 {
     geod_solver *s = NULL;
     geo_edges e = {0};
+    geod__idt idt = {0};
     geo_csr *L = NULL;
     double *mass = NULL, *d = NULL;
     int *remap = NULL;
@@ -174,24 +272,33 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
             errbuf_set(err, errsz, GEOD_EMESH, "edge table: %s", geo_strerror(rc));
         goto out;
     }
-    if (geo_cotan_laplacian(m, &e, &L, err, errsz) != GEO_OK)
-        goto out;
     s = calloc(1, sizeof *s);
     mass = malloc((size_t)m->nv * sizeof *mass);
     d = malloc((size_t)m->nv * sizeof *d);
     if (!s || !mass || !d ||
-        !(s->grad = malloc(9 * (size_t)m->nf * sizeof *s->grad)) ||
+        !(s->grad = malloc(6 * (size_t)m->nf * sizeof *s->grad)) ||
         !(s->area = malloc((size_t)m->nf * sizeof *s->area)) ||
         !(s->comp = malloc((size_t)m->nv * sizeof *s->comp))) {
         errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex solver", m->nv);
         goto out;
     }
-    s->m = m;
     s->nv = m->nv;
     s->nf = m->nf;
-    face_gradients(m, s->grad, s->area);
+    if (geod__idt_build(m, &e, &idt) != GEOD_OK) {
+        errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the intrinsic triangulation");
+        goto out;
+    }
+    s->flips = idt.flips;
+    face_gradients(&idt, s->grad, s->area);
+    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass))) {
+        errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex Laplacian", m->nv);
+        goto out;
+    }
+    s->f = idt.f;
+    idt.f = NULL;
+    s->L = L;
+    s->mass = mass;
     s->ncomp = components(&e, m->nv, s->comp);
-    geo_vertex_areas(m, mass);
 
     double h = 0, msum = 0, lsum = 0;
     int nmass = 0;
@@ -274,10 +381,13 @@ fail_cholmod:
 out:
     if (s && s->cc_started)
         cholmod_free_sparse(&A, &s->cc);
-    free(mass);
     free(d);
     free(remap);
-    geo_csr_free(L);
+    geod__idt_close(&idt);
+    if (!s || !s->L) {   /* not handed over to the solver */
+        geo_csr_free(L);
+        free(mass);
+    }
     geo_edges_close(&e);
     if (!ok) {
         geod_solver_free(s);
