@@ -359,6 +359,7 @@ int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
     p->rhm_dim = s->rhm_dim;
     p->rhm_alpha = s->rhm_alpha;
     p->rhm_landmark_weight = s->rhm_landmark_weight;
+    p->rhm_start = (uint8_t)s->rhm_start;
     p->backend = s->backend ? s->backend : "";
     m->priority = s->priority;
     m->label = s->label ? s->label : "";

@@ -88,6 +88,7 @@ typedef struct mc_job_spec {
     /* RHM, for landmark jobs; 0 = the server's default (200, 8, 5e-4, off) */
     uint32_t rhm_iterations, rhm_dim;
     double rhm_alpha, rhm_landmark_weight;
+    int rhm_start;             /* MC_RHM_START_DISTANCES (0, the default) or MC_RHM_START_VORONOI */
     const char *backend;       /* NULL or "" = server default; "cpu", "opencl", "auto",
                                   optionally ":DEVICE" (a platform or device name part) */
     int32_t priority;          /* higher runs first */
@@ -97,13 +98,14 @@ typedef struct mc_job_spec {
 /* The engine's defaults (those of `meshcorr match`); no meshes, no landmarks. */
 void mc_job_spec_init(mc_job_spec *s);
 
-enum { MC_STAGE_VORONOI = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
+enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1 };
+enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
 
-/* For stages voronoi and rhm the five terms are RHM's (PROTOCOL.md,
+/* For stages start and rhm the five terms are RHM's (PROTOCOL.md,
  * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */
 typedef struct mc_progress {
     uint64_t job_id;
-    int stage;                 /* MC_STAGE_*: 0 voronoi, 1 rhm, 2 ectm, 3 init */
+    int stage;                 /* MC_STAGE_*: 0 start, 1 rhm, 2 ectm, 3 init */
     uint32_t outer, total;     /* outer iteration, planned */
     uint32_t inner[2];         /* L-BFGS iterations: [0] source side, [1] target side */
     double membrane[2], bending[2], mismatch[2], reverse[2], energy[2];

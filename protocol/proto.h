@@ -103,7 +103,7 @@ enum proto_state {
     PROTO_STATE_LAST = 6
 };
 
-#define PROTO_STAGES(X) X(VORONOI, 0) X(RHM, 1) X(ECTM, 2) X(INIT, 3)
+#define PROTO_STAGES(X) X(START, 0) X(RHM, 1) X(ECTM, 2) X(INIT, 3)
 enum proto_stage {
 #define PROTO_ENUM(name, val) PROTO_STAGE_##name = val,
     PROTO_STAGES(PROTO_ENUM)
@@ -120,6 +120,8 @@ enum proto_slot_state {
 };
 
 enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1, PROTO_MODEL_LAST = 1 };
+/* RHM's start map from the landmarks (workers/rhm/rhm.h) */
+enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1, PROTO_RHM_START_LAST = 1 };
 
 /* Energy terms reported per direction in PROGRESS (index into terms[d][]). */
 enum proto_term {
@@ -234,6 +236,7 @@ typedef struct proto_params {
     uint32_t rhm_iterations, rhm_dim;  /* at most K iterations; embedding dimension m */
     double rhm_alpha;                 /* harmonic vs reversibility, in (0, 1) */
     double rhm_landmark_weight;       /* weak landmark term γ (>= 0; 0 = off) */
+    uint8_t rhm_start;                /* enum proto_rhm_start */
     const char *backend;              /* "" = server default */
 } proto_params;
 

@@ -336,6 +336,7 @@ static void io_params(io *c, proto_params *p)
     io_u32(c, &p->rhm_dim);
     io_f64(c, &p->rhm_alpha);
     io_f64(c, &p->rhm_landmark_weight);
+    io_enum(c, &p->rhm_start, PROTO_RHM_START_LAST, "rhm_start");
     io_str(c, &p->backend, "backend");
 }
 

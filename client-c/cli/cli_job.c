@@ -105,6 +105,12 @@ int cli_job_option(cli_job *j, const char *cmd, int c, const char *arg)
     case CLI_O_RHM_DIM: return parse_int(cmd, "rhm-dim", arg, &j->rp.dim);
     case CLI_O_RHM_LANDMARK_WEIGHT:
         return parse_double(cmd, "rhm-landmark-weight", arg, &j->rp.gamma);
+    case CLI_O_RHM_START:
+        if ((j->rp.start = rhm_start_parse(arg)) < 0) {
+            fprintf(stderr, "meshcorr %s: --rhm-start: '%s' is not distances or voronoi\n", cmd, arg);
+            return -1;
+        }
+        return 1;
     }
     return 0;
 }

@@ -16,7 +16,8 @@ enum cli_job_code {
     CLI_O_TARGET_LANDMARKS, CLI_O_ONE_BASED, CLI_O_MODEL, CLI_O_PRESET, CLI_O_ALPHA, CLI_O_ETA,
     CLI_O_BETA0, CLI_O_BETA1, CLI_O_BETA_RAMP, CLI_O_GAMMA, CLI_O_ITERATIONS,
     CLI_O_INNER_ITERATIONS, CLI_O_TOLERANCE, CLI_O_STOP_CHANGE, CLI_O_PARTIAL, CLI_O_BACKEND,
-    CLI_O_DEVICE, CLI_O_RHM_ALPHA, CLI_O_RHM_ITERATIONS, CLI_O_RHM_DIM, CLI_O_RHM_LANDMARK_WEIGHT
+    CLI_O_DEVICE, CLI_O_RHM_ALPHA, CLI_O_RHM_ITERATIONS, CLI_O_RHM_DIM, CLI_O_RHM_LANDMARK_WEIGHT,
+    CLI_O_RHM_START
 };
 
 #define CLI_JOB_OPTIONS                                                                     \
@@ -44,7 +45,8 @@ enum cli_job_code {
     {"rhm-alpha", required_argument, 0, CLI_O_RHM_ALPHA},                                   \
     {"rhm-iterations", required_argument, 0, CLI_O_RHM_ITERATIONS},                         \
     {"rhm-dim", required_argument, 0, CLI_O_RHM_DIM},                                       \
-    {"rhm-landmark-weight", required_argument, 0, CLI_O_RHM_LANDMARK_WEIGHT}
+    {"rhm-landmark-weight", required_argument, 0, CLI_O_RHM_LANDMARK_WEIGHT},     \
+    {"rhm-start", required_argument, 0, CLI_O_RHM_START}
 
 #define CLI_JOB_USAGE                                                                           \
     "  inputs:   --landmarks PAIRS | --source-landmarks A --target-landmarks B [--one-based]\n"  \
@@ -54,13 +56,15 @@ enum cli_job_code {
     "            [--inner-iterations N] [--tolerance T] [--stop-change C] [--partial]\n"        \
     "            [--backend cpu|opencl|auto] [--device NAME]\n"                                 \
     "  RHM:      [--rhm-alpha A] [--rhm-iterations K] [--rhm-dim M] [--rhm-landmark-weight G]\n" \
+    "            [--rhm-start distances|voronoi]\n"                                           \
     "Defaults are the authors' released code's (--preset release): alpha 20, eta 6.667e-4,\n"    \
     "beta 500 -> 1e5 over 200 iterations, gamma 1e4, 300 iterations, 50 L-BFGS steps.\n"        \
-    "Without --init, the initial maps come from the landmarks (at least 3): a geodesic Voronoi\n" \
-    "map, then Reversible Harmonic Maps (alpha 5e-4, beta 5e-3 min(k, 100), 8-D embedding,\n"   \
-    "at most 200 iterations, landmark weight 0). --backend opencl computes the elastic energy\n" \
-    "on an OpenCL device with fp64 whose platform or device name contains NAME (see\n"          \
-    "meshcorr devices); auto: a GPU, else the CPU.\n"
+    "Without --init, the initial maps come from the landmarks (at least 3): a start map\n"      \
+    "matching each vertex's geodesic distances to the landmarks (--rhm-start voronoi: the\n"   \
+    "thesis' geodesic Voronoi cells), then Reversible Harmonic Maps (alpha 5e-4, beta 5e-3\n"  \
+    "min(k, 100), 8-D embedding, at most 200 iterations, landmark weight 0).\n"               \
+    "--backend opencl computes the elastic energy on an OpenCL device with fp64 whose\n"        \
+    "platform or device name contains NAME (see meshcorr devices); auto: a GPU, else the CPU.\n"
 
 typedef struct cli_job {
     ectm_params p;

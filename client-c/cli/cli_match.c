@@ -33,7 +33,7 @@ typedef struct progress_state {
     enum progress_mode mode;
 } progress_state;
 
-/* One RHM report (stage voronoi: the start, rhm: an iteration). */
+/* One RHM report (stage start: the start map, rhm: an iteration). */
 static void rhm_progress(progress_state *ps, const corr_progress *cp)
 {
     const rhm_report *r = cp->rhm;

@@ -129,7 +129,7 @@ static void json_str(const char *s)
 
 static const char *stage_name(int stage)
 {
-    static const char *const names[] = {"voronoi", "rhm", "ectm", "init"};
+    static const char *const names[] = {"start", "rhm", "ectm", "init"};
     return stage >= 0 && stage < 4 ? names[stage] : "?";
 }
 
@@ -227,6 +227,7 @@ static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t 
     s->rhm_dim = (uint32_t)j->rp.dim;
     s->rhm_alpha = j->rp.alpha;
     s->rhm_landmark_weight = j->rp.gamma;
+    s->rhm_start = j->rp.start;
     snprintf(backend, bsz, "%s%s%s", p->backend, p->device[0] ? ":" : "", p->device);
     s->backend = backend;
 }

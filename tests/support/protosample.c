@@ -50,7 +50,7 @@ static void fill_rows(proto_map_row *r, uint32_t n, double s)
 static void fill_progress(proto_progress *g, int v)
 {
     g->job_id = v ? 1 : UINT64_MAX;
-    g->stage = v ? PROTO_STAGE_VORONOI : PROTO_STAGE_ECTM;
+    g->stage = v ? PROTO_STAGE_START : PROTO_STAGE_ECTM;
     g->outer = 17;
     g->total = 40;
     g->inner[0] = 123;
@@ -96,7 +96,7 @@ void protosample_fill(int type, int v, proto_msg *m)
         u->params = (proto_params){ (uint8_t)(v ? PROTO_MODEL_INJECTIVE : PROTO_MODEL_BIJECTIVE),
                                     (uint8_t)!v, 1e-3, 0.1, 1.0, 1e4, 2, 0.25, 30, 200,
                                     1e-8, 1e-6, v ? 0 : 150, v ? 0 : 12, v ? 0 : 1e-3,
-                                    v ? 0 : 0.5, v ? "" : "opencl:pocl" };
+                                    v ? 0 : 0.5, (uint8_t)!v, v ? "" : "opencl:pocl" };
         u->priority = v ? 0 : -7;
         u->label = s;
         break;
@@ -249,7 +249,8 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
         DIFF(p->alpha != q->alpha || p->eta != q->eta || p->beta0 != q->beta0 ||
              p->beta1 != q->beta1 || p->beta_ramp != q->beta_ramp || p->gamma != q->gamma ||
              p->rhm_iterations != q->rhm_iterations || p->rhm_dim != q->rhm_dim ||
-             p->rhm_alpha != q->rhm_alpha || p->rhm_landmark_weight != q->rhm_landmark_weight,
+             p->rhm_alpha != q->rhm_alpha || p->rhm_landmark_weight != q->rhm_landmark_weight ||
+             p->rhm_start != q->rhm_start,
              "params weights");
         DIFF(p->iterations != q->iterations || p->inner_iterations != q->inner_iterations,
              "params iterations");

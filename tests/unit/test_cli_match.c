@@ -135,6 +135,10 @@ TEST(match_refuses_bad_option_value)
              s381, s390, p0);
     CHECK_INT(run(cmd, out, sizeof out), 2);
     CHECK_STR_HAS(out, "gamma");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --rhm-start cells",
+             s381, s390, p0);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--rhm-start: 'cells' is not distances or voronoi");
 }
 
 TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)
@@ -180,9 +184,9 @@ TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)
 }
 
 /* The landmark path end to end with few iterations: JSON progress shows the
- * voronoi start, every RHM iteration and every ECTM iteration; --stages rhm
+ * start map, every RHM iteration and every ECTM iteration; --stages rhm
  * writes RHM's maps; --stages ectm without --init is refused. */
-TEST_T(match_from_landmarks_reports_voronoi_rhm_and_ectm_stages, 120)
+TEST_T(match_from_landmarks_reports_start_rhm_and_ectm_stages, 120)
 {
     char s0[512], s1[512], cmd[4096], out[65536];
     snprintf(s0, sizeof s0, "%s", harness_data_path("faust_r/vtx_5k/tr_reg_000.off"));
@@ -193,7 +197,7 @@ TEST_T(match_from_landmarks_reports_voronoi_rhm_and_ectm_stages, 120)
              "--iterations 2 --out %s/p.map --out-reverse %s/q.map --progress json",
              s0, s1, l, d, d);
     CHECK_INT(run(cmd, out, sizeof out), 0);
-    CHECK_STR_HAS(out, "{\"stage\":\"voronoi\",\"iteration\":0,");
+    CHECK_STR_HAS(out, "{\"stage\":\"start\",\"iteration\":0,");
     int rhm = 0, ectm = 0;
     for (char *p = out; (p = strstr(p, "{\"stage\":\"rhm\",\"iteration\":")); p++)
         rhm++;

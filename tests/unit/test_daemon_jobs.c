@@ -59,7 +59,7 @@ TEST_T(submitted_job_streams_energies_and_completes, 60)
         FAILF("WATCH: %s (%s)", mc_strerror(rc), mc_errmsg(c));
     if (state != MC_COMPLETED)
         FAILF("job ended %s: %s", mc_state_name(state), reason);
-    /* stages in order (init, voronoi, rhm, ectm), iterations rising in each */
+    /* stages in order (init, start, rhm, ectm), iterations rising in each */
     int last = 0, ectm = 0, rhm = 0;
     for (int i = 0; i < w.n; i++) {
         if (i > 0 && w.stage[i] != w.stage[i - 1])

@@ -337,10 +337,10 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     CHECK_INT(wait_exit(pid), 0);
     proto_progress pr[16];
     int np = progress_frames(pbuf, plen, pr, 16);
-    /* init, the Voronoi start, 3 RHM iterations, 2 ECTM iterations */
+    /* init, the start map, 3 RHM iterations, 2 ECTM iterations */
     CHECK_INT(np, 7);
     CHECK_INT(pr[0].stage, PROTO_STAGE_INIT);
-    CHECK_INT(pr[1].stage, PROTO_STAGE_VORONOI);
+    CHECK_INT(pr[1].stage, PROTO_STAGE_START);
     CHECK_INT(pr[1].outer, 0);
     for (int k = 2; k <= 4; k++) {
         CHECK_INT(pr[k].stage, PROTO_STAGE_RHM);

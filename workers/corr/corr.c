@@ -1,5 +1,5 @@
 /* corr.c — the correspondence pipeline (see corr.h): validation, initial
- * maps (Voronoi + RHM), ECTM, progress fan-in. Combines modules; computes
+ * maps (start + RHM), ECTM, progress fan-in. Combines modules; computes
  * nothing itself. */
 #include "corr/corr.h"
 #include "mesh/mesh_check.h"
@@ -22,7 +22,7 @@ const char *corr_stage_name(corr_stage s)
 {
     switch (s) {
     case CORR_STAGE_ECTM: return "ectm";
-    case CORR_STAGE_VORONOI: return "voronoi";
+    case CORR_STAGE_START: return "start";
     case CORR_STAGE_RHM: return "rhm";
     default: return "init";
     }
@@ -71,7 +71,7 @@ static int relay_rhm(void *ctx, const rhm_report *r)
     relay *rl = ctx;
     if (!rl->fn)
         return 0;
-    corr_progress p = { r->iteration ? CORR_STAGE_RHM : CORR_STAGE_VORONOI, NULL,
+    corr_progress p = { r->iteration ? CORR_STAGE_RHM : CORR_STAGE_START, NULL,
                         now() - rl->t0, r };
     return rl->fn(rl->ctx, &p);
 }

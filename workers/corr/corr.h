@@ -3,7 +3,7 @@
  *
  *   validate both meshes (manifold, one component, finite, no degenerate face)
  *   initial maps: the uploaded P (and Q), or from landmarks: geodesic
- *     Voronoi map, then Reversible Harmonic Maps (rhm.h) giving P and Q
+ *     start map (rhm.h), then Reversible Harmonic Maps giving P and Q
  *   ECTM refinement
  *
  * Stages report progress through one callback; a non-zero return cancels.
@@ -37,12 +37,12 @@ const char *corr_strerror(int code);
 typedef enum corr_stage {
     CORR_STAGE_INIT = 0,     /* building the initial map starts             */
     CORR_STAGE_ECTM = 1,     /* one report per ECTM outer iteration         */
-    CORR_STAGE_VORONOI = 2,  /* the Voronoi map is built (its RHM energies) */
+    CORR_STAGE_START = 2,  /* the start map is built (its RHM energies)  */
     CORR_STAGE_RHM = 3       /* one report per RHM iteration                */
 } corr_stage;
-const char *corr_stage_name(corr_stage s);   /* "init", "ectm", "voronoi", "rhm" */
+const char *corr_stage_name(corr_stage s);   /* "init", "ectm", "start", "rhm" */
 
-/* Which stages run: all (landmarks -> Voronoi -> RHM -> ECTM, or ECTM from
+/* Which stages run: all (landmarks -> start -> RHM -> ECTM, or ECTM from
  * an uploaded map), RHM only (from landmarks; its maps are the result), or
  * ECTM only (from an uploaded map). */
 typedef enum corr_stages { CORR_STAGES_ALL = 0, CORR_STAGES_RHM = 1, CORR_STAGES_ECTM = 2 } corr_stages;
@@ -60,7 +60,7 @@ typedef struct corr_progress {
     corr_stage stage;
     const ectm_report *ectm;  /* the outer iteration's report (stage ECTM)  */
     double elapsed;           /* seconds since corr_run started             */
-    const rhm_report *rhm;    /* the RHM report (stages VORONOI and RHM)    */
+    const rhm_report *rhm;    /* the RHM report (stages START and RHM)      */
 } corr_progress;
 
 typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);

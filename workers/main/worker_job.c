@@ -48,6 +48,7 @@ static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params 
     if (w->rhm_alpha != 0)
         r->alpha = w->rhm_alpha;
     r->gamma = w->rhm_landmark_weight;
+    r->start = w->rhm_start;
     char detail[256];
     if (rhm_params_check(r, detail, sizeof detail))
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "RHM %s", detail);

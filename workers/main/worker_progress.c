@@ -95,7 +95,7 @@ void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, doub
     out->elapsed_s = elapsed;
     switch (cp->stage) {
     case CORR_STAGE_ECTM: out->stage = PROTO_STAGE_ECTM; break;
-    case CORR_STAGE_VORONOI: out->stage = PROTO_STAGE_VORONOI; break;
+    case CORR_STAGE_START: out->stage = PROTO_STAGE_START; break;
     case CORR_STAGE_RHM: out->stage = PROTO_STAGE_RHM; break;
     default: out->stage = PROTO_STAGE_INIT; break;
     }

@@ -15,12 +15,23 @@
  * mass; s_i: total area. All in the meshes' own units (the energy is
  * scale-invariant as written).
  *
- * Initialisation (§3.3.2): P12 sends every vertex of a geodesic Voronoi
- * cell of M1 (centres: source landmarks) to the cell's target landmark;
- * P21 sends every vertex v of M2 to the source landmark whose target
- * landmark is nearest to v in M2's embedding (the nearest neighbour of v
- * among the images T12(V1), which are exactly the target landmarks; ties
- * to the lower landmark index); X_ij = P_ij X_j.
+ * Start from the landmarks (p_r on M1, q_r on M2, r = 1..nl), two kinds:
+ *  - distances (the default): every vertex described by its geodesic
+ *    distances to the landmarks of its side, divided by √(area); P12 row v
+ *    = the closest point to v's description on M2 with M2's descriptions as
+ *    vertex coordinates (an exact projection in R^nl, proj.h), P21 the same
+ *    the other way; X_ij = P_ij X_j. Not the thesis' start: it is ours,
+ *    because the Voronoi start below collapses every cell to a point and a
+ *    limb's turn about its axis is then left to chance (measured, FAUST
+ *    tr_reg_000 -> 001 from 12 landmarks, after RHM: geodesic error 0.0377
+ *    -> 0.0235, flipped triangles 14.3 % -> 5.8 %; FAUST 000 onto itself:
+ *    0.046 -> 0.0026, flipped 30 % -> 5.7 %).
+ *  - voronoi (§3.3.2): P12 sends every vertex of a geodesic Voronoi cell of
+ *    M1 (centres: source landmarks) to the cell's target landmark; P21
+ *    sends every vertex v of M2 to the source landmark whose target
+ *    landmark is nearest to v in M2's embedding (the nearest neighbour of v
+ *    among the images T12(V1), which are exactly the target landmarks; ties
+ *    to the lower landmark index); X_ij = P_ij X_j.
  *
  * Iteration k = 1..K (Algorithm 3.1), β_k = beta_step·min(k, beta_ramp):
  * for i = 1, 2: P_ij <- projection, X_ij <- sparse linear solve. Each block
@@ -61,7 +72,16 @@ enum rhm_error {
 };
 const char *rhm_strerror(int code);
 
+typedef enum rhm_start {
+    RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
+    RHM_START_VORONOI = 1      /* the thesis' geodesic Voronoi map          */
+} rhm_start;
+const char *rhm_start_name(int start);   /* "distances", "voronoi", NULL */
+/* RHM_START_* from its name, or -1. */
+int rhm_start_parse(const char *name);
+
 typedef struct rhm_params {
+    int start;             /* RHM_START_*                                   */
     double alpha;          /* harmonic vs reversibility, (0, 1)             */
     double beta_step;      /* β_k = beta_step·min(k, beta_ramp)    (> 0)    */
     int beta_ramp;         /*                                      (>= 1)   */
@@ -74,7 +94,8 @@ typedef struct rhm_params {
 } rhm_params;
 
 /* The authors' release: α = 5e-4, β = 5e-3·min(k, 100), γ = 0, m = 8,
- * K = 200, stop when the relative change is below 1e-9 after iteration 110. */
+ * K = 200, stop when the relative change is below 1e-9 after iteration 110;
+ * start: distances (ours, see above). */
 void rhm_params_init(rhm_params *p);
 /* 0 or RHM_EPARAM with the offending field named in err. */
 int rhm_params_check(const rhm_params *p, char *err, size_t errsz);
@@ -89,7 +110,7 @@ typedef struct rhm_terms {
 } rhm_terms;
 
 typedef struct rhm_report {
-    int iteration, total;  /* 0 = the initial (Voronoi) map; total = K      */
+    int iteration, total;  /* 0 = the start map; total = K                  */
     double beta;
     rhm_terms dir[2];
     double energy;         /* sum of the eight terms                        */

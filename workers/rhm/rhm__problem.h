@@ -40,15 +40,14 @@ typedef struct rhm__problem {
 } rhm__problem;
 
 /* Builds geodesic solvers, embeddings, operators, trees and the X-step
- * symbolic factorisations; the maps are left NULL (rhm__init_voronoi sets
+ * symbolic factorisations; the maps are left NULL (rhm__init_start sets
  * them). Errors as rhm_run. */
 int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
                      rhm__problem **out, char *err, size_t errsz);
 void rhm__problem_free(rhm__problem *pb);
 
-/* §3.3.2: P12 from geodesic Voronoi cells, P21 by nearest target landmark
- * in M2's embedding, X_ij = P_ij X_j. */
-int rhm__init_voronoi(rhm__problem *pb, char *err, size_t errsz);
+/* The start (rhm.h) of kind p.start: P12, P21, X_ij = P_ij X_j. */
+int rhm__init_start(rhm__problem *pb, char *err, size_t errsz);
 
 /* P_ij <- argmin over maps of (1−α)Ē_R(P, X_ji) + βĒ_Q(P, X_ij), row by row
  * (closest point in R^{2m}, exact, seeded with the current P_ij). */

@@ -1,12 +1,14 @@
-/* rhm_init.c — RHM's start from landmarks (thesis §3.3.2): the geodesic
- * Voronoi map P12, its nearest-neighbour reverse P21 and X_ij = P_ij X_j.
- * Builds maps only; no optimisation. */
+/* rhm_init.c — RHM's start from landmarks (rhm.h): P12 and P21 by
+ * projection in the space of geodesic distances to the landmarks, or the
+ * thesis' geodesic Voronoi map (§3.3.2) with its nearest-neighbour reverse;
+ * then X_ij = P_ij X_j. Builds maps only; no optimisation. */
 #include "rhm/rhm__problem.h"
 #include "geod/geod_voronoi.h"
 #include "util/errbuf.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Sets row r of P to vertex v exactly: weight 1 at v's corner of the face
  * vface[v] (see vertex_faces). */
@@ -34,18 +36,77 @@ static int vertex_faces(const mesh *m, int **vface, int **vcorner)
     return 0;
 }
 
-int rhm__init_voronoi(rhm__problem *pb, char *err, size_t errsz)
+/* Side i's distances to its landmarks, nv_i by nl, divided by √s_i. */
+static double *landmark_distances(rhm__side *a, int nl, int *rc)
+{
+    double *f = malloc(sizeof(double) * (size_t)nl * a->n);
+    double *D = malloc(sizeof(double) * (size_t)nl * a->n);
+    *rc = RHM_ENOMEM;
+    if (f && D) {
+        int g = geod_all_pairs_from(a->geod, a->lmk, nl, f);
+        *rc = g == GEOD_OK ? RHM_OK : g == GEOD_ENOMEM ? RHM_ENOMEM : RHM_EMESH;
+    }
+    if (*rc == RHM_OK) {
+        double sc = 1 / sqrt(a->s);
+        for (int v = 0; v < a->n; v++)
+            for (int r = 0; r < nl; r++)
+                D[(size_t)v * nl + r] = sc * f[(size_t)r * a->n + v];
+    } else {
+        free(D);
+        D = NULL;
+    }
+    free(f);
+    return D;
+}
+
+/* P_ij row v: the closest point, in R^nl, of v's (scaled) distances to the
+ * landmarks of side i on side j embedded with its own; exact (proj.h),
+ * the bound from the first three landmarks' distances. */
+static int start_distances(rhm__problem *pb, char *err, size_t errsz)
+{
+    int nl = pb->nl, rc = RHM_OK;
+    double *D[2] = {NULL, NULL};
+    for (int i = 0; i < 2 && rc == RHM_OK; i++)
+        if (!(D[i] = landmark_distances(&pb->side[i], nl, &rc)))
+            errbuf_set(err, errsz, rc, "%s: distances to the landmarks failed",
+                       i ? "target" : "source");
+    for (int i = 0; i < 2 && rc == RHM_OK; i++) {
+        rhm__side *a = &pb->side[i], *b = &pb->side[1 - i];
+        mesh *emb = mesh_new(b->n, b->m->nf);
+        proj_tree *t = NULL;
+        rc = RHM_ENOMEM;
+        if (emb) {
+            for (int v = 0; v < b->n; v++)
+                memcpy(emb->v + 3 * v, D[1 - i] + (size_t)v * nl, 3 * sizeof(double));
+            memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
+            rc = (t = proj_tree_new(emb, NULL, 0)) ? RHM_OK : RHM_ENUMERIC;
+        }
+        for (int v = 0; rc == RHM_OK && v < a->n; v++)
+            a->P->face[v] = -1;
+        if (rc == RHM_OK && proj_closest(t, nl, D[1 - i], 1, a->n, D[i], a->P->face, a->P->w, NULL))
+            rc = RHM_ENUMERIC;
+        if (rc)
+            errbuf_set(err, errsz, rc, "the start map %s: projection failed",
+                       i ? "target -> source" : "source -> target");
+        proj_tree_free(t);
+        mesh_free(emb);
+    }
+    free(D[0]);
+    free(D[1]);
+    return rc;
+}
+
+/* §3.3.2: P12 sends every vertex of a geodesic Voronoi cell of the source
+ * landmarks to the cell's target landmark; P21 every target vertex to the
+ * source landmark whose target landmark is nearest in X2. */
+static int start_voronoi(rhm__problem *pb, char *err, size_t errsz)
 {
     rhm__side *a = &pb->side[0], *b = &pb->side[1];
     int dim = pb->dim, nl = pb->nl, rc = RHM_ENOMEM;
     int *fa = NULL, *ca = NULL, *fb = NULL, *cb = NULL;
     geod_voronoi *vor = NULL;
     char detail[512];
-    bmap_free(a->P);
-    bmap_free(b->P);
-    a->P = bmap_new(a->n, b->n);
-    b->P = bmap_new(b->n, a->n);
-    if (!a->P || !b->P || vertex_faces(a->m, &fa, &ca) || vertex_faces(b->m, &fb, &cb)) {
+    if (vertex_faces(a->m, &fa, &ca) || vertex_faces(b->m, &fb, &cb)) {
         errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
         goto out;
     }
@@ -76,8 +137,6 @@ int rhm__init_voronoi(rhm__problem *pb, char *err, size_t errsz)
         }
         row_at_vertex(b->P, v, fa, ca, a->lmk[best]);
     }
-    bmap_apply(a->P, b->m->f, b->X, dim, a->Xij);
-    bmap_apply(b->P, a->m->f, a->X, dim, b->Xij);
     rc = RHM_OK;
 out:
     geod_voronoi_free(vor);
@@ -86,4 +145,22 @@ out:
     free(fb);
     free(cb);
     return rc;
+}
+
+int rhm__init_start(rhm__problem *pb, char *err, size_t errsz)
+{
+    rhm__side *a = &pb->side[0], *b = &pb->side[1];
+    bmap_free(a->P);
+    bmap_free(b->P);
+    a->P = bmap_new(a->n, b->n);
+    b->P = bmap_new(b->n, a->n);
+    if (!a->P || !b->P)
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    int rc = pb->p.start == RHM_START_VORONOI ? start_voronoi(pb, err, errsz)
+                                              : start_distances(pb, err, errsz);
+    if (rc)
+        return rc;
+    bmap_apply(a->P, b->m->f, b->X, pb->dim, a->Xij);
+    bmap_apply(b->P, a->m->f, a->X, pb->dim, b->Xij);
+    return RHM_OK;
 }

@@ -17,9 +17,23 @@ const char *rhm_strerror(int code)
     return "unknown RHM error";
 }
 
+const char *rhm_start_name(int start)
+{
+    return start == RHM_START_DISTANCES ? "distances" : start == RHM_START_VORONOI ? "voronoi" : NULL;
+}
+
+int rhm_start_parse(const char *name)
+{
+    for (int s = RHM_START_DISTANCES; s <= RHM_START_VORONOI; s++)
+        if (strcmp(name, rhm_start_name(s)) == 0)
+            return s;
+    return -1;
+}
+
 void rhm_params_init(rhm_params *p)
 {
     memset(p, 0, sizeof *p);
+    p->start = RHM_START_DISTANCES;
     p->alpha = 5e-4;
     p->beta_step = 5e-3;
     p->beta_ramp = 100;
@@ -35,6 +49,7 @@ int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
 #define NEED(cond, field, what)                                                     \
     if (!(cond))                                                                    \
         return errbuf_set(err, errsz, RHM_EPARAM, "RHM parameter %s must be %s", field, what)
+    NEED(rhm_start_name(p->start) != NULL, "start", "distances or voronoi");
     NEED(isfinite(p->alpha) && p->alpha > 0 && p->alpha < 1, "alpha", "in (0, 1)");
     NEED(isfinite(p->beta_step) && p->beta_step > 0, "beta-step", "a finite number > 0");
     NEED(p->beta_ramp >= 1, "beta-ramp", "an integer >= 1");

@@ -1,4 +1,4 @@
-/* rhm_run.c — the RHM loop (rhm.h): set-up, Voronoi start, block coordinate
+/* rhm_run.c — the RHM loop (rhm.h): set-up, the start map, block coordinate
  * descent with the β schedule and the stopping rule, progress and
  * cancellation. The numerics are rhm_step.c's. */
 #include "rhm/rhm__problem.h"
@@ -28,7 +28,7 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
     int rc = rhm__problem_new(S, T, L, p, &pb, err, errsz);
     if (rc)
         return rc;
-    if ((rc = rhm__init_voronoi(pb, err, errsz)))
+    if ((rc = rhm__init_start(pb, err, errsz)))
         goto out;
     rhm_report r;
     memset(&r, 0, sizeof r);
