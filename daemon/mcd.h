@@ -131,9 +131,13 @@ typedef struct store_job {
 typedef int (*store_job_fn)(void *ctx, const store_job *j);          /* non-zero stops */
 typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zero stops */
 
+/* Threads: store_submit may run in any thread, several at once, alongside
+ * the loop thread's calls (it has a SQLite connection of its own); every
+ * other store_ function belongs to the event loop thread. */
 int64_t store_now_ms(void);
 /* Opens (creating) <dir>/jobs.db and <dir>/spool. */
 int store_open(const char *dir, store **out, char *err, size_t errsz);
+/* NULL ok; never while a store_submit runs. */
 void store_close(store *s);
 /* After a restart: RUNNING jobs go back to PENDING (a leftover worker of the
  * previous daemon is killed), spool dirs without a row are removed, unfinished
@@ -141,7 +145,9 @@ void store_close(store *s);
  * are left as they are with keep_slurm (the Slurm backend re-attaches), else
  * they go back to PENDING too. */
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
-/* Durable insert: row and spool/<id>/job.frame (fsynced) in one transaction. */
+/* Durable insert: spool/<id>/job.frame (fsynced) and the row, committed
+ * together; *id is the committed row's. Any thread (it blocks on the disk:
+ * the daemon calls it from libuv's thread pool); frame is only read. */
 int store_submit(store *s, const char *user, const char *label, int32_t priority,
                  uint32_t total, const char *params, const void *frame, size_t len,
                  uint64_t *id, char *err, size_t errsz);
