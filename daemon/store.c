@@ -52,6 +52,38 @@ struct store {
 };
 
 #define SPOOL_NEW_PREFIX ".new-"  /* spool/.new-XXXXXX: a job.frame before its row exists */
+#define STORE_BUSY_MS 5000        /* how long a connection waits for the write lock */
+#define STORE_MUTEX_WAITS 8       /* loop: waits on submit_mu before it sleeps instead */
+
+/* The loop's connection found the write lock taken: nearly always by a
+ * store_submit, which holds submit_mu for its whole transaction, so waiting
+ * for the mutex wakes the loop the moment that commits (SQLite's own busy
+ * timeout sleeps 1, 2, 5, 10 ... ms). A lock held by another process (the
+ * sqlite3 shell) leaves the mutex free: then 1 ms sleeps, STORE_BUSY_MS in all. */
+static int loop_busy(void *ctx, int n)
+{
+    store *s = ctx;
+    if (n < STORE_MUTEX_WAITS) {
+        pthread_mutex_lock(&s->submit_mu);
+        pthread_mutex_unlock(&s->submit_mu);
+        return 1;
+    }
+    if (n >= STORE_MUTEX_WAITS + STORE_BUSY_MS)
+        return 0;
+    usleep(1000);
+    return 1;
+}
+
+/* store_submit's connection (a pool thread) waits for a loop-thread write:
+ * those are single statements or short transactions, so poll finely. */
+static int submit_busy(void *ctx, int n)
+{
+    (void)ctx;
+    if (n >= 4 * STORE_BUSY_MS)
+        return 0;
+    usleep(250);
+    return 1;
+}
 
 static const char schema[] =
     "CREATE TABLE IF NOT EXISTS jobs("
@@ -176,14 +208,16 @@ static void spool_remove(const store *s, uint64_t id)
     remove_dir(store_spool_path(s, id, NULL, dir, sizeof dir));
 }
 
-/* Opens path with the pragmas every connection of the store uses. */
-static int open_db(const char *path, sqlite3 **db, char *err, size_t errsz)
+/* Opens path with the pragmas every connection of the store uses and a
+ * busy handler (the wait for another connection's write lock). */
+static int open_db(const char *path, sqlite3 **db, int (*busy)(void *, int), void *ctx,
+                   char *err, size_t errsz)
 {
     char *msg = NULL;
     if (sqlite3_open_v2(path, db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK)
         return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", path, *db ? sqlite3_errmsg(*db) : "cannot open");
-    if (sqlite3_exec(*db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
-                     "PRAGMA busy_timeout=5000;", NULL, NULL, &msg) != SQLITE_OK) {
+    sqlite3_busy_handler(*db, busy, ctx);
+    if (sqlite3_exec(*db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;", NULL, NULL, &msg) != SQLITE_OK) {
         errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", path, msg ? msg : "cannot set up");
         sqlite3_free(msg);
         return PROTO_ESTORAGE;
@@ -217,7 +251,7 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
         goto fail;
     }
     snprintf(path, sizeof path, "%s/jobs.db", dir);
-    if (open_db(path, &s->db, err, errsz))
+    if (open_db(path, &s->db, loop_busy, s, err, errsz))
         goto fail;
     char *msg = NULL;
     if (sqlite3_exec(s->db, schema, NULL, NULL, &msg) != SQLITE_OK) {
@@ -240,7 +274,7 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
         goto fail;
     }
     /* the schema exists now: the submit connection only inserts into it */
-    if (open_db(path, &s->sdb, err, errsz))
+    if (open_db(path, &s->sdb, submit_busy, NULL, err, errsz))
         goto fail;
     *out = s;
     return 0;
