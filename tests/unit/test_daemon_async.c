@@ -1,7 +1,8 @@
 /* test_daemon_async.c — the daemon's disk work (storing a SUBMIT, reading a
  * result) runs in libuv's thread pool while the loop goes on serving: many
  * SUBMITs from several clients at once with PINGs in between, all
- * acknowledged with distinct ids and all durable across a SIGKILL; a client
+ * acknowledged with distinct ids and all durable across a SIGKILL; the
+ * per-user and queue limits exact with SUBMITs still being stored; a client
  * that hangs up right after sending SUBMIT leaves a stored job that runs,
  * and a daemon that keeps serving; a SIGTERM while SUBMITs are being stored
  * still acknowledges them. Black-box, through the real meshcorrd. */
@@ -209,6 +210,103 @@ TEST_T(concurrent_submits_are_all_acknowledged_with_distinct_ids_and_survive_sig
     CHECK_INT(mc_ping(me), 0);
     mc_close(me);
     mc_close(boss);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* ---- limits with SUBMITs in flight ----------------------------------------- */
+
+#define NLIMIT_CLIENTS 4
+#define NLIMIT_SUBMITS 3
+
+typedef struct limit_run {
+    const testdaemon *d;
+    const char *token;
+    int ok, user_limit, queue_full, other;
+} limit_run;
+
+static void *limit_thread(void *arg)
+{
+    limit_run *r = arg;
+    mc_client *c = NULL;
+    char err[256];
+    if (mc_connect(r->d->tcp_addr, r->token, &c, err, sizeof err)) {
+        r->other++;
+        return NULL;
+    }
+    mc_set_timeout(c, 30000);
+    for (int k = 0; k < NLIMIT_SUBMITS; k++) {
+        int rc;
+        testdaemon_submit(c, 2, 0, 0, &rc);
+        r->ok += rc == 0;
+        r->user_limit += rc == MC_EUSER_LIMIT;
+        r->queue_full += rc == MC_EQUEUE_FULL;
+        r->other += rc != 0 && rc != MC_EUSER_LIMIT && rc != MC_EQUEUE_FULL;
+    }
+    mc_close(c);
+    return NULL;
+}
+
+/* Runs NLIMIT_CLIENTS connections of one user, all submitting at once;
+ * sums what they got. */
+static limit_run limit_burst(const testdaemon *d, const char *token)
+{
+    static limit_run runs[NLIMIT_CLIENTS];
+    pthread_t th[NLIMIT_CLIENTS];
+    for (int i = 0; i < NLIMIT_CLIENTS; i++) {
+        runs[i] = (limit_run){d, token, 0, 0, 0, 0};
+        CHECK_INT(pthread_create(&th[i], NULL, limit_thread, &runs[i]), 0);
+    }
+    limit_run sum = {d, token, 0, 0, 0, 0};
+    for (int i = 0; i < NLIMIT_CLIENTS; i++) {
+        pthread_join(th[i], NULL);
+        sum.ok += runs[i].ok;
+        sum.user_limit += runs[i].user_limit;
+        sum.queue_full += runs[i].queue_full;
+        sum.other += runs[i].other;
+    }
+    return sum;
+}
+
+/* The one slot runs bob's long job, so everything else stays pending. Many
+ * SUBMITs at once must not overshoot the limits while earlier ones are
+ * still being stored: alice gets exactly --max-jobs-per-user, and bob (one
+ * running) exactly what fills --max-queue. */
+TEST_T(user_limit_and_full_queue_hold_exactly_with_many_submits_in_flight, 90)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    const char *args[] = {"--max-jobs-per-user", "4", "--max-queue", "6", NULL};
+    testdaemon_start(&d, "limits", args);
+    mc_client *bob = testdaemon_client(&d, TESTDAEMON_BOB);
+    int rc;
+    uint64_t run = testdaemon_submit(bob, 1000, 1, 0, &rc);
+    CHECK_INT(rc, 0);
+    testdaemon_wait_state(bob, run, MC_RUNNING, 20);
+    limit_run a = limit_burst(&d, TESTDAEMON_ALICE);
+    CHECK_INT(a.other, 0);
+    CHECK_INT(a.ok, 4);
+    CHECK_INT(a.user_limit, NLIMIT_CLIENTS * NLIMIT_SUBMITS - 4);
+    limit_run b = limit_burst(&d, TESTDAEMON_BOB);
+    CHECK_INT(b.other, 0);
+    CHECK_INT(b.ok, 2);                         /* 4 + 2 pending = --max-queue */
+    CHECK_INT(b.queue_full, NLIMIT_CLIENTS * NLIMIT_SUBMITS - 2);
+    /* the store holds exactly what was acknowledged */
+    mc_client *boss = testdaemon_client(&d, TESTDAEMON_ADMIN);
+    mc_job_info *jobs = NULL;
+    uint32_t n = 0;
+    CHECK_INT(mc_list(boss, "alice", 0, &jobs, &n), 0);
+    CHECK_INT(n, 4);
+    free(jobs);
+    CHECK_INT(mc_list(boss, "bob", 0, &jobs, &n), 0);
+    CHECK_INT(n, 3);
+    free(jobs);
+    mc_server_stats st;
+    CHECK_INT(mc_stats(boss, &st), 0);
+    CHECK_INT(st.queued, 6);
+    mc_stats_free(&st);
+    CHECK_INT(mc_cancel(bob, run), 0);
+    mc_close(boss);
+    mc_close(bob);
     testdaemon_stop(&d, SIGTERM);
 }
 
