@@ -592,7 +592,11 @@ static void result_done(uv_work_t *w, int status)    /* loop */
         r->rc = PROTO_EINTERNAL;
         snprintf(r->err, sizeof r->err, "the read was not run: %s", uv_strerror(status));
     }
-    if (r->rc) {
+    store_job j;
+    if (r->rc && store_get(r->d->store, r->job_id, &j) == PROTO_ENOT_FOUND) {
+        /* deleted (DELETE, expiry) while it was read */
+        srv_send_error(c, r->request_id, PROTO_ENOT_FOUND, "no job %llu", id);
+    } else if (r->rc) {
         dlog(DLOG_ERROR, "job %llu: result.frame unreadable: %s", id, r->err);
         srv_send_error(c, r->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read", id);
     } else if (srv_conn_open(c)) {
