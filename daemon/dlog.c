@@ -10,18 +10,21 @@
 #include <stdlib.h>
 #include <time.h>
 
+/* Set on the loop (start, SIGHUP), read by any thread: dlog is called from
+ * the thread pool (store_submit) and the dashboard threads too. Each line is
+ * one fprintf, which stdio locks, so lines never interleave. */
 static int level_max = DLOG_INFO;
 
 void dlog_set_level(int level)
 {
-    level_max = level;
+    __atomic_store_n(&level_max, level, __ATOMIC_RELAXED);
 }
 
 void dlog(int level, const char *fmt, ...)
 {
     static const char *names[] = {"error", "warn", "info", "debug"};
     static const int prio[] = {3, 4, 6, 7};
-    if (level > level_max)
+    if (level > __atomic_load_n(&level_max, __ATOMIC_RELAXED))
         return;
     char line[2048];
     va_list ap;

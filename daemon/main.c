@@ -2,9 +2,11 @@
  * queue rebuilt from the store, the backend (backend.h), listeners, the
  * result-expiry sweep and the signal handlers (SIGHUP: reload.c), READY=1 to
  * the service manager, then the loop. Shutdown (SIGTERM/SIGINT) drains: stop
- * accepting, SIGTERM the workers, their jobs go back to PENDING, then close
- * every handle and the store; the dashboard threads (--modbus, --metrics)
- * stop after the loop. Holds no request or job logic. */
+ * accepting, SIGTERM the workers, their jobs go back to PENDING; once no
+ * worker runs and no request is in the thread pool (req.c), close every
+ * handle; the loop ends, and only then the store closes (no store_submit
+ * can be running); the dashboard threads (--modbus, --metrics) stop after
+ * the loop. Holds no request or job logic. */
 #include "backend.h"
 #include "mcd.h"
 
@@ -39,7 +41,10 @@ static void on_sweep(uv_timer_t *t)
 
 void mcd_drained(mcd *d)
 {
-    dlog(DLOG_INFO, "drained: no worker running; closing");
+    if (!d->draining || d->drained || bk_busy(d) || d->work_inflight)
+        return;
+    d->drained = 1;
+    dlog(DLOG_INFO, "drained: no worker running, no request in the thread pool; closing");
     srv_close_all(d);
     bk_close(d);
     snap_close(d);
@@ -62,8 +67,10 @@ static void on_signal(uv_signal_t *h, int sig)
     notify_stopping(d);
     srv_stop_listening(d);
     bk_drain(d);
-    if (!bk_busy(d))
-        mcd_drained(d);
+    if (d->work_inflight)
+        dlog(DLOG_INFO, "waiting for %u request(s) in the thread pool (SUBMITs being stored: their"
+             " SUBMIT_OK still goes out)", d->work_inflight);
+    mcd_drained(d);
 }
 
 int main(int argc, char **argv)

@@ -24,7 +24,13 @@
  * The DESIGN rule every module keeps: an acknowledged job is never lost.
  * SUBMIT_OK goes out only after the spool file is fsynced and the row is
  * committed; a job leaves the store only by DELETE or result expiry; a
- * running job interrupted by anything but its own end goes back to PENDING. */
+ * running job interrupted by anything but its own end goes back to PENDING.
+ *
+ * Threads: everything runs in the libuv loop thread except store_submit
+ * and the read of a result.frame, which req.c runs in libuv's thread pool
+ * (their after callbacks are back on the loop), and the Modbus and metrics
+ * servers, which read the published snapshot (snap_read) in their own
+ * threads. dlog may be called from any thread. */
 #ifndef MCD_H
 #define MCD_H
 #include <stddef.h>
@@ -131,9 +137,13 @@ typedef struct store_job {
 typedef int (*store_job_fn)(void *ctx, const store_job *j);          /* non-zero stops */
 typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zero stops */
 
+/* Threads: store_submit may run in any thread, several at once, alongside
+ * the loop thread's calls (it has a SQLite connection of its own); every
+ * other store_ function belongs to the event loop thread. */
 int64_t store_now_ms(void);
 /* Opens (creating) <dir>/jobs.db and <dir>/spool. */
 int store_open(const char *dir, store **out, char *err, size_t errsz);
+/* NULL ok; never while a store_submit runs. */
 void store_close(store *s);
 /* After a restart: RUNNING jobs go back to PENDING (a leftover worker of the
  * previous daemon is killed), spool dirs without a row are removed, unfinished
@@ -141,7 +151,9 @@ void store_close(store *s);
  * are left as they are with keep_slurm (the Slurm backend re-attaches), else
  * they go back to PENDING too. */
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
-/* Durable insert: row and spool/<id>/job.frame (fsynced) in one transaction. */
+/* Durable insert: spool/<id>/job.frame (fsynced) and the row, committed
+ * together; *id is the committed row's. Any thread (it blocks on the disk:
+ * the daemon calls it from libuv's thread pool); frame is only read. */
 int store_submit(store *s, const char *user, const char *label, int32_t priority,
                  uint32_t total, const char *params, const void *frame, size_t len,
                  uint64_t *id, char *err, size_t errsz);
@@ -262,6 +274,7 @@ void metrics_stop(metrics *m);    /* NULL ok */
 typedef struct conn conn;
 typedef struct wsup_slot wsup_slot;
 typedef struct req_watch req_watch;
+typedef struct req_submit req_submit;
 typedef struct bk_ops bk_ops;
 
 struct mcd {
@@ -273,6 +286,9 @@ struct mcd {
     wsup_slot *slots;             /* conf.workers of them */
     conn *conns;                  /* every open connection */
     req_watch *watches;           /* every live WATCH */
+    req_submit *submits;          /* SUBMITs being stored in the thread pool */
+    uint32_t work_inflight;       /* req_ work items queued and not yet done */
+    int drained;                  /* mcd_drained has closed everything */
     uv_handle_t **listeners;
     int nlisteners;
     uv_signal_t sigterm, sigint;
@@ -348,10 +364,20 @@ typedef struct conn_auth {
 conn_auth *srv_conn_auth(conn *c);
 mcd *srv_conn_daemon(conn *c);
 int srv_conn_fd(conn *c);
+/* The request being handled goes on in the thread pool: c stops being read,
+ * the frame given to req_handle stays valid, and c's memory stays valid
+ * (even if it closes) until the matching srv_conn_release, which consumes
+ * that frame and handles whatever the client sent meanwhile. Loop thread. */
+void srv_conn_hold(conn *c);
+void srv_conn_release(conn *c);
+int srv_conn_open(const conn *c);     /* not closed or closing: replies can go out */
+/* Closed, or the client has hung up (EOF or an error waits on the socket). */
+int srv_conn_hung_up(conn *c);
 
 /* ---- main.c ---------------------------------------------------------------- */
-/* Called by wsup when the last worker has exited during a drain: closes what
- * is left so the loop ends. */
+/* During a drain, once no worker runs (bk_busy) and no request is in the
+ * thread pool (work_inflight): closes what is left so the loop ends. Called
+ * when either may have become 0; does nothing before that, or twice. */
 void mcd_drained(mcd *d);
 
 /* ---- req_ ----------------------------------------------------------------- */

@@ -7,9 +7,24 @@
  * any other job is NOT_FOUND, exactly like a job that never existed, so ids
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
  * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
- * anything is stored. Draco bytes are never decoded here (only workers do). */
+ * anything is stored, counting the SUBMITs still being stored. Draco bytes
+ * are never decoded here (only workers do).
+ *
+ * DESIGN: the loop never waits for the disk on a client's behalf. SUBMIT's
+ * store_submit (spool file, fsyncs, commit) and RESULT's read and decode of
+ * result.frame run in libuv's thread pool (uv_queue_work). A work callback
+ * touches only its own work item: copies of what it needs, the request's
+ * frame (kept in place by srv_conn_hold) and, for SUBMIT, the store's
+ * thread-safe store_submit. Its after callback, on the loop, does the rest:
+ * the scheduler, the log, the reply, bk_schedule. The connection is held
+ * while its work is in flight, so it is not read (one request at a time,
+ * replies in order, at most one work item per client) and its memory
+ * outlives a close; a client that left gets no reply, but its SUBMIT, once
+ * stored, is queued and runs. d->work_inflight counts the work items; a
+ * drain closes the daemon only when it is 0 (mcd_drained). */
 #include "backend.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -166,6 +181,102 @@ static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t m
     return 0;
 }
 
+/* ---- work in the thread pool ----------------------------------------------- */
+
+static int work_start(mcd *d, conn *c, uv_work_t *w, uv_work_cb run, uv_after_work_cb after)
+{
+    int rc = uv_queue_work(d->loop, w, run, after);
+    if (rc)
+        return rc;
+    d->work_inflight++;
+    srv_conn_hold(c);
+    return 0;
+}
+
+/* The end of an after callback: the connection reads its next request, and
+ * a drain may now be complete. */
+static void work_end(mcd *d, conn *c)
+{
+    srv_conn_release(c);
+    d->work_inflight--;
+    if (d->draining)
+        mcd_drained(d);
+}
+
+/* A SUBMIT being stored: everything store_submit needs, copied, so the
+ * thread-pool side touches nothing else. */
+struct req_submit {
+    uv_work_t work;
+    mcd *d;                       /* loop side only */
+    conn *c;                      /* loop side only; held */
+    req_submit *next;             /* d->submits */
+    store *store;                 /* the one daemon object the work uses */
+    uint32_t request_id;
+    const void *frame;            /* in c's read buffer, kept by the hold */
+    size_t len;
+    char user[AUTH_MAX_USER];
+    char label[PROTO_MAX_STRING + 1];
+    int32_t priority;
+    uint32_t total;
+    char params[512];
+    int rc;                       /* store_submit's result, */
+    uint64_t id;                  /* its job id */
+    char msg[PROTO_MAX_STRING];   /* or its error */
+};
+
+/* SUBMITs of user (NULL: of everyone) still being stored. */
+static uint32_t submits_in_flight(const mcd *d, const char *user)
+{
+    uint32_t n = 0;
+    for (const req_submit *s = d->submits; s; s = s->next)
+        n += !user || strcmp(s->user, user) == 0;
+    return n;
+}
+
+static void submit_run(uv_work_t *w)      /* thread pool */
+{
+    req_submit *s = w->data;
+    s->rc = store_submit(s->store, s->user, s->label, s->priority, s->total, s->params, s->frame, s->len,
+                         &s->id, s->msg, sizeof s->msg);
+}
+
+static void submit_done(uv_work_t *w, int status)    /* loop */
+{
+    req_submit *s = w->data;
+    mcd *d = s->d;
+    conn *c = s->c;
+    for (req_submit **p = &d->submits; *p; p = &(*p)->next)
+        if (*p == s) {
+            *p = s->next;
+            break;
+        }
+    if (status < 0) {                       /* never ran: nothing stored */
+        s->rc = PROTO_EINTERNAL;
+        snprintf(s->msg, sizeof s->msg, "the store's work was not run: %s", uv_strerror(status));
+    }
+    if (s->rc) {
+        dlog(DLOG_ERROR, "SUBMIT from %s: %s", s->user, s->msg);
+        srv_send_error(c, s->request_id, s->rc, "job not stored: %s", s->msg);
+    } else {
+        unsigned long long id = (unsigned long long)s->id;
+        store_job j;
+        /* an admin may have cancelled it by id since the commit */
+        if (store_get(d->store, s->id, &j) == 0 && j.state != PROTO_STATE_PENDING)
+            dlog(DLOG_INFO, "job %llu: %s before its SUBMIT_OK: not queued", id, proto_state_name(j.state));
+        else if (sched_add(d->sched, s->id, s->user, s->priority))
+            dlog(DLOG_ERROR, "job %llu: out of memory queueing it (it runs after a restart)", id);
+        dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', %s", id, s->user, s->priority,
+             s->label, s->params);
+        if (srv_conn_hung_up(c))
+            dlog(DLOG_WARN, "job %llu: stored and queued, but the client of %s hung up before SUBMIT_OK",
+                 id, s->user);
+        reply_id(c, PROTO_MSG_SUBMIT_OK, s->request_id, s->id);   /* a no-op on a closed connection */
+        bk_schedule(d);
+    }
+    work_end(d, c);
+    free(s);
+}
+
 static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len)
 {
     mcd *d = srv_conn_daemon(c);
@@ -181,20 +292,27 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
         srv_send_error(c, m->request_id, rc, "%s", msg);
         return;
     }
-    uint32_t mine = sched_user_pending(d->sched, a->user) + sched_user_running(d->sched, a->user);
+    /* jobs still being stored count as pending: they will be */
+    uint32_t mine = sched_user_pending(d->sched, a->user) + sched_user_running(d->sched, a->user) +
+                    submits_in_flight(d, a->user);
     if (mine >= d->conf.max_jobs_per_user) {
         srv_send_error(c, m->request_id, PROTO_EUSER_LIMIT, "user %s already has %u unfinished jobs (limit %u)",
                        a->user, mine, d->conf.max_jobs_per_user);
         return;
     }
-    if (sched_queued(d->sched) >= d->conf.max_queue) {
+    uint32_t pending = sched_queued(d->sched) + submits_in_flight(d, NULL);
+    if (pending >= d->conf.max_queue) {
         srv_send_error(c, m->request_id, PROTO_EQUEUE_FULL, "queue full: %u jobs pending (limit %u); nothing stored",
-                       sched_queued(d->sched), d->conf.max_queue);
+                       pending, d->conf.max_queue);
+        return;
+    }
+    req_submit *w = calloc(1, sizeof *w);
+    if (!w) {
+        srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory; nothing stored");
         return;
     }
     const proto_params *p = &s->params;
-    char params[512];
-    snprintf(params, sizeof params,
+    snprintf(w->params, sizeof w->params,
              "model=%s partial=%u alpha=%g eta=%g beta0=%g beta1=%g beta_ramp=%u gamma=%g iterations=%u"
              " inner=%u tolerance=%g stop_change=%g backend=%s landmarks=%u init_p=%u init_q=%u"
              " source_bytes=%u target_bytes=%u",
@@ -202,19 +320,25 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
              p->beta0, p->beta1, p->beta_ramp, p->gamma, p->iterations, p->inner_iterations, p->tolerance,
              p->stop_change, p->backend[0] ? p->backend : "default", s->nlandmarks, s->p.n, s->q.n,
              s->source.len, s->target.len);
-    uint64_t id;
-    if ((rc = store_submit(d->store, a->user, s->label, s->priority, p->iterations, params, frame, len,
-                           &id, msg, sizeof msg))) {
-        dlog(DLOG_ERROR, "SUBMIT from %s: %s", a->user, msg);
-        srv_send_error(c, m->request_id, rc, "job not stored: %s", msg);
+    w->work.data = w;
+    w->d = d;
+    w->c = c;
+    w->store = d->store;
+    w->request_id = m->request_id;
+    w->frame = frame;
+    w->len = len;
+    snprintf(w->user, sizeof w->user, "%s", a->user);
+    snprintf(w->label, sizeof w->label, "%s", s->label);
+    w->priority = s->priority;
+    w->total = p->iterations;
+    if ((rc = work_start(d, c, &w->work, submit_run, submit_done))) {
+        dlog(DLOG_ERROR, "SUBMIT from %s: cannot queue the store's work: %s", a->user, uv_strerror(rc));
+        srv_send_error(c, m->request_id, PROTO_EINTERNAL, "job not stored: %s", uv_strerror(rc));
+        free(w);
         return;
     }
-    if (sched_add(d->sched, id, a->user, s->priority))
-        dlog(DLOG_ERROR, "job %llu: out of memory queueing it (it runs after a restart)", (unsigned long long)id);
-    dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', %s", (unsigned long long)id, a->user,
-         s->priority, s->label, params);
-    reply_id(c, PROTO_MSG_SUBMIT_OK, m->request_id, id);
-    bk_schedule(d);
+    w->next = d->submits;
+    d->submits = w;
 }
 
 static void on_status(conn *c, const proto_msg *m)
@@ -409,6 +533,98 @@ static void on_cancel(conn *c, const proto_msg *m)
     reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
 }
 
+/* A RESULT being read: result.frame is read and decoded in the thread pool. */
+typedef struct req_result {
+    uv_work_t work;
+    mcd *d;                       /* loop side only */
+    conn *c;                      /* loop side only; held */
+    uint32_t request_id;
+    uint64_t job_id;
+    uint32_t what;                /* PROTO_WANT_* */
+    char path[CONF_PATH + 64];    /* spool/<id>/result.frame */
+    uint8_t *buf;                 /* its bytes; res may point into them */
+    proto_msg res;                /* the decoded RESULT_OK when rc is 0 */
+    int rc;
+    char err[256];
+} req_result;
+
+static void result_run(uv_work_t *w)      /* thread pool */
+{
+    req_result *r = w->data;
+    r->rc = PROTO_EINTERNAL;
+    FILE *fp = fopen(r->path, "rb");
+    if (!fp) {
+        snprintf(r->err, sizeof r->err, "%s", strerror(errno));
+        return;
+    }
+    size_t n = 0;
+    long sz = -1;
+    if (fseek(fp, 0, SEEK_END) == 0 && (sz = ftell(fp)) > 0 && (size_t)sz <= REQ_MAX_RESULT_FILE &&
+        fseek(fp, 0, SEEK_SET) == 0 && (r->buf = malloc((size_t)sz)))
+        n = fread(r->buf, 1, (size_t)sz, fp);
+    fclose(fp);
+    if (!r->buf) {
+        snprintf(r->err, sizeof r->err, "%s",
+                 sz <= 0 ? "empty or unreadable" : (size_t)sz > REQ_MAX_RESULT_FILE ? "too large" : "out of memory");
+        return;
+    }
+    size_t used;
+    int rc = proto_decode(r->buf, n, PROTO_MAX_FRAME, &r->res, &used, r->err, sizeof r->err);
+    if (rc != PROTO_READY) {
+        if (rc >= 0)
+            snprintf(r->err, sizeof r->err, "truncated (%zu bytes)", n);
+        return;
+    }
+    if (r->res.type != PROTO_MSG_RESULT_OK) {
+        snprintf(r->err, sizeof r->err, "a %s frame, not RESULT_OK", proto_type_name(r->res.type));
+        proto_msg_free(&r->res);
+        return;
+    }
+    r->rc = 0;
+}
+
+static void result_done(uv_work_t *w, int status)    /* loop */
+{
+    req_result *r = w->data;
+    conn *c = r->c;
+    unsigned long long id = (unsigned long long)r->job_id;
+    if (status < 0) {                       /* never ran: res was never filled */
+        r->rc = PROTO_EINTERNAL;
+        snprintf(r->err, sizeof r->err, "the read was not run: %s", uv_strerror(status));
+    }
+    store_job j;
+    if (r->rc && store_get(r->d->store, r->job_id, &j) == PROTO_ENOT_FOUND) {
+        /* deleted (DELETE, expiry) while it was read */
+        srv_send_error(c, r->request_id, PROTO_ENOT_FOUND, "no job %llu", id);
+    } else if (r->rc) {
+        dlog(DLOG_ERROR, "job %llu: result.frame unreadable: %s", id, r->err);
+        srv_send_error(c, r->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read", id);
+    } else if (srv_conn_open(c)) {
+        proto_msg m;
+        memset(&m, 0, sizeof m);
+        m.type = PROTO_MSG_RESULT_OK;
+        proto_result_ok *o = &m.u.result_ok;
+        const proto_result_ok *in = &r->res.u.result_ok;
+        o->job_id = r->job_id;
+        if (r->what & PROTO_WANT_P)
+            o->p = in->p;
+        if (r->what & PROTO_WANT_Q)
+            o->q = in->q;
+        if (r->what & PROTO_WANT_DEFORMED)
+            o->deformed = in->deformed;
+        if (r->what & PROTO_WANT_METRICS) {
+            o->metrics = in->metrics;
+            o->nmetrics = in->nmetrics;
+        }
+        reply(c, &m, r->request_id);
+    }
+    if (r->rc == 0)
+        proto_msg_free(&r->res);
+    free(r->buf);
+    work_end(r->d, c);
+    free(r);
+}
+
 static void on_result(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -421,50 +637,26 @@ static void on_result(conn *c, const proto_msg *m)
                        (unsigned long long)j.id, proto_state_name(j.state));
         return;
     }
-    char path[CONF_PATH + 64], err[256];
-    store_spool_path(d->store, j.id, "result.frame", path, sizeof path);
-    FILE *fp = fopen(path, "rb");
-    uint8_t *buf = NULL;
-    size_t n = 0;
-    if (fp) {
-        fseek(fp, 0, SEEK_END);
-        long sz = ftell(fp);
-        fseek(fp, 0, SEEK_SET);
-        if (sz > 0 && (size_t)sz <= REQ_MAX_RESULT_FILE && (buf = malloc((size_t)sz)))
-            n = fread(buf, 1, (size_t)sz, fp);
-        fclose(fp);
-    }
-    proto_msg res;
-    size_t used;
-    int rc = buf ? proto_decode(buf, n, PROTO_MAX_FRAME, &res, &used, err, sizeof err) : PROTO_EINTERNAL;
-    if (rc != PROTO_READY || res.type != PROTO_MSG_RESULT_OK) {
-        dlog(DLOG_ERROR, "job %llu: result.frame unreadable: %s", (unsigned long long)j.id,
-             rc < 0 ? err : "missing or wrong type");
-        srv_send_error(c, m->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
-                       (unsigned long long)j.id);
-        if (rc == PROTO_READY)
-            proto_msg_free(&res);
-        free(buf);
+    req_result *r = calloc(1, sizeof *r);
+    if (!r) {
+        srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory");
         return;
     }
-    proto_msg r;
-    memset(&r, 0, sizeof r);
-    r.type = PROTO_MSG_RESULT_OK;
-    proto_result_ok *o = &r.u.result_ok;
-    o->job_id = j.id;
-    if (q->what & PROTO_WANT_P)
-        o->p = res.u.result_ok.p;
-    if (q->what & PROTO_WANT_Q)
-        o->q = res.u.result_ok.q;
-    if (q->what & PROTO_WANT_DEFORMED)
-        o->deformed = res.u.result_ok.deformed;
-    if (q->what & PROTO_WANT_METRICS) {
-        o->metrics = res.u.result_ok.metrics;
-        o->nmetrics = res.u.result_ok.nmetrics;
+    r->work.data = r;
+    r->d = d;
+    r->c = c;
+    r->request_id = m->request_id;
+    r->job_id = j.id;
+    r->what = q->what;
+    store_spool_path(d->store, j.id, "result.frame", r->path, sizeof r->path);
+    int rc = work_start(d, c, &r->work, result_run, result_done);
+    if (rc) {
+        dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)j.id,
+             uv_strerror(rc));
+        srv_send_error(c, m->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
+                       (unsigned long long)j.id);
+        free(r);
     }
-    reply(c, &r, m->request_id);
-    proto_msg_free(&res);
-    free(buf);
 }
 
 static void on_delete(conn *c, const proto_msg *m)

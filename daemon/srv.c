@@ -10,10 +10,21 @@
  * A frame that breaks the byte stream (bad magic, header CRC, version, type,
  * flags, size) gets ERROR, a log line and a close; a payload that does not
  * decode gets ERROR and the connection stays usable (PROTOCOL.md, Errors).
- * Requests themselves are req.c's business. */
+ * Requests themselves are req.c's business.
+ *
+ * DESIGN: one request at a time per connection. A handler that continues a
+ * request in the thread pool (SUBMIT, RESULT) calls srv_conn_hold: the
+ * connection stops being read, its frame stays where it is in the read
+ * buffer, and the next request waits until srv_conn_release, so replies go
+ * out in request order and one client queues at most one work item. A held
+ * connection may still close (the client leaves, a write fails, a drain):
+ * its memory is freed only when the handle is closed and every hold is
+ * released, so an after-work callback may always look at it (srv_send to a
+ * closed connection is a no-op). */
 #include "mcd.h"
 
 #include <errno.h>
+#include <poll.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,6 +43,10 @@ struct conn {
     uint8_t *wdata;           /* the buffer of the write in flight */
     size_t inflight;
     int writing, closing, close_after_write, paused;
+    int reading;              /* uv_read_start is in effect */
+    int holds;                /* srv_conn_hold not yet released: work in flight */
+    size_t held_len;          /* bytes of in.data the held request's frame takes */
+    int handle_closed;        /* uv_close finished: free once holds is 0 */
 };
 
 conn_auth *srv_conn_auth(conn *c) { return &c->auth; }
@@ -48,13 +63,20 @@ static size_t queued(const conn *c)
     return c->inflight + c->out.len;
 }
 
-static void on_closed(uv_handle_t *h)
+static void conn_free(conn *c)
 {
-    conn *c = h->data;
     proto_buf_free(&c->in);
     proto_buf_free(&c->out);
     free(c->wdata);
     free(c);
+}
+
+static void on_closed(uv_handle_t *h)
+{
+    conn *c = h->data;
+    c->handle_closed = 1;
+    if (c->holds == 0)
+        conn_free(c);
 }
 
 void srv_close(conn *c)
@@ -77,6 +99,25 @@ static void process_input(conn *c);
 static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf);
 static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf);
 static void flush(conn *c);
+
+/* Reads while nothing stops it: a close under way, output over the limit
+ * (paused), or a request whose work is in flight (holds). */
+static void update_reading(conn *c)
+{
+    int want = !c->closing && !c->close_after_write && !c->paused && !c->holds;
+    if (want && !c->reading) {
+        int rc = uv_read_start(&c->u.s, on_alloc, on_read);
+        if (rc) {
+            dlog(DLOG_INFO, "conn %lu: read: %s", c->id, uv_strerror(rc));
+            srv_close(c);
+            return;
+        }
+        c->reading = 1;
+    } else if (!want && c->reading) {
+        uv_read_stop(&c->u.s);
+        c->reading = 0;
+    }
+}
 
 static void on_write(uv_write_t *w, int status)
 {
@@ -101,7 +142,7 @@ static void on_write(uv_write_t *w, int status)
     }
     if (c->paused && queued(c) <= c->d->conf.max_output / 2) {
         c->paused = 0;
-        uv_read_start(&c->u.s, on_alloc, on_read);
+        update_reading(c);
         process_input(c);
     }
 }
@@ -147,10 +188,8 @@ int srv_send(conn *c, const proto_msg *m, int drop_if_full)
             srv_close(c);
             return -1;
         }
-        if (!c->paused) {
-            c->paused = 1;
-            uv_read_stop(&c->u.s);
-        }
+        c->paused = 1;
+        update_reading(c);
     }
     flush(c);
     return 0;
@@ -158,6 +197,8 @@ int srv_send(conn *c, const proto_msg *m, int drop_if_full)
 
 void srv_send_error(conn *c, uint32_t request_id, int code, const char *fmt, ...)
 {
+    if (c->closing)
+        return;
     char msg[PROTO_MAX_STRING + 1];
     va_list ap;
     va_start(ap, fmt);
@@ -190,7 +231,7 @@ void srv_close_soon(conn *c)
     if (c->closing)
         return;
     c->close_after_write = 1;
-    uv_read_stop(&c->u.s);
+    update_reading(c);
     if (!c->writing)
         srv_close(c);
 }
@@ -206,7 +247,7 @@ static void fatal_error(conn *c, uint32_t request_id, int code, const char *msg)
 
 static void process_input(conn *c)
 {
-    while (!c->closing && !c->close_after_write && !c->paused && c->in.len) {
+    while (!c->closing && !c->close_after_write && !c->paused && !c->holds && c->in.len) {
         size_t limit = c->auth.authed ? c->d->conf.max_frame : CONF_HELLO_MAX_FRAME;
         proto_hdr hdr;
         char err[512];
@@ -226,9 +267,54 @@ static void process_input(conn *c)
         } else {
             req_handle(c, &m, c->in.data, flen);
             proto_msg_free(&m);
+            if (c->holds) {
+                /* the frame stays in place for the work (nothing is read
+                 * meanwhile); srv_conn_release consumes it */
+                c->held_len = flen;
+                return;
+            }
         }
         proto_buf_consume(&c->in, flen);
     }
+}
+
+void srv_conn_hold(conn *c)
+{
+    c->holds++;
+    update_reading(c);
+}
+
+void srv_conn_release(conn *c)
+{
+    if (c->holds <= 0) {
+        dlog(DLOG_ERROR, "conn %lu: released more often than held", c->id);
+        return;
+    }
+    if (--c->holds > 0)
+        return;
+    if (c->handle_closed) {
+        conn_free(c);
+        return;
+    }
+    if (c->closing)
+        return;                        /* on_closed frees it */
+    proto_buf_consume(&c->in, c->held_len);
+    c->held_len = 0;
+    update_reading(c);
+    process_input(c);                  /* requests that arrived meanwhile */
+}
+
+int srv_conn_open(const conn *c)
+{
+    return !c->closing;
+}
+
+int srv_conn_hung_up(conn *c)
+{
+    if (c->closing)
+        return 1;
+    struct pollfd p = {srv_conn_fd(c), POLLRDHUP, 0};
+    return p.fd >= 0 && poll(&p, 1, 0) > 0 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR));
 }
 
 static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
@@ -290,7 +376,7 @@ static void on_connection(uv_stream_t *server, int status)
         d->conns->prev = c;
     d->conns = c;
     dlog(DLOG_DEBUG, "conn %lu: accepted (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
-    uv_read_start(&c->u.s, on_alloc, on_read);
+    update_reading(c);
 }
 
 static int listen_unix(mcd *d, const char *path, uv_handle_t **out, char *err, size_t errsz)

@@ -1,26 +1,39 @@
 /* store.c — the job store: SQLite in WAL mode (<state-dir>/jobs.db) and the
  * spool directories (<state-dir>/spool/<id>/).
  *
- * DESIGN: an acknowledged job is never lost. store_submit writes
- * spool/<id>/job.frame (tmp, fsync, rename, fsync the directories) inside the
- * transaction that inserts the row and commits only after that, with
- * synchronous=FULL; the caller answers SUBMIT_OK only after it returns 0. A
- * crash between the two leaves a spool directory without a row, which
- * store_recover removes (the client never heard of that job). Ids come from
- * AUTOINCREMENT and are never reused.
+ * DESIGN: an acknowledged job is never lost. store_submit writes the SUBMIT
+ * frame into a fresh spool/.new-XXXXXX/job.frame (fsync the file and that
+ * directory), then, in one transaction with synchronous=FULL, inserts the
+ * row, renames the directory to spool/<id> (fsync spool/) and commits; the
+ * caller answers SUBMIT_OK only after it returned 0, with the id of the
+ * committed row. A crash before the commit leaves a spool/.new-* directory
+ * or a spool/<id> without a row, which store_recover removes (the client
+ * never heard of that job). Ids come from AUTOINCREMENT and are never
+ * reused.
+ *
+ * Threads: store_submit is the one function that runs in libuv's thread
+ * pool (req.c), possibly several at once and concurrently with the loop's
+ * calls. It uses a SQLite connection of its own (sdb), serialised by a
+ * mutex, and writes the spool file before taking the mutex; WAL lets the
+ * loop's connection read meanwhile, and busy_timeout makes a loop-thread
+ * write wait for the submit's short commit instead of failing. Every other
+ * function runs in the event loop thread only, on db. store_close must not
+ * run while a store_submit does (main.c closes the store after the loop,
+ * which ends only when no work is in flight).
  *
  * Tables: jobs (one row per job; state as its Slurm name; the latest outer
  * iteration and energy), history (one row per PROGRESS record), counters
  * (jobs ended per final state since the store was created). A job handed
  * to Slurm keeps its Slurm job id in its row until it ends, so a restarted
- * daemon re-attaches to it instead of running it again. Runs in the
- * event loop thread only; it never talks to clients or workers. */
+ * daemon re-attaches to it instead of running it again. The store never
+ * talks to clients or workers. */
 #include "mcd.h"
 #include "util/errbuf.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <sqlite3.h>
@@ -31,9 +44,46 @@
 #include <unistd.h>
 
 struct store {
-    sqlite3 *db;
-    char dir[CONF_PATH];
+    sqlite3 *db;                  /* the loop thread's connection */
+    sqlite3 *sdb;                 /* store_submit's connection (thread pool), under submit_mu */
+    pthread_mutex_t submit_mu;
+    int mu_ready;                 /* submit_mu initialised */
+    char dir[CONF_PATH];          /* never changes after store_open */
 };
+
+#define SPOOL_NEW_PREFIX ".new-"  /* spool/.new-XXXXXX: a job.frame before its row exists */
+#define STORE_BUSY_MS 5000        /* how long a connection waits for the write lock */
+#define STORE_MUTEX_WAITS 8       /* loop: waits on submit_mu before it sleeps instead */
+
+/* The loop's connection found the write lock taken: nearly always by a
+ * store_submit, which holds submit_mu for its whole transaction, so waiting
+ * for the mutex wakes the loop the moment that commits (SQLite's own busy
+ * timeout sleeps 1, 2, 5, 10 ... ms). A lock held by another process (the
+ * sqlite3 shell) leaves the mutex free: then 1 ms sleeps, STORE_BUSY_MS in all. */
+static int loop_busy(void *ctx, int n)
+{
+    store *s = ctx;
+    if (n < STORE_MUTEX_WAITS) {
+        pthread_mutex_lock(&s->submit_mu);
+        pthread_mutex_unlock(&s->submit_mu);
+        return 1;
+    }
+    if (n >= STORE_MUTEX_WAITS + STORE_BUSY_MS)
+        return 0;
+    usleep(1000);
+    return 1;
+}
+
+/* store_submit's connection (a pool thread) waits for a loop-thread write:
+ * those are single statements or short transactions, so poll finely. */
+static int submit_busy(void *ctx, int n)
+{
+    (void)ctx;
+    if (n >= 4 * STORE_BUSY_MS)
+        return 0;
+    usleep(250);
+    return 1;
+}
 
 static const char schema[] =
     "CREATE TABLE IF NOT EXISTS jobs("
@@ -96,11 +146,11 @@ const char *store_spool_path(const store *s, uint64_t id, const char *file, char
 
 /* Runs one statement with optional int64/text binds given as a format:
  * 'i' int64_t, 't' const char *, 'd' double. */
-static int exec_v(store *s, const char *sql, const char *fmt, ...)
+static int exec_v(sqlite3 *db, const char *sql, const char *fmt, ...)
 {
     sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL) != SQLITE_OK) {
-        dlog(DLOG_ERROR, "store: %s: %s", sql, sqlite3_errmsg(s->db));
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
+        dlog(DLOG_ERROR, "store: %s: %s", sql, sqlite3_errmsg(db));
         return PROTO_ESTORAGE;
     }
     va_list ap;
@@ -117,7 +167,7 @@ static int exec_v(store *s, const char *sql, const char *fmt, ...)
     int rc = sqlite3_step(st);
     sqlite3_finalize(st);
     if (rc != SQLITE_DONE && rc != SQLITE_ROW) {
-        dlog(DLOG_ERROR, "store: %s: %s", sql, sqlite3_errmsg(s->db));
+        dlog(DLOG_ERROR, "store: %s: %s", sql, sqlite3_errmsg(db));
         return PROTO_ESTORAGE;
     }
     return 0;
@@ -133,11 +183,10 @@ static int fsync_path(const char *path)
     return rc;
 }
 
-/* Removes spool/<id>/ and the files in it (the directory is flat). */
-static void spool_remove(const store *s, uint64_t id)
+/* Removes dir and the files in it (spool directories are flat). */
+static void remove_dir(const char *dir)
 {
-    char dir[CONF_PATH + 64], path[CONF_PATH + 400];
-    store_spool_path(s, id, NULL, dir, sizeof dir);
+    char path[CONF_PATH + 400];
     DIR *dp = opendir(dir);
     if (!dp)
         return;
@@ -152,15 +201,46 @@ static void spool_remove(const store *s, uint64_t id)
         dlog(DLOG_WARN, "store: cannot remove %s: %s", dir, strerror(errno));
 }
 
+/* Removes spool/<id>/ and the files in it. */
+static void spool_remove(const store *s, uint64_t id)
+{
+    char dir[CONF_PATH + 64];
+    remove_dir(store_spool_path(s, id, NULL, dir, sizeof dir));
+}
+
+/* Opens path with the pragmas every connection of the store uses and a
+ * busy handler (the wait for another connection's write lock). */
+static int open_db(const char *path, sqlite3 **db, int (*busy)(void *, int), void *ctx,
+                   char *err, size_t errsz)
+{
+    char *msg = NULL;
+    if (sqlite3_open_v2(path, db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", path, *db ? sqlite3_errmsg(*db) : "cannot open");
+    sqlite3_busy_handler(*db, busy, ctx);
+    if (sqlite3_exec(*db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;", NULL, NULL, &msg) != SQLITE_OK) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", path, msg ? msg : "cannot set up");
+        sqlite3_free(msg);
+        return PROTO_ESTORAGE;
+    }
+    return 0;
+}
+
 int store_open(const char *dir, store **out, char *err, size_t errsz)
 {
     *out = NULL;
+    if (!sqlite3_threadsafe())     /* two threads use two connections */
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "SQLite was built without thread support");
     store *s = calloc(1, sizeof *s);
     if (!s)
         return errbuf_set(err, errsz, PROTO_ENOMEM, "out of memory");
     snprintf(s->dir, sizeof s->dir, "%s", dir);
     char path[CONF_PATH + 32];
     int rc = PROTO_ESTORAGE;
+    if (pthread_mutex_init(&s->submit_mu, NULL) != 0) {
+        errbuf_set(err, errsz, rc, "cannot create a mutex");
+        goto fail;
+    }
+    s->mu_ready = 1;
     if (mkdir(dir, 0700) != 0 && errno != EEXIST) {
         errbuf_set(err, errsz, rc, "%s: %s", dir, strerror(errno));
         goto fail;
@@ -171,14 +251,10 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
         goto fail;
     }
     snprintf(path, sizeof path, "%s/jobs.db", dir);
-    if (sqlite3_open_v2(path, &s->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK) {
-        errbuf_set(err, errsz, rc, "%s: %s", path, s->db ? sqlite3_errmsg(s->db) : "cannot open");
+    if (open_db(path, &s->db, loop_busy, s, err, errsz))
         goto fail;
-    }
     char *msg = NULL;
-    if (sqlite3_exec(s->db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
-                     "PRAGMA busy_timeout=5000;", NULL, NULL, &msg) != SQLITE_OK ||
-        sqlite3_exec(s->db, schema, NULL, NULL, &msg) != SQLITE_OK) {
+    if (sqlite3_exec(s->db, schema, NULL, NULL, &msg) != SQLITE_OK) {
         errbuf_set(err, errsz, rc, "%s: %s", path, msg ? msg : "cannot set up");
         sqlite3_free(msg);
         goto fail;
@@ -197,6 +273,9 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
         sqlite3_free(msg);
         goto fail;
     }
+    /* the schema exists now: the submit connection only inserts into it */
+    if (open_db(path, &s->sdb, submit_busy, NULL, err, errsz))
+        goto fail;
     *out = s;
     return 0;
 fail:
@@ -208,10 +287,12 @@ void store_close(store *s)
 {
     if (!s)
         return;
-    if (s->db) {
-        if (sqlite3_close(s->db) != SQLITE_OK)
-            dlog(DLOG_ERROR, "store: close: %s", sqlite3_errmsg(s->db));
-    }
+    sqlite3 *dbs[2] = {s->sdb, s->db};
+    for (int i = 0; i < 2; i++)
+        if (dbs[i] && sqlite3_close(dbs[i]) != SQLITE_OK)
+            dlog(DLOG_ERROR, "store: close: %s", sqlite3_errmsg(dbs[i]));
+    if (s->mu_ready)
+        pthread_mutex_destroy(&s->submit_mu);
     free(s);
 }
 
@@ -246,7 +327,7 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     int rc = 0;
     /* 0. Slurm runs without the Slurm backend: they run here again. */
     if (!keep_slurm) {
-        if ((rc = exec_v(s, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
+        if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
                          " energy = NULL, slurm_id = '', progress_off = 0"
                          " WHERE state IN ('PENDING', 'RUNNING') AND slurm_id != ''", NULL)))
             return errbuf_set(err, errsz, rc, "recover: cannot re-queue Slurm jobs");
@@ -262,7 +343,7 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     while (sqlite3_step(st) == SQLITE_ROW)
         kill_leftover_worker((long)sqlite3_column_int64(st, 1), (uint64_t)sqlite3_column_int64(st, 0));
     sqlite3_finalize(st);
-    if ((rc = exec_v(s, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
+    if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
                      " energy = NULL WHERE state = 'RUNNING' AND slurm_id = ''", NULL)))
         return errbuf_set(err, errsz, rc, "recover: cannot re-queue running jobs");
     int requeued = sqlite3_changes(s->db);
@@ -275,6 +356,14 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     struct dirent *de;
     int removed = 0;
     while ((de = readdir(dp))) {
+        if (strncmp(de->d_name, SPOOL_NEW_PREFIX, strlen(SPOOL_NEW_PREFIX)) == 0) {
+            /* a SUBMIT cut off before its row was inserted */
+            char dir[CONF_PATH + 300];
+            snprintf(dir, sizeof dir, "%s/%s", spool, de->d_name);
+            remove_dir(dir);
+            removed++;
+            continue;
+        }
         char *e;
         unsigned long long id = strtoull(de->d_name, &e, 10);
         if (de->d_name[0] == '.' || *e != '\0' || id == 0)
@@ -313,68 +402,87 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     return 0;
 }
 
+/* Writes len bytes of data to a new file path and fsyncs it. 0, or -1 with errno. */
+static int write_file_synced(const char *path, const void *data, size_t len)
+{
+    int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0)
+        return -1;
+    for (size_t off = 0; off < len;) {
+        ssize_t w = write(fd, (const char *)data + off, len - off);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0) {
+            int e = w < 0 ? errno : EIO;
+            close(fd);
+            errno = e;
+            return -1;
+        }
+        off += (size_t)w;
+    }
+    if (fsync(fd) != 0) {
+        int e = errno;
+        close(fd);
+        errno = e;
+        return -1;
+    }
+    return close(fd);
+}
+
 int store_submit(store *s, const char *user, const char *label, int32_t priority,
                  uint32_t total, const char *params, const void *frame, size_t len,
                  uint64_t *id, char *err, size_t errsz)
 {
-    char dir[CONF_PATH + 64], tmp[CONF_PATH + 96], fin[CONF_PATH + 96], spool[CONF_PATH + 16];
-    int fd = -1, made_dir = 0;
+    char spool[CONF_PATH + 16], tmpdir[CONF_PATH + 32], file[CONF_PATH + 48], dir[CONF_PATH + 64];
     uint64_t jid = 0;
-    if (exec_v(s, "BEGIN IMMEDIATE", NULL))
+    int renamed = 0;
+    snprintf(spool, sizeof spool, "%s/spool", s->dir);
+    snprintf(tmpdir, sizeof tmpdir, "%s/" SPOOL_NEW_PREFIX "XXXXXX", spool);
+    /* 1. the frame, durable under a name no other submit uses; no lock held */
+    if (!mkdtemp(tmpdir))
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", tmpdir, strerror(errno));
+    snprintf(file, sizeof file, "%s/job.frame", tmpdir);
+    if (write_file_synced(file, frame, len) != 0 || fsync_path(tmpdir) != 0) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", file, strerror(errno));
+        remove_dir(tmpdir);
+        return PROTO_ESTORAGE;
+    }
+    /* 2. row, directory under its id, commit: one submit at a time on sdb */
+    pthread_mutex_lock(&s->submit_mu);
+    if (exec_v(s->sdb, "BEGIN IMMEDIATE", NULL)) {
+        pthread_mutex_unlock(&s->submit_mu);
+        remove_dir(tmpdir);
         return errbuf_set(err, errsz, PROTO_ESTORAGE, "job database busy or failing");
-    if (exec_v(s, "INSERT INTO jobs(user, label, priority, state, submit_ms, params, total)"
+    }
+    if (exec_v(s->sdb, "INSERT INTO jobs(user, label, priority, state, submit_ms, params, total)"
                " VALUES(?, ?, ?, 'PENDING', ?, ?, ?)", "ttiiti", user, label, (int64_t)priority,
                store_now_ms(), params, (int64_t)total)) {
         errbuf_set(err, errsz, PROTO_ESTORAGE, "cannot insert the job row");
         goto fail;
     }
-    jid = (uint64_t)sqlite3_last_insert_rowid(s->db);
+    jid = (uint64_t)sqlite3_last_insert_rowid(s->sdb);
     store_spool_path(s, jid, NULL, dir, sizeof dir);
-    snprintf(tmp, sizeof tmp, "%s/job.frame.tmp", dir);
-    snprintf(fin, sizeof fin, "%s/job.frame", dir);
-    snprintf(spool, sizeof spool, "%s/spool", s->dir);
-    if (mkdir(dir, 0700) != 0) {
-        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", dir, strerror(errno));
+    if (rename(tmpdir, dir) != 0) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s -> %s: %s", tmpdir, dir, strerror(errno));
         goto fail;
     }
-    made_dir = 1;
-    fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-    if (fd < 0) {
-        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", tmp, strerror(errno));
+    renamed = 1;
+    if (fsync_path(spool) != 0) {
+        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: fsync: %s", spool, strerror(errno));
         goto fail;
     }
-    for (size_t off = 0; off < len;) {
-        ssize_t w = write(fd, (const char *)frame + off, len - off);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0) {
-            errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", tmp, strerror(w < 0 ? errno : EIO));
-            goto fail;
-        }
-        off += (size_t)w;
-    }
-    if (fsync(fd) != 0 || close(fd) != 0) {
-        fd = -1;
-        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: fsync: %s", tmp, strerror(errno));
-        goto fail;
-    }
-    fd = -1;
-    if (rename(tmp, fin) != 0 || fsync_path(dir) != 0 || fsync_path(spool) != 0) {
-        errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", fin, strerror(errno));
-        goto fail;
-    }
-    if (exec_v(s, "COMMIT", NULL)) {
+    if (exec_v(s->sdb, "COMMIT", NULL)) {
         errbuf_set(err, errsz, PROTO_ESTORAGE, "cannot commit the job row");
         goto fail;
     }
+    pthread_mutex_unlock(&s->submit_mu);
     *id = jid;
     return 0;
 fail:
-    if (fd >= 0)
-        close(fd);
-    exec_v(s, "ROLLBACK", NULL);
-    if (made_dir)
-        spool_remove(s, jid);
+    exec_v(s->sdb, "ROLLBACK", NULL);
+    /* removed before the lock goes: the next submit may get the same id */
+    remove_dir(renamed ? dir : tmpdir);
+    pthread_mutex_unlock(&s->submit_mu);
     return PROTO_ESTORAGE;
 }
 
@@ -411,24 +519,24 @@ int store_get(store *s, uint64_t id, store_job *out)
 
 int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid)
 {
-    return exec_v(s, "UPDATE jobs SET state = 'RUNNING', start_ms = ?, pid = ?, reason = '' WHERE id = ?",
+    return exec_v(s->db, "UPDATE jobs SET state = 'RUNNING', start_ms = ?, pid = ?, reason = '' WHERE id = ?",
                   "iii", start_ms, (int64_t)pid, (int64_t)id);
 }
 
 int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progress_off)
 {
-    return exec_v(s, "UPDATE jobs SET slurm_id = ?, progress_off = ? WHERE id = ?", "tii", slurm_id,
+    return exec_v(s->db, "UPDATE jobs SET slurm_id = ?, progress_off = ? WHERE id = ?", "tii", slurm_id,
                   progress_off, (int64_t)id);
 }
 
 int store_set_reason(store *s, uint64_t id, const char *reason)
 {
-    return exec_v(s, "UPDATE jobs SET reason = ? WHERE id = ?", "ti", reason, (int64_t)id);
+    return exec_v(s->db, "UPDATE jobs SET reason = ? WHERE id = ?", "ti", reason, (int64_t)id);
 }
 
 int store_add_crash(store *s, uint64_t id, uint32_t *crashes)
 {
-    int rc = exec_v(s, "UPDATE jobs SET crashes = crashes + 1 WHERE id = ?", "i", (int64_t)id);
+    int rc = exec_v(s->db, "UPDATE jobs SET crashes = crashes + 1 WHERE id = ?", "i", (int64_t)id);
     if (rc)
         return rc;
     sqlite3_stmt *st;
@@ -445,23 +553,23 @@ int store_add_crash(store *s, uint64_t id, uint32_t *crashes)
 int store_set_state(store *s, uint64_t id, int state, const char *reason)
 {
     if (!store_is_terminal(state))
-        return exec_v(s, "UPDATE jobs SET state = ?, reason = ?, start_ms = 0, end_ms = 0, pid = 0,"
+        return exec_v(s->db, "UPDATE jobs SET state = ?, reason = ?, start_ms = 0, end_ms = 0, pid = 0,"
                       " outer_it = 0, energy = NULL, slurm_id = '', progress_off = 0 WHERE id = ?", "tti",
                       proto_state_name(state), reason ? reason : "", (int64_t)id);
     const char *counter = state == PROTO_STATE_COMPLETED ? "completed"
                         : state == PROTO_STATE_CANCELLED ? "cancelled" : "failed";
-    int rc = exec_v(s, "BEGIN", NULL);
+    int rc = exec_v(s->db, "BEGIN", NULL);
     if (!rc)
-        rc = exec_v(s, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0, slurm_id = '' WHERE id = ?",
+        rc = exec_v(s->db, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0, slurm_id = '' WHERE id = ?",
                     "ttii",
                     proto_state_name(state), reason ? reason : "", store_now_ms(), (int64_t)id);
     if (!rc)
-        rc = exec_v(s, "INSERT INTO counters(name, value) VALUES(?, 1)"
+        rc = exec_v(s->db, "INSERT INTO counters(name, value) VALUES(?, 1)"
                     " ON CONFLICT(name) DO UPDATE SET value = value + 1", "t", counter);
     if (!rc)
-        rc = exec_v(s, "COMMIT", NULL);
+        rc = exec_v(s->db, "COMMIT", NULL);
     if (rc)
-        exec_v(s, "ROLLBACK", NULL);
+        exec_v(s->db, "ROLLBACK", NULL);
     return rc;
 }
 
@@ -488,7 +596,7 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p)
     sqlite3_finalize(st);
     if (rc != SQLITE_DONE)
         return PROTO_ESTORAGE;
-    return exec_v(s, "UPDATE jobs SET outer_it = ?, total = ?, energy = ? WHERE id = ?", "iidi",
+    return exec_v(s->db, "UPDATE jobs SET outer_it = ?, total = ?, energy = ? WHERE id = ?", "iidi",
                   (int64_t)p->outer, (int64_t)p->total,
                   p->terms[0][PROTO_TERM_ENERGY] + p->terms[1][PROTO_TERM_ENERGY], (int64_t)id);
 }
@@ -500,7 +608,7 @@ int store_clear_run(store *s, uint64_t id)
                                   "progress.frames", "progress.secret", "slurm.out"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         unlink(store_spool_path(s, id, files[i], path, sizeof path));
-    return exec_v(s, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
+    return exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
 }
 
 static void read_progress(sqlite3_stmt *st, uint64_t id, proto_progress *p)
@@ -624,15 +732,15 @@ int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx)
 
 int store_delete(store *s, uint64_t id)
 {
-    int rc = exec_v(s, "BEGIN", NULL);
+    int rc = exec_v(s->db, "BEGIN", NULL);
     if (!rc)
-        rc = exec_v(s, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
+        rc = exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
     if (!rc)
-        rc = exec_v(s, "DELETE FROM jobs WHERE id = ?", "i", (int64_t)id);
+        rc = exec_v(s->db, "DELETE FROM jobs WHERE id = ?", "i", (int64_t)id);
     if (!rc)
-        rc = exec_v(s, "COMMIT", NULL);
+        rc = exec_v(s->db, "COMMIT", NULL);
     if (rc) {
-        exec_v(s, "ROLLBACK", NULL);
+        exec_v(s->db, "ROLLBACK", NULL);
         return rc;
     }
     spool_remove(s, id);

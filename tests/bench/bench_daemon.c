@@ -1,6 +1,6 @@
 /* bench_daemon.c — what the daemon costs a client: SUBMIT of a 10K-vertex
- * pair (Draco encoding and the round trip to SUBMIT_OK, timed apart),
- * PROGRESS fan-out to 20 watchers of one job, and one small job through the
+ * pair (Draco encoding and the round trip to SUBMIT_OK, timed apart), PING
+ * round trips while large SUBMITs are stored, PROGRESS fan-out to 20 watchers of one job, and one small job through the
  * daemon against the same job run in process (corr_run). Prints figures,
  * never fails on time. */
 #include "support/harness.h"
@@ -72,6 +72,82 @@ TEST_T(submit_round_trip_of_a_10k_vertex_pair, 300)
     printf("SUBMIT 390 -> 381 (both Draco: %zu bytes): encode %.1f ms, "
            "round trip to SUBMIT_OK %.1f ms (min %.1f ms), mean of %d\n",
            bytes, 1e3 * enc / NSUBMIT, 1e3 * rt / NSUBMIT, 1e3 * rt_min, NSUBMIT);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* A client submitting large frames (random bytes as "Draco": the daemon
+ * does not decode them, and the worker is /bin/true) while another pings:
+ * how long the loop keeps a PING waiting while a SUBMIT is read and stored. */
+#define BIG_SUBMIT_MB 32
+#define NBIG 4
+
+typedef struct big_pinger {
+    const testdaemon *d;
+    volatile int stop;
+    int n, rc;
+    double max_s, sum_s;
+} big_pinger;
+
+static void *big_ping_thread(void *arg)
+{
+    big_pinger *p = arg;
+    mc_client *c = NULL;
+    char err[256];
+    if ((p->rc = mc_connect(p->d->unix_addr, NULL, &c, err, sizeof err)) != 0)
+        return NULL;
+    mc_set_timeout(c, 60000);
+    while (!p->stop && !p->rc) {
+        double t0 = now();
+        p->rc = mc_ping(c);
+        double dt = now() - t0;
+        p->max_s = dt > p->max_s ? dt : p->max_s;
+        p->sum_s += dt;
+        p->n++;
+    }
+    mc_close(c);
+    return NULL;
+}
+
+TEST_T(ping_round_trip_while_large_submits_are_stored, 300)
+{
+    testdaemon d;
+    const char *args[] = {"--worker", "/bin/true", NULL};
+    testdaemon_start(&d, "bench-bigsubmit", args);
+    size_t half = (size_t)BIG_SUBMIT_MB << 19;
+    unsigned char *blob = malloc(half);
+    CHECK(blob != NULL);
+    for (size_t i = 0; i < half; i++)
+        blob[i] = (unsigned char)(i * 2654435761u >> 13);
+    mc_job_spec spec;
+    mc_job_spec_init(&spec);
+    spec.source = spec.target = blob;
+    spec.source_len = spec.target_len = half;
+    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3};
+    spec.landmarks = lm;
+    spec.nlandmarks = 4;
+    spec.iterations = 3;
+    spec.label = "bench large submit";
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_set_timeout(c, 120000);
+    big_pinger p = {&d, 0, 0, 0, 0, 0};
+    pthread_t th;
+    CHECK_INT(pthread_create(&th, NULL, big_ping_thread, &p), 0);
+    double rt = 0;
+    for (int k = 0; k < NBIG; k++) {
+        uint64_t id;
+        double t0 = now();
+        if (mc_submit(c, &spec, &id))
+            FAILF("SUBMIT: %s", mc_errmsg(c));
+        rt += now() - t0;
+    }
+    p.stop = 1;
+    pthread_join(th, NULL);
+    CHECK_INT(p.rc, 0);
+    printf("%d SUBMITs of %d MB: round trip to SUBMIT_OK %.0f ms (mean); PING meanwhile: %d answered,"
+           " mean %.2f ms, slowest %.1f ms\n", NBIG, BIG_SUBMIT_MB, 1e3 * rt / NBIG, p.n,
+           p.n ? 1e3 * p.sum_s / p.n : 0, 1e3 * p.max_s);
+    free(blob);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
