@@ -314,11 +314,12 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     const proto_params *p = &s->params;
     snprintf(w->params, sizeof w->params,
              "model=%s partial=%u alpha=%g eta=%g beta0=%g beta1=%g beta_ramp=%u gamma=%g iterations=%u"
-             " inner=%u tolerance=%g stop_change=%g backend=%s landmarks=%u init_p=%u init_q=%u"
-             " source_bytes=%u target_bytes=%u",
+             " inner=%u tolerance=%g stop_change=%g backend=%s landmarks=%u rhm_start=%s init_p=%u"
+             " init_q=%u source_bytes=%u target_bytes=%u",
              p->model == PROTO_MODEL_BIJECTIVE ? "bijective" : "injective", p->partial, p->alpha, p->eta,
              p->beta0, p->beta1, p->beta_ramp, p->gamma, p->iterations, p->inner_iterations, p->tolerance,
-             p->stop_change, p->backend[0] ? p->backend : "default", s->nlandmarks, s->p.n, s->q.n,
+             p->stop_change, p->backend[0] ? p->backend : "default", s->nlandmarks,
+             p->rhm_start == PROTO_RHM_START_VORONOI ? "voronoi" : "distances", s->p.n, s->q.n,
              s->source.len, s->target.len);
     w->work.data = w;
     w->d = d;
