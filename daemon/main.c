@@ -39,6 +39,13 @@ static void on_sweep(uv_timer_t *t)
     store_each_expired(d->store, store_now_ms() - (int64_t)d->conf.result_ttl_s * 1000, expire_one, d);
 }
 
+void mcd_sweep_start(mcd *d)
+{
+    /* every minute, or every result-ttl when that is shorter */
+    uint64_t every = d->conf.result_ttl_s < 60 ? d->conf.result_ttl_s * 1000ull : 60000;
+    uv_timer_start(&d->sweep, on_sweep, 0, every);
+}
+
 void mcd_drained(mcd *d)
 {
     if (!d->draining || d->drained || bk_busy(d) || d->work_inflight)
@@ -110,8 +117,7 @@ int main(int argc, char **argv)
     }
     uv_timer_init(d.loop, &d.sweep);
     d.sweep.data = &d;
-    uint64_t every = d.conf.result_ttl_s < 60 ? d.conf.result_ttl_s * 1000ull : 60000;
-    uv_timer_start(&d.sweep, on_sweep, 0, every);
+    mcd_sweep_start(&d);
     uv_signal_init(d.loop, &d.sigterm);
     uv_signal_init(d.loop, &d.sigint);
     d.sigterm.data = d.sigint.data = &d;

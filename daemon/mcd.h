@@ -375,6 +375,11 @@ int srv_conn_open(const conn *c);     /* not closed or closing: replies can go o
 int srv_conn_hung_up(conn *c);
 
 /* ---- main.c ---------------------------------------------------------------- */
+/* (Re)starts the result-expiry sweep from d->conf.result_ttl_s: a sweep
+ * now, then every minute or every result-ttl if shorter (main.c; SIGHUP
+ * calls it again). */
+void mcd_sweep_start(mcd *d);
+
 /* During a drain, once no worker runs (bk_busy) and no request is in the
  * thread pool (work_inflight): closes what is left so the loop ends. Called
  * when either may have become 0; does nothing before that, or twice. */

@@ -79,6 +79,33 @@ TEST_T(finished_job_is_deleted_after_the_result_ttl, 60)
     testdaemon_stop(&d, SIGTERM);
 }
 
+/* result-ttl read again on SIGHUP takes effect at once: a finished job kept
+ * under a week's ttl is deleted soon after the config says 1 s. */
+TEST_T(sighup_with_a_shorter_result_ttl_expires_finished_jobs, 60)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    char conf[700];
+    snprintf(conf, sizeof conf, "%s/ops-ttl.conf", harness_tmpdir());
+    write_file(conf, "result-ttl = 604800\n");
+    const char *args[] = {"--config", conf, NULL};
+    testdaemon_start(&d, "ttlhup", args);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 2, 0);
+    CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_COMPLETED);
+    mc_job_status s;
+    sleep_ms(1500);
+    CHECK_INT(mc_status(c, id, &s), 0);   /* kept: the ttl is a week */
+    write_file(conf, "result-ttl = 1\n");
+    CHECK_INT(kill(d.pid, SIGHUP), 0);
+    int rc = 0;
+    for (int i = 0; i < 100 && (rc = mc_status(c, id, &s)) == 0; i++)
+        sleep_ms(50);
+    CHECK_INT(rc, MC_ENOT_FOUND);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
 TEST_T(config_file_options_take_effect_and_an_unknown_key_names_file_and_line, 30)
 {
     testdaemon_need_worker();
