@@ -271,7 +271,7 @@ int cli_eval(int argc, char **argv)
     }
     double curves[EVAL_MAX_MAPS][EVAL_CURVE_STEPS], gmean[EVAL_MAX_MAPS];
     if (gt) {
-        if (!(gs = geod_solver_new(T, 0, err, sizeof err))) {
+        if (geod_solver_new(T, 0, &gs, err, sizeof err)) {
             fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);
             goto done;
         }

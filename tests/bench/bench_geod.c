@@ -101,7 +101,8 @@ TEST_T(heat_vs_dijkstra_time_faust_5k, 120)
     double best_f = 1e300, best_s = 1e300, best_d = 1e300;
     for (int trial = 0; trial < 3; trial++) {
         double t0 = now();
-        geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+        geod_solver *s = NULL;
+        geod_solver_new(m, 0, &s, err, sizeof err);
         if (!s)
             FAILF("%s", err);
         double t1 = now();
@@ -141,7 +142,8 @@ TEST_T(heat_vs_dijkstra_accuracy_sphere, 120)
     for (int level = 3; level <= 5; level++) {
         mesh *m = testmesh_icosphere(level);
         char err[256] = "";
-        geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+        geod_solver *s = NULL;
+        geod_solver_new(m, 0, &s, err, sizeof err);
         if (!s)
             FAILF("%s", err);
         double *h = malloc(m->nv * sizeof *h), *d = malloc(m->nv * sizeof *d);

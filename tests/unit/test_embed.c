@@ -59,7 +59,8 @@ TEST(distance_fit_of_exact_scaled_and_noisy_pairs)
 TEST(farthest_points_are_spread_and_keep_their_fields)
 {
     mesh *m = testmesh_icosphere(3);
-    geod_solver *s = geod_solver_new(m, 0, NULL, 0);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, NULL, 0);
     CHECK(s != NULL);
     enum { K = 12 };
     int pts[K];
@@ -112,7 +113,8 @@ TEST(sphere_embedding_reproduces_geodesic_distances)
 {
     mesh *m = testmesh_icosphere(4);
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("%s", err);
     double *Z = malloc((size_t)m->nv * EMBED_DIM_DEFAULT * sizeof *Z);
@@ -167,7 +169,8 @@ TEST(disk_embedding_in_2d_recovers_the_disk)
 {
     mesh *m = testmesh_disk(16);
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("%s", err);
     double *Z = malloc((size_t)m->nv * 2 * sizeof *Z);
@@ -194,7 +197,8 @@ TEST(disk_embedding_in_2d_recovers_the_disk)
 TEST(bad_embedding_arguments_are_refused)
 {
     mesh *m = testmesh_icosphere(1);
-    geod_solver *s = geod_solver_new(m, 0, NULL, 0);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, NULL, 0);
     CHECK(s != NULL);
     double *Z = malloc((size_t)m->nv * 8 * sizeof *Z);
     char err[256] = "";
@@ -259,7 +263,8 @@ TEST(biharmonic_extension_interpolates_and_rebuilds_a_sphere)
 {
     mesh *m = testmesh_icosphere(4);
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("%s", err);
     int k = 0, *fixed = malloc(m->nv * sizeof *fixed);

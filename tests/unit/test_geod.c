@@ -48,7 +48,8 @@ static errs compare(const mesh *m, const double *dist, int src, int sphere, doub
 static errs run_one(mesh *m, int src, int sphere, double h)
 {
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("solver: %s", err);
     double *d = malloc(m->nv * sizeof *d);
@@ -106,7 +107,8 @@ TEST(multi_source_is_min_of_single_sources_and_zero_at_sources)
 {
     mesh *m = testmesh_icosphere(4);
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("%s", err);
     int src[3] = {0, 700, 1900};
@@ -139,7 +141,8 @@ TEST(multi_source_is_min_of_single_sources_and_zero_at_sources)
 TEST(bad_sources_are_refused)
 {
     mesh *m = testmesh_icosphere(2);
-    geod_solver *s = geod_solver_new(m, 0, NULL, 0);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, NULL, 0);
     CHECK(s != NULL);
     double *d = malloc(m->nv * sizeof *d);
     int bad = m->nv, neg = -1, ok = 0;
@@ -167,7 +170,8 @@ TEST(other_components_are_infinitely_far)
         m->f[3 * a->nf + t] = a->f[t] + a->nv;
     }
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("%s", err);
     double *d = malloc(m->nv * sizeof *d);
@@ -190,7 +194,8 @@ TEST(other_components_are_infinitely_far)
 TEST(voronoi_cells_cover_and_own_their_landmarks)
 {
     mesh *m = testmesh_icosphere(4);
-    geod_solver *s = geod_solver_new(m, 0, NULL, 0);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, NULL, 0);
     CHECK(s != NULL);
     int lm[7] = {3, 100, 999, 1500, 2000, 2561, 42};
     geod_voronoi *v = NULL;
@@ -221,7 +226,8 @@ TEST(voronoi_cells_cover_and_own_their_landmarks)
 TEST(voronoi_of_antipodal_landmarks_halves_the_sphere)
 {
     mesh *m = testmesh_icosphere(4);
-    geod_solver *s = geod_solver_new(m, 0, NULL, 0);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, NULL, 0);
     CHECK(s != NULL);
     int anti = 0;
     for (int i = 1; i < m->nv; i++) {
@@ -253,7 +259,8 @@ TEST(faust_distances_nearly_symmetric_and_metric)
     char err[256] = "";
     if (mesh_read(harness_data_path("faust_r/vtx_5k/tr_reg_000.off"), &m, err, sizeof err))
         FAILF("%s", err);
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err);
+    geod_solver *s = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
     if (!s)
         FAILF("%s", err);
     enum { K = 20 };
@@ -324,7 +331,9 @@ TEST(intrinsic_delaunay_operators_and_distances_on_a_sheared_grid)
 {
     mesh *m = sheared_grid(25, 0.9, 0.5), *ico = testmesh_icosphere(3);
     char err[256] = "";
-    geod_solver *s = geod_solver_new(m, 0, err, sizeof err), *si = geod_solver_new(ico, 0, err, sizeof err);
+    geod_solver *s = NULL, *si = NULL;
+    geod_solver_new(m, 0, &s, err, sizeof err);
+    geod_solver_new(ico, 0, &si, err, sizeof err);
     if (!s || !si)
         FAILF("%s", err);
     CHECK_INT(geod_solver_flips(si), 0);

@@ -431,7 +431,8 @@ TEST_T(sphere_to_retessellated_sphere_is_found_from_eight_landmarks, 120)
     double *ge = malloc(sizeof(double) * (size_t)S->nv);
     for (int i = 0; i < S->nv; i++)
         id[i] = i;
-    geod_solver *gs = geod_solver_new(T, 0, err, sizeof err);
+    geod_solver *gs = NULL;
+    geod_solver_new(T, 0, &gs, err, sizeof err);
     CHECK(gs != NULL);
     const bmap *maps[1] = {r.P12};
     CHECK_INT(metric_geodesic_errors(gs, T, maps, 1, id, id, S->nv, ge), 0);

@@ -74,11 +74,12 @@ const char *geod_strerror(int code);
 typedef struct geod_solver geod_solver;
 
 /* Builds the operators of m and factorises (M + t L), L + eps M and, when m
- * has a boundary, the interior block of (M + t L). t_factor <= 0 means
- * GEOD_T_FACTOR_DEFAULT. NULL on failure with the detail in err: a
- * non-manifold edge, zero total area or zero mean edge length (GEOD_EMESH),
- * a failed factorisation, out of memory. */
-geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t errsz);
+ * has a boundary, the interior block of (M + t L); *out = the solver.
+ * t_factor <= 0 means GEOD_T_FACTOR_DEFAULT. Returns GEOD_OK, or with *out
+ * NULL and the detail in err: GEOD_EMESH (a non-manifold edge, zero total
+ * area or zero mean edge length), GEOD_EFACTOR (a failed factorisation),
+ * GEOD_ENOMEM (including CHOLMOD running out of memory). */
+int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err, size_t errsz);
 void geod_solver_free(geod_solver *s);
 
 int geod_solver_nv(const geod_solver *s);

@@ -250,9 +250,11 @@ static cholmod_factor *factorise(cholmod_sparse *A, cholmod_common *cc,
     return NULL;
 }
 
-geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t errsz)
+int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err, size_t errsz)
 {
     geod_solver *s = NULL;
+    int code = GEOD_ENOMEM;   /* what a failure below returns, unless it says */
+    *out = NULL;
     geo_edges e = {0};
     geod__idt idt = {0};
     geo_csr *L = NULL;
@@ -261,15 +263,14 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
     cholmod_sparse *A = NULL;
     int ok = 0;
     if (!m || m->nv < 1 || m->nf < 1) {
-        errbuf_set(err, errsz, GEOD_EMESH, "geodesics need a mesh with faces");
-        return NULL;
+        return errbuf_set(err, errsz, GEOD_EMESH, "geodesics need a mesh with faces");
     }
     if (!(t_factor > 0) || !isfinite(t_factor))
         t_factor = GEOD_T_FACTOR_DEFAULT;
     int rc = geo_edges_build(m, &e, err, errsz);
     if (rc != GEO_OK) {
         if (rc != GEO_ENOMEM)
-            errbuf_set(err, errsz, GEOD_EMESH, "edge table: %s", geo_strerror(rc));
+            code = errbuf_set(err, errsz, GEOD_EMESH, "edge table: %s", geo_strerror(rc));
         goto out;
     }
     s = calloc(1, sizeof *s);
@@ -279,19 +280,19 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
         !(s->grad = malloc(6 * (size_t)m->nf * sizeof *s->grad)) ||
         !(s->area = malloc((size_t)m->nf * sizeof *s->area)) ||
         !(s->comp = malloc((size_t)m->nv * sizeof *s->comp))) {
-        errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex solver", m->nv);
+        code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex solver", m->nv);
         goto out;
     }
     s->nv = m->nv;
     s->nf = m->nf;
     if (geod__idt_build(m, &e, &idt) != GEOD_OK) {
-        errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the intrinsic triangulation");
+        code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the intrinsic triangulation");
         goto out;
     }
     s->flips = idt.flips;
     face_gradients(&idt, s->grad, s->area);
     if (!(L = idt_laplacian(&idt, m->nv, s->area, mass))) {
-        errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex Laplacian", m->nv);
+        code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex Laplacian", m->nv);
         goto out;
     }
     s->f = idt.f;
@@ -316,8 +317,8 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
         }
     if (!(h > 0) || !isfinite(h) || nmass == 0 || !(msum > 0) || !(lsum > 0) ||
         !isfinite(msum) || !isfinite(lsum)) {
-        errbuf_set(err, errsz, GEOD_EMESH,
-                   "degenerate mesh: mean edge length %g, total area %g", h, msum);
+        code = errbuf_set(err, errsz, GEOD_EMESH,
+                          "degenerate mesh: mean edge length %g, total area %g", h, msum);
         goto out;
     }
     s->t = t_factor * h * h;
@@ -346,7 +347,7 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
     if (geo_edges_boundary_count(&e) > 0) {
         if (!(remap = malloc((size_t)m->nv * sizeof *remap)) ||
             !(s->interior = malloc((size_t)m->nv * sizeof *s->interior))) {
-            errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the interior list");
+            code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the interior list");
             goto out;
         }
         for (int i = 0; i < m->nv; i++)
@@ -374,10 +375,12 @@ geod_solver *geod_solver_new(const mesh *m, double t_factor, char *err, size_t e
 
 fail_cholmod:
     if (s->cc.status == CHOLMOD_OUT_OF_MEMORY)
-        errbuf_set(err, errsz, GEOD_ENOMEM, "CHOLMOD ran out of memory (%d vertices)", m->nv);
+        code = errbuf_set(err, errsz, GEOD_ENOMEM, "CHOLMOD ran out of memory (%d vertices)", m->nv);
     else if (!A)
-        errbuf_set(err, errsz, GEOD_EFACTOR, "CHOLMOD could not build a matrix (status %d)",
-                   s->cc.status);
+        code = errbuf_set(err, errsz, GEOD_EFACTOR, "CHOLMOD could not build a matrix (status %d)",
+                          s->cc.status);
+    else
+        code = GEOD_EFACTOR;   /* factorise said which */
 out:
     if (s && s->cc_started)
         cholmod_free_sparse(&A, &s->cc);
@@ -391,7 +394,8 @@ out:
     geo_edges_close(&e);
     if (!ok) {
         geod_solver_free(s);
-        return NULL;
+        return code;
     }
-    return s;
+    *out = s;
+    return GEOD_OK;
 }

@@ -86,8 +86,9 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
     if (!sd->mass || !sd->X || !sd->Xij)
         return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
     geo_vertex_areas(m, sd->mass);
-    if (!(sd->geod = geod_solver_new(m, 0, detail, sizeof detail)))
-        return errbuf_set(err, errsz, RHM_EMESH, "%s: geodesics: %s", name, detail);
+    if ((rc = geod_solver_new(m, 0, &sd->geod, detail, sizeof detail)))
+        return errbuf_set(err, errsz, rc == GEOD_ENOMEM ? RHM_ENOMEM : RHM_EMESH, "%s: geodesics: %s",
+                          name, detail);
     if (m->nv <= pb->dim)
         return errbuf_set(err, errsz, RHM_EMESH, "%s: %d vertices are too few for a %d-D embedding",
                           name, m->nv, pb->dim);
