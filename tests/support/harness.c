@@ -13,6 +13,8 @@
 
 static struct { const char *name; harness_fn fn; int timeout; } tests[HARNESS_MAX_TESTS];
 static int ntests;
+static int opt_argc;
+static char **opt_argv;
 
 void harness_register(const char *name, harness_fn fn, int timeout_s)
 {
@@ -49,6 +51,17 @@ const char *harness_data_path(const char *rel)
         SKIP("../shared/data is absent");
     snprintf(path, sizeof path, "%s/%s", dir, rel);
     return path;
+}
+
+const char *harness_option(const char *name)
+{
+    size_t len = strlen(name);
+    for (int a = 1; a < opt_argc; a++) {
+        const char *s = opt_argv[a];
+        if (strncmp(s, "--", 2) == 0 && strncmp(s + 2, name, len) == 0 && s[2 + len] == '=')
+            return s + 3 + len;
+    }
+    return NULL;
 }
 
 const char *harness_tmpdir(void)
@@ -100,9 +113,13 @@ int main(int argc, char **argv)
 {
     ompenv_ensure_passive(argv);
     const char *prog = strrchr(argv[0], '/') ? strrchr(argv[0], '/') + 1 : argv[0];
-    int failed = 0, ran = 0;
+    opt_argc = argc;
+    opt_argv = argv;
+    int failed = 0, ran = 0, named = 0;
+    for (int a = 1; a < argc; a++)
+        named += strncmp(argv[a], "--", 2) != 0;
     for (int i = 0; i < ntests; i++) {
-        if (argc > 1) {  /* run only the named tests */
+        if (named) {  /* run only the named tests */
             int want = 0;
             for (int a = 1; a < argc; a++)
                 want |= strcmp(argv[a], tests[i].name) == 0;
@@ -112,7 +129,7 @@ int main(int argc, char **argv)
         failed += run_one(prog, i);
         ran++;
     }
-    if (ran == 0 && argc > 1) {
+    if (ran == 0 && named) {
         fprintf(stderr, "%s: no test named like that\n", prog);
         return 2;
     }

@@ -45,6 +45,10 @@ const char *harness_data_dir(void);
 /* harness_data_path("faust_r/vtx_5k/tr_reg_000.off") -> static buffer, or
  * SKIP()s the test when the data folder is absent. */
 const char *harness_data_path(const char *rel);
+/* The value of the command-line option --name=VALUE, or NULL when it was
+ * not given (benchmarks take their knobs this way; arguments without a
+ * leading "--" name the tests to run). */
+const char *harness_option(const char *name);
 /* A fresh temporary directory for this test (removed by nobody: /tmp). */
 const char *harness_tmpdir(void);
 

@@ -4,40 +4,102 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
-static int *read_vts(const char *rel, int n, int nv)
+int testgt_read_ids(const char *path, int base, int nv, int **ids, int *n,
+                    char *err, size_t errsz)
 {
-    FILE *fp = fopen(harness_data_path(rel), "r");
-    if (!fp)
-        FAILF("cannot open %s", rel);
-    int *ids = malloc(sizeof(int) * (size_t)n);
-    for (int k = 0; k < n; k++) {
-        if (fscanf(fp, "%d", &ids[k]) != 1 || ids[k] < 1 || ids[k] > nv)
-            FAILF("%s: line %d unreadable", rel, k + 1);
-        ids[k]--;
+    *ids = NULL;
+    *n = 0;
+    FILE *fp = fopen(path, "r");
+    if (!fp) {
+        snprintf(err, errsz, "%s: cannot open", path);
+        return -1;
     }
+    int cap = 1024, len = 0, line = 0, rc = -1;
+    int *v = malloc(sizeof(int) * (size_t)cap);
+    char buf[4096];
+    while (v && fgets(buf, sizeof buf, fp)) {
+        line++;
+        char *p = buf, *e;
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (*p == '\0' || *p == '\n' || *p == '\r' || *p == '#')
+            continue;
+        double x = strtod(p, &e);
+        if (e == p || !(fabs(x - floor(x + 0.5)) < 1e-6)) {
+            snprintf(err, errsz, "%s:%d: not a vertex id", path, line);
+            goto out;
+        }
+        double k = floor(x + 0.5) - base;
+        if (!(k >= 0 && k < nv)) {
+            snprintf(err, errsz, "%s:%d: vertex %.0f out of range [%d, %d]", path, line,
+                     k + base, base, nv - 1 + base);
+            goto out;
+        }
+        if (len == cap) {
+            if (cap >= TESTGT_MAX_LINES) {
+                snprintf(err, errsz, "%s: more than %d lines", path, TESTGT_MAX_LINES);
+                goto out;
+            }
+            int *w = realloc(v, sizeof(int) * (size_t)(cap *= 2));
+            if (!w) {
+                free(v);
+                v = NULL;
+                break;
+            }
+            v = w;
+        }
+        v[len++] = (int)k;
+    }
+    if (!v) {
+        snprintf(err, errsz, "%s: out of memory", path);
+        goto out;
+    }
+    *ids = v;
+    *n = len;
+    v = NULL;
+    rc = 0;
+out:
+    free(v);
     fclose(fp);
+    return rc;
+}
+
+static mesh *read_mesh(const char *rel)
+{
+    char err[512];
+    mesh *m = NULL;
+    if (mesh_read(harness_data_path(rel), &m, err, sizeof err))
+        FAILF("%s", err);
+    return m;
+}
+
+/* ids of rel; fails the test unless there are n of them (n < 0: any). */
+static int *read_ids(const char *rel, int base, int nv, int n, int *count)
+{
+    char err[512];
+    int *ids, len;
+    if (testgt_read_ids(harness_data_path(rel), base, nv, &ids, &len, err, sizeof err))
+        FAILF("%s", err);
+    if (len == 0)
+        FAILF("%s: no vertex ids", rel);
+    if (n >= 0 && len != n)
+        FAILF("%s: %d lines, expected %d", rel, len, n);
+    if (count)
+        *count = len;
     return ids;
 }
 
-void testgt_faust(testgt *g, int nl)
+static void pick_landmarks(testgt *g, int nl)
 {
-    char err[512];
-    const char *dir = "faust_r/vtx_5k/";
-    char p[256];
-    snprintf(p, sizeof p, "%str_reg_000.off", dir);
-    if (mesh_read(harness_data_path(p), &g->S, err, sizeof err))
-        FAILF("%s", err);
-    snprintf(p, sizeof p, "%str_reg_001.off", dir);
-    if (mesh_read(harness_data_path(p), &g->T, err, sizeof err))
-        FAILF("%s", err);
-    g->n = 5000;
-    g->src = read_vts("faust_r/vtx_5k/corres/tr_reg_000.vts", g->n, g->S->nv);
-    g->tgt = read_vts("faust_r/vtx_5k/corres/tr_reg_001.vts", g->n, g->T->nv);
     g->L.n = nl;
     g->L.src = malloc(sizeof(int) * (size_t)nl);
     g->L.tgt = malloc(sizeof(int) * (size_t)nl);
     double *d = malloc(sizeof(double) * (size_t)g->n);
+    if (!g->L.src || !g->L.tgt || !d)
+        FAILF("out of memory");
     for (int k = 0; k < g->n; k++)
         d[k] = INFINITY;
     int pick = 0;
@@ -60,12 +122,52 @@ void testgt_faust(testgt *g, int nl)
     free(d);
 }
 
+void testgt_vts(testgt *g, const char *dir, const char *a, const char *b, int nl)
+{
+    memset(g, 0, sizeof *g);
+    char p[1024];
+    snprintf(p, sizeof p, "%s/%s.off", dir, a);
+    g->S = read_mesh(p);
+    snprintf(p, sizeof p, "%s/%s.off", dir, b);
+    g->T = read_mesh(p);
+    snprintf(p, sizeof p, "%s/corres/%s.vts", dir, a);
+    g->src = read_ids(p, 1, g->S->nv, -1, &g->n);
+    snprintf(p, sizeof p, "%s/corres/%s.vts", dir, b);
+    g->tgt = read_ids(p, 1, g->T->nv, g->n, NULL);
+    snprintf(p, sizeof p, "%s/corres/%s.sym.vts", dir, b);
+    if (access(harness_data_path(p), F_OK) == 0)
+        g->tgt_sym = read_ids(p, 1, g->T->nv, g->n, NULL);
+    pick_landmarks(g, nl);
+}
+
+void testgt_vertex_list(testgt *g, const char *S_rel, const char *T_rel, const char *gt_rel,
+                        int nl)
+{
+    memset(g, 0, sizeof *g);
+    g->S = read_mesh(S_rel);
+    g->T = read_mesh(T_rel);
+    g->n = g->S->nv;
+    g->tgt = read_ids(gt_rel, 0, g->T->nv, g->n, NULL);
+    g->src = malloc(sizeof(int) * (size_t)g->n);
+    if (!g->src)
+        FAILF("out of memory");
+    for (int k = 0; k < g->n; k++)
+        g->src[k] = k;
+    pick_landmarks(g, nl);
+}
+
+void testgt_faust(testgt *g, int nl)
+{
+    testgt_vts(g, "faust_r/vtx_5k", "tr_reg_000", "tr_reg_001", nl);
+}
+
 void testgt_close(testgt *g)
 {
     mesh_free(g->S);
     mesh_free(g->T);
     free(g->src);
     free(g->tgt);
+    free(g->tgt_sym);
     free(g->L.src);
     free(g->L.tgt);
 }
