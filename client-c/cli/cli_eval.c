@@ -11,6 +11,7 @@
  *                pyFM lion2cat); 0-based unless --gt-base 1 */
 #include "cli/cli.h"
 #include "geod/geod.h"
+#include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 #include "metric/metric.h"
@@ -42,61 +43,14 @@ static void usage(FILE *fp)
         "error curves of every map (with a ground truth).\n");
 }
 
-/* Reads the first column of every non-blank, non-'#' line of path as an
- * integer vertex index (written as an integer or a float such as 7.529e+03)
- * minus base, each in [0, nv). *out: malloc()ed, *n its length. */
+/* lmk_read_ids with the message on stderr. */
 static int read_indices(const char *path, int base, int nv, int **out, int *n)
 {
-    FILE *fp = fopen(path, "r");
-    if (!fp) {
-        fprintf(stderr, "meshcorr eval: %s: cannot open\n", path);
-        return -1;
-    }
-    int cap = 1024, len = 0, line = 0, rc = -1;
-    int *v = malloc(sizeof(int) * (size_t)cap);
-    char buf[4096];
-    while (v && fgets(buf, sizeof buf, fp)) {
-        line++;
-        char *p = buf, *e;
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (*p == '\0' || *p == '\n' || *p == '\r' || *p == '#')
-            continue;
-        double x = strtod(p, &e);
-        if (e == p || !(fabs(x - floor(x + 0.5)) < 1e-6)) {
-            fprintf(stderr, "meshcorr eval: %s:%d: not a vertex index\n", path, line);
-            goto out;
-        }
-        long k = (long)floor(x + 0.5) - base;
-        if (k < 0 || k >= nv) {
-            fprintf(stderr, "meshcorr eval: %s:%d: vertex %ld out of range [%d, %d]\n", path,
-                    line, k + base, base, nv - 1 + base);
-            goto out;
-        }
-        if (len == cap) {
-            if (cap >= EVAL_MAX_GT_LINES) {
-                fprintf(stderr, "meshcorr eval: %s: more than %d lines\n", path, EVAL_MAX_GT_LINES);
-                goto out;
-            }
-            int *w = realloc(v, sizeof(int) * (size_t)(cap *= 2));
-            if (!w)
-                break;
-            v = w;
-        }
-        v[len++] = (int)k;
-    }
-    if (!v) {
-        fprintf(stderr, "meshcorr eval: out of memory\n");
-        goto out;
-    }
-    *out = v;
-    *n = len;
-    v = NULL;
-    rc = 0;
-out:
-    free(v);
-    fclose(fp);
-    return rc;
+    char err[512];
+    if (lmk_read_ids(path, base, nv, EVAL_MAX_GT_LINES, out, n, err, sizeof err) == LMK_OK)
+        return 0;
+    fprintf(stderr, "meshcorr eval: %s\n", err);
+    return -1;
 }
 
 /* PREFIX.target.ply coloured by position, PREFIX.source.ply through P. */

@@ -296,3 +296,16 @@ void testdaemon_demo_close(testdaemon_demo *dm)
     mesh_free(dm->T);
     memset(dm, 0, sizeof *dm);
 }
+
+int testdaemon_log_has(const testdaemon *d, const char *what)
+{
+    FILE *fp = fopen(d->log, "r");
+    if (!fp)
+        return 0;
+    char line[4096];
+    int found = 0;
+    while (!found && fgets(line, sizeof line, fp))
+        found = strstr(line, what) != NULL;
+    fclose(fp);
+    return found;
+}

@@ -38,6 +38,8 @@ int testdaemon_stop(testdaemon *d, int sig);
 /* A connected client: token NULL = the Unix socket (peer credentials), else
  * TCP with that token. Fails the test when it cannot connect. */
 mc_client *testdaemon_client(const testdaemon *d, const char *token);
+/* 1 when a line of the daemon's log contains what. */
+int testdaemon_log_has(const testdaemon *d, const char *what);
 /* Pid of the meshcorr-worker the daemon runs for job id, or -1 (waits up to
  * 10 s for it to appear). */
 pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id);

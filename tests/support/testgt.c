@@ -7,66 +7,6 @@
 #include <string.h>
 #include <unistd.h>
 
-int testgt_read_ids(const char *path, int base, int nv, int **ids, int *n,
-                    char *err, size_t errsz)
-{
-    *ids = NULL;
-    *n = 0;
-    FILE *fp = fopen(path, "r");
-    if (!fp) {
-        snprintf(err, errsz, "%s: cannot open", path);
-        return -1;
-    }
-    int cap = 1024, len = 0, line = 0, rc = -1;
-    int *v = malloc(sizeof(int) * (size_t)cap);
-    char buf[4096];
-    while (v && fgets(buf, sizeof buf, fp)) {
-        line++;
-        char *p = buf, *e;
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (*p == '\0' || *p == '\n' || *p == '\r' || *p == '#')
-            continue;
-        double x = strtod(p, &e);
-        if (e == p || !(fabs(x - floor(x + 0.5)) < 1e-6)) {
-            snprintf(err, errsz, "%s:%d: not a vertex id", path, line);
-            goto out;
-        }
-        double k = floor(x + 0.5) - base;
-        if (!(k >= 0 && k < nv)) {
-            snprintf(err, errsz, "%s:%d: vertex %.0f out of range [%d, %d]", path, line,
-                     k + base, base, nv - 1 + base);
-            goto out;
-        }
-        if (len == cap) {
-            if (cap >= TESTGT_MAX_LINES) {
-                snprintf(err, errsz, "%s: more than %d lines", path, TESTGT_MAX_LINES);
-                goto out;
-            }
-            int *w = realloc(v, sizeof(int) * (size_t)(cap *= 2));
-            if (!w) {
-                free(v);
-                v = NULL;
-                break;
-            }
-            v = w;
-        }
-        v[len++] = (int)k;
-    }
-    if (!v) {
-        snprintf(err, errsz, "%s: out of memory", path);
-        goto out;
-    }
-    *ids = v;
-    *n = len;
-    v = NULL;
-    rc = 0;
-out:
-    free(v);
-    fclose(fp);
-    return rc;
-}
-
 static mesh *read_mesh(const char *rel)
 {
     char err[512];
@@ -81,7 +21,7 @@ static int *read_ids(const char *rel, int base, int nv, int n, int *count)
 {
     char err[512];
     int *ids, len;
-    if (testgt_read_ids(harness_data_path(rel), base, nv, &ids, &len, err, sizeof err))
+    if (lmk_read_ids(harness_data_path(rel), base, nv, TESTGT_MAX_LINES, &ids, &len, err, sizeof err))
         FAILF("%s", err);
     if (len == 0)
         FAILF("%s: no vertex ids", rel);

@@ -31,13 +31,6 @@ typedef struct testgt {
     lmk_set L;      /* landmarks: farthest-point sample of the GT source points */
 } testgt;
 
-/* Reads the first column of every non-blank, non-'#' line of path as a
- * vertex id (an integer, or a float within 1e-6 of one) minus base, each in
- * [0, nv). *ids: malloc()ed, *n entries. 0, or -1 with the file and line in
- * err (*ids is then NULL). */
-int testgt_read_ids(const char *path, int base, int nv, int **ids, int *n,
-                    char *err, size_t errsz);
-
 /* The .vts layout: dir relative to the data folder ("faust_r/vtx_5k"),
  * a and b the shape names ("tr_reg_000"). */
 void testgt_vts(testgt *g, const char *dir, const char *a, const char *b, int nl);

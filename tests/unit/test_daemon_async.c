@@ -32,19 +32,6 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int log_has(const testdaemon *d, const char *what)
-{
-    FILE *fp = fopen(d->log, "r");
-    if (!fp)
-        return 0;
-    char line[4096];
-    int found = 0;
-    while (!found && fgets(line, sizeof line, fp))
-        found = strstr(line, what) != NULL;
-    fclose(fp);
-    return found;
-}
-
 /* ---- many SUBMITs at once ------------------------------------------------- */
 
 #define NCLIENTS 6
@@ -455,7 +442,7 @@ TEST_T(client_that_hangs_up_right_after_submit_leaves_a_stored_job_that_runs, 60
     /* the log says so when the hang-up came before the store finished (it
      * nearly always does: the store fsyncs) */
     printf("  log names a job stored for a client that hung up: %s\n",
-           log_has(&d, "hung up before SUBMIT_OK") ? "yes" : "no (SUBMIT_OK was sent before the hang-up)");
+           testdaemon_log_has(&d, "hung up before SUBMIT_OK") ? "yes" : "no (SUBMIT_OK was sent before the hang-up)");
     c = testdaemon_client(&d, TESTDAEMON_BOB);
     CHECK_INT(mc_ping(c), 0);
     mc_close(c);
@@ -509,7 +496,7 @@ TEST_T(sigterm_while_submits_are_stored_acknowledges_them_and_keeps_them, 60)
         pthread_join(th[i], NULL);
     int st = testdaemon_stop(&d, 0);       /* no second signal: wait for the exit */
     CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0);
-    CHECK(log_has(&d, "drained: no worker running, no request in the thread pool"));
+    CHECK(testdaemon_log_has(&d, "drained: no worker running, no request in the thread pool"));
     int acked = 0;
     for (int i = 0; i < 3; i++) {
         /* the SUBMIT after the last one acknowledged failed: refused or cut off */

@@ -158,19 +158,6 @@ static int try_connect(const testdaemon *d, const char *token)
     return rc;
 }
 
-static int log_has(const testdaemon *d, const char *what)
-{
-    FILE *fp = fopen(d->log, "r");
-    if (!fp)
-        return 0;
-    char line[4096];
-    int found = 0;
-    while (!found && fgets(line, sizeof line, fp))
-        found = strstr(line, what) != NULL;
-    fclose(fp);
-    return found;
-}
-
 TEST_T(sighup_reloads_tokens_and_a_bad_tokens_file_keeps_the_old_ones, 30)
 {
     testdaemon d;
@@ -189,13 +176,13 @@ TEST_T(sighup_reloads_tokens_and_a_bad_tokens_file_keeps_the_old_ones, 30)
 
     write_file(tokens, "tok-dave-42 dave admin extra words\n");
     CHECK_INT(kill(d.pid, SIGHUP), 0);
-    for (int i = 0; i < 250 && !log_has(&d, "keeping the previous tokens"); i++)
+    for (int i = 0; i < 250 && !testdaemon_log_has(&d, "keeping the previous tokens"); i++)
         sleep_ms(20);
-    CHECK(log_has(&d, "tokens:1: expected `token user [admin]`"));
+    CHECK(testdaemon_log_has(&d, "tokens:1: expected `token user [admin]`"));
     CHECK_INT(try_connect(&d, "tok-carol-42"), 0);
     CHECK_INT(try_connect(&d, "tok-dave-42"), MC_EUNAUTHORIZED);
-    CHECK(log_has(&d, "<3>"));                /* the error line has its syslog priority */
-    CHECK(log_has(&d, "<6>"));
+    CHECK(testdaemon_log_has(&d, "<3>"));                /* the error line has its syslog priority */
+    CHECK(testdaemon_log_has(&d, "<6>"));
     testdaemon_stop(&d, SIGTERM);
 }
 

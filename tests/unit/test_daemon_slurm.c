@@ -66,18 +66,6 @@ static uint64_t submit_ok(mc_client *c, int iterations, int long_job)
     return id;
 }
 
-static int log_has(const testdaemon *d, const char *what)
-{
-    FILE *fp = fopen(d->log, "r");
-    char line[4096];
-    int found = 0;
-    while (fp && !found && fgets(line, sizeof line, fp))
-        found = strstr(line, what) != NULL;
-    if (fp)
-        fclose(fp);
-    return found;
-}
-
 /* The demo pair 381 -> 390 with its initial maps (no landmarks: ECTM only,
  * so the outer iterations only grow), no early stop. */
 static uint64_t submit_demo(mc_client *c, uint32_t iterations)
@@ -119,7 +107,7 @@ TEST_T(slurm_job_streams_energies_and_gives_the_local_backends_map, 150)
     CHECK(sw.monotone && sw.finite);
     CHECK_INT(sw.last_outer, 2);
     /* the stream came over the authenticated TCP connection, not the file */
-    CHECK(log_has(&sd, "progress connection from its worker"));
+    CHECK(testdaemon_log_has(&sd, "progress connection from its worker"));
     char path[1200];
     struct stat st;
     snprintf(path, sizeof path, "%s/spool/%llu/progress.frames", sd.state, (unsigned long long)sid);
@@ -170,7 +158,7 @@ TEST_T(worker_that_cannot_reach_the_daemon_reports_through_the_progress_file, 90
     CHECK(w.n >= 4);                   /* (landmark jobs: RHM's records, then ECTM's) */
     CHECK_INT(w.last_outer, 4);
     CHECK(w.finite);
-    CHECK(!log_has(&d, "progress connection from its worker"));
+    CHECK(!testdaemon_log_has(&d, "progress connection from its worker"));
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
@@ -237,7 +225,7 @@ TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 
     CHECK_STR_HAS(testslurm_state(&d, a, st, sizeof st), "RUNNING");
     testslurm_daemon(&d, "restart", NULL);
     c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    CHECK(log_has(&d, "re-attached to Slurm job"));
+    CHECK(testdaemon_log_has(&d, "re-attached to Slurm job"));
     for (int i = 0; i < 2; i++) {
         uint64_t id = i ? b : a;
         watch_log w = {0, 0, 1, 1};
@@ -280,7 +268,7 @@ TEST_T(missing_sbatch_is_in_stats_and_the_job_stays_pending, 60)
     CHECK_INT(stats.backend_ok, 0);
     CHECK_STR_HAS(stats.backend_status, "not found in PATH");
     mc_stats_free(&stats);
-    CHECK(log_has(&d, "not found in PATH"));
+    CHECK(testdaemon_log_has(&d, "not found in PATH"));
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }

@@ -1,6 +1,7 @@
-/* test_testgt.c — the ground-truth test support (support/testgt.h): the id
- * reader on small files (integers, floats, first column, comments, both
- * bases, each refusal) and the two loaders on the real pairs. */
+/* test_testgt.c — ground-truth files: the id-list reader (lmk_read_ids, used
+ * by meshcorr eval and the test support) on small files (integers, floats,
+ * first column, comments, both bases, each refusal) and the two loaders of
+ * support/testgt.h on the real pairs. */
 #include "support/harness.h"
 #include "support/testfile.h"
 #include "support/testgt.h"
@@ -32,9 +33,9 @@ TEST(read_ids_takes_integers_floats_and_first_columns_and_names_the_bad_line)
         const char *path = testfile_text("gt.txt", cases[c].text);
         int *ids = NULL, n = -7;
         char err[512] = "";
-        int rc = testgt_read_ids(path, cases[c].base, cases[c].nv, &ids, &n, err, sizeof err);
+        int rc = lmk_read_ids(path, cases[c].base, cases[c].nv, 100, &ids, &n, err, sizeof err);
         if (cases[c].n < 0) {
-            CHECK_INT(rc, -1);
+            CHECK(rc < 0);
             CHECK(ids == NULL);
             CHECK_STR_HAS(err, cases[c].msg);
             CHECK_STR_HAS(err, "gt.txt");
@@ -49,8 +50,14 @@ TEST(read_ids_takes_integers_floats_and_first_columns_and_names_the_bad_line)
     }
     int *ids = NULL, n;
     char err[512];
-    CHECK_INT(testgt_read_ids("/nonexistent/gt.vts", 0, 5, &ids, &n, err, sizeof err), -1);
+    CHECK_INT(lmk_read_ids("/nonexistent/gt.vts", 0, 5, 100, &ids, &n, err, sizeof err), LMK_EIO);
     CHECK_STR_HAS(err, "cannot open");
+    const char *three = testfile_text("gt3.txt", "0\n1\n2\n");
+    CHECK_INT(lmk_read_ids(three, 0, 5, 2, &ids, &n, err, sizeof err), LMK_ECOUNT);
+    CHECK_STR_HAS(err, "more than 2 lines");
+    CHECK_INT(lmk_read_ids(three, 0, 5, 3, &ids, &n, err, sizeof err), LMK_OK);
+    CHECK_INT(n, 3);
+    free(ids);
 }
 
 static void check_landmarks(const testgt *g, int nl)

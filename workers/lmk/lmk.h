@@ -55,4 +55,13 @@ int lmk_read_pairs(const char *path, int one_based, const mesh *S, const mesh *T
 int lmk_read_lists(const char *src_path, const char *tgt_path, int one_based,
                    const mesh *S, const mesh *T, lmk_set **out, char *err, size_t errsz);
 
+/* A list of vertex ids (ground truth and the like; no landmark rule): the
+ * first column of every non-blank, non-'#' line, an integer or a float
+ * within 1e-6 of one (some ground-truth files write ids as floats), minus
+ * base, each in [0, nv); at most max lines. *ids: malloc()ed, *n entries.
+ * LMK_OK, or LMK_EIO / LMK_EPARSE / LMK_ERANGE / LMK_ECOUNT / LMK_ENOMEM with
+ * the file and line in err (*ids is then NULL). */
+int lmk_read_ids(const char *path, int base, int nv, int max, int **ids, int *n,
+                 char *err, size_t errsz);
+
 #endif
