@@ -77,20 +77,26 @@ static void face_gradients(const geod__idt *T, double *grad, double *area)
 
 /* The cotan Laplacian L (positive semi-definite, weight (cot a + cot b) / 2
  * per edge) and the lumped mass (a third of each incident triangle's area)
- * of the intrinsic triangulation. L as CSR with both triangles, duplicate
- * edges summed, loops (an edge from a vertex to itself) dropped: they add
- * nothing to x^T L x. */
-static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass)
+ * of the intrinsic triangulation. L as CSR with both triangles: CHOLMOD
+ * sorts the triplets and sums duplicate edges; loops (an edge from a vertex
+ * to itself) are dropped, they add nothing to x^T L x. */
+static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass,
+                              cholmod_common *cc)
 {
-    size_t nt = 3 * (size_t)T->nf;
-    int *cnt = calloc((size_t)nv + 1, sizeof *cnt);
-    int *tr = malloc(2 * nt * sizeof *tr), *tc = malloc(2 * nt * sizeof *tc);
-    double *tv = malloc(2 * nt * sizeof *tv), *diag = calloc((size_t)nv, sizeof *diag);
+    cholmod_triplet *tr = cholmod_allocate_triplet((size_t)nv, (size_t)nv,
+                                                   12 * (size_t)T->nf + (size_t)nv, 0, CHOLMOD_REAL, cc);
+    cholmod_sparse *A = NULL;
     geo_csr *L = NULL;
-    if (!cnt || !tr || !tc || !tv || !diag)
-        goto out;
-    memset(mass, 0, (size_t)nv * sizeof *mass);
+    if (!tr)
+        return NULL;
+    int *ti = tr->i, *tj = tr->j;
+    double *tx = tr->x;
     size_t n = 0;
+    memset(mass, 0, (size_t)nv * sizeof *mass);
+    for (int i = 0; i < nv; i++) {   /* every row stores its diagonal, even a zero one */
+        ti[n] = tj[n] = i;
+        tx[n++] = 0;
+    }
     for (int t = 0; t < T->nf; t++)
         for (int k = 0; k < 3; k++) {
             const double *l = T->len + 3 * (size_t)t;
@@ -99,70 +105,22 @@ static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, do
             double w = area[t] > 0 ? 0.5 * geod__cot(l[k], l[(k + 1) % 3], l[(k + 2) % 3]) : 0;
             if (i == j || w == 0)
                 continue;
-            diag[i] += w;
-            diag[j] += w;
-            tr[n] = i, tc[n] = j, tv[n++] = -w;
-            tr[n] = j, tc[n] = i, tv[n++] = -w;
-        }
-    /* CSR by counting sort on rows, then per row sort columns and merge */
-    for (size_t q = 0; q < n; q++)
-        cnt[tr[q] + 1]++;
-    for (int i = 0; i < nv; i++)
-        cnt[i + 1] += cnt[i];
-    int *pos = malloc((size_t)nv * sizeof *pos), *col = malloc((n + (size_t)nv) * sizeof *col);
-    double *val = malloc((n + (size_t)nv) * sizeof *val);
-    if (!pos || !col || !val) {
-        free(pos);
-        free(col);
-        free(val);
-        goto out;
-    }
-    for (int i = 0; i < nv; i++)
-        pos[i] = cnt[i] + i;                /* room for the diagonal in each row */
-    for (int i = 0; i < nv; i++) {
-        col[pos[i]] = i;
-        val[pos[i]++] = diag[i];
-    }
-    for (size_t q = 0; q < n; q++) {
-        col[pos[tr[q]]] = tc[q];
-        val[pos[tr[q]]++] = tv[q];
-    }
-    size_t nnz = 0;
-    for (int i = 0; i < nv; i++) {       /* insertion sort: rows are short */
-        int lo = cnt[i] + i, hi = cnt[i + 1] + i + 1;
-        for (int a = lo + 1; a < hi; a++)
-            for (int b = a; b > lo && col[b - 1] > col[b]; b--) {
-                int c = col[b]; col[b] = col[b - 1]; col[b - 1] = c;
-                double v = val[b]; val[b] = val[b - 1]; val[b - 1] = v;
-            }
-        for (int a = lo; a < hi; a++)
-            nnz += a == lo || col[a] != col[a - 1];
-    }
-    if ((L = geo_csr_new(nv, (int)nnz))) {
-        size_t at = 0;
-        for (int i = 0; i < nv; i++) {
-            L->row_start[i] = (int)at;
-            int lo = cnt[i] + i, hi = cnt[i + 1] + i + 1;
-            for (int a = lo; a < hi; a++) {
-                if (a > lo && col[a] == col[a - 1]) {
-                    L->val[at - 1] += val[a];
-                    continue;
-                }
-                L->col[at] = col[a];
-                L->val[at++] = val[a];
+            int e[4][2] = {{i, i}, {j, j}, {i, j}, {j, i}};
+            for (int q = 0; q < 4; q++) {
+                ti[n] = e[q][0];
+                tj[n] = e[q][1];
+                tx[n++] = q < 2 ? w : -w;
             }
         }
-        L->row_start[nv] = (int)at;
+    tr->nnz = n;
+    if ((A = cholmod_triplet_to_sparse(tr, n, cc)) && (L = geo_csr_new(nv, (int)cholmod_nnz(A, cc)))) {
+        /* symmetric with both triangles: column c of the CSC matrix is row c */
+        memcpy(L->row_start, A->p, ((size_t)nv + 1) * sizeof *L->row_start);
+        memcpy(L->col, A->i, (size_t)L->row_start[nv] * sizeof *L->col);
+        memcpy(L->val, A->x, (size_t)L->row_start[nv] * sizeof *L->val);
     }
-    free(pos);
-    free(col);
-    free(val);
-out:
-    free(cnt);
-    free(tr);
-    free(tc);
-    free(tv);
-    free(diag);
+    cholmod_free_sparse(&A, cc);
+    cholmod_free_triplet(&tr, cc);
     return L;
 }
 
@@ -291,7 +249,13 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     }
     s->flips = idt.flips;
     face_gradients(&idt, s->grad, s->area);
-    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass))) {
+    cholmod_start(&s->cc);
+    s->cc_started = 1;
+    s->cc.print = 0;
+    s->cc.nmethods = 1; /* AMD only: deterministic, no METIS */
+    s->cc.method[0].ordering = CHOLMOD_AMD;
+    s->cc.postorder = 1;
+    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass, &s->cc))) {
         code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex Laplacian", m->nv);
         goto out;
     }
@@ -324,12 +288,6 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     s->t = t_factor * h * h;
     double eps = GEOD_POISSON_REG * lsum / msum;
 
-    cholmod_start(&s->cc);
-    s->cc_started = 1;
-    s->cc.print = 0;
-    s->cc.nmethods = 1; /* AMD only: deterministic, no METIS */
-    s->cc.method[0].ordering = CHOLMOD_AMD;
-    s->cc.postorder = 1;
 
     for (int i = 0; i < m->nv; i++)
         d[i] = mass[i];
