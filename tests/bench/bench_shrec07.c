@@ -1,0 +1,395 @@
+/* bench_shrec07.c — map quality from landmarks alone, the way a user gets
+ * it: one pair per SHREC'07 class of ../shared/data/shrec07_bim (the
+ * even-numbered BIM landmarks, 0-based line 0, 2, 4, ..., given; the
+ * odd-numbered ones held out and scored), plus TOSCA wolf0 -> wolf2
+ * (tosca_r_isometric: the same connectivity; all 21 landmarks of
+ * tosca_hires/Corrs/wolf.pid given; dense identity ground truth scored).
+ *
+ * Stages as meshcorr match runs them with its defaults: the start map
+ * (rebuilt by the RHM internals rhm_run begins with), RHM (rhm_run), the
+ * fold repair of its maps (corr_repair), ECTM from the repaired maps
+ * (corr_run with stages ectm): the calls corr_run makes for stages all.
+ *
+ * Per pair and stage, both meshes at unit area: held-out error (mean
+ * geodesic distance on the target from each held-out source landmark's
+ * image to its target landmark, / sqrt(target area); wolf: over all
+ * vertices against the identity), flipped and collapsed triangles (%,
+ * metric_summarize: an image triangle whose normal opposes the target's
+ * where it lands; image area below 1e-12 of the source's), mean-curvature
+ * error ‖PH̃ − H‖ and its ratio to the stage's input (the stage before),
+ * mean |log area ratio| and median conformal distortion over non-collapsed
+ * triangles, wall time of the stage. Then the issue's targets, per pair:
+ * flipped <= 2 %, collapsed <= 0.5 %, full error <= RHM's + 0.003, area
+ * distortion below ECTM's input's (the repaired map), error <= 0.05; and over the classes:
+ * curvature ratio <= 0.75 in at least 8, median error <= 0.035; wolf:
+ * error <= 0.01 and flipped <= 1 %.
+ *
+ * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm
+ * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for
+ * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
+ * the default, for comparing). Each pair runs in
+ * its own process (support/testapart.h). Prints figures, never fails on
+ * quality. */
+#include "support/harness.h"
+#include "support/testapart.h"
+#include "corr/corr.h"
+#include "metric/metric.h"
+#include "rhm/rhm__problem.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct pair_spec {
+    const char *label;
+    int a, b;               /* SHREC'07 ids; 0: the wolf pair */
+} pair_spec;
+
+static const pair_spec pairs[] = {
+    { "glasses", 52, 58 },   { "airplane", 73, 74 }, { "ant", 81, 83 },
+    { "teddy", 162, 165 },   { "hand", 184, 185 },   { "plier", 203, 214 },
+    { "fish", 222, 226 },    { "bird", 241, 245 },   { "human", 1, 2 },
+    { "armadillo", 293, 298 }, { "fourleg", 381, 393 }, { "wolf0-wolf2", 0, 0 },
+};
+#define NPAIRS ((int)(sizeof pairs / sizeof pairs[0]))
+
+enum { START, RHM, REPAIR, ECTM, NSTAGES };
+static const char *const stage_name[NSTAGES] = { "start", "rhm", "repair", "ectm" };
+
+typedef struct pair_fig {
+    int nS, nT, given, held;
+    int nmaps;
+    double err[NSTAGES], curv[NSTAGES], secs[NSTAGES];
+    metric_summary ms[NSTAGES];
+    char why[1024];          /* non-empty: the run stopped there */
+} pair_fig;
+
+typedef struct pair_job {
+    const pair_spec *ps;
+    int ectm_iterations;
+    int last;               /* the last stage to run (--stop) */
+    const char *out_dir;    /* --out-dir: each stage's map is written there */
+    double eta;             /* --eta: ECTM's bending weight, 0: the default */
+} pair_job;
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static mesh *read_mesh(const char *rel)
+{
+    char err[512];
+    mesh *m = NULL;
+    if (mesh_read(harness_data_path(rel), &m, err, sizeof err))
+        FAILF("%s", err);
+    return m;
+}
+
+static int *read_ids(const char *rel, int nv, int *n)
+{
+    char err[512];
+    int *ids;
+    if (lmk_read_ids(harness_data_path(rel), 0, nv, 1000000, &ids, n, err, sizeof err))
+        FAILF("%s", err);
+    return ids;
+}
+
+static int on_progress(void *ctx, const corr_progress *p)
+{
+    (void)ctx;
+    if (p->stage == CORR_STAGE_ECTM && p->ectm->outer % 100 == 0) {
+        printf("    ectm %d/%d, %.0f s\n", p->ectm->outer, p->ectm->total, p->ectm->elapsed);
+        fflush(stdout);
+    }
+    return 0;
+}
+
+static void run_pair(const void *arg, void *out)
+{
+    const pair_job *job = arg;
+    const pair_spec *ps = job->ps;
+    pair_fig *fig = out;
+    memset(fig, 0, sizeof *fig);
+    char p[256], S_name[64], T_name[64];
+    mesh *S, *T;
+    int *ls, *lt, n;
+    if (ps->a) {
+        snprintf(S_name, sizeof S_name, "%d.off", ps->a);
+        snprintf(T_name, sizeof T_name, "%d.off", ps->b);
+        snprintf(p, sizeof p, "shrec07_bim/Meshes/%d.off", ps->a);
+        S = read_mesh(p);
+        snprintf(p, sizeof p, "shrec07_bim/Meshes/%d.off", ps->b);
+        T = read_mesh(p);
+        int nb;
+        snprintf(p, sizeof p, "shrec07_bim/Corrs/%d.vts", ps->a);
+        ls = read_ids(p, S->nv, &n);
+        snprintf(p, sizeof p, "shrec07_bim/Corrs/%d.vts", ps->b);
+        lt = read_ids(p, T->nv, &nb);
+        if (nb != n)
+            FAILF("%s: %d landmarks, %d.vts has %d", p, nb, ps->a, n);
+    } else {
+        snprintf(S_name, sizeof S_name, "wolf0.off");
+        snprintf(T_name, sizeof T_name, "wolf2.off");
+        S = read_mesh("tosca_r_isometric/vtx_5k/wolf0.off");
+        T = read_mesh("tosca_r_isometric/vtx_5k/wolf2.off");
+        ls = read_ids("tosca_hires/Corrs/wolf.pid", S->nv, &n);
+        lt = read_ids("tosca_hires/Corrs/wolf.pid", T->nv, &n);
+    }
+    fig->nS = S->nv;
+    fig->nT = T->nv;
+    /* given: even lines (all for the wolf); held: odd lines (the wolf: every vertex) */
+    long gs[256], gt[256];
+    int hs_n = 0, *hs, *ht;
+    for (int k = 0; k < n && fig->given < 256; k++)
+        if (!ps->a || k % 2 == 0) {
+            gs[fig->given] = ls[k];
+            gt[fig->given++] = lt[k];
+        }
+    if (ps->a) {
+        hs = malloc(sizeof(int) * (size_t)n);
+        ht = malloc(sizeof(int) * (size_t)n);
+        for (int k = 1; k < n; k += 2) {
+            hs[hs_n] = ls[k];
+            ht[hs_n++] = lt[k];
+        }
+    } else {
+        hs = malloc(sizeof(int) * (size_t)S->nv);
+        ht = malloc(sizeof(int) * (size_t)S->nv);
+        for (int v = 0; v < S->nv; v++)
+            hs[hs_n] = ht[hs_n] = v, hs_n++;
+    }
+    fig->held = hs_n;
+    for (int a = 0; a < NSTAGES; a++)
+        fig->err[a] = fig->curv[a] = NAN;
+
+    char err[1024] = "";
+    lmk_set *L = NULL;
+    rhm__problem *pb = NULL;
+    rhm_result rr = {0};
+    ectm_result er = {0};
+    bmap *rhm_P = NULL;
+    double *e = NULL;
+    if (lmk_from_arrays(gs, gt, fig->given, 0, S_name, T_name, S, T, &L, err, sizeof err) ||
+        corr_validate(S, S_name, err, sizeof err) || corr_validate(T, T_name, err, sizeof err))
+        goto out;
+    rhm_params rp;
+    rhm_params_init(&rp);
+    ectm_params ep;
+    ectm_params_init(&ep);
+    if (job->ectm_iterations > 0)
+        ep.iterations = job->ectm_iterations;
+    if (job->eta > 0)
+        ep.eta = job->eta;
+
+    double t0 = now();
+    if (rhm__problem_new(S, T, L, &rp, &pb, err, sizeof err) ||
+        rhm__init_start(pb, err, sizeof err))
+        goto out;
+    fig->secs[START] = now() - t0;
+    const bmap *maps[NSTAGES] = { pb->side[0].P, NULL, NULL, NULL };
+    fig->nmaps = 1;
+    if (job->last == START)
+        goto score;
+
+    /* the pipeline's calls one by one (corr_run): RHM, the fold repair, ECTM */
+    corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL };
+    t0 = now();
+    if (rhm_run(S, T, L, &rp, NULL, NULL, &rr, err, sizeof err))
+        goto score;
+    fig->secs[RHM] = now() - t0;
+    if (!(rhm_P = bmap_new(rr.P12->n, rr.P12->nt)))
+        FAILF("out of memory");
+    memcpy(rhm_P->face, rr.P12->face, sizeof(int) * (size_t)rr.P12->n);
+    memcpy(rhm_P->w, rr.P12->w, sizeof(double) * 3 * (size_t)rr.P12->n);
+    maps[fig->nmaps++] = rhm_P;
+    printf("  %s: rhm %.0f s\n", ps->label, fig->secs[RHM]);
+    fflush(stdout);
+    if (job->last == RHM)
+        goto score;
+    t0 = now();
+    fold_report rep[2];
+    if (corr_repair(&in, rr.P12, rr.P21, rep, err, sizeof err))
+        goto score;
+    fig->secs[REPAIR] = now() - t0;
+    printf("  %s: repair %d -> %d bad faces (%d vertices relaxed), reverse %d -> %d\n", ps->label,
+           rep[0].bad_before, rep[0].bad_after, rep[0].region, rep[1].bad_before, rep[1].bad_after);
+    maps[fig->nmaps++] = rr.P12;
+
+    corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM };
+    t0 = now();
+    if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
+        goto score;
+    fig->secs[ECTM] = now() - t0;
+    maps[fig->nmaps++] = er.P;
+
+score:
+    for (int a = 0; a < fig->nmaps && job->out_dir; a++) {
+        snprintf(p, sizeof p, "%s/%s.%s.map", job->out_dir, ps->label, stage_name[a]);
+        if (bmap_write(p, maps[a], stage_name[a], err, sizeof err))
+            FAILF("%s", err);
+    }
+    e = malloc(sizeof(double) * (size_t)fig->nmaps * (size_t)hs_n);
+    if (!e)
+        FAILF("out of memory");
+    if (metric_geodesic_errors(pb->side[1].geod, T, maps, fig->nmaps, hs, ht, hs_n, e))
+        FAILF("%s: geodesic errors failed", ps->label);
+    for (int a = 0; a < fig->nmaps; a++) {
+        double s = 0;
+        for (int k = 0; k < hs_n; k++)
+            s += e[(size_t)a * hs_n + k];
+        fig->err[a] = s / hs_n;
+        if (metric_summarize(S, T, maps[a], &fig->ms[a]) ||
+            metric_curvature_error(S, T, maps[a], &fig->curv[a]))
+            FAILF("out of memory");
+    }
+out:
+    snprintf(fig->why, sizeof fig->why, "%s", err);
+    free(e);
+    bmap_free(rhm_P);
+    ectm_result_close(&er);
+    rhm_result_close(&rr);
+    rhm__problem_free(pb);
+    lmk_free(L);
+    free(ls);
+    free(lt);
+    free(hs);
+    free(ht);
+    mesh_free(S);
+    mesh_free(T);
+}
+
+static void print_header(void)
+{
+    printf("%-12s %-11s %5s %-6s %8s %7s %7s %8s %6s %7s %8s %7s\n", "pair", "V S->T", "lmk",
+           "stage", "held err", "flip %", "coll %", "curv err", "ratio", "|log a|", "conf med",
+           "time s");
+}
+
+static void print_rows(const pair_spec *ps, const pair_fig *f)
+{
+    char v[32], lm[16];
+    snprintf(v, sizeof v, "%d->%d", f->nS, f->nT);
+    snprintf(lm, sizeof lm, "%d/%d", f->given, ps->a ? f->held : 0);
+    for (int a = 0; a < f->nmaps; a++) {
+        char ratio[16] = "-";
+        if (a > START)
+            snprintf(ratio, sizeof ratio, "%.2f", f->curv[a] / f->curv[a - 1]);
+        const metric_summary *m = &f->ms[a];
+        printf("%-12s %-11s %5s %-6s %8.4f %7.2f %7.2f %8.3f %6s %7.3f %8.3f %7.1f\n", ps->label,
+               v, lm, stage_name[a], f->err[a], 100 * m->flipped_fraction,
+               100 * m->collapsed_fraction, f->curv[a], ratio, m->mean_abs_log_area,
+               m->median_conformal, f->secs[a]);
+    }
+    if (f->why[0]) {
+        char one[1024];
+        snprintf(one, sizeof one, "%s", f->why);
+        for (char *c = one; *c; c++)
+            if (*c == '\n')
+                *c = ' ';
+        printf("%-12s error after %s: %s\n", ps->label, f->nmaps ? stage_name[f->nmaps - 1] : "loading", one);
+    }
+}
+
+static int wanted(const char *list, const char *label)
+{
+    if (!list)
+        return 1;
+    size_t n = strlen(label);
+    for (const char *p = list; (p = strstr(p, label)); p += n)
+        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
+            return 1;
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The targets, pair by pair and over the classes. */
+static void print_targets(const int *ran, const pair_fig *figs)
+{
+    int classes = 0, ratio_ok = 0, all = 0;
+    double errs[NPAIRS];
+    printf("\ntargets (full pipeline): flipped <= 2 %%, collapsed <= 0.5 %%, error <= RHM + 0.003, "
+           "|log a| below ECTM's input's, error <= 0.05 (wolf: <= 0.01, flipped <= 1 %%)\n");
+    for (int i = 0; i < NPAIRS; i++) {
+        const pair_fig *f = &figs[i];
+        if (!ran[i])
+            continue;
+        if (f->nmaps < NSTAGES) {
+            printf("  %-12s no full map\n", pairs[i].label);
+            continue;
+        }
+        const metric_summary *m = &f->ms[ECTM], *r = &f->ms[ECTM - 1];   /* ECTM's input */
+        int wolf = !pairs[i].a;
+        int flip = m->flipped_fraction <= (wolf ? 0.01 : 0.02);
+        int coll = m->collapsed_fraction <= 0.005;
+        int keep = f->err[ECTM] <= f->err[RHM] + 0.003;
+        int area = m->mean_abs_log_area < r->mean_abs_log_area;
+        int acc = f->err[ECTM] <= (wolf ? 0.01 : 0.05);
+        int ok = flip && coll && (wolf || (keep && area)) && acc;
+        all += ok;
+        if (!wolf) {
+            errs[classes++] = f->err[ECTM];
+            ratio_ok += f->curv[ECTM] / f->curv[ECTM - 1] <= 0.75;
+        }
+        printf("  %-12s %s  flipped %s  collapsed %s  error-vs-rhm %s  area %s  accuracy %s\n",
+               pairs[i].label, ok ? "MET " : "open", flip ? "ok" : "NO", coll ? "ok" : "NO",
+               wolf ? "-" : keep ? "ok" : "NO", wolf ? "-" : area ? "ok" : "NO", acc ? "ok" : "NO");
+    }
+    if (classes) {
+        qsort(errs, (size_t)classes, sizeof *errs, cmp_double);
+        double med = classes % 2 ? errs[classes / 2] : 0.5 * (errs[classes / 2 - 1] + errs[classes / 2]);
+        printf("  pairs meeting every per-pair target: %d; classes with curvature ratio <= 0.75: "
+               "%d of %d (target 8 of 11); median held-out error %.4f (target <= 0.035)\n",
+               all, ratio_ok, classes, med);
+    }
+}
+
+TEST_T(shrec07_classes_from_landmarks, 86400)
+{
+    if (!harness_data_dir())
+        SKIP("../shared/data is absent");
+    const char *o_it = harness_option("ectm-iterations"), *o_pairs = harness_option("pairs");
+    const char *o_stop = harness_option("stop"), *o_out = harness_option("out-dir");
+    double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
+    int iters = o_it ? atoi(o_it) : 0, last = ECTM;
+    if (o_stop)
+        last = !strcmp(o_stop, "start") ? START : !strcmp(o_stop, "rhm") ? RHM : -1;
+    if (last < 0)
+        FAILF("--stop takes start or rhm");
+    if (o_it && iters < 1)
+        FAILF("--ectm-iterations takes a positive integer");
+    ectm_params ep;
+    ectm_params_init(&ep);
+    printf("landmarks -> start -> RHM -> ECTM, meshcorr match's defaults, ECTM %d outer "
+           "iterations%s; %s\n", iters ? iters : ep.iterations,
+           iters && iters != ep.iterations ? " (not the default)" : "", harness_data_dir());
+    static pair_fig figs[NPAIRS];
+    int ran[NPAIRS] = {0};
+    for (int i = 0; i < NPAIRS; i++) {
+        if (!wanted(o_pairs, pairs[i].label))
+            continue;
+        pair_job job = { &pairs[i], iters, last, o_out, eta };
+        char why[256];
+        if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
+            snprintf(figs[i].why, sizeof figs[i].why, "%s", why);
+        ran[i] = 1;
+        print_header();
+        print_rows(&pairs[i], &figs[i]);
+        fflush(stdout);
+    }
+    printf("\nheld err: mean geodesic error of the held-out landmarks / sqrt(target area) "
+           "(wolf: every vertex against the identity); ratio: curvature error over the stage "
+           "before's; |log a|, conf med over non-collapsed triangles\n");
+    print_header();
+    for (int i = 0; i < NPAIRS; i++)
+        if (ran[i])
+            print_rows(&pairs[i], &figs[i]);
+    print_targets(ran, figs);
+}
