@@ -6,6 +6,7 @@
 #include "support/testgt.h"
 #include "support/testmesh.h"
 #include "ectm/ectm.h"
+#include "geo/geo_orient.h"
 #include "geod/geod.h"
 #include "metric/metric.h"
 #include "rhm/rhm__problem.h"
@@ -31,16 +32,19 @@ static int print_progress(void *ctx, const rhm_report *r)
     return 0;
 }
 
-/* Landmarks -> start -> RHM -> ECTM (30 outer iterations, as corr_run
- * chains them) on FAUST tr_reg_000 -> tr_reg_001 with 12 landmarks, scored
- * against the 5000-point ground truth, for both starts. Measured (mean
- * geodesic error / sqrt(area); median conformal; flipped; collapsed):
- *   distances start  0.0304                 Voronoi start  0.1335
- *   RHM              0.0235 0.036 5.8 % 10.0 %      0.0377 0.064 14.3 % 14.4 %
- *   RHM + ECTM       0.0224 0.031 8.5 %  2.2 %      0.0368 0.061 16.8 %  9.0 %
- * mean |log area| with the distances start: RHM 0.535 -> ECTM 0.404. (With
- * the classical landmark-MDS embedding and the plain cotan geodesics the
- * Voronoi start gave RHM 0.0417, flipped 29.7 %.) */
+/* Landmarks -> start -> RHM -> ECTM (30 outer iterations; without the
+ * pipeline's fold repair between them, which test_fold covers) on FAUST
+ * tr_reg_000 -> tr_reg_001 with 12 landmarks, scored against the
+ * 5000-point ground truth, for both starts. Measured (mean geodesic error
+ * / sqrt(area); median conformal; flipped; collapsed):
+ *   distances start  0.0258                 Voronoi start  0.1335
+ *   RHM              0.0216 0.031 6.1 % 10.2 %      0.0377 0.064 14.3 % 14.4 %
+ *   RHM + ECTM       0.0207 0.023 8.4 %  3.4 %      0.0367 0.059 16.7 %  9.4 %
+ * mean |log area| with the distances start: RHM 0.469 -> ECTM 0.386.
+ * (Before the start's orientation features, rhm__problem.h, the distances
+ * start gave 0.0304, RHM 0.0235 with 5.8 % flipped, RHM + ECTM 0.0224;
+ * with the classical landmark-MDS embedding and the plain cotan geodesics
+ * the Voronoi start gave RHM 0.0417, flipped 29.7 %.) */
 static void faust_pipeline(int start, double ge[3], metric_summary ms[3])
 {
     testgt g;
@@ -133,47 +137,57 @@ static rhm__problem *faust_problem(testgt *g, int iters)
     return faust_problem_from(g, iters, RHM_START_DISTANCES);
 }
 
-/* The distances start: every row a point of the other side whose scaled
- * distances to the landmarks are the closest (checked against brute force
- * on a sample of rows), each landmark mapped near its partner, and
+/* The distances start: every row a point of the other side whose
+ * description (scaled distances to the landmarks, then the weighted sines
+ * of rhm__problem.h) is the closest (checked against brute force on a
+ * sample of rows), each landmark mapped near its partner, and
  * X_ij = P_ij X_j. */
+static double *description(rhm__side *a, int nl, int dd, double *D)
+{
+    double *Z = malloc(sizeof(double) * dd * a->n), *o = malloc(sizeof(double) * a->n);
+    CHECK_INT(geod_all_pairs_from(a->geod, a->lmk, nl, D), GEOD_OK);
+    double sc = 1 / sqrt(a->s);
+    for (int v = 0; v < a->n; v++)
+        for (int r = 0; r < nl; r++)
+            Z[(size_t)v * dd + r] = sc * D[(size_t)r * a->n + v];
+    for (int r = 0; r < nl; r++) {
+        CHECK(geo_gradient_sine(a->m, D + (size_t)r * a->n, 1, D + (size_t)((r + 1) % nl) * a->n,
+                                1, o) == 0);
+        for (int v = 0; v < a->n; v++)
+            Z[(size_t)v * dd + nl + r] = RHM__ORIENT_WEIGHT * o[v];
+    }
+    free(o);
+    return Z;
+}
+
 TEST(distances_start_matches_landmark_distances_and_sets_the_split_variables)
 {
     testgt g;
     rhm__problem *pb = faust_problem(&g, 0);
-    int nl = pb->nl;
+    int nl = pb->nl, dd = 2 * nl;
     for (int i = 0; i < 2; i++) {
         rhm__side *a = &pb->side[i], *b = &pb->side[1 - i];
         double *Da = malloc(sizeof(double) * nl * a->n), *Db = malloc(sizeof(double) * nl * b->n);
-        CHECK_INT(geod_all_pairs_from(a->geod, a->lmk, nl, Da), GEOD_OK);
-        CHECK_INT(geod_all_pairs_from(b->geod, b->lmk, nl, Db), GEOD_OK);
-        double sa = 1 / sqrt(a->s), sb = 1 / sqrt(b->s);
-        /* descriptions as rows, then brute force over b's faces for a sample */
-        double *Za = malloc(sizeof(double) * nl * a->n), *Zb = malloc(sizeof(double) * nl * b->n);
-        for (int v = 0; v < a->n; v++)
-            for (int r = 0; r < nl; r++)
-                Za[(size_t)v * nl + r] = sa * Da[(size_t)r * a->n + v];
-        for (int v = 0; v < b->n; v++)
-            for (int r = 0; r < nl; r++)
-                Zb[(size_t)v * nl + r] = sb * Db[(size_t)r * b->n + v];
+        double *Za = description(a, nl, dd, Da), *Zb = description(b, nl, dd, Db);
+        double sb = 1 / sqrt(b->s);
         enum { ROWS = 50 };
         int face[ROWS];
-        double bary[3 * ROWS], cost[ROWS], Qs[ROWS * 16];
+        double bary[3 * ROWS], cost[ROWS], Qs[ROWS * 32];
         int stride = a->n / ROWS;
-        CHECK(nl <= 16);
+        CHECK(dd <= 32);
         for (int q = 0; q < ROWS; q++)
-            memcpy(Qs + q * nl, Za + (size_t)q * stride * nl, sizeof(double) * nl);
+            memcpy(Qs + q * dd, Za + (size_t)q * stride * dd, sizeof(double) * dd);
         mesh emb = { b->n, b->m->nf, NULL, b->m->f };
-        proj_closest_brute(&emb, nl, Zb, ROWS, Qs, face, bary, cost);
+        proj_closest_brute(&emb, dd, Zb, ROWS, Qs, face, bary, cost);
         for (int q = 0; q < ROWS; q++) {
             int l = q * stride;
             const int *f = b->m->f + 3 * a->P->face[l];
             double c2 = 0;
-            for (int r = 0; r < nl; r++) {
+            for (int r = 0; r < dd; r++) {
                 double x = 0;
                 for (int k = 0; k < 3; k++)
-                    x += a->P->w[3 * l + k] * Zb[(size_t)f[k] * nl + r];
-                c2 += (x - Qs[q * nl + r]) * (x - Qs[q * nl + r]);
+                    x += a->P->w[3 * l + k] * Zb[(size_t)f[k] * dd + r];
+                c2 += (x - Qs[q * dd + r]) * (x - Qs[q * dd + r]);
             }
             CHECK_NEAR(c2, cost[q], 1e-10 * (1 + cost[q]));
         }

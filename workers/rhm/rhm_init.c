@@ -3,6 +3,7 @@
  * thesis' geodesic Voronoi map (§3.3.2) with its nearest-neighbour reverse;
  * then X_ij = P_ij X_j. Builds maps only; no optimisation. */
 #include "rhm/rhm__problem.h"
+#include "geo/geo_orient.h"
 #include "geod/geod_voronoi.h"
 #include "util/errbuf.h"
 
@@ -36,13 +37,17 @@ static int vertex_faces(const mesh *m, int **vface, int **vcorner)
     return 0;
 }
 
-/* Side i's distances to its landmarks, nv_i by nl, divided by √s_i. */
-static double *landmark_distances(rhm__side *a, int nl, int *rc)
+/* Side i's description of its vertices, nv_i by dd = nl + no: the
+ * distances to its landmarks divided by √s_i, then no = nl orientation
+ * features RHM__ORIENT_WEIGHT·sin∠(∇d_r, ∇d_{r+1}) (geo_orient.h; r + 1
+ * modulo nl), which a mirrored match negates. */
+static double *landmark_description(rhm__side *a, int nl, int dd, int *rc)
 {
     double *f = malloc(sizeof(double) * (size_t)nl * a->n);
-    double *D = malloc(sizeof(double) * (size_t)nl * a->n);
+    double *D = malloc(sizeof(double) * (size_t)dd * a->n);
+    double *o = malloc(sizeof(double) * (size_t)a->n);
     *rc = RHM_ENOMEM;
-    if (f && D) {
+    if (f && D && o) {
         int g = geod_all_pairs_from(a->geod, a->lmk, nl, f);
         *rc = g == GEOD_OK ? RHM_OK : g == GEOD_ENOMEM ? RHM_ENOMEM : RHM_EMESH;
     }
@@ -50,24 +55,35 @@ static double *landmark_distances(rhm__side *a, int nl, int *rc)
         double sc = 1 / sqrt(a->s);
         for (int v = 0; v < a->n; v++)
             for (int r = 0; r < nl; r++)
-                D[(size_t)v * nl + r] = sc * f[(size_t)r * a->n + v];
-    } else {
+                D[(size_t)v * dd + r] = sc * f[(size_t)r * a->n + v];
+        for (int r = 0; nl + r < dd && *rc == RHM_OK; r++) {
+            if (geo_gradient_sine(a->m, f + (size_t)r * a->n, 1,
+                                  f + (size_t)((r + 1) % nl) * a->n, 1, o)) {
+                *rc = RHM_ENOMEM;
+                break;
+            }
+            for (int v = 0; v < a->n; v++)
+                D[(size_t)v * dd + nl + r] = RHM__ORIENT_WEIGHT * o[v];
+        }
+    }
+    if (*rc != RHM_OK) {
         free(D);
         D = NULL;
     }
     free(f);
+    free(o);
     return D;
 }
 
-/* P_ij row v: the closest point, in R^nl, of v's (scaled) distances to the
- * landmarks of side i on side j embedded with its own; exact (proj.h),
- * the bound from the first three landmarks' distances. */
+/* P_ij row v: the closest point, in R^dd, of v's description (above) on
+ * side j embedded with its own; exact (proj.h), the bound from the first
+ * three landmarks' distances. */
 static int start_distances(rhm__problem *pb, char *err, size_t errsz)
 {
-    int nl = pb->nl, rc = RHM_OK;
+    int nl = pb->nl, dd = nl + (RHM__ORIENT_WEIGHT > 0 ? nl : 0), rc = RHM_OK;
     double *D[2] = {NULL, NULL};
     for (int i = 0; i < 2 && rc == RHM_OK; i++)
-        if (!(D[i] = landmark_distances(&pb->side[i], nl, &rc)))
+        if (!(D[i] = landmark_description(&pb->side[i], nl, dd, &rc)))
             errbuf_set(err, errsz, rc, "%s: distances to the landmarks failed",
                        i ? "target" : "source");
     for (int i = 0; i < 2 && rc == RHM_OK; i++) {
@@ -77,13 +93,13 @@ static int start_distances(rhm__problem *pb, char *err, size_t errsz)
         rc = RHM_ENOMEM;
         if (emb) {
             for (int v = 0; v < b->n; v++)
-                memcpy(emb->v + 3 * v, D[1 - i] + (size_t)v * nl, 3 * sizeof(double));
+                memcpy(emb->v + 3 * v, D[1 - i] + (size_t)v * dd, 3 * sizeof(double));
             memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
             rc = (t = proj_tree_new(emb, NULL, 0)) ? RHM_OK : RHM_ENUMERIC;
         }
         for (int v = 0; rc == RHM_OK && v < a->n; v++)
             a->P->face[v] = -1;
-        if (rc == RHM_OK && proj_closest(t, nl, D[1 - i], 1, a->n, D[i], a->P->face, a->P->w, NULL))
+        if (rc == RHM_OK && proj_closest(t, dd, D[1 - i], 1, a->n, D[i], a->P->face, a->P->w, NULL))
             rc = RHM_ENUMERIC;
         if (rc)
             errbuf_set(err, errsz, rc, "the start map %s: projection failed",
