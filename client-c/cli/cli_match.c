@@ -8,6 +8,7 @@
 #include "corr/corr.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
+#include "metric/metric.h"
 #include "mesh/mesh.h"
 
 #include <getopt.h>
@@ -263,6 +264,21 @@ int cli_match(int argc, char **argv)
         free(pt);
         if (w)
             goto done;
+    }
+    /* the last line: how good the map is (the worker's metrics and rule) */
+    metric_summary ms;
+    if (metric_summarize(S, T, res.P, &ms)) {
+        fprintf(stderr, "meshcorr match: out of memory\n");
+        goto done;
+    }
+    printf("map quality: flipped %.2f %%, collapsed %.2f %%, mean |log area| %.4f, median conformal "
+           "%.4f\n", 100 * ms.flipped_fraction, 100 * ms.collapsed_fraction, ms.mean_abs_log_area,
+           ms.median_conformal);
+    int verdict = metric_verdict(ms.flipped_fraction, ms.collapsed_fraction);
+    if (verdict) {
+        char text[256];
+        metric_verdict_text(verdict, ms.flipped_fraction, ms.collapsed_fraction, text, sizeof text);
+        fprintf(stderr, "meshcorr match: warning: %s\n", text);
     }
     status = 0;
 done:

@@ -5,6 +5,7 @@
  * $MESHCORR_TOKEN) and print one line per fact, or JSON where asked. No
  * numerics, no protocol details: meshcorr.h is the whole interface. */
 #include "cli/cli.h"
+#include "metric/metric.h"
 #include "cli/cli_job.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
@@ -534,8 +535,28 @@ int cli_result(int argc, char **argv)
         free(Y.v);
         free(Y.f);
     }
-    for (uint32_t i = 0; i < res.nmetrics; i++)
-        printf("%s %.10g\n", res.metric_keys[i], res.metric_values[i]);
+    double verdict = 0, fl[2] = {0, 0}, co[2] = {0, 0};
+    for (uint32_t i = 0; i < res.nmetrics; i++) {
+        const char *k = res.metric_keys[i];
+        double v = res.metric_values[i];
+        printf("%s %.10g\n", k, v);
+        if (!strcmp(k, "quality_verdict"))
+            verdict = v;
+        for (int r = 0; r < 2; r++) {
+            if (!strcmp(k, r ? "reverse_flipped_fraction" : "flipped_fraction"))
+                fl[r] = v;
+            if (!strcmp(k, r ? "reverse_collapsed_fraction" : "collapsed_fraction"))
+                co[r] = v;
+        }
+    }
+    if (verdict > 0) {
+        /* the worse of the two maps, by the worker's rule */
+        int r = metric_verdict(fl[1], co[1]) > metric_verdict(fl[0], co[0]);
+        char text[256];
+        metric_verdict_text((int)verdict, fl[r], co[r], text, sizeof text);
+        fprintf(stderr, "meshcorr result: warning: job %llu: %s%s\n", (unsigned long long)id,
+                r ? "the reverse map: " : "", text);
+    }
     status = 0;
 done:
     mesh_free(T);

@@ -3,6 +3,7 @@
  * in-process pipeline, cancel (pending and running), worker crash, daemon
  * SIGKILL and graceful shutdown (the job runs again and completes). */
 #include "support/harness.h"
+#include "metric/metric.h"
 #include "support/testdaemon.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
@@ -92,6 +93,23 @@ TEST_T(submitted_job_streams_energies_and_completes, 60)
     CHECK_INT(r.np, 162);
     CHECK_INT(r.nq, 162);
     CHECK(r.nmetrics > 0);
+    /* the quality summary of both maps travels with the result, and its
+     * verdict is the one rule (metric_verdict) applied to the worse map */
+    double q[6] = {NAN, NAN, NAN, NAN, NAN, NAN};
+    static const char *const keys[6] = { "flipped_fraction", "collapsed_fraction",
+                                         "reverse_flipped_fraction", "reverse_collapsed_fraction",
+                                         "quality_verdict", "median_conformal" };
+    for (uint32_t i = 0; i < r.nmetrics; i++)
+        for (int k = 0; k < 6; k++)
+            if (!strcmp(r.metric_keys[i], keys[k]))
+                q[k] = r.metric_values[i];
+    for (int k = 0; k < 6; k++)
+        if (!isfinite(q[k]))
+            FAILF("RESULT_OK metric %s missing or not finite", keys[k]);
+    printf("  flipped %.2f %% / %.2f %%, collapsed %.2f %% / %.2f %%, verdict %g\n", 100 * q[0],
+           100 * q[2], 100 * q[1], 100 * q[3], q[4]);
+    int vp = metric_verdict(q[0], q[1]), vq = metric_verdict(q[2], q[3]);
+    CHECK_INT(q[4], vp > vq ? vp : vq);
     mc_result_free(&r);
     mc_close(c);
     CHECK(WIFEXITED(testdaemon_stop(&d, SIGTERM)));

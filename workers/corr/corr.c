@@ -88,6 +88,22 @@ static int from_rhm(int rc)
     }
 }
 
+int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char *err,
+                size_t errsz)
+{
+    fold_params fp;
+    fold_params_init(&fp);
+    memset(rep, 0, 2 * sizeof *rep);
+    int n = in->L ? in->L->n : 0;
+    int rc = fold_repair(in->S, in->T, in->L ? in->L->src : NULL, n, &fp, P, &rep[0]);
+    if (!rc && Q)
+        rc = fold_repair(in->T, in->S, in->L ? in->L->tgt : NULL, n, &fp, Q, &rep[1]);
+    if (rc)
+        return errbuf_set(err, errsz, rc == FOLD_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+                          "repairing the folds of the initial maps: %s", fold_strerror(rc));
+    return CORR_OK;
+}
+
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz)
 {
@@ -127,6 +143,11 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         }
         if ((rc = rhm_run(in->S, in->T, in->L, &rp, relay_rhm, &rl, &init, err, errsz)))
             return from_rhm(rc);
+        fold_report rep[2];
+        if ((rc = corr_repair(in, init.P12, init.P21, rep, err, errsz))) {
+            rhm_result_close(&init);
+            return rc;
+        }
         if (in->stages == CORR_STAGES_RHM) {
             out->P = init.P12;
             out->Q = init.P21;

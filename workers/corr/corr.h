@@ -3,7 +3,8 @@
  *
  *   validate both meshes (manifold, one component, finite, no degenerate face)
  *   initial maps: the uploaded P (and Q), or from landmarks: geodesic
- *     start map (rhm.h), then Reversible Harmonic Maps giving P and Q
+ *     start map (rhm.h), then Reversible Harmonic Maps giving P and Q,
+ *     whose folds are then repaired (corr_repair, fold.h)
  *   ECTM refinement
  *
  * Stages report progress through one callback; a non-zero return cancels.
@@ -13,6 +14,7 @@
 #define CORR_H
 #include <stddef.h>
 #include "ectm/ectm.h"
+#include "fold/fold.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -69,8 +71,15 @@ typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
+/* The fold repair the pipeline applies to RHM's maps: fold_repair of P
+ * (S -> T) and, when Q is not NULL, of Q (T -> S), the landmarks fixed
+ * (in->L may be NULL), with fold_params_init's values. rep[0], rep[1]:
+ * P's and Q's reports. CORR_OK, CORR_ENOMEM or CORR_EINIT. */
+int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char *err,
+                size_t errsz);
+
 /* Runs the pipeline. Needs P0 or at least LMK_MIN_PAIRS landmarks. With
- * stages RHM, out->P and out->Q are RHM's maps and out->Y, out->Yt, out->last
+ * stages RHM, out->P and out->Q are RHM's repaired maps and out->Y, out->Yt, out->last
  * stay empty. */
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz);

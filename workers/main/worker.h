@@ -84,7 +84,7 @@ typedef struct wrk_result {
     proto_msg msg;
     proto_map_row *p, *q;
     unsigned char *deformed;
-    proto_metric metrics[8];
+    proto_metric metrics[12];
 } wrk_result;
 int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
                      double elapsed, wrk_result *r, char *err, size_t errsz);

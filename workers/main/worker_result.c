@@ -60,10 +60,16 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
     }
     ok->deformed = (proto_blob){ r->deformed, (uint32_t)len };
 
-    metric_summary ms;
-    if (metric_summarize(job->S, job->T, res->P, &ms)) {
+    metric_summary ms, mq = {0};
+    if (metric_summarize(job->S, job->T, res->P, &ms) ||
+        (res->Q && metric_summarize(job->T, job->S, res->Q, &mq))) {
         wrk_result_close(r);
         return errbuf_set(err, errsz, PROTO_ENOMEM, "metrics: out of memory");
+    }
+    int verdict = metric_verdict(ms.flipped_fraction, ms.collapsed_fraction);
+    if (res->Q) {
+        int vq = metric_verdict(mq.flipped_fraction, mq.collapsed_fraction);
+        verdict = vq > verdict ? vq : verdict;
     }
     const proto_metric m[] = {
         { "mean_abs_log_area", ms.mean_abs_log_area },
@@ -73,9 +79,15 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
         { "final_energy", res->last.energy },
         { "elapsed_s", elapsed },
         { "iterations", res->last.outer },
+        { "quality_verdict", verdict },
+        /* the reverse map Q's, when there is one (last: nmetrics drops them) */
+        { "reverse_mean_abs_log_area", mq.mean_abs_log_area },
+        { "reverse_median_conformal", mq.median_conformal },
+        { "reverse_flipped_fraction", mq.flipped_fraction },
+        { "reverse_collapsed_fraction", mq.collapsed_fraction },
     };
     memcpy(r->metrics, m, sizeof m);
     ok->metrics = r->metrics;
-    ok->nmetrics = sizeof m / sizeof m[0];
+    ok->nmetrics = sizeof m / sizeof m[0] - (res->Q ? 0 : 4);
     return 0;
 }

@@ -4,6 +4,7 @@
 #include "geo/geo_normals.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 static void tri_frame(const double *a, const double *b, const double *c,
@@ -63,43 +64,87 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* The fold rule of metric_fold_faces on one face, with the image img, the
+ * target's vertex normals tn and the face's area distortion lr and
+ * conformal distortion cf. */
+static int face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                     const double *tn, int t, double lr, double cf)
+{
+    if (!(exp(lr) > 1e-12) || !isfinite(cf))
+        return METRIC_FACE_COLLAPSED;
+    const int *f = S->f + 3 * t;
+    const double *a = img + 3 * f[0], *b = img + 3 * f[1], *c = img + 3 * f[2];
+    double n[3] = { (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
+                    (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
+                    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) };
+    /* the target's normal where the triangle's corners land */
+    double dot = 0;
+    for (int k = 0; k < 3; k++) {
+        int row = f[k];
+        const int *tf = T->f + 3 * P->face[row];
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                dot += P->w[3 * row + j] * tn[3 * tf[j] + d] * n[d];
+    }
+    return dot < 0 ? METRIC_FACE_FLIPPED : METRIC_FACE_OK;
+}
+
+/* img, tn, lr, cf of the map (see face_kind); 0, or -1 when out of memory
+ * (all four then freed and NULL). */
+static int map_images(const mesh *S, const mesh *T, const bmap *P, double **img, double **tn,
+                      double **lr, double **cf)
+{
+    *img = malloc(sizeof(double) * ((size_t)S->nv * 3 + 1));
+    *tn = malloc(sizeof(double) * ((size_t)T->nv * 3 + 1));
+    *lr = malloc(sizeof(double) * ((size_t)S->nf + 1));
+    *cf = malloc(sizeof(double) * ((size_t)S->nf + 1));
+    if (!*img || !*tn || !*lr || !*cf) {
+        free(*img);
+        free(*tn);
+        free(*lr);
+        free(*cf);
+        *img = *tn = *lr = *cf = NULL;
+        return -1;
+    }
+    bmap_apply(P, T->f, T->v, 3, *img);
+    geo_vertex_normals(T, *tn);
+    metric_area_distortion(S, *img, geo_total_area(S), geo_total_area(T), *lr);
+    metric_conformal_distortion(S, *img, *cf);
+    return 0;
+}
+
+int metric_fold_faces(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind)
+{
+    double *img, *tn, *lr, *cf;
+    if (map_images(S, T, P, &img, &tn, &lr, &cf))
+        return -1;
+    int bad = 0;
+    for (int t = 0; t < S->nf; t++)
+        bad += (kind[t] = (unsigned char)face_kind(S, T, P, img, tn, t, lr[t], cf[t])) != 0;
+    free(img);
+    free(tn);
+    free(lr);
+    free(cf);
+    return bad;
+}
+
 int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary *out)
 {
-    int nf = S->nf, rc = -1;
-    double *img = malloc(sizeof(double) * ((size_t)S->nv * 3 + 1));
-    double *tn = malloc(sizeof(double) * ((size_t)T->nv * 3 + 1));
-    double *lr = malloc(sizeof(double) * ((size_t)nf + 1));
-    double *cf = malloc(sizeof(double) * ((size_t)nf + 1));
+    int nf = S->nf;
+    double *img, *tn, *lr, *cf;
     out->mean_abs_log_area = out->median_conformal = out->mean_conformal = NAN;
     out->flipped_fraction = out->collapsed_fraction = NAN;
-    if (!img || !tn || !lr || !cf)
-        goto out;
-    bmap_apply(P, T->f, T->v, 3, img);
-    geo_vertex_normals(T, tn);
-    metric_area_distortion(S, img, geo_total_area(S), geo_total_area(T), lr);
-    metric_conformal_distortion(S, img, cf);
+    if (map_images(S, T, P, &img, &tn, &lr, &cf))
+        return -1;
     int ok = 0, collapsed = 0, flipped = 0;
     double sum = 0, csum = 0;
     for (int t = 0; t < nf; t++) {
-        const int *f = S->f + 3 * t;
-        if (!(exp(lr[t]) > 1e-12) || !isfinite(cf[t])) {
+        int kind = face_kind(S, T, P, img, tn, t, lr[t], cf[t]);
+        if (kind == METRIC_FACE_COLLAPSED) {
             collapsed++;
             continue;
         }
-        const double *a = img + 3 * f[0], *b = img + 3 * f[1], *c = img + 3 * f[2];
-        double n[3] = { (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
-                        (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
-                        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) };
-        /* the target's normal where the triangle's corners land */
-        double dot = 0;
-        for (int k = 0; k < 3; k++) {
-            int row = f[k];
-            const int *tf = T->f + 3 * P->face[row];
-            for (int j = 0; j < 3; j++)
-                for (int d = 0; d < 3; d++)
-                    dot += P->w[3 * row + j] * tn[3 * tf[j] + d] * n[d];
-        }
-        flipped += dot < 0;
+        flipped += kind == METRIC_FACE_FLIPPED;
         sum += fabs(lr[t]);
         csum += cf[t];
         cf[ok++] = cf[t];
@@ -112,11 +157,32 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
         qsort(cf, (size_t)ok, sizeof *cf, cmp_double);
         out->median_conformal = ok % 2 ? cf[ok / 2] : 0.5 * (cf[ok / 2 - 1] + cf[ok / 2]);
     }
-    rc = 0;
-out:
     free(img);
     free(tn);
     free(lr);
     free(cf);
-    return rc;
+    return 0;
+}
+
+int metric_verdict(double flipped_fraction, double collapsed_fraction)
+{
+    if (flipped_fraction > 0.5)
+        return METRIC_VERDICT_REVERSED;
+    if (!(flipped_fraction + collapsed_fraction <= METRIC_FOLDED_MAX))
+        return METRIC_VERDICT_FOLDED;
+    return METRIC_VERDICT_OK;
+}
+
+void metric_verdict_text(int verdict, double flipped_fraction, double collapsed_fraction,
+                         char *buf, size_t bufsz)
+{
+    if (verdict == METRIC_VERDICT_REVERSED)
+        snprintf(buf, bufsz, "the map reverses orientation (%.1f %% of its triangles are flipped): "
+                 "the shape came out mirrored; check the landmarks", 100 * flipped_fraction);
+    else if (verdict == METRIC_VERDICT_FOLDED)
+        snprintf(buf, bufsz, "the map is folded: %.1f %% of its triangles are flipped and %.1f %% "
+                 "collapsed (more than %.0f %%)", 100 * flipped_fraction, 100 * collapsed_fraction,
+                 100 * METRIC_FOLDED_MAX);
+    else if (bufsz)
+        buf[0] = '\0';
 }

@@ -16,6 +16,8 @@
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 
+#include <stddef.h>
+
 /* logratio: nf values. src_area, img_area_total: total areas used for the
  * unit-area normalisation of source and image (the target's total area). */
 void metric_area_distortion(const mesh *S, const double *img, double src_area,
@@ -31,6 +33,29 @@ typedef struct metric_summary {
                                    target's normal where it lands            */
     double collapsed_fraction;  /* image area below 1e-12 of the source's     */
 } metric_summary;
+
+/* Per source face t of the map P from S onto T, the rule metric_summarize
+ * counts by: kind[t] = METRIC_FACE_COLLAPSED when its image's area is below
+ * 1e-12 of the source face's (unit-area scale) or its conformal distortion
+ * is not finite, METRIC_FACE_FLIPPED when the image's normal is opposite to
+ * the target's vertex normals interpolated where its corners land, else
+ * METRIC_FACE_OK. Returns the number of faces not OK, or -1 when out of
+ * memory. */
+enum { METRIC_FACE_OK = 0, METRIC_FACE_FLIPPED = 1, METRIC_FACE_COLLAPSED = 2 };
+int metric_fold_faces(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind);
+
+/* The verdict a result carries (the one rule for the worker and the
+ * clients): METRIC_VERDICT_REVERSED when more than half of the triangles
+ * are flipped (the map reverses orientation: a shape mirrored front onto
+ * back or left onto right), METRIC_VERDICT_FOLDED when flipped plus
+ * collapsed exceed METRIC_FOLDED_MAX, else METRIC_VERDICT_OK. */
+#define METRIC_FOLDED_MAX 0.05
+enum { METRIC_VERDICT_OK = 0, METRIC_VERDICT_FOLDED = 1, METRIC_VERDICT_REVERSED = 2 };
+int metric_verdict(double flipped_fraction, double collapsed_fraction);
+/* "" for OK, else a sentence for the user, e.g. "the map reverses
+ * orientation (63.2 % of its triangles are flipped)". */
+void metric_verdict_text(int verdict, double flipped_fraction, double collapsed_fraction,
+                         char *buf, size_t bufsz);
 
 /* Summary of the map P from S onto T (images P·X̃). Returns 0, or -1 when
  * out of memory (out is then NaN-filled). */

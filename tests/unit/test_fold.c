@@ -1,0 +1,136 @@
+/* test_fold.c — fold repair (fold.h): a fold planted in the identity map
+ * of a mesh onto itself is found (metric_fold_faces) and relaxed away,
+ * landmarks stay put, and a map mirrored as a whole is left as it was
+ * (the repair never makes a map worse). */
+#include "support/harness.h"
+#include "support/testmesh.h"
+#include "fold/fold.h"
+#include "metric/metric.h"
+#include "proj/proj.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* P's rows: the closest points of img (nv by 3) on T. */
+static bmap *map_of_points(const mesh *T, const double *img, int n)
+{
+    bmap *P = bmap_new(n, T->nv);
+    proj_tree *t = proj_tree_new(T, NULL, 0);
+    CHECK(P && t);
+    for (int v = 0; v < n; v++)
+        P->face[v] = -1;
+    CHECK(proj_closest(t, 3, T->v, 1, n, img, P->face, P->w, NULL) == 0);
+    proj_tree_free(t);
+    return P;
+}
+
+static int count_bad(const mesh *S, const mesh *T, const bmap *P, int want)
+{
+    unsigned char *k = malloc((size_t)S->nf);
+    CHECK(metric_fold_faces(S, T, P, k) >= 0);
+    int n = 0;
+    for (int t = 0; t < S->nf; t++)
+        n += k[t] == want;
+    free(k);
+    return n;
+}
+
+/* The identity of a flat disk with the images of a patch (radius 0.3
+ * about (0.3, 0)) reflected through the line x = 0.3 inside it: the patch
+ * folds over itself. The repair brings every face back the right way. */
+TEST(planted_fold_is_found_and_relaxed_away)
+{
+    mesh *m = testmesh_disk(20);
+    int nv = m->nv;
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, m->v, sizeof(double) * 3 * (size_t)nv);
+    int fixed = -1, planted = 0;
+    for (int v = 0; v < nv; v++) {
+        double dx = m->v[3 * v] - 0.3, dy = m->v[3 * v + 1];
+        if (dx * dx + dy * dy < 0.09) {
+            img[3 * v] = 0.3 - dx;
+            planted++;
+            if (fixed < 0 && dx * dx + dy * dy < 0.0025)
+                fixed = v;   /* a landmark inside the fold, near its centre */
+        }
+    }
+    bmap *P = map_of_points(m, img, nv);
+    int flipped = count_bad(m, m, P, METRIC_FACE_FLIPPED);
+    printf("  %d vertices reflected, %d of %d faces flipped\n", planted, flipped, m->nf);
+    CHECK(flipped > 100);
+    double keep[3];
+    int keep_face = P->face[fixed];
+    memcpy(keep, P->w + 3 * fixed, sizeof keep);
+
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(m, m, &fixed, 1, &fp, P, &rep), FOLD_OK);
+    printf("  bad faces %d -> %d, %d vertices relaxed\n", rep.bad_before, rep.bad_after, rep.region);
+    CHECK(rep.accepted);
+    CHECK_INT(rep.bad_before, flipped);
+    CHECK_INT(rep.bad_after, 0);
+    CHECK_INT(count_bad(m, m, P, METRIC_FACE_FLIPPED), 0);
+    CHECK_INT(count_bad(m, m, P, METRIC_FACE_COLLAPSED), 0);
+    CHECK_INT(P->face[fixed], keep_face);
+    CHECK(memcmp(P->w + 3 * fixed, keep, sizeof keep) == 0);
+    free(img);
+    mesh_free(m);
+    bmap_free(P);
+}
+
+/* The identity of a sphere onto its mirror image (x -> -x, faces reversed
+ * so the normals stay outward) reverses orientation everywhere: every face
+ * counts as flipped, and no relaxation can fix it; the repair leaves the
+ * map as it was. */
+TEST(map_mirrored_as_a_whole_is_detected_and_left_unchanged)
+{
+    mesh *m = testmesh_icosphere(3);
+    mesh *r = mesh_new(m->nv, m->nf);
+    memcpy(r->v, m->v, sizeof(double) * 3 * (size_t)m->nv);
+    for (int v = 0; v < m->nv; v++)
+        r->v[3 * v] = -r->v[3 * v];
+    for (int t = 0; t < m->nf; t++) {
+        r->f[3 * t] = m->f[3 * t];
+        r->f[3 * t + 1] = m->f[3 * t + 2];
+        r->f[3 * t + 2] = m->f[3 * t + 1];
+    }
+    double *img = malloc(sizeof(double) * 3 * (size_t)m->nv);
+    memcpy(img, r->v, sizeof(double) * 3 * (size_t)m->nv);
+    bmap *P = map_of_points(r, img, m->nv);
+    metric_summary ms;
+    CHECK(metric_summarize(m, r, P, &ms) == 0);
+    printf("  identity onto the mirror image: %.1f %% flipped\n", 100 * ms.flipped_fraction);
+    CHECK(ms.flipped_fraction > 0.99);
+    bmap *before = map_of_points(r, img, m->nv);
+    fold_params fp;
+    fold_params_init(&fp);
+    fp.iterations = 50;
+    fold_report rep;
+    CHECK_INT(fold_repair(m, r, NULL, 0, &fp, P, &rep), FOLD_OK);
+    CHECK(!rep.accepted);
+    CHECK(rep.bad_after == rep.bad_before);
+    CHECK(memcmp(P->face, before->face, sizeof(int) * (size_t)m->nv) == 0);
+    CHECK(memcmp(P->w, before->w, sizeof(double) * 3 * (size_t)m->nv) == 0);
+    bmap_free(before);
+    bmap_free(P);
+    free(img);
+    mesh_free(r);
+    mesh_free(m);
+}
+
+TEST(refuses_bad_arguments)
+{
+    mesh *m = testmesh_disk(3);
+    bmap *P = bmap_new(m->nv - 1, m->nv);
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
+    bmap_free(P);
+    P = bmap_new(m->nv, m->nv);
+    fp.iterations = 0;
+    CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
+    bmap_free(P);
+    mesh_free(m);
+}
