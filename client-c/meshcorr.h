@@ -45,6 +45,8 @@ enum mc_error {
     /* the server's codes, the same numbers as the protocol's */
     MC_EUNAUTHORIZED = -13, MC_EFORBIDDEN = -14, MC_ENOT_FOUND = -15,
     MC_EBAD_STATE = -16, MC_EQUEUE_FULL = -17, MC_EUSER_LIMIT = -18,
+    MC_EBUSY = -26,            /* a connection limit: retry later (at connect) */
+    MC_ETIMED_OUT = -27,       /* the server cut a silent, slow or idle connection */
 #define MC_ENUM(name, val, msg) name = val,
     MC_ERRORS(MC_ENUM)
 #undef MC_ENUM
