@@ -170,6 +170,8 @@ static void on_write(uv_write_t *w, int status)
     }
     if (c->paused && queued(c) <= c->d->conf.max_output / 2) {
         c->paused = 0;
+        if (c->frame_ms)               /* the request clock stood while we did not read */
+            c->frame_ms = c->active_ms;
         update_reading(c);
         process_input(c);
     }
