@@ -1,6 +1,8 @@
 /* mc_mesh.c — libmeshcorr's mesh helpers: a mesh file, or vertex and face
- * arrays in memory, as the Draco bytes a job carries, with the engine's order-preserving encoder (landmarks and
- * maps use the file's vertex order). A .drc file is sent as it is. */
+ * arrays in memory, as the Draco bytes a job carries, with the engine's
+ * order-preserving encoder (landmarks and maps use the file's vertex order),
+ * positions lossless unless the caller asks for quantization. A .drc file is
+ * sent as it is. */
 #include "meshcorr.h"
 #include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
@@ -9,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+
+_Static_assert(MC_QUANTIZATION_LOSSLESS == DRACOB_LOSSLESS, "one lossless code for the API and the bridge");
 
 static int read_whole(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
 {
@@ -38,18 +42,23 @@ static int read_whole(const char *path, unsigned char **bytes, size_t *len, char
     return 0;
 }
 
-int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
-                   char *err, size_t errsz)
+int mc_encode_mesh_quantized(const double *v, int nv, const int *f, int nf, int quantization_bits,
+                             unsigned char **bytes, size_t *len, char *err, size_t errsz)
 {
     *bytes = NULL;
     *len = 0;
+    if (quantization_bits < MC_QUANTIZATION_LOSSLESS || quantization_bits > MC_QUANTIZATION_MAX_BITS) {
+        snprintf(err, errsz, "quantization of %d bits: expected %d (lossless) or 1 to %d", quantization_bits,
+                 MC_QUANTIZATION_LOSSLESS, MC_QUANTIZATION_MAX_BITS);
+        return MC_EARG;
+    }
     if (!v || !f || nv < 3 || nf < 1 || nv > MESH_MAX_VERTICES || nf > MESH_MAX_FACES) {
         snprintf(err, errsz, "need 3 to %d vertices and 1 to %d faces (got %d and %d)", MESH_MAX_VERTICES,
                  MESH_MAX_FACES, nv, nf);
         return MC_EARG;
     }
     char derr[512];
-    int rc = dracob_encode(v, nv, f, nf, MESH_DRC_QUANTIZATION_BITS, bytes, len, derr, sizeof derr);
+    int rc = dracob_encode(v, nv, f, nf, quantization_bits, bytes, len, derr, sizeof derr);
     if (rc) {
         snprintf(err, errsz, "%s", derr);
         return rc == DRACOB_ENOMEM ? MC_ENOMEM : rc == DRACOB_EARG ? MC_EARG : MC_EFILE;
@@ -57,10 +66,22 @@ int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char 
     return 0;
 }
 
-int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
+int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
+                   char *err, size_t errsz)
+{
+    return mc_encode_mesh_quantized(v, nv, f, nf, MC_QUANTIZATION_LOSSLESS, bytes, len, err, errsz);
+}
+
+int mc_encode_mesh_file_quantized(const char *path, int quantization_bits, unsigned char **bytes,
+                                  size_t *len, char *err, size_t errsz)
 {
     *bytes = NULL;
     *len = 0;
+    if (quantization_bits < MC_QUANTIZATION_LOSSLESS || quantization_bits > MC_QUANTIZATION_MAX_BITS) {
+        snprintf(err, errsz, "%s: quantization of %d bits: expected %d (lossless) or 1 to %d", path,
+                 quantization_bits, MC_QUANTIZATION_LOSSLESS, MC_QUANTIZATION_MAX_BITS);
+        return MC_EARG;
+    }
     size_t pl = strlen(path);
     if (pl > 4 && strcasecmp(path + pl - 4, ".drc") == 0)
         return read_whole(path, bytes, len, err, errsz);
@@ -68,9 +89,15 @@ int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, ch
     if (mesh_read(path, &m, err, errsz))
         return MC_EFILE;
     char merr[600];
-    int rc = mc_encode_mesh(m->v, m->nv, m->f, m->nf, bytes, len, merr, sizeof merr);
+    int rc = mc_encode_mesh_quantized(m->v, m->nv, m->f, m->nf, quantization_bits, bytes, len, merr,
+                                      sizeof merr);
     mesh_free(m);
     if (rc)
         snprintf(err, errsz, "%s: %s", path, merr);
     return rc == MC_EARG ? MC_EFILE : rc;
+}
+
+int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
+{
+    return mc_encode_mesh_file_quantized(path, MC_QUANTIZATION_LOSSLESS, bytes, len, err, errsz);
 }

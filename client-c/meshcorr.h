@@ -45,6 +45,8 @@ enum mc_error {
     /* the server's codes, the same numbers as the protocol's */
     MC_EUNAUTHORIZED = -13, MC_EFORBIDDEN = -14, MC_ENOT_FOUND = -15,
     MC_EBAD_STATE = -16, MC_EQUEUE_FULL = -17, MC_EUSER_LIMIT = -18,
+    MC_EBUSY = -26,            /* a connection limit: retry later (at connect) */
+    MC_ETIMED_OUT = -27,       /* the server cut a silent, slow or idle connection */
 #define MC_ENUM(name, val, msg) name = val,
     MC_ERRORS(MC_ENUM)
 #undef MC_ENUM
@@ -190,17 +192,38 @@ int mc_ping(mc_client *c);
 int mc_send_raw(mc_client *c, const void *bytes, size_t len);
 
 /* A mesh file (.off .obj .ply, or .drc sent as it is) as Draco bytes with
- * the user's vertex order kept (the engine's order-preserving encoder).
- * *bytes is malloc()ed. */
+ * the user's vertex order kept (the engine's order-preserving encoder) and
+ * every position exactly as read: the server computes on the same doubles
+ * as `meshcorr match` does and returns the same map, bit for bit. *bytes is
+ * malloc()ed. */
 int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz);
 /* The same from arrays in memory: v is nv by 3 doubles (x y z per vertex),
  * f is nf by 3 0-based vertex indices (counter-clockwise), both read only and
  * still the caller's. The Draco bytes keep vertex i as vertex i (landmark
- * ids and maps refer to it), positions quantized to 16 bits over the
- * bounding box (as the files). *bytes is malloc()ed: free() it once
+ * ids and maps refer to it) and every position bit for bit (float32 when
+ * all are floats, else float64). *bytes is malloc()ed: free() it once
  * mc_submit has returned. Bad sizes or indices: MC_EARG. */
 int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
                    char *err, size_t errsz);
+
+/* Position coding of the two calls below: MC_QUANTIZATION_LOSSLESS (what
+ * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate
+ * over the bounding box. Quantizing trades the server's exact view of the
+ * mesh for size: each coordinate moves by up to half a step, about
+ * bbox / 2^(bits + 1), and the blob shrinks (wolf0, 4344 vertices: 156 KB
+ * lossless, 72 KB at 16 bits), but the server then computes on other
+ * positions than `meshcorr match` reads and its map differs (wolf0 -> wolf1,
+ * 2 iterations: every row, mean 1.3e-3 and max 4e-2 of sqrt(area)). */
+#define MC_QUANTIZATION_LOSSLESS 0
+#define MC_QUANTIZATION_MAX_BITS 30
+/* mc_encode_mesh_file with quantization_bits; a .drc file is sent as it is
+ * whatever quantization_bits says (its author chose its coding). Bits out
+ * of range: MC_EARG. */
+int mc_encode_mesh_file_quantized(const char *path, int quantization_bits, unsigned char **bytes,
+                                  size_t *len, char *err, size_t errsz);
+/* mc_encode_mesh with quantization_bits. */
+int mc_encode_mesh_quantized(const double *v, int nv, const int *f, int nf, int quantization_bits,
+                             unsigned char **bytes, size_t *len, char *err, size_t errsz);
 
 #ifdef __cplusplus
 }

@@ -37,6 +37,13 @@ static const struct option_def {
     {"job-timeout", K_U32, OFF(job_timeout_s), 1, 100000000, "SECONDS of wall time per job"},
     {"result-ttl", K_U32, OFF(result_ttl_s), 1, 100000000, "SECONDS a finished job is kept"},
     {"max-output", K_U32, OFF(max_output), 4096, 1u << 31, "BYTES queued to one client before a watcher is dropped"},
+    {"max-connections", K_U32, OFF(max_connections), 1, 1000000, "N client connections in all (default 512)"},
+    {"max-connections-per-user", K_U32, OFF(max_connections_per_user), 1, 1000000, "N sessions of one user, admins exempt (default 64)"},
+    {"max-unauthenticated", K_U32, OFF(max_unauthenticated), 1, 1000000, "N connections before HELLO (default 64)"},
+    {"hello-timeout", K_U32, OFF(hello_timeout_s), 0, 86400, "SECONDS from connect to HELLO (default 10; 0 none)"},
+    {"request-timeout", K_U32, OFF(request_timeout_s), 0, 86400, "SECONDS a request frame may take to arrive (default 300; 0 none)"},
+    {"idle-timeout", K_U32, OFF(idle_timeout_s), 0, 100000000, "SECONDS a session with nothing going on is kept (default 600; 0 forever)"},
+    {"fd-reserve", K_U32, OFF(fd_reserve), 0, 1000000, "N descriptors kept free for workers (default 0: 32 + 4 per slot)"},
     {"admin-uid", K_LONG, OFF(admin_uid), -1, INT_MAX, "UID treated as admin on the Unix socket (root always is)"},
     {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp:HOST:PORT addresses to"},
     {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
@@ -70,6 +77,12 @@ void conf_init(mcd_conf *c)
     c->job_timeout_s = CONF_DEFAULT_JOB_TIMEOUT_S;
     c->result_ttl_s = CONF_DEFAULT_RESULT_TTL_S;
     c->max_output = CONF_DEFAULT_MAX_OUTPUT;
+    c->max_connections = CONF_DEFAULT_MAX_CONNECTIONS;
+    c->max_connections_per_user = CONF_DEFAULT_MAX_CONNECTIONS_PER_USER;
+    c->max_unauthenticated = CONF_DEFAULT_MAX_UNAUTHENTICATED;
+    c->hello_timeout_s = CONF_DEFAULT_HELLO_TIMEOUT_S;
+    c->request_timeout_s = CONF_DEFAULT_REQUEST_TIMEOUT_S;
+    c->idle_timeout_s = CONF_DEFAULT_IDLE_TIMEOUT_S;
     c->admin_uid = -1;
     c->log_level = DLOG_INFO;
     c->modbus.port = c->metrics.port = -1;

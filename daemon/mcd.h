@@ -52,6 +52,15 @@
 #define CONF_KILL_GRACE_S 5                  /* SIGTERM -> SIGKILL */
 #define CONF_DEFAULT_SLURM_MAX_JOBS 100
 #define CONF_DEFAULT_SLURM_POLL_MS 5000
+/* Connections (srv.c): caps, timeouts, and the descriptors kept free. */
+#define CONF_DEFAULT_MAX_CONNECTIONS 512          /* client connections in all */
+#define CONF_DEFAULT_MAX_CONNECTIONS_PER_USER 64  /* sessions of one user (admins exempt) */
+#define CONF_DEFAULT_MAX_UNAUTHENTICATED 64       /* connections that have not done HELLO */
+#define CONF_DEFAULT_HELLO_TIMEOUT_S 10           /* accept -> HELLO done */
+#define CONF_DEFAULT_REQUEST_TIMEOUT_S 300        /* first byte of a frame -> its last */
+#define CONF_DEFAULT_IDLE_TIMEOUT_S 600           /* a session with nothing going on */
+#define CONF_FD_RESERVE_BASE 32                   /* --fd-reserve 0: this many ... */
+#define CONF_FD_RESERVE_PER_SLOT 4                /* ... plus this many per backend slot */
 
 #define CONF_HOST 256
 /* A dashboard server's address (--modbus, --metrics); port -1 = off. */
@@ -74,6 +83,9 @@ typedef struct mcd_conf {
     uint32_t max_jobs_per_user, max_queue;
     uint32_t job_timeout_s, result_ttl_s;
     uint32_t max_output;          /* output bytes queued per connection */
+    uint32_t max_connections, max_connections_per_user, max_unauthenticated;
+    uint32_t hello_timeout_s, request_timeout_s, idle_timeout_s;   /* 0 = none */
+    uint32_t fd_reserve;          /* descriptors kept free under RLIMIT_NOFILE; 0 = automatic */
     long admin_uid;               /* Unix-socket uid treated as admin; -1 none (root always) */
     int log_level;                /* DLOG_* */
     conf_endpoint modbus;         /* Modbus TCP input registers (MODBUS.md) */
@@ -371,6 +383,10 @@ int srv_conn_fd(conn *c);
 void srv_conn_hold(conn *c);
 void srv_conn_release(conn *c);
 int srv_conn_open(const conn *c);     /* not closed or closing: replies can go out */
+/* HELLO, once the user is known and before HELLO_OK: 0 when the session
+ * may go on, else PROTO_EBUSY with the reason in msg (logged here): the
+ * user already has --max-connections-per-user sessions (admins never do). */
+int srv_conn_admit_user(conn *c, char *msg, size_t msgsz);
 /* Closed, or the client has hung up (EOF or an error waits on the socket). */
 int srv_conn_hung_up(conn *c);
 
@@ -391,5 +407,6 @@ void req_handle(conn *c, const proto_msg *m, const void *frame, size_t len);
 void req_progress(mcd *d, const proto_progress *p);   /* fan out to watchers */
 void req_job_ended(mcd *d, uint64_t id);              /* END to watchers */
 void req_conn_closed(mcd *d, conn *c);                /* forget its watches */
+int req_conn_watching(const mcd *d, const conn *c);   /* 1: a WATCH of c is live */
 
 #endif

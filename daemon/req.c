@@ -67,6 +67,14 @@ void req_conn_closed(mcd *d, conn *c)
     prune(d);
 }
 
+int req_conn_watching(const mcd *d, const conn *c)
+{
+    for (const req_watch *w = d->watches; w; w = w->next)
+        if (w->c == c)
+            return 1;
+    return 0;
+}
+
 static void reply(conn *c, proto_msg *m, uint32_t request_id)
 {
     m->request_id = request_id;
@@ -114,6 +122,11 @@ static void on_hello(conn *c, const proto_msg *m)
     if (rc) {
         dlog(DLOG_WARN, "HELLO from client '%s' refused: %s", h->client, err);
         srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "authentication failed: %s", err);
+        srv_close_soon(c);
+        return;
+    }
+    if ((rc = srv_conn_admit_user(c, err, sizeof err)) != 0) {
+        srv_send_error(c, m->request_id, rc, "%s", err);
         srv_close_soon(c);
         return;
     }

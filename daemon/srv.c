@@ -20,16 +20,36 @@
  * connection may still close (the client leaves, a write fails, a drain):
  * its memory is freed only when the handle is closed and every hold is
  * released, so an after-work callback may always look at it (srv_send to a
- * closed connection is a no-op). */
+ * closed connection is a no-op).
+ *
+ * DESIGN: idle clients never cost an acknowledged job. A connection is
+ * accepted only while more than the descriptor reserve (--fd-reserve) is
+ * left under RLIMIT_NOFILE, so starting a worker (its pipes) always finds
+ * descriptors, and only under --max-connections in all and
+ * --max-unauthenticated before HELLO; HELLO adds --max-connections-per-user.
+ * A refused client is told why (ERROR BUSY, request id 0), the refusal is
+ * logged, and the connection lingers a moment (reading and dropping what
+ * the client sends) so the ERROR is read rather than lost to a reset. A
+ * timer cuts connections that hold resources for nothing: no HELLO within
+ * --hello-timeout, a frame still incomplete --request-timeout after its
+ * first byte, or a session with nothing going on (no request in flight, no
+ * live WATCH, nothing unread, no byte from the client) for --idle-timeout;
+ * each gets ERROR TIMED_OUT and a log line. */
 #include "mcd.h"
+#include "backend.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <poll.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#define SRV_SWEEP_MS 250           /* how often the connection timeouts are checked */
+#define SRV_REFUSE_LINGER_MS 2000  /* a refused connection waits this long for the client's EOF */
 
 struct conn {
     union { uv_handle_t h; uv_stream_t s; uv_tcp_t tcp; uv_pipe_t pipe; } u;
@@ -47,7 +67,14 @@ struct conn {
     int holds;                /* srv_conn_hold not yet released: work in flight */
     size_t held_len;          /* bytes of in.data the held request's frame takes */
     int handle_closed;        /* uv_close finished: free once holds is 0 */
+    int refused;              /* accepted only to say BUSY: input dropped, closed soon */
+    uint64_t accepted_ms;     /* loop time of the accept */
+    uint64_t frame_ms;        /* when the incomplete frame in `in` began; 0: none */
+    uint64_t active_ms;       /* last byte read, write done or request finished */
 };
+
+static uv_timer_t sweep_timer;     /* the connection timeouts (one loop) */
+static int sweep_on;
 
 conn_auth *srv_conn_auth(conn *c) { return &c->auth; }
 mcd *srv_conn_daemon(conn *c) { return c->d; }
@@ -126,6 +153,7 @@ static void on_write(uv_write_t *w, int status)
     c->wdata = NULL;
     c->inflight = 0;
     c->writing = 0;
+    c->active_ms = uv_now(c->d->loop);
     if (c->closing)
         return;
     if (status < 0) {
@@ -142,6 +170,8 @@ static void on_write(uv_write_t *w, int status)
     }
     if (c->paused && queued(c) <= c->d->conf.max_output / 2) {
         c->paused = 0;
+        if (c->frame_ms)               /* the request clock stood while we did not read */
+            c->frame_ms = c->active_ms;
         update_reading(c);
         process_input(c);
     }
@@ -275,6 +305,7 @@ static void process_input(conn *c)
             }
         }
         proto_buf_consume(&c->in, flen);
+        c->frame_ms = c->in.len ? uv_now(c->d->loop) : 0;
     }
 }
 
@@ -300,6 +331,8 @@ void srv_conn_release(conn *c)
         return;                        /* on_closed frees it */
     proto_buf_consume(&c->in, c->held_len);
     c->held_len = 0;
+    c->active_ms = uv_now(c->d->loop);
+    c->frame_ms = c->in.len ? c->active_ms : 0;
     update_reading(c);
     process_input(c);                  /* requests that arrived meanwhile */
 }
@@ -334,14 +367,75 @@ static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf)
         srv_close(c);
         return;
     }
-    if (n == 0 || c->closing || c->close_after_write)
-        return;
+    if (n == 0 || c->closing || c->close_after_write || c->refused)
+        return;                        /* a refused client's bytes are dropped */
+    c->active_ms = uv_now(c->d->loop);
+    if (c->in.len == 0)
+        c->frame_ms = c->active_ms;
     proto_buf_put(&c->in, buf->base, (size_t)n);
     if (c->in.err) {
         fatal_error(c, 0, PROTO_ENOMEM, "out of memory for the request");
         return;
     }
     process_input(c);
+}
+
+/* Descriptors still free under the soft RLIMIT_NOFILE: the limit less
+ * those open (counted in /proc/self/fd, exact; the count's own descriptor
+ * is not left out, a margin of one). 0 when not even that can be opened;
+ * INT32_MAX when it cannot be counted. */
+static long fds_free(void)
+{
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
+        return INT32_MAX;
+    DIR *dir = opendir("/proc/self/fd");
+    if (!dir)
+        return errno == EMFILE || errno == ENFILE ? 0 : INT32_MAX;
+    long open = 0;
+    while (readdir(dir))
+        open++;
+    closedir(dir);
+    open -= 2;                         /* "." and ".." */
+    return (long)rl.rlim_cur - open;
+}
+
+static long fd_reserve(const mcd *d)
+{
+    if (d->conf.fd_reserve)
+        return d->conf.fd_reserve;
+    return CONF_FD_RESERVE_BASE + (long)CONF_FD_RESERVE_PER_SLOT * bk_nslots(d);
+}
+
+/* Client connections (refused ones not counted): all, and before HELLO. */
+static void count_conns(const mcd *d, uint32_t *all, uint32_t *unauth)
+{
+    *all = *unauth = 0;
+    for (const conn *c = d->conns; c; c = c->next)
+        if (!c->closing && !c->refused) {
+            ++*all;
+            *unauth += !c->auth.authed;
+        }
+}
+
+/* Refusals, logged at most once a second per reason (a flood of clients
+ * gives one line a second, with the number it stands for). */
+enum { REFUSE_FDS, REFUSE_TOTAL, REFUSE_UNAUTH, REFUSE_USER, REFUSE_KINDS };
+static void log_refusal(const mcd *d, int kind, const char *what, const char *why)
+{
+    static uint64_t last_ms[REFUSE_KINDS];
+    static unsigned long held_back[REFUSE_KINDS];
+    uint64_t now = uv_now(d->loop);
+    if (last_ms[kind] && now - last_ms[kind] < 1000) {
+        held_back[kind]++;
+        return;
+    }
+    if (held_back[kind])
+        dlog(DLOG_WARN, "%s refused: %s (and %lu more like it in the last second)", what, why, held_back[kind]);
+    else
+        dlog(DLOG_WARN, "%s refused: %s", what, why);
+    last_ms[kind] = now;
+    held_back[kind] = 0;
 }
 
 static void on_connection(uv_stream_t *server, int status)
@@ -351,6 +445,23 @@ static void on_connection(uv_stream_t *server, int status)
     if (status < 0) {
         dlog(DLOG_WARN, "accept: %s", uv_strerror(status));
         return;
+    }
+    /* the caps, before the accept takes a descriptor */
+    char why[256] = "";
+    int kind = -1;
+    uint32_t all, unauth;
+    count_conns(d, &all, &unauth);
+    long left = fds_free(), reserve = fd_reserve(d);
+    if (left <= reserve) {
+        kind = REFUSE_FDS;
+        snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
+                 "(--fd-reserve)", left, reserve);
+    } else if (all >= d->conf.max_connections) {
+        kind = REFUSE_TOTAL;
+        snprintf(why, sizeof why, "%u connections open, the limit (--max-connections)", all);
+    } else if (unauth >= d->conf.max_unauthenticated) {
+        kind = REFUSE_UNAUTH;
+        snprintf(why, sizeof why, "%u connections without HELLO, the limit (--max-unauthenticated)", unauth);
     }
     conn *c = calloc(1, sizeof *c);
     if (!c) {
@@ -375,8 +486,100 @@ static void on_connection(uv_stream_t *server, int status)
     if (d->conns)
         d->conns->prev = c;
     d->conns = c;
-    dlog(DLOG_DEBUG, "conn %lu: accepted (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
-    update_reading(c);
+    c->accepted_ms = c->active_ms = uv_now(d->loop);
+    if (kind < 0) {
+        dlog(DLOG_DEBUG, "conn %lu: accepted (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
+        update_reading(c);
+        return;
+    }
+    char what[64];
+    snprintf(what, sizeof what, "conn %lu (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
+    log_refusal(d, kind, what, why);
+    c->refused = 1;
+    srv_send_error(c, 0, PROTO_EBUSY, "server busy: %s; retry later", why);
+    if (left <= reserve / 2)
+        srv_close(c);                  /* no descriptor to spare for lingering */
+    else
+        update_reading(c);             /* until the client's EOF, or the linger time */
+}
+
+int srv_conn_admit_user(conn *c, char *msg, size_t msgsz)
+{
+    const mcd *d = c->d;
+    if (c->auth.admin)
+        return 0;
+    uint32_t n = 0;
+    for (const conn *o = d->conns; o; o = o->next)
+        n += o != c && !o->closing && !o->refused && o->auth.authed && strcmp(o->auth.user, c->auth.user) == 0;
+    if (n < d->conf.max_connections_per_user)
+        return 0;
+    snprintf(msg, msgsz, "server busy: user %s has %u sessions, the limit (--max-connections-per-user); "
+             "retry later", c->auth.user, n);
+    char what[AUTH_MAX_USER + 64];
+    snprintf(what, sizeof what, "conn %lu (user %s)", c->id, c->auth.user);
+    log_refusal(d, REFUSE_USER, what, msg);
+    return PROTO_EBUSY;
+}
+
+/* ERROR TIMED_OUT (request id 0), a log line, and a close once it is written. */
+static void time_out(conn *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void time_out(conn *c, const char *fmt, ...)
+{
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    dlog(DLOG_WARN, "conn %lu (%s): %s: closing", c->id, c->auth.authed ? c->auth.user : "-", msg);
+    srv_send_error(c, 0, PROTO_ETIMED_OUT, "%s", msg);
+    srv_close_soon(c);
+}
+
+/* Bytes the frame begun in c->in will have, or 0 while its header is incomplete. */
+static size_t frame_size(const conn *c)
+{
+    if (c->in.len < PROTO_HDR_SIZE)
+        return 0;
+    const uint8_t *p = c->in.data + 12;  /* payload len, little-endian */
+    return PROTO_HDR_SIZE + ((size_t)p[0] | (size_t)p[1] << 8 | (size_t)p[2] << 16 | (size_t)p[3] << 24);
+}
+
+static void on_sweep(uv_timer_t *t)
+{
+    mcd *d = t->data;
+    const mcd_conf *k = &d->conf;
+    uint64_t now = uv_now(d->loop);
+    conn *next;
+    for (conn *c = d->conns; c; c = next) {
+        next = c->next;                /* srv_close unlinks c */
+        if (c->closing || c->close_after_write)
+            continue;
+        if (c->refused) {
+            if (now - c->accepted_ms >= SRV_REFUSE_LINGER_MS)
+                srv_close(c);
+        } else if (!c->auth.authed && k->hello_timeout_s && now - c->accepted_ms >= 1000ull * k->hello_timeout_s) {
+            time_out(c, "no HELLO within %u s (--hello-timeout)", k->hello_timeout_s);
+        } else if (c->frame_ms && !c->holds && !c->paused &&
+                   now - c->frame_ms >= 1000ull * k->request_timeout_s && k->request_timeout_s) {
+            size_t want = frame_size(c);
+            if (want)
+                time_out(c, "request frame incomplete after %u s, %zu of %zu bytes (--request-timeout)",
+                         k->request_timeout_s, c->in.len, want);
+            else
+                time_out(c, "request frame incomplete after %u s, %zu header bytes (--request-timeout)",
+                         k->request_timeout_s, c->in.len);
+        } else if (c->auth.authed && k->idle_timeout_s && !c->holds && !c->in.len && !queued(c) &&
+                   now - c->active_ms >= 1000ull * k->idle_timeout_s && !req_conn_watching(d, c)) {
+            time_out(c, "idle for %u s (--idle-timeout)", k->idle_timeout_s);
+        }
+    }
+}
+
+static void sweep_stop(void)
+{
+    if (sweep_on)
+        uv_close((uv_handle_t *)&sweep_timer, NULL);
+    sweep_on = 0;
 }
 
 static int listen_unix(mcd *d, const char *path, uv_handle_t **out, char *err, size_t errsz)
@@ -464,6 +667,11 @@ int srv_listen(mcd *d, char *err, size_t errsz)
             return snprintf(err, errsz, "%s: %s", tmp, strerror(errno)), -1;
     }
     int rc = 0;
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_NOFILE, &rl) == 0)
+        dlog(DLOG_INFO, "file descriptors: soft limit %llu, %ld kept for the workers; at most %u connections "
+             "(%u per user, %u before HELLO)", (unsigned long long)rl.rlim_cur, fd_reserve(d),
+             d->conf.max_connections, d->conf.max_connections_per_user, d->conf.max_unauthenticated);
     for (int i = 0; i < d->conf.nlisten && !rc; i++) {
         const char *a = d->conf.listen[i];
         uv_handle_t *h = NULL;
@@ -482,6 +690,12 @@ int srv_listen(mcd *d, char *err, size_t errsz)
             snprintf(err, errsz, "%s: %s", d->conf.port_file, strerror(errno));
             rc = -1;
         }
+    }
+    if (!rc && !sweep_on) {
+        uv_timer_init(d->loop, &sweep_timer);
+        sweep_timer.data = d;
+        uv_timer_start(&sweep_timer, on_sweep, SRV_SWEEP_MS, SRV_SWEEP_MS);
+        sweep_on = 1;
     }
     return rc;
 }
@@ -504,10 +718,13 @@ void srv_stop_listening(mcd *d)
         uv_close(h, free_handle);
     }
     d->nlisteners = 0;
+    if (!d->conns)
+        sweep_stop();              /* else the timeouts go on until srv_close_all */
 }
 
 void srv_close_all(mcd *d)
 {
+    sweep_stop();
     while (d->conns)
         srv_close(d->conns);
 }

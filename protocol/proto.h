@@ -68,7 +68,9 @@
     X(PROTO_ESTORAGE,     -22, "STORAGE",       "job could not be stored durably")    \
     X(PROTO_EINTERNAL,    -23, "INTERNAL",      "internal server error")              \
     X(PROTO_ESHUTTING_DOWN,-24,"SHUTTING_DOWN", "server shutting down")              \
-    X(PROTO_ECANCELLED,   -25, "CANCELLED",     "job cancelled")
+    X(PROTO_ECANCELLED,   -25, "CANCELLED",     "job cancelled")                      \
+    X(PROTO_EBUSY,        -26, "BUSY",          "server at a connection limit; retry later") \
+    X(PROTO_ETIMED_OUT,   -27, "TIMED_OUT",     "connection idle, or a request too slow, past its timeout")
 
 enum proto_error {
 #define PROTO_ENUM(sym, val, name, msg) sym = val,

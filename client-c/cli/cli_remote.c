@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 
 typedef struct remote {
@@ -208,6 +209,12 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     return 1;
 }
 
+static int is_drc(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 4 && strcasecmp(path + n - 4, ".drc") == 0;
+}
+
 /* The wire spec of a parsed job (meshes, landmarks and maps are added by the caller). */
 static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t bsz)
 {
@@ -235,10 +242,11 @@ static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t 
 
 int cli_submit(int argc, char **argv)
 {
-    enum { O_PRIORITY = 1, O_LABEL, O_WATCH, O_PROGRESS };
+    enum { O_PRIORITY = 1, O_LABEL, O_WATCH, O_PROGRESS, O_QUANTIZATION };
     static const struct option opts[] = {
         REMOTE_OPTS, CLI_JOB_OPTIONS,
         {"priority", required_argument, 0, O_PRIORITY}, {"label", required_argument, 0, O_LABEL},
+        {"quantization", required_argument, 0, O_QUANTIZATION},
         {"watch", no_argument, 0, O_WATCH}, {"progress", required_argument, 0, O_PROGRESS},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     remote r;
@@ -247,7 +255,7 @@ int cli_submit(int argc, char **argv)
     mc_job_spec_init(&spec);
     cli_job job;
     cli_job_init(&job, argc, argv);
-    int c, bad = 0, watch = 0;
+    int c, bad = 0, watch = 0, qbits = MC_QUANTIZATION_LOSSLESS;
     watch_opts w = {0, 0, 0};
     char *e;
     optind = 1;
@@ -268,19 +276,36 @@ int cli_submit(int argc, char **argv)
             }
             break;
         case O_LABEL: spec.label = optarg; break;
+        case O_QUANTIZATION:
+            qbits = (int)strtol(optarg, &e, 10);
+            if (!*optarg || *e || qbits < 1 || qbits > MC_QUANTIZATION_MAX_BITS) {
+                fprintf(stderr, "meshcorr submit: --quantization: '%s' is not a number of bits from 1 to %d\n",
+                        optarg, MC_QUANTIZATION_MAX_BITS);
+                bad = 1;
+            }
+            break;
         case O_WATCH: watch = 1; break;
         case O_PROGRESS: watch_opt('p', &w); break;
         case 'h':
             printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
-                   "         [--watch [--progress text|json]]\n" REMOTE_USAGE
+                   "         [--quantization BITS] [--watch [--progress text|json]]\n" REMOTE_USAGE
                    "prints the job id; with --watch then follows the job as `meshcorr watch` does\n"
-                   "(and exits as it: 0 when the job COMPLETED)\n" CLI_JOB_USAGE);
+                   "(and exits as it: 0 when the job COMPLETED)\n"
+                   "Meshes go to the server lossless: it computes on exactly the positions read and\n"
+                   "returns the map `meshcorr match` gives. --quantization BITS (1-%d; 16 is Draco's\n"
+                   "usual) sends each coordinate quantized over the bounding box instead: a smaller\n"
+                   "upload, but the map differs from the local one. A .drc file is sent as it is.\n"
+                   CLI_JOB_USAGE, MC_QUANTIZATION_MAX_BITS);
             return 0;
         default: bad = 1;
         }
     }
     if (!bad && argc - optind != 2) {
         fprintf(stderr, "meshcorr submit: need SOURCE TARGET (see --help)\n");
+        bad = 1;
+    }
+    if (!bad && qbits != MC_QUANTIZATION_LOSSLESS && (is_drc(argv[optind]) || is_drc(argv[optind + 1]))) {
+        fprintf(stderr, "meshcorr submit: --quantization: a .drc file is sent as it is, with its own coding\n");
         bad = 1;
     }
     if (!watch && w.json) {
@@ -307,8 +332,8 @@ int cli_submit(int argc, char **argv)
     }
     if (cli_job_load(&job, "submit", S, T, &L, &P0, &Q0))
         goto done;
-    if (mc_encode_mesh_file(src, &sb, &spec.source_len, err, sizeof err) ||
-        mc_encode_mesh_file(tgt, &tb, &spec.target_len, err, sizeof err)) {
+    if (mc_encode_mesh_file_quantized(src, qbits, &sb, &spec.source_len, err, sizeof err) ||
+        mc_encode_mesh_file_quantized(tgt, qbits, &tb, &spec.target_len, err, sizeof err)) {
         fprintf(stderr, "meshcorr submit: %s\n", err);
         goto done;
     }

@@ -2,7 +2,8 @@
  * real meshcorrd (tests/support/testdaemon): submit prints the id alone,
  * watch prints one line per iteration and exits 0 only for a COMPLETED job,
  * result writes the maps mc_result returns, list/stats --json are JSON,
- * --token-file works over TCP and a bad token is refused in words. */
+ * --token-file works over TCP and a bad token is refused in words, and a
+ * lossless upload gives the map `meshcorr match` gives, bit for bit. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testfile.h"
@@ -17,6 +18,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 
 static char src[600], tgt[600], lmk[600], out[1 << 16];
 
@@ -218,4 +220,148 @@ TEST_T(token_file_authenticates_over_tcp_and_a_bad_token_fails_with_a_clear_mess
                        harness_tmpdir()), 1);
     CHECK_STR_HAS(out, "cannot open");
     testdaemon_stop(&d, SIGTERM);
+}
+
+/* The daemon's exit after SIGTERM: 0, not a signal or an error status. */
+static void stop_clean(testdaemon *d)
+{
+    int st = testdaemon_stop(d, SIGTERM);
+    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0)
+        FAILF("meshcorrd ended with status %d after SIGTERM; log %s", st, d->log);
+}
+
+/* Rows of P and R that are not the same bits (face and weights). */
+static int rows_differing(const bmap *P, const bmap *R)
+{
+    int n = 0;
+    for (int i = 0; i < P->n; i++)
+        n += P->face[i] != R->face[i] || memcmp(&P->w[3 * i], &R->w[3 * i], 3 * sizeof(double)) != 0;
+    return n;
+}
+
+/* Mean and largest distance between the points the maps give each source
+ * vertex on T, over sqrt(area of T); returns the rows over 1e-3 of it. */
+static int map_distance(const bmap *P, const bmap *R, const mesh *T, double *mean, double *max)
+{
+    int far = 0;
+    double area = 0, sum = 0;
+    *max = 0;
+    for (int t = 0; t < T->nf; t++) {
+        const double *a = &T->v[3 * T->f[3 * t]], *b = &T->v[3 * T->f[3 * t + 1]], *c = &T->v[3 * T->f[3 * t + 2]];
+        double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    }
+    for (int i = 0; i < P->n; i++) {
+        double x[2][3] = {{0}};
+        const bmap *M[2] = {P, R};
+        for (int m = 0; m < 2; m++)
+            for (int k = 0; k < 3; k++)
+                for (int d = 0; d < 3; d++)
+                    x[m][d] += M[m]->w[3 * i + k] * T->v[3 * T->f[3 * M[m]->face[i] + k] + d];
+        double e = sqrt((x[0][0] - x[1][0]) * (x[0][0] - x[1][0]) + (x[0][1] - x[1][1]) * (x[0][1] - x[1][1]) +
+                        (x[0][2] - x[1][2]) * (x[0][2] - x[1][2])) / sqrt(area);
+        sum += e;
+        *max = e > *max ? e : *max;
+        far += e > 1e-3;
+    }
+    *mean = sum / P->n;
+    return far;
+}
+
+#define WOLF_OPTS "--iterations 2 --beta-ramp 2 --inner-iterations 10 --rhm-iterations 3"
+
+/* `meshcorr submit` then `meshcorr result` of job options and extra; returns the map P (and Q in *Q). */
+static bmap *remote_map(const testdaemon *d, const char *s, const char *t, const char *pairs, const char *extra,
+                        const mesh *S, const mesh *T, bmap **Q)
+{
+    char P[700], Qp[700], err[512];
+    snprintf(P, sizeof P, "%s/remote.map", harness_tmpdir());
+    snprintf(Qp, sizeof Qp, "%s/remote-q.map", harness_tmpdir());
+    int rc = testrunf(out, sizeof out, "build/meshcorr submit %s %s --landmarks %s " WOLF_OPTS " %s --watch "
+                      "--server %s 2>&1", s, t, pairs, extra, d->unix_addr);
+    if (rc)
+        FAILF("submit %s exited %d:\n%s", extra, rc, out);
+    unsigned long long id = strtoull(out, NULL, 10);
+    CHECK(id > 0);
+    rc = testrunf(out, sizeof out, "build/meshcorr result %llu --out %s --out-reverse %s --server %s 2>&1", id, P,
+                  Qp, d->unix_addr);
+    if (rc)
+        FAILF("result exited %d:\n%s", rc, out);
+    bmap *Pm = NULL;
+    if (bmap_read(P, S, T, &Pm, err, sizeof err) || bmap_read(Qp, T, S, Q, err, sizeof err))
+        FAILF("bmap_read: %s", err);
+    return Pm;
+}
+
+/* The lossless upload: the daemon computes on the very doubles `meshcorr
+ * match` reads from the same files and returns its map bit for bit (wolf0
+ * -> wolf1, the 21 BIM landmarks, 2 ECTM and 3 RHM iterations, one thread
+ * on both sides). --quantization 16 trades that for size: its map is
+ * another one. */
+TEST_T(submit_returns_the_map_meshcorr_match_computes_bit_for_bit_and_quantization_changes_it, 240)
+{
+    testdaemon_need_worker();
+    char s[600], t[600], pairs[700], P[700], Q[700], err[512];
+    snprintf(s, sizeof s, "%s", harness_data_path("tosca_hires/Meshes/wolf0.off"));
+    snprintf(t, sizeof t, "%s", harness_data_path("tosca_hires/Meshes/wolf1.off"));
+    /* the same landmark ids on both poses (tosca_hires: identity by index) */
+    FILE *fp = fopen(harness_data_path("tosca_hires/Corrs/wolf.pid"), "r");
+    CHECK(fp);
+    char lines[4096] = "";
+    int id, n = 0;
+    while (fscanf(fp, "%d %*d %*d %*d", &id) == 1)
+        n += snprintf(lines + n, sizeof lines - (size_t)n, "%d %d\n", id, id);
+    fclose(fp);
+    CHECK(n > 0);
+    snprintf(pairs, sizeof pairs, "%s", testfile_text("wolf.lmk", lines));
+    snprintf(P, sizeof P, "%s/local.map", harness_tmpdir());
+    snprintf(Q, sizeof Q, "%s/local-q.map", harness_tmpdir());
+    int rc = testrunf(out, sizeof out, "build/meshcorr match %s %s --landmarks %s " WOLF_OPTS " --threads 1 "
+                      "--progress none --out %s --out-reverse %s 2>&1", s, t, pairs, P, Q);
+    if (rc)
+        FAILF("match exited %d:\n%s", rc, out);
+    mesh *S = NULL, *T = NULL;
+    CHECK_INT(mesh_read(s, &S, err, sizeof err), 0);
+    CHECK_INT(mesh_read(t, &T, err, sizeof err), 0);
+    bmap *Pl = NULL, *Ql = NULL;
+    if (bmap_read(P, S, T, &Pl, err, sizeof err) || bmap_read(Q, T, S, &Ql, err, sizeof err))
+        FAILF("bmap_read: %s", err);
+
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    bmap *Qr = NULL, *Pr = remote_map(&d, s, t, pairs, "", S, T, &Qr);
+    CHECK_INT(Pr->n, Pl->n);
+    CHECK_INT(Qr->n, Ql->n);
+    int dp = rows_differing(Pl, Pr), dq = rows_differing(Ql, Qr);
+    if (dp || dq)
+        FAILF("lossless upload: %d of %d rows of P and %d of %d of Q differ from meshcorr match's", dp, Pl->n, dq,
+              Ql->n);
+
+    bmap *Qq = NULL, *Pq = remote_map(&d, s, t, pairs, "--quantization 16", S, T, &Qq);
+    double mean, max;
+    int far = map_distance(Pl, Pq, T, &mean, &max);
+    printf("  --quantization 16: %d of %d rows of P differ; mean %.3g, max %.3g of sqrt(area); %d rows over 1e-3\n",
+           rows_differing(Pl, Pq), Pl->n, mean, max, far);
+    CHECK(rows_differing(Pl, Pq) > 0);
+
+    /* a .drc is sent as it is: --quantization does not apply; bits out of range */
+    char drc[700];
+    snprintf(drc, sizeof drc, "%s/wolf0.drc", harness_tmpdir());
+    CHECK_INT(mesh_write(drc, S, err, sizeof err), 0);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr submit %s %s --landmarks %s --quantization 16 "
+                       "--server %s 2>&1", drc, t, pairs, d.unix_addr), 2);
+    CHECK_STR_HAS(out, "a .drc file is sent as it is");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr submit %s %s --landmarks %s --quantization 31 "
+                       "--server %s 2>&1", s, t, pairs, d.unix_addr), 2);
+    CHECK_STR_HAS(out, "--quantization: '31' is not a number of bits from 1 to 30");
+    stop_clean(&d);
+    bmap_free(Pl);
+    bmap_free(Ql);
+    bmap_free(Pr);
+    bmap_free(Qr);
+    bmap_free(Pq);
+    bmap_free(Qq);
+    mesh_free(S);
+    mesh_free(T);
 }

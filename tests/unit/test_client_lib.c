@@ -1,5 +1,5 @@
 /* test_client_lib.c — libmeshcorr as a user gets it: in-memory meshes encoded
- * with their vertex order kept, and `make install` (the library part, into a
+ * with their vertex order and positions kept (or quantized on request), and `make install` (the library part, into a
  * temporary DESTDIR) giving a header, static and shared libraries and a
  * pkg-config file that a small program builds with and talks to a real
  * meshcorrd through. */
@@ -35,11 +35,8 @@ TEST(in_memory_mesh_encodes_to_draco_keeping_vertex_order_and_faces)
     CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf, err, sizeof err), 0);
     CHECK_INT(nv, m->nv);
     CHECK_INT(nf, m->nf);
-    double ext = 0;
-    for (int i = 0; i < 3 * nv; i++)
-        ext = fmax(ext, fabs(m->v[i]));
-    for (int i = 0; i < 3 * nv; i++)
-        CHECK_NEAR(v[i], m->v[i], 2 * ext / 65535.0 * 2);
+    /* lossless by default: the same doubles */
+    CHECK(memcmp(v, m->v, sizeof(double) * 3 * (size_t)nv) == 0);
     for (int t = 0; t < nf; t++) {     /* the same triangle, possibly rotated */
         int r = 0;
         while (r < 3 && f[3 * t] != m->f[3 * t + r])
@@ -51,6 +48,55 @@ TEST(in_memory_mesh_encodes_to_draco_keeping_vertex_order_and_faces)
     free(v);
     free(f);
     free(buf);
+    mesh_free(m);
+}
+
+/* --quantization's library side: 16 bits is within a step of the bounding
+ * box and smaller; a file encodes as its arrays do; bits out of range and a
+ * .drc file given bits are told apart. */
+TEST(quantized_encoding_is_smaller_within_its_step_and_bad_bits_are_refused)
+{
+    mesh *m = NULL;
+    char err[512], path[600];
+    snprintf(path, sizeof path, "%s", harness_data_path("tosca_hires/Meshes/wolf0.off"));
+    CHECK_INT(mesh_read(path, &m, err, sizeof err), 0);
+    unsigned char *lb = NULL, *qb = NULL, *fb = NULL;
+    size_t ll = 0, ql = 0, fl = 0;
+    CHECK_INT(mc_encode_mesh(m->v, m->nv, m->f, m->nf, &lb, &ll, err, sizeof err), 0);
+    CHECK_INT(mc_encode_mesh_quantized(m->v, m->nv, m->f, m->nf, 16, &qb, &ql, err, sizeof err), 0);
+    CHECK_INT(mc_encode_mesh_file(path, &fb, &fl, err, sizeof err), 0);
+    CHECK(fl == ll && memcmp(fb, lb, ll) == 0);
+    free(fb);
+    CHECK_INT(mc_encode_mesh_file_quantized(path, 16, &fb, &fl, err, sizeof err), 0);
+    CHECK(fl == ql && memcmp(fb, qb, ql) == 0);
+    CHECK(ql < ll);
+    double *v = NULL, ext = 0;
+    int *f = NULL, nv = 0, nf = 0;
+    CHECK_INT(dracob_decode(qb, ql, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf, err, sizeof err), 0);
+    for (int k = 0; k < 3; k++) {
+        double lo = m->v[k], hi = m->v[k];
+        for (int i = 1; i < m->nv; i++)
+            lo = fmin(lo, m->v[3 * i + k]), hi = fmax(hi, m->v[3 * i + k]);
+        ext = fmax(ext, hi - lo);
+    }
+    int moved = 0;
+    for (int i = 0; i < 3 * nv; i++) {
+        CHECK_NEAR(v[i], m->v[i], ext / 65535.0);
+        moved += v[i] != m->v[i];
+    }
+    CHECK(moved > 0);
+    free(v);
+    free(f);
+    unsigned char *bad = (unsigned char *)"x";
+    size_t bl = 1;
+    CHECK_INT(mc_encode_mesh_quantized(m->v, m->nv, m->f, m->nf, 31, &bad, &bl, err, sizeof err), MC_EARG);
+    CHECK(bad == NULL && bl == 0);
+    CHECK_STR_HAS(err, "quantization of 31 bits");
+    CHECK_INT(mc_encode_mesh_file_quantized(path, -1, &bad, &bl, err, sizeof err), MC_EARG);
+    CHECK_STR_HAS(err, "quantization of -1 bits");
+    free(lb);
+    free(qb);
+    free(fb);
     mesh_free(m);
 }
 

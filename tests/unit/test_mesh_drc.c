@@ -1,6 +1,7 @@
 /* test_mesh_drc.c — Draco: the vertex order survives our encoder (proved
- * vertex by vertex on real meshes), the OFF->OBJ->PLY->DRC->OFF chain, and
- * malformed buffers (truncated, random bytes) give errors, never crashes. */
+ * vertex by vertex on real meshes), the OFF->OBJ->PLY->DRC->OFF chain, the
+ * lossless coding keeps every double bit for bit, and malformed buffers
+ * (truncated, random bytes) give errors, never crashes. */
 #include "support/harness.h"
 #include "support/testfile.h"
 #include "support/testmesh.h"
@@ -25,14 +26,21 @@ static double bbox_size(const mesh *m)
     return s;
 }
 
-/* Every decoded vertex is within quantization of the original vertex at the
- * SAME index, faces identical: the order is the original one. */
-static void check_same_order(const mesh *a, const mesh *b)
+/* Every decoded vertex is within quantization to `bits` of the original
+ * vertex at the SAME index (the very bits when lossless), faces identical:
+ * the order is the original one. */
+static void check_same_order(const mesh *a, const mesh *b, int bits)
 {
     CHECK_INT(b->nv, a->nv);
     CHECK_INT(b->nf, a->nf);
     CHECK(memcmp(a->f, b->f, sizeof(int) * 3 * a->nf) == 0);
-    double tol = bbox_size(a) / (1 << MESH_DRC_QUANTIZATION_BITS);
+    if (bits == DRACOB_LOSSLESS) {
+        for (int i = 0; i < 3 * a->nv; i++)
+            if (memcmp(&a->v[i], &b->v[i], sizeof(double)) != 0)
+                FAILF("vertex %d coordinate %d: %a decoded as %a", i / 3, i % 3, a->v[i], b->v[i]);
+        return;
+    }
+    double tol = bbox_size(a) / (1 << bits);
     for (int i = 0; i < a->nv; i++)
         for (int k = 0; k < 3; k++)
             if (!(fabs(a->v[3 * i + k] - b->v[3 * i + k]) <= tol))
@@ -60,7 +68,7 @@ static void chain_round_trip(const char *rel)
             mesh_free(m);
         m = next;
     }
-    check_same_order(orig, m);
+    check_same_order(orig, m, MESH_DRC_QUANTIZATION_BITS);
     mesh_free(orig);
     mesh_free(m);
 }
@@ -95,8 +103,17 @@ TEST(drc_keeps_unreferenced_vertices_and_order_of_generated_torus)
     CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf,
                             err, sizeof err), 0);
     mesh got = { nv, nf, v, f };
-    check_same_order(m, &got);
+    check_same_order(m, &got, 16);
     CHECK_NEAR(v[3 * t->nv], 9.0, 1e-3);
+    free(v);
+    free(f);
+    free(buf);
+    /* and lossless: the same, every bit kept */
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, DRACOB_LOSSLESS, &buf, &len, err, sizeof err), 0);
+    CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf,
+                            err, sizeof err), 0);
+    got = (mesh){ nv, nf, v, f };
+    check_same_order(m, &got, DRACOB_LOSSLESS);
     free(v);
     free(f);
     free(buf);
@@ -176,26 +193,87 @@ TEST_T(drc_random_61_byte_buffers_never_crash, 60)
     CHECK(refused > 2900);
 }
 
-TEST(drc_unquantized_encoding_keeps_float32_positions_nan_included)
+/* Encodes m with bits, decodes, and returns the encoded size; the decoded
+ * positions go to *v (malloc()ed). */
+static size_t round_trip(const mesh *m, int bits, double **v)
 {
-    mesh *m = testmesh_icosphere(1);
-    m->v[4] = NAN;
     unsigned char *buf = NULL;
     size_t len = 0;
     char err[512];
-    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, 0, &buf, &len, err, sizeof err), 0);
-    double *v = NULL;
+    if (dracob_encode(m->v, m->nv, m->f, m->nf, bits, &buf, &len, err, sizeof err))
+        FAILF("dracob_encode(%d bits): %s", bits, err);
     int *f = NULL, nv = 0, nf = 0;
-    CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf,
-                            err, sizeof err), 0);
+    if (dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, v, &nv, &f, &nf, err, sizeof err))
+        FAILF("dracob_decode(%d bits): %s", bits, err);
     CHECK_INT(nv, m->nv);
-    CHECK(isnan(v[4]));
-    for (int i = 0; i < 3 * nv; i++)
-        if (i != 4)
-            CHECK(v[i] == (double)(float)m->v[i]);
-    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, -1, &buf, &len, err, sizeof err),
-              DRACOB_EARG);
-    free(v);
+    CHECK_INT(nf, m->nf);
+    CHECK(memcmp(f, m->f, sizeof(int) * 3 * (size_t)nf) == 0);
     free(f);
+    free(buf);
+    return len;
+}
+
+/* Lossless keeps any double bit for bit: random bit patterns (every
+ * exponent), NaN, -0, the smallest denormal, the largest finite values. */
+TEST(drc_lossless_round_trip_keeps_every_double_bit_for_bit)
+{
+    mesh *m = testmesh_icosphere(2);
+    unsigned long long st = 0xd0b1e;
+    for (int i = 0; i < 3 * m->nv; i++) {
+        unsigned long long b = 0;
+        for (int k = 0; k < 4; k++)
+            b = b << 16 | (unsigned long long)(testmesh_rand(&st) * 65536);
+        memcpy(&m->v[i], &b, sizeof b);
+    }
+    m->v[0] = -0.0;
+    m->v[1] = 4.9406564584124654e-324;
+    m->v[2] = NAN;
+    m->v[3] = -1.7976931348623157e308;
+    m->v[4] = INFINITY;
+    m->v[5] = 0.1;
+    double *v = NULL;
+    round_trip(m, DRACOB_LOSSLESS, &v);
+    for (int i = 0; i < 3 * m->nv; i++)
+        if (memcmp(&v[i], &m->v[i], sizeof(double)) != 0)
+            FAILF("coordinate %d: %a decoded as %a", i, m->v[i], v[i]);
+    free(v);
+    mesh_free(m);
+}
+
+/* A mesh read from a text file: lossless is exact, float64 storage; a
+ * mesh whose coordinates are all floats goes as float32 (smaller, still
+ * exact, NaN included); 16 bits is within its step and smaller still.
+ * Prints the sizes on the 4344-vertex wolf. */
+TEST(drc_lossless_is_exact_on_a_real_mesh_float32_when_it_can_and_16_bits_smaller)
+{
+    mesh *m = NULL;
+    char err[512];
+    CHECK_INT(mesh_read(harness_data_path("tosca_hires/Meshes/wolf0.off"), &m, err, sizeof err), 0);
+    double *v = NULL;
+    size_t lossless = round_trip(m, DRACOB_LOSSLESS, &v);
+    mesh got = { m->nv, m->nf, v, m->f };
+    check_same_order(m, &got, DRACOB_LOSSLESS);
+    free(v);
+    size_t q16 = round_trip(m, 16, &v);
+    got.v = v;
+    check_same_order(m, &got, 16);
+    free(v);
+    mesh *g = mesh_copy(m);
+    for (int i = 0; i < 3 * g->nv; i++)
+        g->v[i] = (float)g->v[i];
+    g->v[4] = NAN;
+    size_t f32 = round_trip(g, DRACOB_LOSSLESS, &v);
+    for (int i = 0; i < 3 * g->nv; i++)
+        if (memcmp(&v[i], &g->v[i], sizeof(double)) != 0)
+            FAILF("float32 coordinate %d: %a decoded as %a", i, g->v[i], v[i]);
+    free(v);
+    printf("  wolf0 (%d vertices, %d faces): lossless %zu bytes (float64), float32 %zu, 16 bits %zu "
+           "(%.2f x smaller than lossless)\n", m->nv, m->nf, lossless, f32, q16, (double)lossless / (double)q16);
+    CHECK(q16 < f32 && f32 < lossless);
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, -1, &buf, &len, err, sizeof err), DRACOB_EARG);
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, 31, &buf, &len, err, sizeof err), DRACOB_EARG);
+    mesh_free(g);
     mesh_free(m);
 }

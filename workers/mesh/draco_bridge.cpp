@@ -126,14 +126,32 @@ int decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
     return DRACOB_OK;
 }
 
+// 1 when every coordinate is a float exactly (bit for bit, NaN payloads and
+// -0 included), so float32 storage loses nothing.
+bool all_float32(const double *v, int nv)
+{
+    for (long long i = 0; i < 3LL * nv; i++) {
+        const double back = static_cast<double>(static_cast<float>(v[i]));
+        if (memcmp(&back, &v[i], sizeof back) != 0)
+            return false;
+    }
+    return true;
+}
+
 int encode(const double *v, int nv, const int *f, int nf, int bits,
            unsigned char **buf, size_t *len, char *err, size_t errsz)
 {
     draco::Mesh dm;
     dm.set_num_points(static_cast<uint32_t>(nv));
+    // Lossless (bits 0): Draco's sequential encoder stores an unquantized
+    // float attribute as its raw values, so float32 positions stay float32
+    // and anything else goes as float64. Quantized: the quantizer reads
+    // float32 values, an error far below its step.
+    const bool f64 = bits == DRACOB_LOSSLESS && !all_float32(v, nv);
     draco::GeometryAttribute ga;
-    ga.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_FLOAT32, false,
-            sizeof(float) * 3, 0);
+    ga.Init(draco::GeometryAttribute::POSITION, nullptr, 3,
+            f64 ? draco::DT_FLOAT64 : draco::DT_FLOAT32, false,
+            (f64 ? sizeof(double) : sizeof(float)) * 3, 0);
     const int pos_id = dm.AddAttribute(ga, true, static_cast<uint32_t>(nv));
     draco::GeometryAttribute gi;
     gi.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_INT32, false,
@@ -144,10 +162,14 @@ int encode(const double *v, int nv, const int *f, int nf, int bits,
     draco::PointAttribute *pa = dm.attribute(pos_id);
     draco::PointAttribute *ia = dm.attribute(idx_id);
     for (int i = 0; i < nv; i++) {
-        const float q[3] = { static_cast<float>(v[3 * i]), static_cast<float>(v[3 * i + 1]),
-                             static_cast<float>(v[3 * i + 2]) };
         const int32_t id = i;
-        pa->SetAttributeValue(draco::AttributeValueIndex(i), q);
+        if (f64) {
+            pa->SetAttributeValue(draco::AttributeValueIndex(i), &v[3 * i]);
+        } else {
+            const float q[3] = { static_cast<float>(v[3 * i]), static_cast<float>(v[3 * i + 1]),
+                                 static_cast<float>(v[3 * i + 2]) };
+            pa->SetAttributeValue(draco::AttributeValueIndex(i), q);
+        }
         ia->SetAttributeValue(draco::AttributeValueIndex(i), &id);
     }
     std::unique_ptr<draco::AttributeMetadata> md(new draco::AttributeMetadata());
@@ -161,7 +183,7 @@ int encode(const double *v, int nv, const int *f, int nf, int bits,
     }
     draco::Encoder enc;
     enc.SetEncodingMethod(draco::MESH_SEQUENTIAL_ENCODING);
-    if (bits > 0)   // 0: positions stored as float32, unquantized
+    if (bits != DRACOB_LOSSLESS)
         enc.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
     draco::EncoderBuffer eb;
     const draco::Status st = enc.EncodeMeshToBuffer(dm, &eb);

@@ -50,9 +50,16 @@ const char *dracob_strerror(int code);
 int dracob_decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
                   double **v, int *nv, int **f, int *nf, char *err, size_t errsz);
 
-/* Encodes nv by 3 positions and nf by 3 faces, positions quantized to
- * quantization_bits (1..30; 16 is the usual; 0 stores float32 positions
- * unquantized, as other tools may). Indices must be in range. */
+/* quantization_bits of dracob_encode that keeps every position exactly. */
+#define DRACOB_LOSSLESS 0
+
+/* Encodes nv by 3 positions and nf by 3 faces. Positions: DRACOB_LOSSLESS
+ * stores them unquantized and decodes them bit for bit (NaN, -0 and
+ * denormals included): as float32 when every coordinate is a float
+ * exactly, else as float64; 1..30 quantizes each coordinate to that many
+ * bits over the bounding box (16 is Draco's usual: an error up to about
+ * bbox / 2^17, and 72 KB instead of 156 KB lossless on a 4344-vertex mesh).
+ * Indices must be in range. */
 int dracob_encode(const double *v, int nv, const int *f, int nf, int quantization_bits,
                   unsigned char **buf, size_t *len, char *err, size_t errsz);
 

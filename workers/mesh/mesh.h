@@ -57,9 +57,10 @@ int mesh_read(const char *path, mesh **out, char *err, size_t errsz);
 /* Writes by extension (.off .obj .ply .drc). */
 int mesh_write(const char *path, const mesh *m, char *err, size_t errsz);
 
-/* Position quantization of the .drc files we write (bits per coordinate over
- * the bounding box): the error is at most bbox_size / 2^16 per coordinate. */
-#define MESH_DRC_QUANTIZATION_BITS 16
+/* Position quantization of the .drc files and blobs we write: 0, lossless
+ * (DRACOB_LOSSLESS: every position decodes bit for bit, float64 unless all
+ * are floats). A client may ask for 1..30 bits instead (mc_encode_mesh_quantized). */
+#define MESH_DRC_QUANTIZATION_BITS 0
 
 /* Per-format entry points; mesh_read/mesh_write pick one by extension.
  * OFF and OBJ: text, triangles only (a polygon is refused naming file, line

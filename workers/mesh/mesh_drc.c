@@ -1,6 +1,6 @@
 /* mesh_drc.c — .drc (Draco) reader and writer: file bytes in and out, the
  * coding itself through draco_bridge.h. Written files use
- * MESH_DRC_QUANTIZATION_BITS and keep the vertex order (see mesh.h). The
+ * MESH_DRC_QUANTIZATION_BITS (lossless) and keep the vertex order (see mesh.h). The
  * _mem entry points do the same on buffers (the worker's SUBMIT blobs). */
 #include "mesh/mesh.h"
 #include "mesh/draco_bridge.h"
