@@ -522,7 +522,7 @@ int cli_result(int argc, char **argv)
     if (!c)
         return 1;
     mc_job_result res;
-    unsigned what = MC_WANT_P | MC_WANT_Q | (o.out_def ? MC_WANT_DEFORMED : 0);
+    unsigned what = MC_WANT_P | MC_WANT_Q | MC_WANT_METRICS | (o.out_def ? MC_WANT_DEFORMED : 0);
     int rc = mc_result(c, id, what, &res), status = 1;
     if (rc)
         return fail("result", c, rc);

@@ -46,24 +46,22 @@
  *   --scale=S             multiply both meshes' coordinates by S first
  *                         (a check of scale invariance)
  *   --rhm-start=NAME      distances (the default) or voronoi
- * Each pair runs in its own process: a crash or an error becomes that
- * pair's row, and the other pairs still run. Prints figures, never fails
+ * Each pair runs in its own process (support/testapart.h): a crash or an
+ * error becomes that pair's row, and the other pairs still run. The rhm
+ * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
+ * repair (corr_repair). Prints figures, never fails
  * on quality. */
 #include "support/harness.h"
+#include "support/testapart.h"
 #include "support/testgt.h"
 #include "corr/corr.h"
 #include "geo/geo_area.h"
 #include "metric/metric.h"
 #include "rhm/rhm__problem.h"
 
-#include <errno.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
 #include <time.h>
-#include <unistd.h>
 
 #define NL 12   /* landmarks */
 
@@ -166,8 +164,19 @@ static double median_conformal_all(const mesh *S, const mesh *T, const bmap *P)
     return m;
 }
 
-static void run_pair(const pair_spec *ps, int ectm_iterations, double scale, pair_fig *fig)
+typedef struct pair_job {
+    const pair_spec *ps;
+    int ectm_iterations;
+    double scale;
+} pair_job;
+
+static void run_pair(const void *arg, void *out)
 {
+    const pair_job *job = arg;
+    const pair_spec *ps = job->ps;
+    int ectm_iterations = job->ectm_iterations;
+    double scale = job->scale;
+    pair_fig *fig = out;
     memset(fig, 0, sizeof *fig);
     testgt g;
     if (ps->vts)
@@ -264,48 +273,6 @@ out:
     testgt_close(&g);
 }
 
-/* Runs one pair in a child process; a child that dies leaves an error row. */
-static void run_pair_apart(const pair_spec *ps, int ectm_iterations, double scale, pair_fig *fig)
-{
-    int fd[2];
-    if (pipe(fd))
-        FAILF("pipe: %s", strerror(errno));
-    fflush(stdout);
-    fflush(stderr);
-    pid_t pid = fork();
-    if (pid < 0)
-        FAILF("fork: %s", strerror(errno));
-    if (pid == 0) {
-        prctl(PR_SET_PDEATHSIG, SIGKILL);   /* the harness's timeout ends us too */
-        close(fd[0]);
-        pair_fig f;
-        run_pair(ps, ectm_iterations, scale, &f);
-        fflush(stdout);
-        _exit(write(fd[1], &f, sizeof f) == (ssize_t)sizeof f ? 0 : 1);
-    }
-    close(fd[1]);
-    size_t got = 0;
-    while (got < sizeof *fig) {
-        ssize_t r = read(fd[0], (char *)fig + got, sizeof *fig - got);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0)
-            break;
-        got += (size_t)r;
-    }
-    close(fd[0]);
-    int st = 0;
-    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
-    if (got < sizeof *fig) {
-        memset(fig, 0, sizeof *fig);
-        if (WIFSIGNALED(st))
-            snprintf(fig->err, sizeof fig->err, "crashed (signal %d)", WTERMSIG(st));
-        else
-            snprintf(fig->err, sizeof fig->err, "failed (exit %d; message above)",
-                     WIFEXITED(st) ? WEXITSTATUS(st) : -1);
-    }
-}
-
 static void print_header(void)
 {
     printf("%-16s %-12s %5s  %-8s %8s %8s %8s %8s %8s %7s %7s %5s %8s\n", "pair", "V S->T",
@@ -377,7 +344,10 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     for (int i = 0; i < NPAIRS; i++) {
         if (!wanted(o_pairs, pairs[i].label))
             continue;
-        run_pair_apart(&pairs[i], iters, scale, &figs[i]);
+        pair_job job = { &pairs[i], iters, scale };
+        char why[256];
+        if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
+            snprintf(figs[i].err, sizeof figs[i].err, "%s", why);
         ran[i] = 1;
         print_header();
         print_rows(&pairs[i], &figs[i]);

@@ -110,6 +110,10 @@ TEST_T(submit_prints_the_id_watch_prints_energies_and_exits_0_and_result_writes_
     snprintf(Y, sizeof Y, "%s/y.ply", harness_tmpdir());
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr result %llu --out %s --out-reverse %s --out-deformed %s "
                        "--server %s 2>&1", (unsigned long long)id, P, Q, Y, d.unix_addr), 0);
+    /* the quality of both maps is printed with the result */
+    CHECK_STR_HAS(out, "flipped_fraction ");
+    CHECK_STR_HAS(out, "reverse_collapsed_fraction ");
+    CHECK_STR_HAS(out, "quality_verdict ");
     mesh *S = NULL, *T = NULL, *D = NULL;
     CHECK_INT(mesh_read(src, &S, err, sizeof err), 0);
     CHECK_INT(mesh_read(tgt, &T, err, sizeof err), 0);
