@@ -31,7 +31,6 @@
 #include <unistd.h>
 
 #define REQ_LIST_PAGE 1000
-#define REQ_MAX_ITERATIONS 1000000u
 #define REQ_MAX_RESULT_FILE ((size_t)PROTO_MAX_FRAME)
 
 struct req_watch {
@@ -131,54 +130,26 @@ static void on_hello(conn *c, const proto_msg *m)
     reply(c, &r, m->request_id);
 }
 
-/* Structural checks the daemon can make without decoding Draco; the worker
- * checks the meshes and the landmark ids against them. 0 or a code with msg. */
+/* What the daemon checks itself before the validator runs: blobs present,
+ * the server's landmark limit, and every parameter with the one validator
+ * (proto_params_check, the worker's and the CLI's too). 0 or a code with
+ * msg. */
 static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t msz)
 {
-    const proto_params *p = &s->params;
     const mcd_conf *cf = &d->conf;
     if (s->source.len == 0 || s->target.len == 0)
         return snprintf(msg, msz, "%s mesh: no Draco bytes", s->source.len ? "target" : "source"), PROTO_EBAD_MESH;
     if (s->nlandmarks > cf->max_landmarks)
-        return snprintf(msg, msz, "landmark count %u over the server's limit (%u)", s->nlandmarks,
+        return snprintf(msg, msz, "landmarks: %u pairs, over the server's limit (%u)", s->nlandmarks,
                         cf->max_landmarks), PROTO_EBAD_LANDMARKS;
-    for (uint32_t i = 0; i < s->nlandmarks; i++)
-        if (s->landmarks[i].src >= cf->max_vertices || s->landmarks[i].tgt >= cf->max_vertices)
-            return snprintf(msg, msz, "landmark %u: vertex id over the vertex limit (%u)", i,
-                            cf->max_vertices), PROTO_EBAD_LANDMARKS;
-    if (s->p.n == 0 && s->nlandmarks < 4)
-        return snprintf(msg, msz, "need an initial map p or at least 4 landmark pairs (got %u)",
-                        s->nlandmarks), PROTO_EBAD_LANDMARKS;
-    if (s->p.n > cf->max_vertices || s->q.n > cf->max_vertices)
-        return snprintf(msg, msz, "initial map with %u rows over the vertex limit (%u)",
-                        s->p.n > s->q.n ? s->p.n : s->q.n, cf->max_vertices), PROTO_EBAD_PARAMS;
+    if (s->p.n == 0 && s->nlandmarks < PROTO_MIN_LANDMARKS)
+        return snprintf(msg, msz, "need an initial map p or at least %d landmark pairs (got %u)",
+                        PROTO_MIN_LANDMARKS, s->nlandmarks), PROTO_EBAD_LANDMARKS;
     if (s->q.n && !s->p.n)
         return snprintf(msg, msz, "initial map q without p"), PROTO_EBAD_PARAMS;
-    if (s->q.n && p->model == PROTO_MODEL_INJECTIVE)
+    if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
         return snprintf(msg, msz, "initial map q needs the bijective model"), PROTO_EBAD_PARAMS;
-    const struct { const char *name; double v, min; int open; } r[] = {
-        {"alpha", p->alpha, 0, 1}, {"eta", p->eta, 0, 0}, {"beta0", p->beta0, 0, 1},
-        {"beta1", p->beta1, 0, 1}, {"beta_ramp", p->beta_ramp, 1, 0}, {"gamma", p->gamma, 0, 0},
-        {"tolerance", p->tolerance, 0, 1}, {"stop_change", p->stop_change, 0, 0},
-    };
-    for (size_t i = 0; i < sizeof r / sizeof r[0]; i++)
-        if (!isfinite(r[i].v) || r[i].v < r[i].min || (r[i].open && r[i].v <= r[i].min))
-            return snprintf(msg, msz, "%s = %g: must be finite and %s 0", r[i].name, r[i].v,
-                            r[i].open ? ">" : ">="), PROTO_EBAD_PARAMS;
-    if (p->iterations < 1 || p->iterations > REQ_MAX_ITERATIONS ||
-        p->inner_iterations < 1 || p->inner_iterations > REQ_MAX_ITERATIONS)
-        return snprintf(msg, msz, "iterations %u / inner_iterations %u: must be in [1, %u]", p->iterations,
-                        p->inner_iterations, REQ_MAX_ITERATIONS), PROTO_EBAD_PARAMS;
-    /* backend: "" (the server's default, cpu), "cpu", "opencl" or "auto", with an
-     * optional ":DEVICE" the worker matches against OpenCL platform/device names */
-    if (p->backend[0]) {
-        size_t k = strcspn(p->backend, ":");
-        if (!((k == 3 && !strncmp(p->backend, "cpu", 3)) || (k == 6 && !strncmp(p->backend, "opencl", 6)) ||
-              (k == 4 && !strncmp(p->backend, "auto", 4))))
-            return snprintf(msg, msz, "backend '%s': not cpu, opencl or auto (optionally :DEVICE)",
-                            p->backend), PROTO_EBAD_PARAMS;
-    }
-    return 0;
+    return proto_params_check(&s->params, msg, msz);
 }
 
 /* ---- work in the thread pool ----------------------------------------------- */
@@ -218,7 +189,7 @@ struct req_submit {
     char label[PROTO_MAX_STRING + 1];
     int32_t priority;
     uint32_t total;
-    char params[512];
+    char params[1024];            /* the parameters, for the log and the row */
     int rc;                       /* store_submit's result, */
     uint64_t id;                  /* its job id */
     char msg[PROTO_MAX_STRING];   /* or its error */
@@ -312,15 +283,10 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
         return;
     }
     const proto_params *p = &s->params;
-    snprintf(w->params, sizeof w->params,
-             "model=%s partial=%u alpha=%g eta=%g beta0=%g beta1=%g beta_ramp=%u gamma=%g iterations=%u"
-             " inner=%u tolerance=%g stop_change=%g backend=%s landmarks=%u rhm_start=%s init_p=%u"
-             " init_q=%u source_bytes=%u target_bytes=%u",
-             p->model == PROTO_MODEL_BIJECTIVE ? "bijective" : "injective", p->partial, p->alpha, p->eta,
-             p->beta0, p->beta1, p->beta_ramp, p->gamma, p->iterations, p->inner_iterations, p->tolerance,
-             p->stop_change, p->backend[0] ? p->backend : "default", s->nlandmarks,
-             p->rhm_start == PROTO_RHM_START_VORONOI ? "voronoi" : "distances", s->p.n, s->q.n,
-             s->source.len, s->target.len);
+    char pbuf[sizeof w->params - 128];
+    snprintf(w->params, sizeof w->params, "%s landmarks=%u init_p=%u init_q=%u source_bytes=%u target_bytes=%u",
+             proto_params_format(p, pbuf, sizeof pbuf), s->nlandmarks, s->p.n, s->q.n, s->source.len,
+             s->target.len);
     w->work.data = w;
     w->d = d;
     w->c = c;

@@ -207,29 +207,13 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     return 1;
 }
 
-/* The wire spec of a parsed job (meshes, landmarks and maps are added by the caller). */
-static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t bsz)
+/* The job parameters of a parsed job into the spec, one per row of the list
+ * (meshes, landmarks and maps are added by the caller). */
+static void spec_of_job(const cli_job *j, mc_job_spec *s)
 {
-    const ectm_params *p = &j->p;
-    s->model = p->model == ECTM_INJECTIVE ? MC_INJECTIVE : MC_BIJECTIVE;
-    s->partial = p->partial;
-    s->alpha = p->alpha;
-    s->eta = p->eta;
-    s->beta0 = p->beta0;
-    s->beta1 = p->beta1;
-    s->beta_ramp = p->beta_ramp;
-    s->gamma = p->gamma;
-    s->iterations = (uint32_t)p->iterations;
-    s->inner_iterations = (uint32_t)p->inner_iterations;
-    s->tolerance = p->tolerance;
-    s->stop_change = p->stop_change;
-    s->rhm_iterations = (uint32_t)j->rp.iterations;
-    s->rhm_dim = (uint32_t)j->rp.dim;
-    s->rhm_alpha = j->rp.alpha;
-    s->rhm_landmark_weight = j->rp.gamma;
-    s->rhm_start = j->rp.start;
-    snprintf(backend, bsz, "%s%s%s", p->backend, p->device[0] ? ":" : "", p->device);
-    s->backend = backend;
+#define SPEC_PARAM(name, cli, type, ...) s->name = j->w.name;
+    PROTO_PARAMS(SPEC_PARAM)
+#undef SPEC_PARAM
 }
 
 int cli_submit(int argc, char **argv)
@@ -273,7 +257,8 @@ int cli_submit(int argc, char **argv)
             printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
                    "         [--watch [--progress text|json]]\n" REMOTE_USAGE
                    "prints the job id; with --watch then follows the job as `meshcorr watch` does\n"
-                   "(and exits as it: 0 when the job COMPLETED)\n" CLI_JOB_USAGE);
+                   "(and exits as it: 0 when the job COMPLETED). Job options:\n");
+            cli_job_usage(stdout);
             return 0;
         default: bad = 1;
         }
@@ -288,8 +273,7 @@ int cli_submit(int argc, char **argv)
     }
     if (bad || w.bad || cli_job_check(&job, "submit"))
         return 2;
-    char backend[160];
-    spec_of_job(&job, &spec, backend, sizeof backend);
+    spec_of_job(&job, &spec);
     const char *src = argv[optind], *tgt = argv[optind + 1];
     char err[4096];
     int status = 1;

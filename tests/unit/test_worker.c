@@ -495,7 +495,7 @@ TEST(worker_refuses_beta_ramp_of_zero_iterations)
     demo_job(&j, NULL, 0, 1);
     j.msg.u.submit.params.beta_ramp = 0;
     save(&j);
-    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "beta-ramp", NULL);
+    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "params.beta_ramp = 0 < 1", NULL);
 }
 
 TEST(worker_refuses_job_frame_with_corrupted_blob_checksum)

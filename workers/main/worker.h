@@ -39,8 +39,10 @@ typedef struct wrk_job {
 
 /* worker_job.c — the one mapping from a SUBMIT to a job: decodes both Draco
  * meshes (BAD_MESH naming "source mesh"/"target mesh", over the limits
- * included), validates them (corr_validate), maps the parameters onto
- * ectm_params (BAD_PARAMS naming the field), builds the landmark set
+ * included), validates them (corr_validate), checks and maps the
+ * parameters onto ectm_params and rhm_params (corr_params_from_job, i.e.
+ * proto_params_check: BAD_PARAMS naming the field), checks that there are
+ * landmarks or a map (and q only with p, bijective), builds the landmark set
  * (lmk_from_arrays: BAD_LANDMARKS) and the initial maps (bmap_check_row:
  * BAD_PARAMS). On error job is left closed. */
 int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
