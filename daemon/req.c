@@ -7,11 +7,15 @@
  * any other job is NOT_FOUND, exactly like a job that never existed, so ids
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
  * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
- * anything is stored, counting the SUBMITs still being stored. Draco bytes
- * are never decoded here (only workers do).
+ * anything is stored, counting the SUBMITs still being checked or stored.
+ * Before the store, val_submit has a short-lived `meshcorr-worker
+ * --validate` child decode and check the meshes, the landmarks against
+ * them, the maps and the parameters, so a job that can never run is refused
+ * naming the blob or field and nothing is stored. Draco bytes are never
+ * decoded in this process.
  *
- * DESIGN: the loop never waits for the disk on a client's behalf. SUBMIT's
- * store_submit (spool file, fsyncs, commit) and RESULT's read and decode of
+ * DESIGN: the loop never waits for the disk or a child on a client's behalf.
+ * SUBMIT's val_submit and store_submit (spool file, fsyncs, commit) and RESULT's read and decode of
  * result.frame run in libuv's thread pool (uv_queue_work). A work callback
  * touches only its own work item: copies of what it needs, the request's
  * frame (kept in place by srv_conn_hold) and, for SUBMIT, the store's
@@ -130,10 +134,10 @@ static void on_hello(conn *c, const proto_msg *m)
     reply(c, &r, m->request_id);
 }
 
-/* What the daemon checks itself before the validator runs: blobs present,
- * the server's landmark limit, and every parameter with the one validator
- * (proto_params_check, the worker's and the CLI's too). 0 or a code with
- * msg. */
+/* What the daemon checks itself, on the loop, before the validator child
+ * (val_submit) checks the rest: blobs present, the server's landmark limit,
+ * and every parameter with the one validator (proto_params_check, the
+ * worker's and the CLI's too). 0 or a code with msg. */
 static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t msz)
 {
     const mcd_conf *cf = &d->conf;
@@ -142,13 +146,6 @@ static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t m
     if (s->nlandmarks > cf->max_landmarks)
         return snprintf(msg, msz, "landmarks: %u pairs, over the server's limit (%u)", s->nlandmarks,
                         cf->max_landmarks), PROTO_EBAD_LANDMARKS;
-    if (s->p.n == 0 && s->nlandmarks < PROTO_MIN_LANDMARKS)
-        return snprintf(msg, msz, "need an initial map p or at least %d landmark pairs (got %u)",
-                        PROTO_MIN_LANDMARKS, s->nlandmarks), PROTO_EBAD_LANDMARKS;
-    if (s->q.n && !s->p.n)
-        return snprintf(msg, msz, "initial map q without p"), PROTO_EBAD_PARAMS;
-    if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
-        return snprintf(msg, msz, "initial map q needs the bijective model"), PROTO_EBAD_PARAMS;
     return proto_params_check(&s->params, msg, msz);
 }
 
@@ -190,6 +187,9 @@ struct req_submit {
     int32_t priority;
     uint32_t total;
     char params[1024];            /* the parameters, for the log and the row */
+    val_conf vc;                  /* the validator's program and limits */
+    double val_ms, val_cpu_ms;    /* how long the check took, and its CPU time */
+    int refused;                  /* rc is val_submit's: nothing was stored */
     int rc;                       /* store_submit's result, */
     uint64_t id;                  /* its job id */
     char msg[PROTO_MAX_STRING];   /* or its error */
@@ -207,6 +207,10 @@ static uint32_t submits_in_flight(const mcd *d, const char *user)
 static void submit_run(uv_work_t *w)      /* thread pool */
 {
     req_submit *s = w->data;
+    if ((s->rc = val_submit(&s->vc, s->frame, s->len, &s->val_ms, &s->val_cpu_ms, s->msg, sizeof s->msg))) {
+        s->refused = 1;
+        return;
+    }
     s->rc = store_submit(s->store, s->user, s->label, s->priority, s->total, s->params, s->frame, s->len,
                          &s->id, s->msg, sizeof s->msg);
 }
@@ -225,7 +229,11 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
         s->rc = PROTO_EINTERNAL;
         snprintf(s->msg, sizeof s->msg, "the store's work was not run: %s", uv_strerror(status));
     }
-    if (s->rc) {
+    if (s->refused) {
+        dlog(s->rc == PROTO_EINTERNAL ? DLOG_ERROR : DLOG_INFO, "SUBMIT from %s refused (%s, checked in %.1f ms, %.1f ms CPU): %s",
+             s->user, proto_err_name(s->rc), s->val_ms, s->val_cpu_ms, s->msg);
+        srv_send_error(c, s->request_id, s->rc, "%s", s->msg);
+    } else if (s->rc) {
         dlog(DLOG_ERROR, "SUBMIT from %s: %s", s->user, s->msg);
         srv_send_error(c, s->request_id, s->rc, "job not stored: %s", s->msg);
     } else {
@@ -236,8 +244,8 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
             dlog(DLOG_INFO, "job %llu: %s before its SUBMIT_OK: not queued", id, proto_state_name(j.state));
         else if (sched_add(d->sched, s->id, s->user, s->priority))
             dlog(DLOG_ERROR, "job %llu: out of memory queueing it (it runs after a restart)", id);
-        dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', %s", id, s->user, s->priority,
-             s->label, s->params);
+        dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', checked in %.1f ms (%.1f ms CPU), %s",
+             id, s->user, s->priority, s->label, s->val_ms, s->val_cpu_ms, s->params);
         if (srv_conn_hung_up(c))
             dlog(DLOG_WARN, "job %llu: stored and queued, but the client of %s hung up before SUBMIT_OK",
                  id, s->user);
@@ -298,6 +306,7 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     snprintf(w->label, sizeof w->label, "%s", s->label);
     w->priority = s->priority;
     w->total = p->iterations;
+    val_conf_of(d, &w->vc);
     if ((rc = work_start(d, c, &w->work, submit_run, submit_done))) {
         dlog(DLOG_ERROR, "SUBMIT from %s: cannot queue the store's work: %s", a->user, uv_strerror(rc));
         srv_send_error(c, m->request_id, PROTO_EINTERNAL, "job not stored: %s", uv_strerror(rc));

@@ -92,6 +92,12 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
                      double elapsed, wrk_result *r, char *err, size_t errsz);
 void wrk_result_close(wrk_result *r);
 
+/* worker_validate.c — `--validate`: reads one SUBMIT frame from in_fd and
+ * builds the job from it as a run would (wrk_job_from_submit), running
+ * nothing. WRK_EXIT_OK when it would run; else one ERROR frame (the code and
+ * the message naming the blob or field) on out_fd and WRK_EXIT_JOB. */
+int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim);
+
 /* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with
  * fp64, one per line on stdout; 0 when printed. */
 int wrk_list_devices(int threads);

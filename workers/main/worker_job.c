@@ -86,11 +86,12 @@ static int map_map(const proto_map *w, const char *name, const mesh *from, const
     if (!P)
         return errbuf_set(err, errsz, PROTO_ENOMEM, "%s: out of memory", name);
     for (int i = 0; i < P->n; i++) {
-        char where[64];
-        snprintf(where, sizeof where, "%s: row %d", name, i);
         double *wt = P->w + 3 * (size_t)i;
         memcpy(wt, w->rows[i].w, sizeof w->rows[i].w);
-        if (bmap_check_row(w->rows[i].face, wt, to->nf, where, err, errsz)) {
+        if (bmap_check_row(w->rows[i].face, wt, to->nf, name, NULL, 0)) {
+            char where[64];                  /* the row's name only when it is bad */
+            snprintf(where, sizeof where, "%s: row %d", name, i);
+            bmap_check_row(w->rows[i].face, wt, to->nf, where, err, errsz);
             bmap_free(P);
             return PROTO_EBAD_PARAMS;
         }
