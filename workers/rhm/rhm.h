@@ -76,9 +76,8 @@ typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
     RHM_START_VORONOI = 1      /* the thesis' geodesic Voronoi map          */
 } rhm_start;
-const char *rhm_start_name(int start);   /* "distances", "voronoi", NULL */
-/* RHM_START_* from its name, or -1. */
-int rhm_start_parse(const char *name);
+/* Their names are the values of rhm_start in PROTO_PARAMS (proto_params.h):
+ * proto_param_value_name, proto_param_parse. */
 
 /* start, alpha, gamma, dim and iterations are job parameters: their
  * defaults and ranges are PROTO_PARAMS' (protocol/proto_params.h, ENGINE

@@ -18,19 +18,6 @@ const char *rhm_strerror(int code)
     return "unknown RHM error";
 }
 
-const char *rhm_start_name(int start)
-{
-    return start == RHM_START_DISTANCES ? "distances" : start == RHM_START_VORONOI ? "voronoi" : NULL;
-}
-
-int rhm_start_parse(const char *name)
-{
-    for (int s = RHM_START_DISTANCES; s <= RHM_START_VORONOI; s++)
-        if (strcmp(name, rhm_start_name(s)) == 0)
-            return s;
-    return -1;
-}
-
 /* The job parameters' defaults and ranges are the rows of PROTO_PARAMS
  * (proto_params.h) whose ENGINE column is RHM; the rest is RHM's own. */
 #define RHM_ROW_RHM(x) x
