@@ -4,17 +4,21 @@
  * past the decoded vertex count, random bytes as Draco, half a Draco file,
  * a non-manifold mesh (all four checked in the sandboxed validator), and
  * parameters out of range (the one validator). The daemon keeps serving,
- * runs a good job, and exits 0 on SIGTERM. */
+ * answers other clients while a check runs, runs a good job, and exits 0
+ * on SIGTERM. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testmesh.h"
 #include "mesh/mesh.h"
 #include "proto.h"
 
+#include <dirent.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* A raw SUBMIT of the level-2 icosphere pair (162 vertices each), 6
  * identity landmarks, the list's defaults but 2 iterations. */
@@ -184,5 +188,100 @@ TEST_T(parameters_out_of_range_are_refused_naming_the_field, 60)
     CHECK_INT(raw_send(c, &r), 0);                       /* 3 pairs are enough */
     raw_close(&r);
     mc_close(c);
+    CHECK_INT(testdaemon_stop(&d, SIGTERM), 0);
+}
+
+/* Pid of a `--validate` child of the daemon, or -1. */
+static pid_t validator_pid(const testdaemon *d)
+{
+    DIR *dp = opendir("/proc");
+    struct dirent *de;
+    pid_t found = -1;
+    while (dp && found < 0 && (de = readdir(dp))) {
+        pid_t pid = (pid_t)atoi(de->d_name);
+        char path[64], buf[4096];
+        if (pid <= 0)
+            continue;
+        snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+        FILE *fp = fopen(path, "r");
+        int ppid = -1;
+        if (fp && fgets(buf, sizeof buf, fp) && strrchr(buf, ')'))
+            sscanf(strrchr(buf, ')') + 2, "%*c %d", &ppid);
+        if (fp)
+            fclose(fp);
+        if (ppid != d->pid)
+            continue;
+        snprintf(path, sizeof path, "/proc/%d/cmdline", (int)pid);
+        if (!(fp = fopen(path, "r")))
+            continue;
+        size_t n = fread(buf, 1, sizeof buf - 1, fp);
+        fclose(fp);
+        for (size_t i = 0; i < n; i += strlen(buf + i) + 1)
+            if (strcmp(buf + i, "--validate") == 0)
+                found = pid;
+    }
+    if (dp)
+        closedir(dp);
+    return found;
+}
+
+typedef struct big_submit {
+    const testdaemon *d;
+    raw_submit r;
+    int rc;
+} big_submit;
+
+static void *big_submit_thread(void *arg)
+{
+    big_submit *b = arg;
+    mc_client *c = testdaemon_client(b->d, TESTDAEMON_ALICE);
+    mc_set_timeout(c, 120000);
+    b->rc = raw_send(c, &b->r);
+    mc_close(c);
+    return NULL;
+}
+
+/* A SUBMIT of a 163842-vertex pair (refused at the end, for a landmark id
+ * past the decoded count) keeps its validator busy long enough to be seen;
+ * a PING from another client is answered while that child still runs: the
+ * check blocks a thread-pool thread, never the event loop. */
+TEST_T(other_clients_are_answered_while_a_submit_is_checked, 120)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    testdaemon_start(&d, "refuse-loop", NULL);
+    big_submit b;
+    memset(&b, 0, sizeof b);
+    b.d = &d;
+    b.rc = 1;
+    raw_init(&b.r);
+    mesh *S = testmesh_icosphere(7);
+    char err[256];
+    size_t len;
+    free(b.r.sb);
+    CHECK_INT(mesh_encode_drc(S, &b.r.sb, &len, err, sizeof err), 0);
+    b.r.msg.u.submit.source = b.r.msg.u.submit.target = (proto_blob){b.r.sb, (uint32_t)len};
+    b.r.lm[5].tgt = (uint32_t)S->nv;           /* found after both meshes: nothing runs */
+    mesh_free(S);
+    mc_client *other = testdaemon_client(&d, TESTDAEMON_BOB);
+    pthread_t th;
+    CHECK_INT(pthread_create(&th, NULL, big_submit_thread, &b), 0);
+    pid_t v = -1;
+    for (int tries = 0; tries < 20000 && v < 0; tries++) {
+        v = validator_pid(&d);
+        if (v < 0)
+            nanosleep(&(struct timespec){0, 200000}, NULL);
+    }
+    CHECK(v > 0);                                       /* the check is running */
+    CHECK_INT(mc_ping(other), 0);
+    char path[64];
+    snprintf(path, sizeof path, "/proc/%d", (int)v);
+    int still = access(path, F_OK) == 0;
+    pthread_join(th, NULL);
+    printf("  validator %d %s when the PONG came\n", (int)v, still ? "still running" : "already gone");
+    CHECK(still);
+    CHECK_INT(b.rc, PROTO_EBAD_LANDMARKS);              /* and then the SUBMIT was refused */
+    mc_close(other);
+    raw_close(&b.r);
     CHECK_INT(testdaemon_stop(&d, SIGTERM), 0);
 }
