@@ -5,6 +5,7 @@
 #   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
 #   make demo       install deps, build, run the demo job on Debian's CGAL meshes
 #   make install    PREFIX=/usr/local DESTDIR=
+#   make doc-params PROTOCOL.md's parameter table from protocol/proto_params.h
 PREFIX  ?= /usr/local
 DESTDIR ?=
 BUILD   ?= build
@@ -68,7 +69,7 @@ WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
 
-.PHONY: all test bench demo install install-lib clean
+.PHONY: all test bench demo install install-lib clean doc-params
 # Objects built through pattern chains are kept (make would otherwise delete
 # them after the run and print that as the last line of `make test`).
 .SECONDARY:
@@ -138,6 +139,14 @@ test: $(PROGRAMS) $(TEST_BIN) $(FUZZ_BIN)
 bench: $(PROGRAMS) $(BENCH_BIN)
 	@for b in $(BENCH_BIN); do echo "== $$b"; ./$$b || exit 1; done
 
+# The job parameter table of PROTOCOL.md, between its params:begin/end
+# markers, from the one list (test_proto_params fails when it is stale).
+doc-params: $(BUILD)/meshcorr
+	$(BUILD)/meshcorr params --markdown > $(BUILD)/params.md
+	awk -v t=$(BUILD)/params.md '/<!-- params:end/ { while ((getline l < t) > 0) print l; skip = 0 } \
+	  !skip { print } /<!-- params:begin/ { skip = 1 }' protocol/PROTOCOL.md > $(BUILD)/PROTOCOL.md.tmp
+	mv $(BUILD)/PROTOCOL.md.tmp protocol/PROTOCOL.md
+
 demo:
 	sh deploy/install-deps.sh
 	$(MAKE) all
@@ -156,7 +165,7 @@ all: $(CLIENT_SO)
 install: install-lib
 install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_LIB) $(PROTO_LIB)
 	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
-	install -m 644 client-c/meshcorr.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 client-c/meshcorr.h protocol/proto_params.h $(DESTDIR)$(PREFIX)/include/
 	install -m 644 $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DESTDIR)$(PREFIX)/lib/
 	install -m 755 $(CLIENT_SO) $(DESTDIR)$(PREFIX)/lib/
 	ln -sf libmeshcorr.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr.so

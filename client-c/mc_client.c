@@ -4,7 +4,6 @@
  * no mesh code (mc_mesh.c) and no command-line code (cli/). */
 #include "meshcorr.h"
 #include "proto.h"
-#include "ectm/ectm.h"
 
 #include <errno.h>
 #include <netdb.h>
@@ -68,21 +67,16 @@ int mc_is_admin(const mc_client *c) { return c->admin; }
 
 void mc_job_spec_init(mc_job_spec *s)
 {
-    ectm_params p;
-    ectm_params_init(&p);
     memset(s, 0, sizeof *s);
-    s->model = p.model == ECTM_INJECTIVE ? MC_INJECTIVE : MC_BIJECTIVE;
-    s->partial = p.partial;
-    s->alpha = p.alpha;
-    s->eta = p.eta;
-    s->beta0 = p.beta0;
-    s->beta1 = p.beta1;
-    s->beta_ramp = p.beta_ramp;
-    s->gamma = p.gamma;
-    s->iterations = (uint32_t)p.iterations;
-    s->inner_iterations = (uint32_t)p.inner_iterations;
-    s->tolerance = p.tolerance;
-    s->stop_change = p.stop_change;
+#define MC_DEFAULT_STR(name, dflt) s->name = NULL;
+#define MC_DEFAULT_NUM(name, dflt) s->name = dflt;
+#define MC_DEFAULT_ENUM MC_DEFAULT_NUM
+#define MC_DEFAULT_BOOL MC_DEFAULT_NUM
+#define MC_DEFAULT_U32  MC_DEFAULT_NUM
+#define MC_DEFAULT_F64  MC_DEFAULT_NUM
+#define MC_DEFAULT(name, cli, type, dflt, ...) MC_DEFAULT_##type(name, dflt)
+    PROTO_PARAMS(MC_DEFAULT)
+#undef MC_DEFAULT
 }
 
 static int64_t now_ms(void)
@@ -343,24 +337,17 @@ int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
     m->p = (proto_map){(proto_map_row *)s->p, s->np};
     m->q = (proto_map){(proto_map_row *)s->q, s->nq};
     proto_params *p = &m->params;
-    p->model = (uint8_t)s->model;
-    p->partial = (uint8_t)s->partial;
-    p->alpha = s->alpha;
-    p->eta = s->eta;
-    p->beta0 = s->beta0;
-    p->beta1 = s->beta1;
-    p->beta_ramp = s->beta_ramp > 0 ? (uint32_t)s->beta_ramp : 0;  /* 0: refused by the worker */
-    p->gamma = s->gamma;
-    p->iterations = s->iterations;
-    p->inner_iterations = s->inner_iterations;
-    p->tolerance = s->tolerance;
-    p->stop_change = s->stop_change;
-    p->rhm_iterations = s->rhm_iterations;
-    p->rhm_dim = s->rhm_dim;
-    p->rhm_alpha = s->rhm_alpha;
-    p->rhm_landmark_weight = s->rhm_landmark_weight;
-    p->rhm_start = (uint8_t)s->rhm_start;
-    p->backend = s->backend ? s->backend : "";
+    /* one assignment per row of the list; an int that does not fit a u8
+     * becomes 255, which the server refuses naming the field */
+#define MC_WIRE_U8(v) (uint8_t)((v) < 0 || (v) > 255 ? 255 : (v))
+#define MC_WIRE_ENUM(name) p->name = MC_WIRE_U8(s->name);
+#define MC_WIRE_BOOL(name) p->name = MC_WIRE_U8(s->name);
+#define MC_WIRE_U32(name)  p->name = s->name;
+#define MC_WIRE_F64(name)  p->name = s->name;
+#define MC_WIRE_STR(name)  p->name = s->name ? s->name : "";
+#define MC_WIRE(name, cli, type, ...) MC_WIRE_##type(name)
+    PROTO_PARAMS(MC_WIRE)
+#undef MC_WIRE
     m->priority = s->priority;
     m->label = s->label ? s->label : "";
     int rc = request(c, &req, PROTO_MSG_SUBMIT_OK, &rep);

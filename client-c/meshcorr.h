@@ -25,6 +25,7 @@
 #define MESHCORR_H
 #include <stddef.h>
 #include <stdint.h>
+#include "proto_params.h"   /* PROTO_PARAMS: the job parameters, installed with this header */
 
 #ifdef __cplusplus
 extern "C" {
@@ -79,25 +80,28 @@ typedef struct mc_job_spec {
     const uint32_t *landmarks; uint32_t nlandmarks;   /* nlandmarks (src, tgt) pairs, 2n ids */
     const mc_map_row *p; uint32_t np;                 /* optional initial map, np = source vertices */
     const mc_map_row *q; uint32_t nq;                 /* optional reverse map (bijective) */
-    int model;                 /* MC_BIJECTIVE or MC_INJECTIVE */
-    int partial;               /* 0 or 1 */
-    double alpha, eta;         /* membrane and bending weights */
-    double beta0, beta1;       /* mismatch weight at iteration 1, and its cap */
-    int beta_ramp;             /* iterations of the linear ramp from beta0 to beta1 */
-    double gamma;              /* reverse-map weight */
-    uint32_t iterations, inner_iterations;
-    double tolerance, stop_change;
-    /* RHM, for landmark jobs; 0 = the server's default (200, 8, 5e-4, off) */
-    uint32_t rhm_iterations, rhm_dim;
-    double rhm_alpha, rhm_landmark_weight;
-    int rhm_start;             /* MC_RHM_START_DISTANCES (0, the default) or MC_RHM_START_VORONOI */
-    const char *backend;       /* NULL or "" = server default; "cpu", "opencl", "auto",
-                                  optionally ":DEVICE" (a platform or device name part) */
+    /* The job's parameters: one member per row of the one list PROTO_PARAMS
+     * (proto_params.h: name, type, default, range, meaning; `meshcorr
+     * params` prints it), in its order: model (MC_BIJECTIVE, MC_INJECTIVE),
+     * partial, alpha, eta, beta0, beta1, beta_ramp, gamma, iterations,
+     * inner_iterations, tolerance, stop_change, rhm_iterations, rhm_dim,
+     * rhm_alpha, rhm_landmark_weight, rhm_start (MC_RHM_START_*), backend
+     * (NULL or "" = the server's default; "cpu", "opencl", "auto",
+     * optionally ":DEVICE", a platform or device name part). */
+#define MC_PARAM_CTYPE_ENUM int
+#define MC_PARAM_CTYPE_BOOL int
+#define MC_PARAM_CTYPE_U32  uint32_t
+#define MC_PARAM_CTYPE_F64  double
+#define MC_PARAM_CTYPE_STR  const char *
+#define MC_PARAM_MEMBER(name, cli, type, ...) MC_PARAM_CTYPE_##type name;
+    PROTO_PARAMS(MC_PARAM_MEMBER)
+#undef MC_PARAM_MEMBER
     int32_t priority;          /* higher runs first */
     const char *label;         /* NULL = "" */
 } mc_job_spec;
 
-/* The engine's defaults (those of `meshcorr match`); no meshes, no landmarks. */
+/* Every parameter its default (the list's, those of `meshcorr match`); no
+ * meshes, no landmarks. */
 void mc_job_spec_init(mc_job_spec *s);
 
 enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1 };

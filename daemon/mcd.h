@@ -354,6 +354,25 @@ const char *wsup_worker_path(const mcd *d, char *buf, size_t sz);
 /* The worker's --max-faces for the configured --max-vertices. */
 unsigned long long wsup_max_faces(const mcd *d);
 
+/* ---- val_: a SUBMIT checked in a sandboxed child (val.c) ------------------- */
+#define VAL_BASE_MEMORY_MB 1024u  /* plus 256 bytes per allowed vertex of both meshes */
+#define VAL_MAX_CPU_S      30u    /* CPU seconds for decoding and checking a pair */
+typedef struct val_conf {         /* a copy taken on the loop, for the thread pool */
+    char worker[CONF_PATH + 64];
+    unsigned max_vertices;
+    unsigned long long max_faces;
+    unsigned max_memory_mb, max_cpu_s;
+} val_conf;
+void val_conf_of(const mcd *d, val_conf *vc);
+/* Runs `meshcorr-worker --validate` on the SUBMIT frame[len] and waits for
+ * it (thread-pool side; blocks its thread only). 0 when the job can run;
+ * else the code (BAD_MESH, BAD_LANDMARKS, BAD_PARAMS, ...) with the message
+ * naming the blob or field in msg; PROTO_EINTERNAL when the check itself
+ * could not run. *ms and *cpu_ms (may be NULL): the wall time it took and
+ * the child's CPU time. */
+int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, double *cpu_ms, char *msg,
+               size_t msz);
+
 /* ---- srv_ ----------------------------------------------------------------- */
 int srv_listen(mcd *d, char *err, size_t errsz);
 void srv_stop_listening(mcd *d);

@@ -7,11 +7,15 @@
  * any other job is NOT_FOUND, exactly like a job that never existed, so ids
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
  * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
- * anything is stored, counting the SUBMITs still being stored. Draco bytes
- * are never decoded here (only workers do).
+ * anything is stored, counting the SUBMITs still being checked or stored.
+ * Before the store, val_submit has a short-lived `meshcorr-worker
+ * --validate` child decode and check the meshes, the landmarks against
+ * them, the maps and the parameters, so a job that can never run is refused
+ * naming the blob or field and nothing is stored. Draco bytes are never
+ * decoded in this process.
  *
- * DESIGN: the loop never waits for the disk on a client's behalf. SUBMIT's
- * store_submit (spool file, fsyncs, commit) and RESULT's read and decode of
+ * DESIGN: the loop never waits for the disk or a child on a client's behalf.
+ * SUBMIT's val_submit and store_submit (spool file, fsyncs, commit) and RESULT's read and decode of
  * result.frame run in libuv's thread pool (uv_queue_work). A work callback
  * touches only its own work item: copies of what it needs, the request's
  * frame (kept in place by srv_conn_hold) and, for SUBMIT, the store's
@@ -31,7 +35,6 @@
 #include <unistd.h>
 
 #define REQ_LIST_PAGE 1000
-#define REQ_MAX_ITERATIONS 1000000u
 #define REQ_MAX_RESULT_FILE ((size_t)PROTO_MAX_FRAME)
 
 struct req_watch {
@@ -144,54 +147,19 @@ static void on_hello(conn *c, const proto_msg *m)
     reply(c, &r, m->request_id);
 }
 
-/* Structural checks the daemon can make without decoding Draco; the worker
- * checks the meshes and the landmark ids against them. 0 or a code with msg. */
+/* What the daemon checks itself, on the loop, before the validator child
+ * (val_submit) checks the rest: blobs present, the server's landmark limit,
+ * and every parameter with the one validator (proto_params_check, the
+ * worker's and the CLI's too). 0 or a code with msg. */
 static int check_submit(const mcd *d, const proto_submit *s, char *msg, size_t msz)
 {
-    const proto_params *p = &s->params;
     const mcd_conf *cf = &d->conf;
     if (s->source.len == 0 || s->target.len == 0)
         return snprintf(msg, msz, "%s mesh: no Draco bytes", s->source.len ? "target" : "source"), PROTO_EBAD_MESH;
     if (s->nlandmarks > cf->max_landmarks)
-        return snprintf(msg, msz, "landmark count %u over the server's limit (%u)", s->nlandmarks,
+        return snprintf(msg, msz, "landmarks: %u pairs, over the server's limit (%u)", s->nlandmarks,
                         cf->max_landmarks), PROTO_EBAD_LANDMARKS;
-    for (uint32_t i = 0; i < s->nlandmarks; i++)
-        if (s->landmarks[i].src >= cf->max_vertices || s->landmarks[i].tgt >= cf->max_vertices)
-            return snprintf(msg, msz, "landmark %u: vertex id over the vertex limit (%u)", i,
-                            cf->max_vertices), PROTO_EBAD_LANDMARKS;
-    if (s->p.n == 0 && s->nlandmarks < 4)
-        return snprintf(msg, msz, "need an initial map p or at least 4 landmark pairs (got %u)",
-                        s->nlandmarks), PROTO_EBAD_LANDMARKS;
-    if (s->p.n > cf->max_vertices || s->q.n > cf->max_vertices)
-        return snprintf(msg, msz, "initial map with %u rows over the vertex limit (%u)",
-                        s->p.n > s->q.n ? s->p.n : s->q.n, cf->max_vertices), PROTO_EBAD_PARAMS;
-    if (s->q.n && !s->p.n)
-        return snprintf(msg, msz, "initial map q without p"), PROTO_EBAD_PARAMS;
-    if (s->q.n && p->model == PROTO_MODEL_INJECTIVE)
-        return snprintf(msg, msz, "initial map q needs the bijective model"), PROTO_EBAD_PARAMS;
-    const struct { const char *name; double v, min; int open; } r[] = {
-        {"alpha", p->alpha, 0, 1}, {"eta", p->eta, 0, 0}, {"beta0", p->beta0, 0, 1},
-        {"beta1", p->beta1, 0, 1}, {"beta_ramp", p->beta_ramp, 1, 0}, {"gamma", p->gamma, 0, 0},
-        {"tolerance", p->tolerance, 0, 1}, {"stop_change", p->stop_change, 0, 0},
-    };
-    for (size_t i = 0; i < sizeof r / sizeof r[0]; i++)
-        if (!isfinite(r[i].v) || r[i].v < r[i].min || (r[i].open && r[i].v <= r[i].min))
-            return snprintf(msg, msz, "%s = %g: must be finite and %s 0", r[i].name, r[i].v,
-                            r[i].open ? ">" : ">="), PROTO_EBAD_PARAMS;
-    if (p->iterations < 1 || p->iterations > REQ_MAX_ITERATIONS ||
-        p->inner_iterations < 1 || p->inner_iterations > REQ_MAX_ITERATIONS)
-        return snprintf(msg, msz, "iterations %u / inner_iterations %u: must be in [1, %u]", p->iterations,
-                        p->inner_iterations, REQ_MAX_ITERATIONS), PROTO_EBAD_PARAMS;
-    /* backend: "" (the server's default, cpu), "cpu", "opencl" or "auto", with an
-     * optional ":DEVICE" the worker matches against OpenCL platform/device names */
-    if (p->backend[0]) {
-        size_t k = strcspn(p->backend, ":");
-        if (!((k == 3 && !strncmp(p->backend, "cpu", 3)) || (k == 6 && !strncmp(p->backend, "opencl", 6)) ||
-              (k == 4 && !strncmp(p->backend, "auto", 4))))
-            return snprintf(msg, msz, "backend '%s': not cpu, opencl or auto (optionally :DEVICE)",
-                            p->backend), PROTO_EBAD_PARAMS;
-    }
-    return 0;
+    return proto_params_check(&s->params, msg, msz);
 }
 
 /* ---- work in the thread pool ----------------------------------------------- */
@@ -231,7 +199,10 @@ struct req_submit {
     char label[PROTO_MAX_STRING + 1];
     int32_t priority;
     uint32_t total;
-    char params[512];
+    char params[1024];            /* the parameters, for the log and the row */
+    val_conf vc;                  /* the validator's program and limits */
+    double val_ms, val_cpu_ms;    /* how long the check took, and its CPU time */
+    int refused;                  /* rc is val_submit's: nothing was stored */
     int rc;                       /* store_submit's result, */
     uint64_t id;                  /* its job id */
     char msg[PROTO_MAX_STRING];   /* or its error */
@@ -249,6 +220,10 @@ static uint32_t submits_in_flight(const mcd *d, const char *user)
 static void submit_run(uv_work_t *w)      /* thread pool */
 {
     req_submit *s = w->data;
+    if ((s->rc = val_submit(&s->vc, s->frame, s->len, &s->val_ms, &s->val_cpu_ms, s->msg, sizeof s->msg))) {
+        s->refused = 1;
+        return;
+    }
     s->rc = store_submit(s->store, s->user, s->label, s->priority, s->total, s->params, s->frame, s->len,
                          &s->id, s->msg, sizeof s->msg);
 }
@@ -267,7 +242,11 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
         s->rc = PROTO_EINTERNAL;
         snprintf(s->msg, sizeof s->msg, "the store's work was not run: %s", uv_strerror(status));
     }
-    if (s->rc) {
+    if (s->refused) {
+        dlog(s->rc == PROTO_EINTERNAL ? DLOG_ERROR : DLOG_INFO, "SUBMIT from %s refused (%s, checked in %.1f ms, %.1f ms CPU): %s",
+             s->user, proto_err_name(s->rc), s->val_ms, s->val_cpu_ms, s->msg);
+        srv_send_error(c, s->request_id, s->rc, "%s", s->msg);
+    } else if (s->rc) {
         dlog(DLOG_ERROR, "SUBMIT from %s: %s", s->user, s->msg);
         srv_send_error(c, s->request_id, s->rc, "job not stored: %s", s->msg);
     } else {
@@ -278,8 +257,8 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
             dlog(DLOG_INFO, "job %llu: %s before its SUBMIT_OK: not queued", id, proto_state_name(j.state));
         else if (sched_add(d->sched, s->id, s->user, s->priority))
             dlog(DLOG_ERROR, "job %llu: out of memory queueing it (it runs after a restart)", id);
-        dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', %s", id, s->user, s->priority,
-             s->label, s->params);
+        dlog(DLOG_INFO, "job %llu: submitted by %s, priority %d, label '%s', checked in %.1f ms (%.1f ms CPU), %s",
+             id, s->user, s->priority, s->label, s->val_ms, s->val_cpu_ms, s->params);
         if (srv_conn_hung_up(c))
             dlog(DLOG_WARN, "job %llu: stored and queued, but the client of %s hung up before SUBMIT_OK",
                  id, s->user);
@@ -325,15 +304,10 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
         return;
     }
     const proto_params *p = &s->params;
-    snprintf(w->params, sizeof w->params,
-             "model=%s partial=%u alpha=%g eta=%g beta0=%g beta1=%g beta_ramp=%u gamma=%g iterations=%u"
-             " inner=%u tolerance=%g stop_change=%g backend=%s landmarks=%u rhm_start=%s init_p=%u"
-             " init_q=%u source_bytes=%u target_bytes=%u",
-             p->model == PROTO_MODEL_BIJECTIVE ? "bijective" : "injective", p->partial, p->alpha, p->eta,
-             p->beta0, p->beta1, p->beta_ramp, p->gamma, p->iterations, p->inner_iterations, p->tolerance,
-             p->stop_change, p->backend[0] ? p->backend : "default", s->nlandmarks,
-             p->rhm_start == PROTO_RHM_START_VORONOI ? "voronoi" : "distances", s->p.n, s->q.n,
-             s->source.len, s->target.len);
+    char pbuf[sizeof w->params - 128];
+    snprintf(w->params, sizeof w->params, "%s landmarks=%u init_p=%u init_q=%u source_bytes=%u target_bytes=%u",
+             proto_params_format(p, pbuf, sizeof pbuf), s->nlandmarks, s->p.n, s->q.n, s->source.len,
+             s->target.len);
     w->work.data = w;
     w->d = d;
     w->c = c;
@@ -345,6 +319,7 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     snprintf(w->label, sizeof w->label, "%s", s->label);
     w->priority = s->priority;
     w->total = p->iterations;
+    val_conf_of(d, &w->vc);
     if ((rc = work_start(d, c, &w->work, submit_run, submit_done))) {
         dlog(DLOG_ERROR, "SUBMIT from %s: cannot queue the store's work: %s", a->user, uv_strerror(rc));
         srv_send_error(c, m->request_id, PROTO_EINTERNAL, "job not stored: %s", uv_strerror(rc));

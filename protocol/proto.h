@@ -23,6 +23,7 @@
 #define PROTO_H
 #include <stddef.h>
 #include <stdint.h>
+#include "proto_params.h"
 
 /* ---- framing ------------------------------------------------------------ */
 #define PROTO_MAGIC      0x5052434Du  /* bytes "MCRP" on the wire */
@@ -34,7 +35,7 @@
 #define PROTO_DEFAULT_MAX_FRAME (256u << 20) /* daemon default, <= hard cap */
 #define PROTO_MAX_MESH_BYTES    (256u << 20) /* one Draco blob */
 #define PROTO_MAX_MAP_ROWS      (1u << 24)   /* rows of P or Q */
-#define PROTO_MAX_LANDMARKS     65536u       /* landmark pairs */
+/* PROTO_MAX_LANDMARKS (landmark pairs) is in proto_params.h */
 #define PROTO_MAX_STRING        1024u        /* bytes, terminator excluded */
 #define PROTO_MAX_LIST          4096u        /* job summaries in LIST_OK */
 #define PROTO_MAX_METRICS       256u         /* key/value pairs in RESULT_OK */
@@ -121,9 +122,10 @@ enum proto_slot_state {
     PROTO_SLOT_LAST = 3
 };
 
-enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1, PROTO_MODEL_LAST = 1 };
+/* values of the ENUM parameters model and rhm_start (their names: proto_params.h) */
+enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1 };
 /* RHM's start map from the landmarks (workers/rhm/rhm.h) */
-enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1, PROTO_RHM_START_LAST = 1 };
+enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1 };
 
 /* Energy terms reported per direction in PROGRESS (index into terms[d][]). */
 enum proto_term {
@@ -225,22 +227,69 @@ typedef struct proto_limits {         /* what the server enforces */
     uint32_t max_jobs_per_user, max_queue, max_wall_s;
 } proto_limits;
 
+/* A job's parameters: one member per PROTO_PARAMS row (proto_params.h), in
+ * wire order. Decoded strings point into the payload (see above). */
+#define PROTO_PARAM_CTYPE_ENUM uint8_t
+#define PROTO_PARAM_CTYPE_BOOL uint8_t
+#define PROTO_PARAM_CTYPE_U32  uint32_t
+#define PROTO_PARAM_CTYPE_F64  double
+#define PROTO_PARAM_CTYPE_STR  const char *
 typedef struct proto_params {
-    uint8_t model;                    /* enum proto_model */
-    uint8_t partial;                  /* 0 or 1 */
-    double alpha, eta;                /* membrane and bending weights */
-    double beta0, beta1;              /* mismatch weight at outer iteration 1, and after the ramp */
-    uint32_t beta_ramp;               /* outer iterations of the linear ramp beta0 -> beta1 (>= 1) */
-    double gamma;                     /* reverse-map weight (bijective) */
-    uint32_t iterations, inner_iterations;  /* outer; L-BFGS per outer */
-    double tolerance, stop_change;    /* gradient tolerance; relative energy change */
-    /* RHM (landmark jobs): 0 means the release default for each */
-    uint32_t rhm_iterations, rhm_dim;  /* at most K iterations; embedding dimension m */
-    double rhm_alpha;                 /* harmonic vs reversibility, in (0, 1) */
-    double rhm_landmark_weight;       /* weak landmark term γ (>= 0; 0 = off) */
-    uint8_t rhm_start;                /* enum proto_rhm_start */
-    const char *backend;              /* "" = server default */
+#define PROTO_PARAM_MEMBER(name, cli, type, ...) PROTO_PARAM_CTYPE_##type name;
+    PROTO_PARAMS(PROTO_PARAM_MEMBER)
+#undef PROTO_PARAM_MEMBER
 } proto_params;
+
+/* Row indices: PROTO_P_alpha, ...; PROTO_NPARAMS rows. */
+enum proto_param_index {
+#define PROTO_PARAM_INDEX(name, ...) PROTO_P_##name,
+    PROTO_PARAMS(PROTO_PARAM_INDEX)
+#undef PROTO_PARAM_INDEX
+    PROTO_NPARAMS
+};
+enum proto_param_type {
+    PROTO_PARAM_ENUM, PROTO_PARAM_BOOL, PROTO_PARAM_U32, PROTO_PARAM_F64, PROTO_PARAM_STR
+};
+/* One row of the list as data, for code that walks it (codec, CLI, help,
+ * the PROTOCOL.md table). */
+typedef struct proto_param_info {
+    const char *name, *cli;
+    int type;                         /* enum proto_param_type */
+    double dflt, min, max;
+    unsigned flags;                   /* PROTO_PARAM_* */
+    const char *values, *help;
+    size_t offset;                    /* of the member in proto_params */
+} proto_param_info;
+extern const proto_param_info proto_param_infos[PROTO_NPARAMS];
+
+/* Every member its default (backend ""). */
+void proto_params_init(proto_params *p);
+/* THE validator: every field in its range (0 allowed where 0 means the
+ * default), enumerations among their values, backend "" or cpu|opencl|auto
+ * with an optional ":DEVICE" of at most PROTO_MAX_DEVICE bytes. 0, or
+ * PROTO_EBAD_PARAMS with the field named in err, e.g.
+ * "params.inner_iterations = 500000 > 100000". */
+int proto_params_check(const proto_params *p, char *err, size_t errsz);
+/* The range rule of row i for one numeric value v (no 0-means-default
+ * rule): 0 or PROTO_EBAD_PARAMS with "params.NAME = V ..." in err. The
+ * engine checks its own copies of the fields with it. */
+int proto_param_check(int i, double v, char *err, size_t errsz);
+/* Numeric member i as a double (STR: 0). */
+double proto_param_get(const proto_params *p, int i);
+/* Sets member i from text (a number, a value name of an ENUM, "0"/"1" for
+ * BOOL; STR keeps the pointer: text must outlive p). Only parses: ranges
+ * are proto_params_check's. 0, or PROTO_EBAD_PARAMS with "'x' is not ..." */
+int proto_param_parse(proto_params *p, int i, const char *text, char *err, size_t errsz);
+/* Name of value v of ENUM row i ("injective"); NULL if none. */
+const char *proto_param_value_name(int i, unsigned v, char *buf, size_t sz);
+/* The range of row i as PROTOCOL.md writes it: "[1, 100000]", "(0, inf)",
+ * "0 `bijective`, 1 `injective`" (enumerations); returns buf. */
+const char *proto_param_range(int i, char *buf, size_t sz);
+/* "model=bijective partial=0 alpha=20 ... backend=" into buf; returns buf. */
+char *proto_params_format(const proto_params *p, char *buf, size_t sz);
+/* The parameter table of PROTOCOL.md (markdown, one row per field, wire
+ * order) into buf; returns the length it needs (as snprintf). */
+size_t proto_params_table(char *buf, size_t sz);
 
 typedef struct proto_progress {
     uint64_t job_id;

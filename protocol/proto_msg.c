@@ -318,26 +318,19 @@ static void io_progress(io *c, proto_progress *g)
     io_f64(c, &g->elapsed_s);
 }
 
+/* The parameters, one field per PROTO_PARAMS row in list order; ENUM and
+ * BOOL values past the row's max are BAD_FRAME both ways (ranges are
+ * proto_params_check's, not the codec's). */
+#define IO_PARAM_ENUM(c, f, name, max) io_enum(c, f, max, name)
+#define IO_PARAM_BOOL(c, f, name, max) io_enum(c, f, max, name)
+#define IO_PARAM_U32(c, f, name, max)  io_u32(c, f)
+#define IO_PARAM_F64(c, f, name, max)  io_f64(c, f)
+#define IO_PARAM_STR(c, f, name, max)  io_str(c, f, name)
 static void io_params(io *c, proto_params *p)
 {
-    io_enum(c, &p->model, PROTO_MODEL_LAST, "model");
-    io_enum(c, &p->partial, 1, "partial");
-    io_f64(c, &p->alpha);
-    io_f64(c, &p->eta);
-    io_f64(c, &p->beta0);
-    io_f64(c, &p->beta1);
-    io_u32(c, &p->beta_ramp);
-    io_f64(c, &p->gamma);
-    io_u32(c, &p->iterations);
-    io_u32(c, &p->inner_iterations);
-    io_f64(c, &p->tolerance);
-    io_f64(c, &p->stop_change);
-    io_u32(c, &p->rhm_iterations);
-    io_u32(c, &p->rhm_dim);
-    io_f64(c, &p->rhm_alpha);
-    io_f64(c, &p->rhm_landmark_weight);
-    io_enum(c, &p->rhm_start, PROTO_RHM_START_LAST, "rhm_start");
-    io_str(c, &p->backend, "backend");
+#define IO_PARAM(name, cli, type, dflt, lo, hi, ...) IO_PARAM_##type(c, &p->name, #name, hi);
+    PROTO_PARAMS(IO_PARAM)
+#undef IO_PARAM
 }
 
 /* Smallest wire sizes of list elements (strings empty), for io_count. */

@@ -9,6 +9,7 @@ int cli_convert(int argc, char **argv);
 int cli_match(int argc, char **argv);
 int cli_eval(int argc, char **argv);
 int cli_devices(int argc, char **argv);
+int cli_params(int argc, char **argv);
 /* cli_remote.c: through meshcorrd (libmeshcorr) */
 int cli_submit(int argc, char **argv);
 int cli_status(int argc, char **argv);

@@ -1,68 +1,76 @@
 /* cli_job.c — see cli_job.h. Parsing and loading only; running a job is the
- * command's business. */
+ * command's business. The job parameters are the rows of PROTO_PARAMS:
+ * parsed by proto_param_parse, checked by proto_params_check. */
 #include "cli/cli_job.h"
+#include "corr/corr.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static int parse_double(const char *cmd, const char *opt, const char *s, double *out)
+void cli_job_usage(FILE *fp)
 {
-    char *e;
-    double v = strtod(s, &e);
-    if (*s == '\0' || *e != '\0') {
-        fprintf(stderr, "meshcorr %s: --%s: '%s' is not a number\n", cmd, opt, s);
-        return -1;
-    }
-    *out = v;
-    return 1;
-}
-
-static int parse_int(const char *cmd, const char *opt, const char *s, int *out)
-{
-    char *e;
-    long v = strtol(s, &e, 10);
-    if (*s == '\0' || *e != '\0' || v < -1000000000L || v > 1000000000L) {
-        fprintf(stderr, "meshcorr %s: --%s: '%s' is not an integer\n", cmd, opt, s);
-        return -1;
-    }
-    *out = (int)v;
-    return 1;
-}
-
-static int parse_word(const char *cmd, const char *opt, const char *s, const char *const *words,
-                      int *out)
-{
-    for (int i = 0; words[i]; i++)
-        if (strcmp(s, words[i]) == 0) {
-            *out = i;
-            return 1;
+    fprintf(fp,
+        "  inputs:  --landmarks PAIRS | --source-landmarks A --target-landmarks B [--one-based]\n"
+        "           | --init P.map [--init-reverse Q.map]\n"
+        "           (landmarks: at least %d pairs; without --init the initial maps come from\n"
+        "           them: a start map (--rhm-start), then Reversible Harmonic Maps)\n"
+        "  --preset release|paper  the weights of the authors' released code (the defaults\n"
+        "           below) or of the paper's text (eta 1e-3, beta 1e3 -> 2e5, gamma 2e4)\n"
+        "  --device NAME           with --backend opencl|auto: an OpenCL device with fp64 whose\n"
+        "           platform or device name contains NAME (see meshcorr devices)\n"
+        "  job parameters (meshcorr params lists them; the server checks the same ranges):\n",
+        PROTO_MIN_LANDMARKS);
+    for (int i = 0; i < PROTO_NPARAMS; i++) {
+        const proto_param_info *f = &proto_param_infos[i];
+        char opt[96], dflt[64], name[64];
+        const char *arg = f->type == PROTO_PARAM_U32 ? " N" : f->type == PROTO_PARAM_F64 ? " X" : "";
+        if (f->type == PROTO_PARAM_ENUM || f->type == PROTO_PARAM_STR) {
+            snprintf(opt, sizeof opt, "--%s %s", f->cli, f->values);
+        } else {
+            snprintf(opt, sizeof opt, "--%s%s", f->cli, arg);
         }
-    fprintf(stderr, "meshcorr %s: --%s: '%s' is not one of", cmd, opt, s);
-    for (int i = 0; words[i]; i++)
-        fprintf(stderr, "%s %s", i ? "," : "", words[i]);
-    fprintf(stderr, "\n");
-    return -1;
+        if (f->type == PROTO_PARAM_STR)
+            snprintf(dflt, sizeof dflt, "cpu");
+        else if (f->type == PROTO_PARAM_ENUM)
+            snprintf(dflt, sizeof dflt, "%s", proto_param_value_name(i, (unsigned)f->dflt, name, sizeof name));
+        else if (f->type == PROTO_PARAM_BOOL)
+            snprintf(dflt, sizeof dflt, "off");
+        else
+            snprintf(dflt, sizeof dflt, "%.10g", f->dflt);
+        char range[160];
+        fprintf(fp, "  %-30s %s\n  %-30s default %s", opt, f->help, "", dflt);
+        if (f->type == PROTO_PARAM_U32 || f->type == PROTO_PARAM_F64)
+            fprintf(fp, ", in %s", proto_param_range(i, range, sizeof range));
+        fprintf(fp, "\n");
+    }
 }
 
 void cli_job_init(cli_job *j, int argc, char **argv)
 {
     memset(j, 0, sizeof *j);
-    ectm_params_init(&j->p);
-    rhm_params_init(&j->rp);
+    proto_params_init(&j->w);
     for (int i = 1; i < argc; i++)
         if (strcmp(argv[i], "--preset=paper") == 0 ||
-            (i + 1 < argc && strcmp(argv[i], "--preset") == 0 && strcmp(argv[i + 1], "paper") == 0))
-            ectm_params_paper(&j->p);
+            (i + 1 < argc && strcmp(argv[i], "--preset") == 0 && strcmp(argv[i + 1], "paper") == 0)) {
+            ectm_params e;
+            ectm_params_paper(&e);
+            corr_params_to_job(&e, NULL, &j->w, NULL, 0);
+        }
 }
 
 int cli_job_option(cli_job *j, const char *cmd, int c, const char *arg)
 {
-    static const char *const models[] = {"bijective", "injective", NULL};
-    static const char *const presets[] = {"release", "paper", NULL};
-    static const char *const backends[] = {"cpu", "opencl", "auto", NULL};
-    ectm_params *p = &j->p;
-    int k;
+    char err[256];
+    if (c >= CLI_O_PARAM && c < CLI_O_PARAM + PROTO_NPARAMS) {
+        int i = c - CLI_O_PARAM;
+        const proto_param_info *f = &proto_param_infos[i];
+        if (proto_param_parse(&j->w, i, f->type == PROTO_PARAM_BOOL ? "1" : arg, err, sizeof err)) {
+            fprintf(stderr, "meshcorr %s: --%s: %s\n", cmd, f->cli, err);
+            return -1;
+        }
+        return 1;
+    }
     switch (c) {
     case CLI_O_INIT: j->init = arg; return 1;
     case CLI_O_INIT_REVERSE: j->init_rev = arg; return 1;
@@ -70,52 +78,18 @@ int cli_job_option(cli_job *j, const char *cmd, int c, const char *arg)
     case CLI_O_SOURCE_LANDMARKS: j->lmk_src = arg; return 1;
     case CLI_O_TARGET_LANDMARKS: j->lmk_tgt = arg; return 1;
     case CLI_O_ONE_BASED: j->one_based = 1; return 1;
-    case CLI_O_MODEL:
-        if (parse_word(cmd, "model", arg, models, &k) < 0)
-            return -1;
-        p->model = k ? ECTM_INJECTIVE : ECTM_BIJECTIVE;
-        return 1;
-    case CLI_O_PRESET: return parse_word(cmd, "preset", arg, presets, &k);  /* applied by init */
-    case CLI_O_ALPHA: return parse_double(cmd, "alpha", arg, &p->alpha);
-    case CLI_O_ETA: return parse_double(cmd, "eta", arg, &p->eta);
-    case CLI_O_BETA0: return parse_double(cmd, "beta0", arg, &p->beta0);
-    case CLI_O_BETA1: return parse_double(cmd, "beta1", arg, &p->beta1);
-    case CLI_O_BETA_RAMP: return parse_int(cmd, "beta-ramp", arg, &p->beta_ramp);
-    case CLI_O_GAMMA: return parse_double(cmd, "gamma", arg, &p->gamma);
-    case CLI_O_ITERATIONS: return parse_int(cmd, "iterations", arg, &p->iterations);
-    case CLI_O_INNER_ITERATIONS: return parse_int(cmd, "inner-iterations", arg, &p->inner_iterations);
-    case CLI_O_TOLERANCE: return parse_double(cmd, "tolerance", arg, &p->tolerance);
-    case CLI_O_STOP_CHANGE: return parse_double(cmd, "stop-change", arg, &p->stop_change);
-    case CLI_O_PARTIAL: p->partial = 1; return 1;
-    case CLI_O_BACKEND:
-        if (parse_word(cmd, "backend", arg, backends, &k) < 0)
-            return -1;
-        snprintf(p->backend, sizeof p->backend, "%s", backends[k]);
-        return 1;
-    case CLI_O_DEVICE:
-        if (strlen(arg) >= sizeof p->device) {
-            fprintf(stderr, "meshcorr %s: --device: name longer than %zu bytes\n", cmd,
-                    sizeof p->device - 1);
-            return -1;
-        }
-        snprintf(p->device, sizeof p->device, "%s", arg);
-        return 1;
-    case CLI_O_RHM_ALPHA: return parse_double(cmd, "rhm-alpha", arg, &j->rp.alpha);
-    case CLI_O_RHM_ITERATIONS: return parse_int(cmd, "rhm-iterations", arg, &j->rp.iterations);
-    case CLI_O_RHM_DIM: return parse_int(cmd, "rhm-dim", arg, &j->rp.dim);
-    case CLI_O_RHM_LANDMARK_WEIGHT:
-        return parse_double(cmd, "rhm-landmark-weight", arg, &j->rp.gamma);
-    case CLI_O_RHM_START:
-        if ((j->rp.start = rhm_start_parse(arg)) < 0) {
-            fprintf(stderr, "meshcorr %s: --rhm-start: '%s' is not distances or voronoi\n", cmd, arg);
+    case CLI_O_PRESET:                      /* applied by cli_job_init */
+        if (strcmp(arg, "release") && strcmp(arg, "paper")) {
+            fprintf(stderr, "meshcorr %s: --preset: '%s' is not one of release, paper\n", cmd, arg);
             return -1;
         }
         return 1;
+    case CLI_O_DEVICE: j->device = arg; return 1;
     }
     return 0;
 }
 
-int cli_job_check(const cli_job *j, const char *cmd)
+int cli_job_check(cli_job *j, const char *cmd)
 {
     char err[512];
     if (!j->init && !j->lmk_pairs && !(j->lmk_src && j->lmk_tgt)) {
@@ -131,11 +105,35 @@ int cli_job_check(const cli_job *j, const char *cmd)
         fprintf(stderr, "meshcorr %s: --init-reverse needs --init\n", cmd);
         return -1;
     }
-    if (j->p.model == ECTM_INJECTIVE && j->init_rev) {
+    if (j->w.model == PROTO_MODEL_INJECTIVE && j->init_rev) {
         fprintf(stderr, "meshcorr %s: --init-reverse needs the bijective model\n", cmd);
         return -1;
     }
-    if (ectm_params_check(&j->p, err, sizeof err) || rhm_params_check(&j->rp, err, sizeof err)) {
+    if (j->device) {
+        if (strchr(j->w.backend, ':')) {
+            fprintf(stderr, "meshcorr %s: --device and a backend with :DEVICE exclude each other\n", cmd);
+            return -1;
+        }
+        if (strlen(j->device) > PROTO_MAX_DEVICE) {
+            fprintf(stderr, "meshcorr %s: --device: name longer than %d bytes\n", cmd, PROTO_MAX_DEVICE);
+            return -1;
+        }
+        snprintf(j->backend, sizeof j->backend, "%.30s:%s", j->w.backend[0] ? j->w.backend : "cpu",
+                 j->device);
+        j->w.backend = j->backend;
+        j->device = NULL;
+    }
+    if (proto_params_check(&j->w, err, sizeof err)) {
+        fprintf(stderr, "meshcorr %s: %s\n", cmd, err);
+        return -1;
+    }
+    return 0;
+}
+
+int cli_job_engine(const cli_job *j, const char *cmd, int threads, ectm_params *p, rhm_params *r)
+{
+    char err[512];
+    if (corr_params_from_job(&j->w, threads, p, r, err, sizeof err)) {
         fprintf(stderr, "meshcorr %s: %s\n", cmd, err);
         return -1;
     }

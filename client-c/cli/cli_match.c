@@ -25,9 +25,9 @@ static void usage(FILE *fp)
         "usage: meshcorr match SOURCE TARGET INPUTS --out P.map [--out-reverse Q.map]\n"
         "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--stages all|rhm|ectm]\n"
         "         [--log-eps E] [--threads N] [--progress auto|text|json|none] [job options]\n"
-        CLI_JOB_USAGE
         "--stages rhm stops after RHM and writes its maps; --stages ectm runs ECTM alone\n"
-        "(needs --init).\n");
+        "(needs --init). Job options:\n");
+    cli_job_usage(fp);
 }
 
 typedef struct progress_state {
@@ -152,7 +152,11 @@ int cli_match(int argc, char **argv)
     corr_stages stages = CORR_STAGES_ALL;
     cli_job job;
     cli_job_init(&job, argc, argv);
-    ectm_params *pp = &job.p;
+    ectm_params pe;
+    rhm_params rp;
+    ectm_params_init(&pe);               /* log_eps and threads: match's own options */
+    double log_eps = pe.log_eps;
+    int threads = 0;
     progress_state ps = { PROGRESS_AUTO };
     int c, bad = 0;
     char *e;
@@ -169,14 +173,14 @@ int cli_match(int argc, char **argv)
         case O_OUT_DEFORMED: out_def = optarg; break;
         case O_OUT_REMESHED: out_rem = optarg; break;
         case O_LOG_EPS:
-            pp->log_eps = strtod(optarg, &e);
+            log_eps = strtod(optarg, &e);
             if (!*optarg || *e) {
                 fprintf(stderr, "meshcorr match: --log-eps: '%s' is not a number\n", optarg);
                 bad = 1;
             }
             break;
         case O_THREADS:
-            pp->threads = (int)strtol(optarg, &e, 10);
+            threads = (int)strtol(optarg, &e, 10);
             if (!*optarg || *e) {
                 fprintf(stderr, "meshcorr match: --threads: '%s' is not an integer\n", optarg);
                 bad = 1;
@@ -203,10 +207,11 @@ int cli_match(int argc, char **argv)
         fprintf(stderr, "meshcorr match: need SOURCE TARGET and --out\n");
         bad = 1;
     }
-    if (bad || cli_job_check(&job, "match")) {
+    if (bad || cli_job_check(&job, "match") || cli_job_engine(&job, "match", threads, &pe, &rp)) {
         usage(stderr);
         return 2;
     }
+    pe.log_eps = log_eps;
     if (stages == CORR_STAGES_ECTM && !job.init) {
         fprintf(stderr, "meshcorr match: --stages ectm needs --init\n");
         return 2;
@@ -216,7 +221,7 @@ int cli_match(int argc, char **argv)
                 "(no --init, no --out-deformed)\n");
         return 2;
     }
-    if (pp->model == ECTM_INJECTIVE && out_rev) {
+    if (pe.model == ECTM_INJECTIVE && out_rev) {
         fprintf(stderr, "meshcorr match: --out-reverse needs the bijective model\n");
         return 2;
     }
@@ -232,9 +237,8 @@ int cli_match(int argc, char **argv)
     const char *src = argv[optind], *tgt = argv[optind + 1];
     if (!(S = load(src)) || !(T = load(tgt)) || cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
-    job.rp.threads = pp->threads;
-    corr_input in = { S, T, src, tgt, L, P0, Q0, &job.rp, stages };
-    if (corr_run(&in, pp, on_progress, &ps, &res, err, sizeof err)) {
+    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages };
+    if (corr_run(&in, &pe, on_progress, &ps, &res, err, sizeof err)) {
         fprintf(stderr, "\nmeshcorr match: %s\n", err);
         goto done;
     }
@@ -244,7 +248,7 @@ int cli_match(int argc, char **argv)
     else
         snprintf(comment, sizeof comment,
                  "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",
-                 src, tgt, pp->model == ECTM_BIJECTIVE ? "bijective" : "injective",
+                 src, tgt, pe.model == ECTM_BIJECTIVE ? "bijective" : "injective",
                  res.last.outer, res.last.energy);
     if (bmap_write(out, res.P, comment, err, sizeof err) ||
         (out_rev && res.Q && bmap_write(out_rev, res.Q, comment, err, sizeof err))) {

@@ -215,29 +215,13 @@ static int is_drc(const char *path)
     return n > 4 && strcasecmp(path + n - 4, ".drc") == 0;
 }
 
-/* The wire spec of a parsed job (meshes, landmarks and maps are added by the caller). */
-static void spec_of_job(const cli_job *j, mc_job_spec *s, char *backend, size_t bsz)
+/* The job parameters of a parsed job into the spec, one per row of the list
+ * (meshes, landmarks and maps are added by the caller). */
+static void spec_of_job(const cli_job *j, mc_job_spec *s)
 {
-    const ectm_params *p = &j->p;
-    s->model = p->model == ECTM_INJECTIVE ? MC_INJECTIVE : MC_BIJECTIVE;
-    s->partial = p->partial;
-    s->alpha = p->alpha;
-    s->eta = p->eta;
-    s->beta0 = p->beta0;
-    s->beta1 = p->beta1;
-    s->beta_ramp = p->beta_ramp;
-    s->gamma = p->gamma;
-    s->iterations = (uint32_t)p->iterations;
-    s->inner_iterations = (uint32_t)p->inner_iterations;
-    s->tolerance = p->tolerance;
-    s->stop_change = p->stop_change;
-    s->rhm_iterations = (uint32_t)j->rp.iterations;
-    s->rhm_dim = (uint32_t)j->rp.dim;
-    s->rhm_alpha = j->rp.alpha;
-    s->rhm_landmark_weight = j->rp.gamma;
-    s->rhm_start = j->rp.start;
-    snprintf(backend, bsz, "%s%s%s", p->backend, p->device[0] ? ":" : "", p->device);
-    s->backend = backend;
+#define SPEC_PARAM(name, cli, type, ...) s->name = j->w.name;
+    PROTO_PARAMS(SPEC_PARAM)
+#undef SPEC_PARAM
 }
 
 int cli_submit(int argc, char **argv)
@@ -295,7 +279,8 @@ int cli_submit(int argc, char **argv)
                    "returns the map `meshcorr match` gives. --quantization BITS (1-%d; 16 is Draco's\n"
                    "usual) sends each coordinate quantized over the bounding box instead: a smaller\n"
                    "upload, but the map differs from the local one. A .drc file is sent as it is.\n"
-                   CLI_JOB_USAGE, MC_QUANTIZATION_MAX_BITS);
+                   "Job options:\n", MC_QUANTIZATION_MAX_BITS);
+            cli_job_usage(stdout);
             return 0;
         default: bad = 1;
         }
@@ -314,8 +299,7 @@ int cli_submit(int argc, char **argv)
     }
     if (bad || w.bad || cli_job_check(&job, "submit"))
         return 2;
-    char backend[160];
-    spec_of_job(&job, &spec, backend, sizeof backend);
+    spec_of_job(&job, &spec);
     const char *src = argv[optind], *tgt = argv[optind + 1];
     char err[4096];
     int status = 1;

@@ -57,6 +57,7 @@
 #include "corr/corr.h"
 #include "geo/geo_area.h"
 #include "metric/metric.h"
+#include "proto.h"
 #include "rhm/rhm__problem.h"
 
 #include <stdlib.h>
@@ -326,8 +327,12 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
         SKIP("../shared/data is absent");
     const char *o_it = harness_option("ectm-iterations"), *o_pairs = harness_option("pairs");
     const char *o_scale = harness_option("scale"), *o_start = harness_option("rhm-start");
-    if (o_start && (start_kind = rhm_start_parse(o_start)) < 0)
-        FAILF("--rhm-start takes distances or voronoi");
+    proto_params w;                      /* the start's names are the list's */
+    char perr[256], start_name[32];
+    proto_params_init(&w);
+    if (o_start && proto_param_parse(&w, PROTO_P_rhm_start, o_start, perr, sizeof perr))
+        FAILF("--rhm-start: %s", perr);
+    start_kind = w.rhm_start;
     int iters = o_it ? atoi(o_it) : 0;
     double scale = o_scale ? atof(o_scale) : 1;
     if ((o_it && iters < 1) || !(scale > 0))
@@ -335,7 +340,7 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     ectm_params ep;
     ectm_params_init(&ep);
     printf("start (%s) -> RHM -> ECTM from %d farthest-point landmarks; RHM defaults; ECTM defaults "
-           "with %d outer iterations%s; scale x%g; %s\n", rhm_start_name(start_kind), NL,
+           "with %d outer iterations%s; scale x%g; %s\n", proto_param_value_name(PROTO_P_rhm_start, (unsigned)start_kind, start_name, sizeof start_name), NL,
            iters ? iters : ep.iterations,
            iters && iters != ep.iterations ? " (not the default)" : " (the default)", scale,
            harness_data_dir() ? harness_data_dir() : "no data folder");

@@ -245,17 +245,14 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
         DIFF(map_ne(x->p, y->p), "submit.p");
         DIFF(map_ne(x->q, y->q), "submit.q");
         const proto_params *p = &x->params, *q = &y->params;
-        DIFF(p->model != q->model || p->partial != q->partial, "params.model/partial");
-        DIFF(p->alpha != q->alpha || p->eta != q->eta || p->beta0 != q->beta0 ||
-             p->beta1 != q->beta1 || p->beta_ramp != q->beta_ramp || p->gamma != q->gamma ||
-             p->rhm_iterations != q->rhm_iterations || p->rhm_dim != q->rhm_dim ||
-             p->rhm_alpha != q->rhm_alpha || p->rhm_landmark_weight != q->rhm_landmark_weight ||
-             p->rhm_start != q->rhm_start,
-             "params weights");
-        DIFF(p->iterations != q->iterations || p->inner_iterations != q->inner_iterations,
-             "params iterations");
-        DIFF(p->tolerance != q->tolerance || p->stop_change != q->stop_change, "params stops");
-        DIFF(str_ne(p->backend, q->backend), "params.backend");
+        for (int i = 0; i < PROTO_NPARAMS; i++) {      /* every row of the one list */
+            const proto_param_info *f = &proto_param_infos[i];
+            if (f->type == PROTO_PARAM_STR)
+                DIFF(str_ne(*(const char *const *)((const char *)p + f->offset),
+                            *(const char *const *)((const char *)q + f->offset)), f->name);
+            else
+                DIFF(proto_param_get(p, i) != proto_param_get(q, i), f->name);
+        }
         DIFF(x->priority != y->priority, "submit.priority");
         DIFF(str_ne(x->label, y->label), "submit.label");
         return NULL;

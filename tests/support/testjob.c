@@ -1,5 +1,6 @@
 /* testjob.c — see testjob.h. Builds and writes job.frame; runs nothing. */
 #include "support/testjob.h"
+#include "corr/corr.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 
@@ -8,24 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-
-void testjob_params_to_wire(const ectm_params *p, proto_params *w)
-{
-    memset(w, 0, sizeof *w);
-    w->model = p->model == ECTM_INJECTIVE ? PROTO_MODEL_INJECTIVE : PROTO_MODEL_BIJECTIVE;
-    w->partial = (uint8_t)(p->partial != 0);
-    w->alpha = p->alpha;
-    w->eta = p->eta;
-    w->beta0 = p->beta0;
-    w->beta1 = p->beta1;
-    w->beta_ramp = (uint32_t)p->beta_ramp;
-    w->gamma = p->gamma;
-    w->iterations = (uint32_t)p->iterations;
-    w->inner_iterations = (uint32_t)p->inner_iterations;
-    w->tolerance = p->tolerance;
-    w->stop_change = p->stop_change;
-    w->backend = "";
-}
 
 void testjob_close(testjob *j)
 {
@@ -98,7 +81,8 @@ int testjob_build(testjob *j, const char *src_path, const char *tgt_path,
     }
     ectm_params def;
     ectm_params_init(&def);
-    testjob_params_to_wire(params ? params : &def, &s->params);
+    proto_params_init(&s->params);
+    corr_params_to_job(params ? params : &def, NULL, &s->params, NULL, 0);
     s->label = "testjob";
     rc = 0;
 done:

@@ -35,7 +35,4 @@ int testjob_write(const char *dir, const char *src_path, const char *tgt_path,
                   const proto_landmark *landmarks, unsigned nlandmarks, const char *p0_path,
                   const char *q0_path, const ectm_params *params, char *err, size_t errsz);
 
-/* The wire form of p (the inverse of the worker's mapping). */
-void testjob_params_to_wire(const ectm_params *p, proto_params *w);
-
 #endif

@@ -1,9 +1,9 @@
 /* test_daemon_input.c — bad input through the real daemon and client: a
  * frame of another protocol version, a SUBMIT whose mesh blob fails its
- * checksum (refused, nothing stored), a Draco buffer that is no mesh and a
- * landmark index out of range (accepted — only the worker decodes meshes —
- * then FAILED with the worker's message). Each time the daemon keeps
- * serving the other clients. */
+ * checksum (refused, nothing stored), an unknown backend (refused) and a
+ * known one per job. Each time the daemon keeps serving the other clients.
+ * SUBMITs whose meshes, landmarks or parameters cannot run:
+ * test_daemon_refusals.c. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testjob.h"
@@ -85,65 +85,6 @@ static void sphere_spec(mc_job_spec *s, unsigned char **sb, unsigned char **tb,
     s->beta_ramp = 2;
     s->rhm_iterations = 2;
     mesh_free(S);
-}
-
-TEST_T(draco_bytes_that_are_no_mesh_fail_the_job_naming_the_source_mesh, 60)
-{
-    testdaemon_need_worker();
-    testdaemon d;
-    testdaemon_start(&d, "draco", NULL);
-    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3};
-    mc_job_spec s;
-    unsigned char *sb, *tb;
-    sphere_spec(&s, &sb, &tb, lm, 4);
-    unsigned char junk[200];
-    unsigned long long st = 12345;
-    for (size_t i = 0; i < sizeof junk; i++)
-        junk[i] = (unsigned char)(testmesh_rand(&st) * 256);
-    memcpy(junk, "DRACO", 5);                  /* looks like a header, is not a mesh */
-    s.source = junk;
-    s.source_len = sizeof junk;
-    uint64_t id = 0;
-    CHECK_INT(mc_submit(c, &s, &id), 0);       /* accepted: the daemon never decodes Draco */
-    CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_FAILED);
-    mc_job_status js;
-    CHECK_INT(mc_status(c, id, &js), 0);
-    CHECK_STR_HAS(js.reason, "BAD_MESH");
-    CHECK_STR_HAS(js.reason, "source mesh");
-    uint64_t ok;                               /* the next job runs as usual */
-    int rc;
-    ok = testdaemon_submit(c, 2, 0, 0, &rc);
-    CHECK_INT(rc, 0);
-    CHECK_INT(testdaemon_wait_state(c, ok, -1, 60), MC_COMPLETED);
-    free(sb);
-    free(tb);
-    mc_close(c);
-    testdaemon_stop(&d, SIGTERM);
-}
-
-TEST_T(landmark_index_out_of_range_fails_the_job_naming_landmark_and_range, 60)
-{
-    testdaemon_need_worker();
-    testdaemon d;
-    testdaemon_start(&d, "landmark", NULL);
-    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 162};   /* 162 vertices: 0..161 */
-    mc_job_spec s;
-    unsigned char *sb, *tb;
-    sphere_spec(&s, &sb, &tb, lm, 4);
-    uint64_t id = 0;
-    CHECK_INT(mc_submit(c, &s, &id), 0);
-    CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_FAILED);
-    mc_job_status js;
-    CHECK_INT(mc_status(c, id, &js), 0);
-    CHECK_STR_HAS(js.reason, "BAD_LANDMARKS");
-    CHECK_STR_HAS(js.reason, "landmark 4");
-    CHECK_STR_HAS(js.reason, "162 out of range");
-    free(sb);
-    free(tb);
-    mc_close(c);
-    testdaemon_stop(&d, SIGTERM);
 }
 
 TEST_T(backend_is_chosen_per_job_and_an_unknown_one_is_refused, 120)

@@ -134,7 +134,7 @@ TEST(params_check_names_the_bad_field)
     ectm_params_init(&p);
     p.beta_ramp = 0;
     CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
-    CHECK_STR_HAS(err, "beta-ramp");
+    CHECK_STR_HAS(err, "params.beta_ramp = 0 < 1");
 }
 
 TEST(map_sized_for_other_meshes_is_refused)

@@ -9,6 +9,7 @@
 #include "geo/geo_orient.h"
 #include "geod/geod.h"
 #include "metric/metric.h"
+#include "proto.h"
 #include "rhm/rhm__problem.h"
 
 #include <math.h>
@@ -60,7 +61,9 @@ static void faust_pipeline(int start, double ge[3], metric_summary ms[3])
     rhm_result res;
     if (rhm_run(g.S, g.T, &g.L, &p, print_progress, NULL, &res, err, sizeof err))
         FAILF("%s", err);
-    printf("  start %s; RHM: %d iterations, %.1f ms per iteration\n", rhm_start_name(start),
+    char name[32];
+    printf("  start %s; RHM: %d iterations, %.1f ms per iteration\n",
+           proto_param_value_name(PROTO_P_rhm_start, (unsigned)start, name, sizeof name),
            res.last.iteration, 1e3 * (res.last.elapsed - res.last.t_setup) / res.last.iteration);
     ectm_params ep;
     ectm_params_init(&ep);

@@ -494,7 +494,7 @@ TEST(worker_refuses_beta_ramp_of_zero_iterations)
     demo_job(&j, NULL, 0, 1);
     j.msg.u.submit.params.beta_ramp = 0;
     save(&j);
-    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "beta-ramp", NULL);
+    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "params.beta_ramp = 0 < 1", NULL);
 }
 
 TEST(worker_refuses_job_frame_with_corrupted_blob_checksum)
@@ -583,4 +583,79 @@ TEST_T(worker_sigterm_cancels_within_seconds_with_cancelled_error, 60)
     printf("  stopped %.2f s after SIGTERM: %s\n", dt, m.u.error.message);
     proto_msg_free(&m);
     free(file);
+}
+
+/* `--validate` on dir/job.frame as its stdin and a pipe as its stdout (as
+ * the daemon runs it: the sandbox lets it write no file): the exit status
+ * (-signal when killed), and what it wrote in *out (free()d by the caller). */
+static int validate(const char *limits, unsigned char **out, size_t *outlen)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "exec %s --validate %s < %s/job.frame", WORKER, limits ? limits : "",
+             job_dir());
+    FILE *p = popen(cmd, "r");
+    CHECK(p != NULL);
+    *out = read_all(dup(fileno(p)), outlen);
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? -WTERMSIG(st) : -1000;
+}
+
+TEST(validate_accepts_a_job_it_could_run_writes_nothing_and_leaves_the_directory_alone)
+{
+    testjob j;
+    demo_job(&j, NULL, 0, 1);
+    save(&j);
+    unsigned char *out;
+    size_t n;
+    CHECK_INT(validate("--max-memory-mb 2048 --max-cpu-s 30", &out, &n), 0);
+    CHECK_INT(n, 0);
+    free(out);
+    char names[256];
+    listing(job_dir(), names, sizeof names);
+    CHECK_STR_HAS(names, "job.frame");
+    CHECK(strstr(names, "result") == NULL && strstr(names, "error") == NULL);
+}
+
+TEST(validate_refuses_with_one_error_frame_naming_the_field)
+{
+    testjob j;
+    demo_job(&j, NULL, 0, 1);
+    j.msg.u.submit.params.inner_iterations = 500000;
+    save(&j);
+    unsigned char *out;
+    size_t n, used;
+    CHECK_INT(validate(NULL, &out, &n), 1);
+    proto_msg m;
+    char err[256];
+    CHECK_INT(proto_decode(out, n, PROTO_MAX_FRAME, &m, &used, err, sizeof err), PROTO_READY);
+    CHECK_INT(used, n);
+    CHECK_INT(m.type, PROTO_MSG_ERROR);
+    CHECK_INT(m.u.error.code, PROTO_EBAD_PARAMS);
+    CHECK_STR_HAS(m.u.error.message, "params.inner_iterations = 500000 > 100000");
+    proto_msg_free(&m);
+    free(out);
+}
+
+/* The sandbox's limits hold: with too little address space the job is not
+ * accepted (NOMEM, or a signal where a library aborts), never exit 0. */
+TEST(validate_under_a_tiny_memory_limit_does_not_accept)
+{
+    testjob j;
+    demo_job(&j, NULL, 0, 1);
+    save(&j);
+    unsigned char *out;
+    size_t n;
+    int st = validate("--max-memory-mb 1", &out, &n);
+    CHECK(st != 0);
+    proto_msg m;
+    size_t used;
+    char err[256];
+    if (st == 1 && proto_decode(out, n, PROTO_MAX_FRAME, &m, &used, err, sizeof err) == PROTO_READY) {
+        printf("  --max-memory-mb 1: %s: %s\n", proto_err_name(m.u.error.code), m.u.error.message);
+        CHECK_INT(m.u.error.code, PROTO_ENOMEM);
+        proto_msg_free(&m);
+    } else {
+        printf("  --max-memory-mb 1: status %d, %zu bytes of answer\n", st, n);
+    }
+    free(out);
 }

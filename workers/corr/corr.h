@@ -19,6 +19,7 @@
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 #include "rhm/rhm.h"
+#include "proto.h"
 
 #define CORR_ERRORS(X)                                                          \
     X(CORR_OK,         0, "ok")                                                 \
@@ -78,7 +79,20 @@ int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char *err,
                 size_t errsz);
 
-/* Runs the pipeline. Needs P0 or at least LMK_MIN_PAIRS landmarks. With
+/* A job's parameters (the wire form of the one list, proto_params.h) as the
+ * engine's: checked with proto_params_check (CORR_EINPUT, "params.NAME ..."
+ * in err), a 0 that means the default left at the default, backend
+ * "NAME[:DEVICE]" split into p->backend and p->device, threads into both.
+ * p and r start from their _init defaults (log_eps stays ECTM's). */
+int corr_params_from_job(const proto_params *w, int threads, ectm_params *p, rhm_params *r,
+                         char *err, size_t errsz);
+/* The inverse: w's job fields from p and r (NULL: rhm_params_init's); with
+ * backend non-NULL, "NAME[:DEVICE]" is written there and w->backend points
+ * at it, else w->backend is left as it is. */
+void corr_params_to_job(const ectm_params *p, const rhm_params *r, proto_params *w, char *backend,
+                        size_t bsz);
+
+/* Runs the pipeline. Needs P0 or at least PROTO_MIN_LANDMARKS landmarks. With
  * stages RHM, out->P and out->Q are RHM's repaired maps and out->Y, out->Yt, out->last
  * stay empty. */
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,

@@ -8,6 +8,7 @@
 #include "geo/geo_edges.h"
 #include "opt/opt_lbfgs.h"
 #include "proj/proj.h"
+#include "proto.h"
 #include "util/errbuf.h"
 
 #include <math.h>
@@ -26,20 +27,20 @@ const char *ectm_strerror(int code)
     return "unknown ECTM error";
 }
 
+/* The job parameters' defaults and ranges are the rows of PROTO_PARAMS
+ * (proto_params.h) whose ENGINE column is ECTM; the rest is ECTM's own. */
+#define ECTM_ROW_ECTM(x) x
+#define ECTM_ROW_RHM(x)
+#define ECTM_ROW_NONE(x)
+_Static_assert((int)ECTM_INJECTIVE == (int)PROTO_MODEL_INJECTIVE, "model values");
+
 void ectm_params_init(ectm_params *p)
 {
     memset(p, 0, sizeof *p);
-    p->model = ECTM_BIJECTIVE;
-    p->alpha = 20;
-    p->eta = 2e-3 / 3;
-    p->beta0 = 500;
-    p->beta1 = 1e5;
-    p->beta_ramp = 200;
-    p->gamma = 1e4;
-    p->iterations = 300;
-    p->inner_iterations = 50;
-    p->tolerance = 1e-8;
-    p->stop_change = 0;
+#define ECTM_DEFAULT(name, cli, type, dflt, lo, hi, fl, eng, efield, ...) \
+    ECTM_ROW_##eng(p->efield = dflt;)
+    PROTO_PARAMS(ECTM_DEFAULT)
+#undef ECTM_DEFAULT
     p->log_eps = ENER_LOG_EPS_DEFAULT;
     strcpy(p->backend, "cpu");
 }
@@ -55,20 +56,14 @@ void ectm_params_paper(ectm_params *p)
 
 int ectm_params_check(const ectm_params *p, char *err, size_t errsz)
 {
+#define ECTM_CHECK(name, cli, type, dflt, lo, hi, fl, eng, efield, ...)                      \
+    ECTM_ROW_##eng(if (proto_param_check(PROTO_P_##name, (double)p->efield, err, errsz)) \
+                       return ECTM_EPARAM;)
+    PROTO_PARAMS(ECTM_CHECK)
+#undef ECTM_CHECK
 #define NEED(cond, field, what)                                                     \
     if (!(cond))                                                                    \
         return errbuf_set(err, errsz, ECTM_EPARAM, "parameter %s must be %s", field, what)
-    NEED(p->model == ECTM_BIJECTIVE || p->model == ECTM_INJECTIVE, "model", "bijective or injective");
-    NEED(isfinite(p->alpha) && p->alpha > 0, "alpha", "a finite number > 0");
-    NEED(isfinite(p->eta) && p->eta >= 0, "eta", "a finite number >= 0");
-    NEED(isfinite(p->beta0) && p->beta0 > 0, "beta0", "a finite number > 0");
-    NEED(isfinite(p->beta1) && p->beta1 > 0, "beta1", "a finite number > 0");
-    NEED(p->beta_ramp >= 1, "beta-ramp", "an integer >= 1");
-    NEED(isfinite(p->gamma) && p->gamma >= 0, "gamma", "a finite number >= 0");
-    NEED(p->iterations >= 1 && p->iterations <= 1000000, "iterations", "an integer in [1, 1000000]");
-    NEED(p->inner_iterations >= 1 && p->inner_iterations <= 100000, "inner-iterations", "an integer in [1, 100000]");
-    NEED(isfinite(p->tolerance) && p->tolerance > 0, "tolerance", "a finite number > 0");
-    NEED(isfinite(p->stop_change) && p->stop_change >= 0, "stop-change", "a finite number >= 0");
     NEED(isfinite(p->log_eps) && p->log_eps > 0 && p->log_eps < 1, "log-eps", "in (0, 1)");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");
     NEED(memchr(p->backend, 0, sizeof p->backend) &&

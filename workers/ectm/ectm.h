@@ -39,17 +39,19 @@ const char *ectm_strerror(int code);
 
 typedef enum ectm_model { ECTM_BIJECTIVE = 0, ECTM_INJECTIVE = 1 } ectm_model;
 
+/* The fields that are job parameters take their defaults and ranges from
+ * the one list, PROTO_PARAMS (protocol/proto_params.h, ENGINE column ECTM). */
 typedef struct ectm_params {
     ectm_model model;
-    double alpha;          /* membrane weight                         (> 0)  */
-    double eta;            /* bending weight                          (>= 0) */
-    double beta0, beta1;   /* β at k = 1 and at k >= beta_ramp        (> 0)  */
-    int beta_ramp;         /* iterations of the linear ramp           (>= 1) */
-    double gamma;          /* reversibility weight, bijective only    (>= 0) */
-    int iterations;        /* outer iterations K                      (>= 1) */
-    int inner_iterations;  /* L-BFGS iterations per Y-step            (>= 1) */
-    double tolerance;      /* L-BFGS gradient tolerance               (> 0)  */
-    double stop_change;    /* stop when |ΔE|/E < this at fixed β; 0: never */
+    double alpha;          /* membrane weight                                */
+    double eta;            /* bending weight                                 */
+    double beta0, beta1;   /* β at k = 1 and at k >= beta_ramp               */
+    int beta_ramp;         /* iterations of the linear ramp                  */
+    double gamma;          /* reversibility weight, bijective only           */
+    int iterations;        /* outer iterations K                             */
+    int inner_iterations;  /* L-BFGS iterations per Y-step                   */
+    double tolerance;      /* L-BFGS gradient tolerance                      */
+    double stop_change;    /* stop when |ΔE|/E < this at fixed β; 0: never   */
     double log_eps;        /* −log extension threshold on det G       (> 0)  */
     int partial;           /* partial matching: no rescaling          (0/1)  */
     int threads;           /* OpenMP threads; 0: all cores                   */
@@ -66,7 +68,8 @@ void ectm_params_init(ectm_params *p);
 /* The values the paper's text gives: α = 20, η = 1e-3, β 1e3 → 2e5 over
  * 200 iterations, γ = 2e4 (twice the released code's β and γ). */
 void ectm_params_paper(ectm_params *p);
-/* 0 or ECTM_EPARAM with the offending field named in err. */
+/* 0 or ECTM_EPARAM with the offending field named in err (the job
+ * parameters by proto_param_check: "params.alpha = 0 <= 0"). */
 int ectm_params_check(const ectm_params *p, char *err, size_t errsz);
 /* β at outer iteration k (1-based). */
 double ectm_beta(const ectm_params *p, int k);

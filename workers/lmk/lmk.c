@@ -50,9 +50,9 @@ static int read_columns(const char *path, int cols, long **vals, int *rows,
             p++;
         if (*p == '\0')
             continue;
-        if (n == LMK_MAX_PAIRS) {
+        if (n == PROTO_MAX_LANDMARKS) {
             rc = errbuf_set(err, errsz, LMK_ECOUNT, "%s:%ld: more than %d landmarks",
-                            path, lineno, LMK_MAX_PAIRS);
+                            path, lineno, PROTO_MAX_LANDMARKS);
             goto out;
         }
         if (n == cap) {
@@ -110,12 +110,12 @@ int lmk_from_arrays(const long *src, const long *tgt, long n, int one_based,
 {
     *out = NULL;
     long base = one_based ? 1 : 0;
-    if (n < LMK_MIN_PAIRS)
+    if (n < PROTO_MIN_LANDMARKS)
         return errbuf_set(err, errsz, LMK_ECOUNT, "%s: %ld landmark pairs, at least %d are needed",
-                          src_name, n, LMK_MIN_PAIRS);
-    if (n > LMK_MAX_PAIRS)
+                          src_name, n, PROTO_MIN_LANDMARKS);
+    if (n > PROTO_MAX_LANDMARKS)
         return errbuf_set(err, errsz, LMK_ECOUNT, "%s: %ld landmark pairs, at most %d are allowed",
-                          src_name, n, LMK_MAX_PAIRS);
+                          src_name, n, PROTO_MAX_LANDMARKS);
     for (long k = 0; k < n; k++) {
         if (src[k] < base || src[k] - base >= S->nv)
             return errbuf_set(err, errsz, LMK_ERANGE,

@@ -5,8 +5,8 @@
  * BIM .vts layout "id x y z" is accepted: only the first column is read).
  * '#' starts a comment; blank lines are skipped. Indices are 0-based unless
  * one_based is set. Reading validates against the meshes: index in range,
- * no duplicate source landmark, at least LMK_MIN_PAIRS pairs, at most
- * LMK_MAX_PAIRS; errors name the file and line.
+ * no duplicate source landmark, at least PROTO_MIN_LANDMARKS pairs, at most
+ * PROTO_MAX_LANDMARKS; errors name the file and line.
  * lmk_from_arrays is that one rule for pairs from anywhere (the file readers
  * and the worker's wire landmarks both go through it).
  * Ownership: lmk_read* and lmk_from_arrays return a set freed with lmk_free (NULL ok). */
@@ -15,9 +15,7 @@
 #include <stddef.h>
 #include "mesh/mesh.h"
 
-#define LMK_MIN_PAIRS 3        /* three pairs fix orientation: fewer leave the
-                                  Voronoi/RHM start free to mirror the shape */
-#define LMK_MAX_PAIRS 100000
+#include "proto_params.h"   /* PROTO_MIN_LANDMARKS, PROTO_MAX_LANDMARKS: the one rule */
 
 #define LMK_ERRORS(X)                                                     \
     X(LMK_OK,        0, "ok")                                             \
@@ -43,7 +41,7 @@ typedef struct lmk_set {
 
 void lmk_free(lmk_set *l);
 /* Builds a set from n pairs as given (1-based when one_based) and validates
- * it: LMK_MIN_PAIRS <= n <= LMK_MAX_PAIRS, each index in range for its mesh,
+ * it: PROTO_MIN_LANDMARKS <= n <= PROTO_MAX_LANDMARKS, each index in range for its mesh,
  * no source vertex used twice. Messages start with src_name or tgt_name and
  * count landmarks from 1: "NAME: landmark 3: source vertex 9999 out of range
  * [0, 6937]". */

@@ -39,8 +39,10 @@ typedef struct wrk_job {
 
 /* worker_job.c — the one mapping from a SUBMIT to a job: decodes both Draco
  * meshes (BAD_MESH naming "source mesh"/"target mesh", over the limits
- * included), validates them (corr_validate), maps the parameters onto
- * ectm_params (BAD_PARAMS naming the field), builds the landmark set
+ * included), validates them (corr_validate), checks and maps the
+ * parameters onto ectm_params and rhm_params (corr_params_from_job, i.e.
+ * proto_params_check: BAD_PARAMS naming the field), checks that there are
+ * landmarks or a map (and q only with p, bijective), builds the landmark set
  * (lmk_from_arrays: BAD_LANDMARKS) and the initial maps (bmap_check_row:
  * BAD_PARAMS). On error job is left closed. */
 int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
@@ -89,6 +91,12 @@ typedef struct wrk_result {
 int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
                      double elapsed, wrk_result *r, char *err, size_t errsz);
 void wrk_result_close(wrk_result *r);
+
+/* worker_validate.c — `--validate`: reads one SUBMIT frame from in_fd and
+ * builds the job from it as a run would (wrk_job_from_submit), running
+ * nothing. WRK_EXIT_OK when it would run; else one ERROR frame (the code and
+ * the message naming the blob or field) on out_fd and WRK_EXIT_JOB. */
+int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim);
 
 /* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with
  * fp64, one per line on stdout; 0 when printed. */

@@ -4,7 +4,6 @@
 #include "main/worker.h"
 #include "util/errbuf.h"
 
-#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,52 +34,17 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
     return 0;
 }
 
-static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params *p,
-                      rhm_params *r, char *err, size_t errsz)
+/* The inputs' combination: a map or landmarks, q only with p and bijective. */
+static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 {
-    rhm_params_init(r);
-    r->threads = lim->threads;
-    if (w->rhm_iterations) {
-        r->iterations = w->rhm_iterations > 1000000 ? 1000001 : (int)w->rhm_iterations;
-    }
-    if (w->rhm_dim)
-        r->dim = w->rhm_dim > 1000 ? 1001 : (int)w->rhm_dim;
-    if (w->rhm_alpha != 0)
-        r->alpha = w->rhm_alpha;
-    r->gamma = w->rhm_landmark_weight;
-    r->start = w->rhm_start;
-    char detail[256];
-    if (rhm_params_check(r, detail, sizeof detail))
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "RHM %s", detail);
-    ectm_params_init(p);
-    /* backend: "" (cpu), "cpu", "opencl", "auto", optionally ":DEVICE" */
-    if (w->backend[0]) {
-        const char *colon = strchr(w->backend, ':');
-        size_t n = colon ? (size_t)(colon - w->backend) : strlen(w->backend);
-        if (n >= sizeof p->backend || (colon && strlen(colon + 1) >= sizeof p->device))
-            return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "parameter backend: '%s' is too long",
-                              w->backend);
-        memcpy(p->backend, w->backend, n);
-        p->backend[n] = '\0';
-        if (colon)
-            snprintf(p->device, sizeof p->device, "%s", colon + 1);
-    }
-    p->model = w->model == PROTO_MODEL_INJECTIVE ? ECTM_INJECTIVE : ECTM_BIJECTIVE;
-    p->partial = w->partial;
-    p->alpha = w->alpha;
-    p->eta = w->eta;
-    p->gamma = w->gamma;
-    /* counts above INT_MAX become INT_MAX, which ectm_params_check refuses */
-    p->iterations = w->iterations > INT_MAX ? INT_MAX : (int)w->iterations;
-    p->inner_iterations = w->inner_iterations > INT_MAX ? INT_MAX : (int)w->inner_iterations;
-    p->tolerance = w->tolerance;
-    p->stop_change = w->stop_change;
-    p->threads = lim->threads;
-    p->beta0 = w->beta0;
-    p->beta1 = w->beta1;
-    p->beta_ramp = w->beta_ramp > INT_MAX ? INT_MAX : (int)w->beta_ramp;
-    if (ectm_params_check(p, err, errsz))
-        return PROTO_EBAD_PARAMS;
+    if (s->p.n == 0 && s->nlandmarks == 0)
+        return errbuf_set(err, errsz, PROTO_EBAD_LANDMARKS,
+                          "landmarks: none, and no initial map p: need one or at least %d pairs",
+                          PROTO_MIN_LANDMARKS);
+    if (s->q.n && !s->p.n)
+        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q without p");
+    if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
+        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q needs the bijective model");
     return 0;
 }
 
@@ -122,11 +86,12 @@ static int map_map(const proto_map *w, const char *name, const mesh *from, const
     if (!P)
         return errbuf_set(err, errsz, PROTO_ENOMEM, "%s: out of memory", name);
     for (int i = 0; i < P->n; i++) {
-        char where[64];
-        snprintf(where, sizeof where, "%s: row %d", name, i);
         double *wt = P->w + 3 * (size_t)i;
         memcpy(wt, w->rows[i].w, sizeof w->rows[i].w);
-        if (bmap_check_row(w->rows[i].face, wt, to->nf, where, err, errsz)) {
+        if (bmap_check_row(w->rows[i].face, wt, to->nf, name, NULL, 0)) {
+            char where[64];                  /* the row's name only when it is bad */
+            snprintf(where, sizeof where, "%s: row %d", name, i);
+            bmap_check_row(w->rows[i].face, wt, to->nf, where, err, errsz);
             bmap_free(P);
             return PROTO_EBAD_PARAMS;
         }
@@ -141,7 +106,11 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
 {
     memset(job, 0, sizeof *job);
     int rc;
-    if ((rc = map_params(&s->params, lim, &job->params, &job->rhm, err, errsz)) ||
+    if ((rc = corr_params_from_job(&s->params, lim->threads, &job->params, &job->rhm, err, errsz))) {
+        wrk_job_close(job);
+        return rc == CORR_ENOMEM ? PROTO_ENOMEM : PROTO_EBAD_PARAMS;
+    }
+    if ((rc = check_inputs(s, err, errsz)) ||
         (rc = load_mesh(&s->source, "source mesh", lim, &job->S, err, errsz)) ||
         (rc = load_mesh(&s->target, "target mesh", lim, &job->T, err, errsz)) ||
         (rc = map_landmarks(s, job->S, job->T, &job->L, err, errsz)) ||

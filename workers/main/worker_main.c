@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <getopt.h>
 #include <inttypes.h>
+#include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,6 +41,8 @@ static void usage(void)
         "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
         "       meshcorr-worker --list-devices [--threads N]\n"
+        "       meshcorr-worker --validate [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
+        "                       [--max-cpu-s N]   (a SUBMIT frame on stdin; refusal: ERROR on stdout)\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage. See workers/WORKER.md.\n");
 }
@@ -113,9 +116,24 @@ static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
     return code == PROTO_ECANCELLED ? WRK_EXIT_CANCELLED : WRK_EXIT_JOB;
 }
 
+/* Sets resource limit res to v (soft and hard); -1 with a message. */
+static int limit(int res, const char *what, rlim_t v)
+{
+    struct rlimit rl = { v, v };
+    if (setrlimit(res, &rl) == 0)
+        return 0;
+    fprintf(stderr, "meshcorr-worker: %s: setrlimit: %s\n", what, strerror(errno));
+    return -1;
+}
+
 int main(int argc, char **argv)
 {
-    ompenv_ensure_passive(argv);
+    int validate = 0;
+    for (int i = 1; i < argc; i++)
+        validate |= strcmp(argv[i], "--validate") == 0;
+    /* a validation runs no OpenMP region: it starts at once, no re-exec */
+    if (!validate)
+        ompenv_ensure_passive(argv);
     double t0 = now();
     static const struct option opts[] = {
         {"job", required_argument, 0, 'j'},          {"job-id", required_argument, 0, 'i'},
@@ -123,12 +141,13 @@ int main(int argc, char **argv)
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"list-devices", no_argument, 0, 'L'},
+        {"validate", no_argument, 0, 'V'},           {"max-cpu-s", required_argument, 0, 'C'},
         {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
     uint64_t job_id = 0;
     int have_id = 0, progress_fd = -1, bad = 0, list_devices = 0;
-    unsigned long long max_memory_mb = 0;
+    unsigned long long max_memory_mb = 0, max_cpu_s = 0;
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
     unsigned long long v;
     int c;
@@ -163,12 +182,34 @@ int main(int argc, char **argv)
             bad |= parse_num("max-memory-mb", optarg, 1, 1ull << 24, &max_memory_mb) != 0;
             break;
         case 'L': list_devices = 1; break;
+        case 'V': break;                       /* seen above */
+        case 'C': bad |= parse_num("max-cpu-s", optarg, 1, 1ull << 20, &max_cpu_s) != 0; break;
         case 'h': usage(); return WRK_EXIT_USAGE;
         default: bad = 1;
         }
     }
     if (!bad && list_devices)
         return wrk_list_devices(lim.threads) ? WRK_EXIT_USAGE : 0;
+    if (!bad && validate) {
+        if (dir || have_id || progress_fd >= 0 || progress_tcp || optind != argc) {
+            fprintf(stderr, "meshcorr-worker: --validate takes limits only (the frame is on stdin)\n");
+            usage();
+            return WRK_EXIT_USAGE;
+        }
+        /* the sandbox: bounded memory and CPU time, no files written, no
+         * core dumped, few descriptors; set before any input is read */
+        signal(SIGPIPE, SIG_IGN);
+        /* the two meshes' buffers come and go: keep freed memory for reuse
+         * instead of an mmap and its page faults per large buffer */
+        mallopt(M_MMAP_THRESHOLD, 64 << 20);
+        mallopt(M_TRIM_THRESHOLD, 256 << 20);
+        if ((max_memory_mb && limit(RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20)) ||
+            (max_cpu_s && limit(RLIMIT_CPU, "--max-cpu-s", (rlim_t)max_cpu_s)) ||
+            limit(RLIMIT_FSIZE, "file size", 0) || limit(RLIMIT_CORE, "core size", 0) ||
+            limit(RLIMIT_NOFILE, "descriptors", 16))
+            return WRK_EXIT_USAGE;
+        return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim);
+    }
     if (!bad && (!dir || !have_id || optind != argc)) {
         fprintf(stderr, "meshcorr-worker: --job and --job-id are required, nothing else\n");
         bad = 1;
@@ -186,15 +227,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "meshcorr-worker: --progress-fd %d: not an open descriptor\n", progress_fd);
         bad = 1;
     }
-    if (!bad && max_memory_mb) {
-        /* allocations past the limit fail (NOMEM) instead of waking the OOM killer */
-        struct rlimit rl = { (rlim_t)max_memory_mb << 20, (rlim_t)max_memory_mb << 20 };
-        if (setrlimit(RLIMIT_AS, &rl) != 0) {
-            fprintf(stderr, "meshcorr-worker: --max-memory-mb %llu: setrlimit: %s\n", max_memory_mb,
-                    strerror(errno));
-            bad = 1;
-        }
-    }
+    /* allocations past the limit fail (NOMEM) instead of waking the OOM killer */
+    if (!bad && max_memory_mb && limit(RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20))
+        bad = 1;
     if (bad) {
         usage();
         return WRK_EXIT_USAGE;

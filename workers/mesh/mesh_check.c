@@ -49,6 +49,47 @@ static int tri_cmp(const void *x, const void *y)
     return p->face < q->face ? -1 : p->face > q->face;
 }
 
+/* Sorts n elements of size sz whose first member is an int key in
+ * [0, nkeys) into the order of qsort with cmp, where cmp compares that key
+ * first: a counting sort by key (O(n + nkeys)), then each bucket (a vertex's
+ * half-edges or faces: a few) by insertion, or by qsort when it is large, so
+ * a hostile fan stays O(n log n). Falls back to qsort without memory. */
+static void key_sort(void *base, size_t n, size_t sz, int nkeys, int (*cmp)(const void *, const void *))
+{
+    char *a = base, *tmp = malloc(n * sz + 1);
+    size_t *start = calloc((size_t)nkeys + 2, sizeof *start);
+    if (!tmp || !start) {
+        free(tmp);
+        free(start);
+        qsort(base, n, sz, cmp);
+        return;
+    }
+    for (size_t i = 0; i < n; i++)
+        start[*(const int *)(a + i * sz) + 2]++;
+    for (int k = 2; k < nkeys + 2; k++)
+        start[k] += start[k - 1];
+    for (size_t i = 0; i < n; i++)          /* start[k + 1]: next slot of key k */
+        memcpy(tmp + start[*(const int *)(a + i * sz) + 1]++ * sz, a + i * sz, sz);
+    memcpy(a, tmp, n * sz);
+    for (int k = 0; k < nkeys; k++) {       /* bucket k is [start[k], start[k + 1]) */
+        size_t lo = start[k], m = start[k + 1] - lo;
+        char *b = a + lo * sz;
+        if (m > 16) {
+            qsort(b, m, sz, cmp);
+            continue;
+        }
+        for (size_t i = 1; i < m; i++) {
+            memcpy(tmp, b + i * sz, sz);
+            size_t j = i;
+            for (; j > 0 && cmp(b + (j - 1) * sz, tmp) > 0; j--)
+                memcpy(b + j * sz, b + (j - 1) * sz, sz);
+            memcpy(b + j * sz, tmp, sz);
+        }
+    }
+    free(tmp);
+    free(start);
+}
+
 static int uf_find(int *par, int x)
 {
     while (par[x] != x) {
@@ -183,7 +224,7 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
             r->first_unreferenced_vertex = i;
     }
 
-    qsort(tk, (size_t)ntk, sizeof *tk, tri_cmp);
+    key_sort(tk, (size_t)ntk, sizeof *tk, nv, tri_cmp);    /* by s[0], then the rest */
     for (int i = 1; i < ntk; i++)
         if (memcmp(tk[i].s, tk[i - 1].s, sizeof tk[i].s) == 0 && r->duplicate_faces++ == 0) {
             r->first_duplicate_pair[0] = tk[i - 1].face;
@@ -191,7 +232,7 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
         }
 
     /* Edges: group the sorted half-edges by vertex pair. */
-    qsort(h, (size_t)nh, sizeof *h, half_cmp);
+    key_sort(h, (size_t)nh, sizeof *h, nv, half_cmp);      /* by a, then b, face */
     for (int i = 0; i < nv; i++)
         comp[i] = i;
     for (int t = 0; t < nf; t++)

@@ -76,18 +76,21 @@ typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
     RHM_START_VORONOI = 1      /* the thesis' geodesic Voronoi map          */
 } rhm_start;
-const char *rhm_start_name(int start);   /* "distances", "voronoi", NULL */
-/* RHM_START_* from its name, or -1. */
-int rhm_start_parse(const char *name);
+/* Their names are the values of rhm_start in PROTO_PARAMS (proto_params.h):
+ * proto_param_value_name, proto_param_parse. */
 
+/* start, alpha, gamma, dim and iterations are job parameters: their
+ * defaults and ranges are PROTO_PARAMS' (protocol/proto_params.h, ENGINE
+ * column RHM: rhm_start, rhm_alpha, rhm_landmark_weight, rhm_dim,
+ * rhm_iterations). */
 typedef struct rhm_params {
     int start;             /* RHM_START_*                                   */
-    double alpha;          /* harmonic vs reversibility, (0, 1)             */
+    double alpha;          /* harmonic vs reversibility                     */
     double beta_step;      /* β_k = beta_step·min(k, beta_ramp)    (> 0)    */
     int beta_ramp;         /*                                      (>= 1)   */
-    double gamma;          /* weak landmark weight; 0 = off        (>= 0)   */
-    int dim;               /* embedding dimension m      (3..EMBED_MAX_DIM) */
-    int iterations;        /* at most K iterations                 (>= 1)   */
+    double gamma;          /* weak landmark weight; 0 = off                 */
+    int dim;               /* embedding dimension m                         */
+    int iterations;        /* at most K iterations                          */
     int min_iterations;    /* no early stop before this iteration  (>= 1)   */
     double stop_change;    /* relative energy change to stop; 0 = never     */
     int threads;           /* OpenMP threads; 0: all cores                  */
@@ -129,7 +132,7 @@ typedef struct rhm_result {
 void rhm_result_close(rhm_result *r);
 
 /* Runs RHM from the landmark pairs L (L->src on S = M1, L->tgt on T = M2,
- * at least LMK_MIN_PAIRS). The meshes must be validated (manifold,
+ * at least PROTO_MIN_LANDMARKS). The meshes must be validated (manifold,
  * connected, no degenerate face). Errors: RHM_EPARAM, RHM_EINPUT,
  * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC; detail in err. */
 int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,

@@ -2,6 +2,7 @@
  * the β schedule), error strings and the result's destructor. */
 #include "rhm/rhm.h"
 #include "embed/embed.h"
+#include "proto.h"
 #include "util/errbuf.h"
 
 #include <math.h>
@@ -17,45 +18,39 @@ const char *rhm_strerror(int code)
     return "unknown RHM error";
 }
 
-const char *rhm_start_name(int start)
-{
-    return start == RHM_START_DISTANCES ? "distances" : start == RHM_START_VORONOI ? "voronoi" : NULL;
-}
-
-int rhm_start_parse(const char *name)
-{
-    for (int s = RHM_START_DISTANCES; s <= RHM_START_VORONOI; s++)
-        if (strcmp(name, rhm_start_name(s)) == 0)
-            return s;
-    return -1;
-}
+/* The job parameters' defaults and ranges are the rows of PROTO_PARAMS
+ * (proto_params.h) whose ENGINE column is RHM; the rest is RHM's own. */
+#define RHM_ROW_RHM(x) x
+#define RHM_ROW_ECTM(x)
+#define RHM_ROW_NONE(x)
+_Static_assert(EMBED_MAX_DIM == PROTO_RHM_MAX_DIM, "rhm_dim's max in PROTO_PARAMS is EMBED_MAX_DIM");
+_Static_assert((int)RHM_START_VORONOI == (int)PROTO_RHM_START_VORONOI, "rhm_start values");
 
 void rhm_params_init(rhm_params *p)
 {
     memset(p, 0, sizeof *p);
-    p->start = RHM_START_DISTANCES;
-    p->alpha = 5e-4;
+#define RHM_DEFAULT(name, cli, type, dflt, lo, hi, fl, eng, efield, ...) \
+    RHM_ROW_##eng(p->efield = dflt;)
+    PROTO_PARAMS(RHM_DEFAULT)
+#undef RHM_DEFAULT
     p->beta_step = 5e-3;
     p->beta_ramp = 100;
-    p->gamma = 0;
-    p->dim = EMBED_DIM_DEFAULT;
-    p->iterations = 200;
     p->min_iterations = 110;
     p->stop_change = 1e-9;
 }
 
 int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
 {
+#define RHM_CHECK(name, cli, type, dflt, lo, hi, fl, eng, efield, ...)                      \
+    RHM_ROW_##eng(if (proto_param_check(PROTO_P_##name, (double)p->efield, err, errsz)) \
+                      return RHM_EPARAM;)
+    PROTO_PARAMS(RHM_CHECK)
+#undef RHM_CHECK
 #define NEED(cond, field, what)                                                     \
     if (!(cond))                                                                    \
         return errbuf_set(err, errsz, RHM_EPARAM, "RHM parameter %s must be %s", field, what)
-    NEED(rhm_start_name(p->start) != NULL, "start", "distances or voronoi");
-    NEED(isfinite(p->alpha) && p->alpha > 0 && p->alpha < 1, "alpha", "in (0, 1)");
     NEED(isfinite(p->beta_step) && p->beta_step > 0, "beta-step", "a finite number > 0");
     NEED(p->beta_ramp >= 1, "beta-ramp", "an integer >= 1");
-    NEED(isfinite(p->gamma) && p->gamma >= 0, "landmark-weight", "a finite number >= 0");
-    NEED(p->dim >= 3 && p->dim <= EMBED_MAX_DIM, "dim", "an integer in [3, 64]");
-    NEED(p->iterations >= 1 && p->iterations <= 1000000, "iterations", "an integer in [1, 1000000]");
     NEED(p->min_iterations >= 1, "min-iterations", "an integer >= 1");
     NEED(isfinite(p->stop_change) && p->stop_change >= 0, "stop-change", "a finite number >= 0");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");

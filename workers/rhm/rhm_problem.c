@@ -128,9 +128,9 @@ int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_p
     int rc = rhm_params_check(p, err, errsz);
     if (rc)
         return rc;
-    if (!L || L->n < LMK_MIN_PAIRS)
+    if (!L || L->n < PROTO_MIN_LANDMARKS)
         return errbuf_set(err, errsz, RHM_EINPUT, "RHM needs at least %d landmark pairs, got %d",
-                          LMK_MIN_PAIRS, L ? L->n : 0);
+                          PROTO_MIN_LANDMARKS, L ? L->n : 0);
     for (int r = 0; r < L->n; r++) {
         if (L->src[r] < 0 || L->src[r] >= S->nv || L->tgt[r] < 0 || L->tgt[r] >= T->nv)
             return errbuf_set(err, errsz, RHM_EINPUT, "landmark %d (%d, %d) out of range",
