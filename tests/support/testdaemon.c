@@ -97,24 +97,69 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     FAILF("meshcorrd did not write its port file; log %s", d->log);
 }
 
-int testdaemon_stop(testdaemon *d, int sig)
+/* "exit status N" / "killed by signal N (NAME)" for a wait status. */
+static const char *status_text(int st, char *buf, size_t sz)
 {
-    int st = 0;
-    if (d->pid <= 0)
-        return -1;
-    kill(d->pid, sig);
-    for (int i = 0; i < 2000; i++) {
+    if (WIFEXITED(st))
+        snprintf(buf, sz, "exit status %d", WEXITSTATUS(st));
+    else if (WIFSIGNALED(st))
+        snprintf(buf, sz, "killed by signal %d (%s)%s", WTERMSIG(st), strsignal(WTERMSIG(st)),
+                 WCOREDUMP(st) ? ", core dumped" : "");
+    else
+        snprintf(buf, sz, "wait status %#x", st);
+    return buf;
+}
+
+/* The daemon's wait status once it has exited, waiting at most ms; -1 if it
+ * still runs. */
+static int reap(testdaemon *d, int ms)
+{
+    int st;
+    for (int i = 0; i <= ms / 10; i++) {
         if (waitpid(d->pid, &st, WNOHANG) == d->pid) {
             d->pid = 0;
             return st;
         }
-        sleep_ms(10);
+        if (i < ms / 10)
+            sleep_ms(10);
     }
+    return -1;
+}
+
+void testdaemon_stop(testdaemon *d, int sig)
+{
+    char what[128];
+    if (d->pid <= 0)
+        FAILF("testdaemon_stop: meshcorrd is not running");
+    if (sig)
+        kill(d->pid, sig);
+    int st = reap(d, 20000);
+    if (st == -1) {
+        kill(d->pid, SIGKILL);
+        waitpid(d->pid, &st, 0);
+        d->pid = 0;
+        FAILF("meshcorrd did not exit within 20 s of signal %d; log %s", sig, d->log);
+    }
+    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0)
+        FAILF("meshcorrd stopped with signal %d ended with %s, not exit status 0; log %s", sig,
+              status_text(st, what, sizeof what), d->log);
+}
+
+void testdaemon_kill(testdaemon *d)
+{
+    char what[128];
+    if (d->pid <= 0)
+        FAILF("testdaemon_kill: meshcorrd is not running");
+    int st = reap(d, 0);
+    if (st != -1)
+        FAILF("meshcorrd had already ended (%s) before the test's SIGKILL; log %s",
+              status_text(st, what, sizeof what), d->log);
     kill(d->pid, SIGKILL);
     waitpid(d->pid, &st, 0);
     d->pid = 0;
-    FAILF("meshcorrd did not exit within 20 s of signal %d", sig);
-    return st;
+    if (!WIFSIGNALED(st) || WTERMSIG(st) != SIGKILL)
+        FAILF("meshcorrd ended with %s, not by the test's SIGKILL; log %s", status_text(st, what, sizeof what),
+              d->log);
 }
 
 mc_client *testdaemon_client(const testdaemon *d, const char *token)

@@ -32,9 +32,14 @@ void testdaemon_need_worker(void);
  * until it listens; with the same name again, restarts on the same state.
  * Fails the test when it cannot. */
 void testdaemon_start(testdaemon *d, const char *name, const char *const *args);
-/* Sends sig and waits for the daemon's exit (at most 20 s, then SIGKILL);
- * returns its wait status. */
-int testdaemon_stop(testdaemon *d, int sig);
+/* Sends sig (0: none, the daemon is already shutting down) and waits for
+ * its exit, at most 20 s (then SIGKILL). Fails the test unless meshcorrd
+ * exited with status 0: a daemon that dies by a signal or exits non-zero at
+ * any point before it is stopped fails the test that stops it. */
+void testdaemon_stop(testdaemon *d, int sig);
+/* A crash: SIGKILLs the daemon and reaps it. Fails the test when it had
+ * already died (by a signal or an exit) before the SIGKILL. */
+void testdaemon_kill(testdaemon *d);
 /* A connected client: token NULL = the Unix socket (peer credentials), else
  * TCP with that token. Fails the test when it cannot connect. */
 mc_client *testdaemon_client(const testdaemon *d, const char *token);

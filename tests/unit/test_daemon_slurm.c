@@ -219,7 +219,7 @@ TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 
     testdaemon_wait_state(c, b, MC_RUNNING, 30);
     sleep_ms(500);
     mc_close(c);
-    testdaemon_stop(&d, SIGKILL);
+    testdaemon_kill(&d);
     /* the Slurm jobs run on without meshcorrd */
     char st[64];
     CHECK_STR_HAS(testslurm_state(&d, a, st, sizeof st), "RUNNING");
