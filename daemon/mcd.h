@@ -325,18 +325,7 @@ void notify_close(mcd *d);        /* stops the STATUS= timer */
 void reload_init(mcd *d, int argc, char **argv);  /* SIGHUP handler */
 void reload_close(mcd *d);
 
-/* ---- wsup_: the local backend (called through bk_, backend.h) ------------- */
-int wsup_init(mcd *d, char *err, size_t errsz);
-/* Starts pending jobs on idle slots while both exist. */
-void wsup_schedule(mcd *d);
-/* Sends SIGTERM to the worker running job id; 0, or -1 when none runs it. */
-int wsup_cancel(mcd *d, uint64_t id);
-/* Shutdown: SIGTERM every worker; their jobs return to PENDING. */
-void wsup_drain(mcd *d);
-int wsup_busy(const mcd *d);    /* slots not idle */
-/* Slot i's state (PROTO_SLOT_*) and job (0 = none). */
-void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
-void wsup_close(mcd *d);
+/* ---- wsup_: the local backend (its operations are bk_local, backend.h) -- */
 /* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
 const char *wsup_worker_path(const mcd *d, char *buf, size_t sz);
 /* The worker's --max-faces for the configured --max-vertices. */

@@ -47,6 +47,7 @@ struct wsup_slot {
 };
 
 static void slot_finish(wsup_slot *s);
+static void wsup_schedule(mcd *d);
 
 const char *wsup_worker_path(const mcd *d, char *buf, size_t sz)
 {
@@ -69,7 +70,7 @@ unsigned long long wsup_max_faces(const mcd *d)
     return mf > 40000000 ? 40000000 : mf;
 }
 
-int wsup_init(mcd *d, char *err, size_t errsz)
+static int wsup_init(mcd *d, char *err, size_t errsz)
 {
     d->slots = calloc((size_t)d->conf.workers, sizeof *d->slots);
     if (!d->slots) {
@@ -355,7 +356,7 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     uv_timer_start(&s->timer, on_timer, (uint64_t)d->conf.job_timeout_s * 1000, 0);
 }
 
-void wsup_schedule(mcd *d)
+static void wsup_schedule(mcd *d)
 {
     if (d->draining)
         return;
@@ -371,7 +372,7 @@ void wsup_schedule(mcd *d)
     }
 }
 
-int wsup_cancel(mcd *d, uint64_t id)
+static int wsup_cancel(mcd *d, uint64_t id)
 {
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
@@ -384,7 +385,7 @@ int wsup_cancel(mcd *d, uint64_t id)
     return -1;
 }
 
-void wsup_drain(mcd *d)
+static void wsup_drain(mcd *d)
 {
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
@@ -396,7 +397,7 @@ void wsup_drain(mcd *d)
     }
 }
 
-int wsup_busy(const mcd *d)
+static int wsup_busy(const mcd *d)
 {
     int n = 0;
     for (int i = 0; i < d->conf.workers; i++)
@@ -404,13 +405,13 @@ int wsup_busy(const mcd *d)
     return n;
 }
 
-void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id)
+static void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id)
 {
     *state = d->slots[i].state;
     *job_id = d->slots[i].job_id;
 }
 
-void wsup_close(mcd *d)
+static void wsup_close(mcd *d)
 {
     if (!d->slots)
         return;

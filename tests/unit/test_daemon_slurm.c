@@ -4,7 +4,8 @@
  * spool's progress.frames; the demo pair's map identical to the local
  * backend's; CANCEL as scancel; Slurm's time limit as TIMEOUT; meshcorrd
  * SIGKILLed and restarted while Slurm runs its jobs re-attaches without
- * submitting anything twice; a missing sbatch or an unreachable controller is
+ * submitting anything twice; SIGTERM under systemd (sd_notify) exits 0 and
+ * leaves the jobs in Slurm; a missing sbatch or an unreachable controller is
  * in STATS and the job stays PENDING.
  *
  * The binary re-executes itself inside a private pid + network namespace
@@ -21,10 +22,13 @@
 #include "mesh/mesh.h"
 #include "meshcorr.h"
 
+#include <poll.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -242,6 +246,75 @@ TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 
         mc_result_free(&r);
         CHECK_INT(testslurm_count(&d, id), 1);   /* one sbatch per job */
     }
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* Reads notify datagrams until one contains `want` (all text kept in log). */
+static int notify_wait(int fd, const char *want, char *log, size_t logsz, int timeout_ms)
+{
+    for (int waited = 0; waited < timeout_ms; waited += 50) {
+        struct pollfd p = {fd, POLLIN, 0};
+        if (poll(&p, 1, 50) <= 0)
+            continue;
+        char msg[1024];
+        ssize_t n = recv(fd, msg, sizeof msg - 1, 0);
+        if (n <= 0)
+            continue;
+        msg[n] = '\0';
+        size_t used = strlen(log);
+        snprintf(log + used, logsz - used, "%s|", msg);
+        if (strstr(msg, want))
+            return 1;
+    }
+    return 0;
+}
+
+/* The local backend's worker slots do not exist here: READY's STATUS= and
+ * the STOPPING=1 of a drain must count the Slurm backend's slots (they read
+ * the local pool's, which only the local backend allocates: SIGSEGV). */
+TEST_T(sigterm_of_a_slurm_daemon_under_systemd_exits_0_and_its_job_completes_after_restart, 120)
+{
+    testslurm_need();
+    char path[700];
+    snprintf(path, sizeof path, "%s/notify.sock", harness_tmpdir());
+    int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    CHECK(fd >= 0);
+    struct sockaddr_un a = {.sun_family = AF_UNIX};
+    CHECK(strlen(path) < sizeof a.sun_path);
+    strcpy(a.sun_path, path);
+    unlink(path);
+    CHECK_INT(bind(fd, (struct sockaddr *)&a, sizeof a), 0);
+    CHECK_INT(setenv("NOTIFY_SOCKET", path, 1), 0);
+    testdaemon d;
+    const char *args[] = {"--slurm-max-jobs", "3", NULL};
+    testslurm_daemon(&d, "term", args);
+    unsetenv("NOTIFY_SOCKET");
+    static char log[16384];
+    if (!notify_wait(fd, "READY=1", log, sizeof log, 5000))
+        FAILF("no READY=1: %s", log);
+    CHECK_STR_HAS(log, "STATUS=0 queued, 0 of 3 slot(s) busy");
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_demo(c, 25);           /* seconds */
+    testdaemon_wait_state(c, id, MC_RUNNING, 30);
+    if (!notify_wait(fd, "1 of 3 slot(s) busy", log, sizeof log, 5000))
+        FAILF("no STATUS= with the job in Slurm: %s", log);
+    mc_close(c);
+    CHECK_INT(kill(d.pid, SIGTERM), 0);
+    if (!notify_wait(fd, "STOPPING=1", log, sizeof log, 5000))
+        FAILF("no STOPPING=1: %s", log);
+    testdaemon_stop(&d, 0);                     /* exit status 0, no second signal */
+    close(fd);
+    char st[64];
+    CHECK_STR_HAS(testslurm_state(&d, id, st, sizeof st), "RUNNING");
+    testslurm_daemon(&d, "term", args);
+    c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    int end = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, NULL, NULL, &end, reason, sizeof reason), 0);
+    if (end != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(end), reason);
+    CHECK_INT(testslurm_count(&d, id), 1);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
