@@ -39,6 +39,22 @@ void bk_close(mcd *d)
         d->bk->close(d);
 }
 
+void bk_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
+{
+    changed[0] = '\0';
+    /* the backend itself is chosen once */
+    bk_note_change(strcmp(n->backend, d->conf.backend) != 0, "backend", changed, sz);
+    memcpy(n->backend, d->conf.backend, sizeof n->backend);
+    ops_of(d)->keep_on_reload(d, n, changed, sz);
+}
+
+void bk_note_change(int differs, const char *name, char *changed, size_t sz)
+{
+    size_t len = strlen(changed);
+    if (differs && len + 1 < sz)
+        snprintf(changed + len, sz - len, "%s%s", len ? ", " : "", name);
+}
+
 int bk_progress_take(mcd *d, uint64_t id, proto_buf *in)
 {
     int n = 0;

@@ -25,6 +25,11 @@ typedef struct bk_ops {
     void (*slot_info)(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
     int (*health)(const mcd *d, char *msg, size_t sz);  /* 1 usable, 0 not (msg says why) */
     void (*close)(mcd *d);                     /* closes its handles (the loop then ends) */
+    /* SIGHUP: n is the re-read configuration; puts back into n the running
+     * values of the options this backend applies only at start (its slot
+     * count above all: the snapshot and the dashboards are sized from it),
+     * and names those that differed in changed ("" none). */
+    void (*keep_on_reload)(const mcd *d, mcd_conf *n, char *changed, size_t sz);
 } bk_ops;
 
 extern const bk_ops bk_local, bk_slurm;
@@ -40,6 +45,9 @@ void bk_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
 int bk_health(const mcd *d, char *msg, size_t sz);
 const char *bk_name(const mcd *d);
 void bk_close(mcd *d);
+void bk_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz);
+/* Appends ", name" (or "name" first) to changed when the option differs. */
+void bk_note_change(int differs, const char *name, char *changed, size_t sz);
 
 /* Decodes the whole PROGRESS frames at the front of in, consumes them, and
  * stores and fans out each as job id's. Returns the number taken, or -1 at a

@@ -815,7 +815,28 @@ static void slurm_close(mcd *d)
         drop_job(S.jobs);
 }
 
+/* slurm-max-jobs is the slot count (the snapshot, STATS and the Modbus
+ * registers are sized from it at start); the progress listener, the spool
+ * paths and the poll timer are set up once too. The sbatch options
+ * (partition, account, time, cpus, mem, extra, worker) are read at each
+ * submission: a reload applies them to the next one. */
+static void slurm_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
+{
+    const mcd_conf *o = &d->conf;
+    bk_note_change(n->slurm_max_jobs != o->slurm_max_jobs, "slurm-max-jobs", changed, sz);
+    bk_note_change(n->slurm_poll_ms != o->slurm_poll_ms, "slurm-poll-ms", changed, sz);
+    bk_note_change(strcmp(n->slurm_spool, o->slurm_spool) != 0, "slurm-spool", changed, sz);
+    bk_note_change(strcmp(n->slurm_progress, o->slurm_progress) != 0, "slurm-progress", changed, sz);
+    bk_note_change(strcmp(n->slurm_progress_host, o->slurm_progress_host) != 0, "slurm-progress-host",
+                   changed, sz);
+    n->slurm_max_jobs = o->slurm_max_jobs;
+    n->slurm_poll_ms = o->slurm_poll_ms;
+    memcpy(n->slurm_spool, o->slurm_spool, sizeof n->slurm_spool);
+    memcpy(n->slurm_progress, o->slurm_progress, sizeof n->slurm_progress);
+    memcpy(n->slurm_progress_host, o->slurm_progress_host, sizeof n->slurm_progress_host);
+}
+
 const bk_ops bk_slurm = {
     "slurm", slurm_init, slurm_schedule, slurm_cancel, slurm_drain, slurm_busy,
-    slurm_nslots, slurm_slot_info, slurm_health, slurm_close,
+    slurm_nslots, slurm_slot_info, slurm_health, slurm_close, slurm_keep_on_reload,
 };

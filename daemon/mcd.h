@@ -219,7 +219,7 @@ typedef struct mcd_snapshot {
     uint32_t uptime_s;            /* since the daemon started */
     uint32_t queued, running, workers;
     uint64_t completed, failed, cancelled;
-    uint32_t nslots;              /* = workers */
+    uint32_t nslots;              /* the backend's slots: workers or slurm-max-jobs */
     snap_slot *slots;             /* nslots, owned by whoever allocated the snapshot */
 } mcd_snapshot;
 
@@ -230,7 +230,8 @@ typedef struct mcd mcd;
 
 /* Loop thread: the snapshot state and a timer publishing every SNAP_PERIOD_MS. */
 int snap_init(mcd *d, char *err, size_t errsz);
-/* Loop thread: the figures now; out->slots holds conf.workers entries. */
+/* Loop thread: the figures now; out->slots holds bk_nslots() entries (the
+ * backend's slot count, fixed at start), fewer if out has less room. */
 void snap_collect(mcd *d, mcd_snapshot *out);
 /* Loop thread: a worker's progress record (kept for its slot's figures). */
 void snap_progress(mcd *d, const proto_progress *p);

@@ -438,7 +438,14 @@ static int wsup_health(const mcd *d, char *msg, size_t sz)
     return 1;
 }
 
+/* The slots are allocated once. */
+static void wsup_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
+{
+    bk_note_change(n->workers != d->conf.workers, "workers", changed, sz);
+    n->workers = d->conf.workers;
+}
+
 const bk_ops bk_local = {
     "local", wsup_init, wsup_schedule, wsup_cancel, wsup_drain, wsup_busy,
-    wsup_nslots, wsup_slot_info, wsup_health, wsup_close,
+    wsup_nslots, wsup_slot_info, wsup_health, wsup_close, wsup_keep_on_reload,
 };

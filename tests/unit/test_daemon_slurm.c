@@ -319,6 +319,67 @@ TEST_T(sigterm_of_a_slurm_daemon_under_systemd_exits_0_and_its_job_completes_aft
     testdaemon_stop(&d, SIGTERM);
 }
 
+static void write_text(const char *path, const char *text)
+{
+    FILE *fp = fopen(path, "w");
+    if (!fp)
+        FAILF("cannot write %s", path);
+    fputs(text, fp);
+    fclose(fp);
+}
+
+/* slurm-max-jobs is the Slurm backend's slot count, and the status snapshot
+ * is sized from it at start: a SIGHUP raising it must keep the running value
+ * (with a warning), never let the snapshot index past its arrays. The daemon
+ * runs with glibc's malloc checks (a canary after every block, checked when
+ * it is freed), so a write past the snapshot ends it by SIGABRT. */
+TEST_T(sighup_raising_slurm_max_jobs_keeps_the_slot_count_and_writes_nothing_past_it, 120)
+{
+    testslurm_need();
+    static const char dbg[] = "/usr/lib/x86_64-linux-gnu/libc_malloc_debug.so.0";
+    if (access(dbg, R_OK) == 0) {
+        setenv("LD_PRELOAD", dbg, 1);
+        setenv("GLIBC_TUNABLES", "glibc.malloc.check=3", 1);
+    }
+    char conf[700];
+    snprintf(conf, sizeof conf, "%s/reload.conf", harness_tmpdir());
+    write_text(conf, "slurm-max-jobs = 2\n");
+    testdaemon d;
+    const char *args[] = {"--config", conf, NULL};
+    testslurm_daemon(&d, "reload", args);
+    unsetenv("LD_PRELOAD");
+    unsetenv("GLIBC_TUNABLES");
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_server_stats st;
+    CHECK_INT(mc_stats(c, &st), 0);
+    CHECK_INT(st.nslots, 2);
+    mc_stats_free(&st);
+    write_text(conf, "slurm-max-jobs = 64\n");
+    CHECK_INT(kill(d.pid, SIGHUP), 0);
+    for (int i = 0; i < 500 && !testdaemon_log_has(&d, "reload: options applied"); i++)
+        sleep_ms(10);
+    CHECK(testdaemon_log_has(&d, "reload: options applied"));
+    CHECK(testdaemon_log_has(&d, "slurm-max-jobs changed but take(s) effect at the next start only"));
+    uint64_t ids[4];
+    for (int i = 0; i < 4; i++)
+        ids[i] = submit_ok(c, 2, 0);
+    uint32_t most = 0;
+    for (int done = 0; !done;) {
+        CHECK_INT(mc_stats(c, &st), 0);
+        CHECK_INT(st.nslots, 2);            /* the slot count of the start */
+        if (st.running > most)
+            most = st.running;
+        done = st.completed + st.failed + st.cancelled == 4;
+        mc_stats_free(&st);
+        sleep_ms(100);
+    }
+    CHECK(most >= 1 && most <= 2);          /* still at most 2 jobs in Slurm at once */
+    for (int i = 0; i < 4; i++)
+        CHECK_INT(testdaemon_wait_state(c, ids[i], -1, 10), MC_COMPLETED);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);           /* exit 0: no canary was overwritten */
+}
+
 TEST_T(missing_sbatch_is_in_stats_and_the_job_stays_pending, 60)
 {
     testslurm_need();
