@@ -5,6 +5,7 @@
  *   dlog.c   dlog_   leveled log lines on stderr
  *   auth.c   auth_   tokens file (TCP) and peer credentials (Unix socket)
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
+ *   wlock.c  wlock_  a job's worker lock: two workers of one job never run
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
  *   backend.c bk_    where jobs run (backend.h): `local` or `slurm`
  *   wsup.c   wsup_   the local backend: worker processes, progress pipe, exit
@@ -145,11 +146,13 @@ int64_t store_now_ms(void);
 int store_open(const char *dir, store **out, char *err, size_t errsz);
 /* NULL ok; never while a store_submit runs. */
 void store_close(store *s);
-/* After a restart: RUNNING jobs go back to PENDING (a leftover worker of the
- * previous daemon is killed), spool dirs without a row are removed, unfinished
- * rows without job.frame become FAILED. Unfinished jobs with a Slurm job id
- * are left as they are with keep_slurm (the Slurm backend re-attaches), else
- * they go back to PENDING too. */
+/* After a restart: every worker a previous daemon left running is killed
+ * (found by its job's worker lock, wlock_), an unfinished local job whose
+ * worker had written a valid result.frame is COMPLETED with it (adopted, not
+ * run again), other RUNNING jobs go back to PENDING, spool dirs without a
+ * row are removed, unfinished rows without job.frame become FAILED.
+ * Unfinished jobs with a Slurm job id are left as they are with keep_slurm
+ * (the Slurm backend re-attaches), else they go back to PENDING too. */
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
 /* Durable insert: spool/<id>/job.frame (fsynced) and the row, committed
  * together; *id is the committed row's. Any thread (it blocks on the disk:
@@ -167,6 +170,9 @@ int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progres
 int store_set_reason(store *s, uint64_t id, const char *reason);
 /* One more run of job id ended in a worker crash: the count after it. */
 int store_add_crash(store *s, uint64_t id, uint32_t *crashes);
+/* 1 when spool/<id>/result.frame is a whole, valid RESULT_OK frame of job id
+ * (CRCs checked); 0 otherwise, with why in why. Reads the whole file. */
+int store_result_ok(store *s, uint64_t id, char *why, size_t wsz);
 /* Drops a previous run's history and result files before a (re)run. */
 int store_clear_run(store *s, uint64_t id);
 int store_latest_progress(store *s, uint64_t id, proto_progress *out); /* 0 or NOT_FOUND */
@@ -185,6 +191,22 @@ void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *c
 /* <dir>/spool/<id>[/file] into buf. */
 const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz);
 int store_is_terminal(int state);
+
+/* ---- wlock_ --------------------------------------------------------------- */
+#define WLOCK_FILE "worker.lock"      /* in the job's spool directory */
+#define WLOCK_WORKER_FD 4             /* the worker's descriptor of the locked file */
+#define WLOCK_HELD 1
+#define WLOCK_RECOVER_WAIT_MS 5000    /* recovery: a killed orphan lets go within this */
+#define WLOCK_START_WAIT_MS 200       /* a start that finds an orphan: the loop waits at most this */
+/* Opens (creating) path and takes its lock: 0 with *fd (close-on-exec)
+ * locked, WLOCK_HELD when another process holds it, or -errno. */
+int wlock_take(const char *path, int *fd);
+/* The worker's pid into the locked file, for people (nothing reads it back). */
+void wlock_note_pid(int fd, long pid);
+/* SIGKILLs every process that holds path's lock and waits, at most wait_ms,
+ * until it is free: the number of processes killed (0: it was free), or -1
+ * when it is still held. Blocks the caller for that long. */
+int wlock_kill_holders(const char *path, int wait_ms);
 
 /* ---- sched_ --------------------------------------------------------------- */
 typedef struct sched sched;

@@ -27,6 +27,8 @@
 #define WSUP_PROGRESS_FD 3
 #define WSUP_EOF_GRACE_MS 2000      /* after exit, wait this long for the pipe's EOF */
 #define WSUP_MAX_CRASHES 2          /* worker crashes that fail a job */
+#define WSUP_RETRY_MIN_MS 500       /* a start failed for a passing reason: the first retry */
+#define WSUP_RETRY_MAX_MS 30000     /* ... and the longest wait between retries */
 
 struct wsup_slot {
     mcd *d;
@@ -45,6 +47,16 @@ struct wsup_slot {
     int progress_bad;               /* a malformed frame: ignore the rest */
     proto_buf in;
 };
+
+/* Starts are paused after one failed for a passing reason (descriptors or
+ * processes exhausted, an orphan still holding the job's lock): the job goes
+ * back to the queue and starts resume after a delay that doubles, up to
+ * WSUP_RETRY_MAX_MS, until a start succeeds. */
+static struct {
+    uv_timer_t timer;
+    int open, paused;
+    uint64_t delay_ms;
+} R;
 
 static void slot_finish(wsup_slot *s);
 static void wsup_schedule(mcd *d);
@@ -86,6 +98,11 @@ static int wsup_init(mcd *d, char *err, size_t errsz)
         uv_timer_init(d->loop, &s->timer);
         s->timer.data = s;
     }
+    uv_timer_init(d->loop, &R.timer);
+    R.timer.data = d;
+    R.open = 1;
+    R.paused = 0;
+    R.delay_ms = WSUP_RETRY_MIN_MS;
     char buf[PATH_MAX];
     const char *w = wsup_worker_path(d, buf, sizeof buf);
     if (access(w, X_OK) != 0)
@@ -273,9 +290,80 @@ static void slot_finish(wsup_slot *s)
         uv_close((uv_handle_t *)&s->proc, on_handle_closed);
 }
 
-static void slot_start(wsup_slot *s, uint64_t id, const char *user)
+
+static void on_retry(uv_timer_t *t)
+{
+    R.paused = 0;
+    wsup_schedule(t->data);
+}
+
+static int transient_spawn_error(int uv_err)
+{
+    return uv_err == UV_EMFILE || uv_err == UV_ENFILE || uv_err == UV_EAGAIN || uv_err == UV_ENOMEM;
+}
+
+/* Job id could not start for a passing reason (why): back to the queue,
+ * with why as its reason, and starts paused for a while. */
+static void start_later(mcd *d, uint64_t id, const char *user, const char *why)
+{
+    char reason[PROTO_MAX_STRING + 1];
+    snprintf(reason, sizeof reason, "waiting to start: %s (retried in %.1f s)", why, (double)R.delay_ms / 1000);
+    dlog(DLOG_WARN, "job %llu: %s", (unsigned long long)id, reason);
+    sched_done(d->sched, user);
+    store_job j;
+    if (store_get(d->store, id, &j) == 0 && sched_add(d->sched, id, user, j.priority) == 0)
+        store_set_reason(d->store, id, reason);
+    else
+        dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue (it runs after the next restart)",
+             (unsigned long long)id);
+    R.paused = 1;
+    uv_timer_start(&R.timer, on_retry, R.delay_ms, 0);
+    R.delay_ms = R.delay_ms * 2 > WSUP_RETRY_MAX_MS ? WSUP_RETRY_MAX_MS : R.delay_ms * 2;
+}
+
+/* Takes job id's worker lock (wlock.c) into *fd: 0, or 1 when the job cannot
+ * start now (start_later was called). A holder can only be a worker some
+ * earlier daemon left that recovery could not end: it is killed first. */
+static int take_worker_lock(mcd *d, uint64_t id, const char *user, int *fd)
+{
+    char path[CONF_PATH + 64], why[PROTO_MAX_STRING];
+    store_spool_path(d->store, id, WLOCK_FILE, path, sizeof path);
+    int rc = wlock_take(path, fd);
+    if (rc == WLOCK_HELD) {
+        int n = wlock_kill_holders(path, WLOCK_START_WAIT_MS);
+        dlog(DLOG_WARN, "job %llu: a worker of an earlier daemon still held the job: %s",
+             (unsigned long long)id, n > 0 ? "killed" : "still alive");
+        rc = n >= 0 ? wlock_take(path, fd) : WLOCK_HELD;
+    }
+    if (rc == 0)
+        return 0;
+    if (rc == WLOCK_HELD)
+        snprintf(why, sizeof why, "a worker of an earlier daemon still runs it");
+    else
+        snprintf(why, sizeof why, "cannot lock %.900s: %s", path, strerror(-rc));
+    start_later(d, id, user, why);
+    return 1;
+}
+
+/* Starts job id on slot s: 0 when the slot took it (or it ended at once),
+ * 1 when starts are paused (start_later). */
+static int slot_start(wsup_slot *s, uint64_t id, const char *user)
 {
     mcd *d = s->d;
+    int lock_fd;
+    if (take_worker_lock(d, id, user, &lock_fd))
+        return 1;
+    char why[256];
+    if (store_result_ok(d->store, id, why, sizeof why)) {
+        /* a worker finished it while no daemon watched: the answer is there */
+        close(lock_fd);
+        dlog(DLOG_INFO, "job %llu: COMPLETED: result.frame already there (adopted)", (unsigned long long)id);
+        if (store_set_state(d->store, id, PROTO_STATE_COMPLETED, "finished while the daemon was down: result adopted"))
+            dlog(DLOG_ERROR, "job %llu: cannot record its end", (unsigned long long)id);
+        sched_done(d->sched, user);
+        req_job_ended(d, id);
+        return 0;
+    }
     memset(&s->proc, 0, sizeof s->proc);
     s->job_id = id;
     snprintf(s->user, sizeof s->user, "%s", user);
@@ -317,48 +405,56 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     s->pipe.data = s;
     s->proc.data = s;
     s->open_handles = 2;
-    uv_stdio_container_t stdio[4];
+    uv_stdio_container_t stdio[WLOCK_WORKER_FD + 1];
     stdio[0].flags = UV_IGNORE;
     stdio[1].flags = UV_INHERIT_FD;    /* the worker's output joins our log */
     stdio[1].data.fd = 2;
     stdio[2].flags = UV_INHERIT_FD;
     stdio[2].data.fd = 2;
-    stdio[3].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
-    stdio[3].data.stream = (uv_stream_t *)&s->pipe;
+    stdio[WSUP_PROGRESS_FD].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
+    stdio[WSUP_PROGRESS_FD].data.stream = (uv_stream_t *)&s->pipe;
+    stdio[WLOCK_WORKER_FD].flags = UV_INHERIT_FD;   /* the job's lock, held from the fork on */
+    stdio[WLOCK_WORKER_FD].data.fd = lock_fd;
     uv_process_options_t opt;
     memset(&opt, 0, sizeof opt);
     opt.file = argv[0];
     opt.args = argv;
     opt.exit_cb = on_exit_cb;
     opt.stdio = stdio;
-    opt.stdio_count = 4;
+    opt.stdio_count = WLOCK_WORKER_FD + 1;
     int rc = uv_spawn(d->loop, &s->proc, &opt);
+    if (rc == 0)
+        wlock_note_pid(lock_fd, (long)s->proc.pid);
+    close(lock_fd);                    /* the worker holds the lock now, alone */
     if (rc) {
         dlog(DLOG_ERROR, "job %llu: cannot start %s: %s", (unsigned long long)id, argv[0], uv_strerror(rc));
-        store_set_running(d->store, id, store_now_ms(), 0);
-        /* finish as a crash with the reason below */
-        s->exited = s->eof = 1;
-        s->exit_status = 127;
-        s->finished = 1;
-        char reason[PROTO_MAX_STRING];
-        snprintf(reason, sizeof reason, "cannot start worker %s: %s", argv[0], uv_strerror(rc));
-        store_set_state(d->store, id, PROTO_STATE_FAILED, reason);
-        sched_done(d->sched, s->user);
-        req_job_ended(d, id);
+        /* no process: the slot is idle once both handles are closed */
+        s->exited = s->eof = s->finished = 1;
         uv_close((uv_handle_t *)&s->pipe, on_handle_closed);
         uv_close((uv_handle_t *)&s->proc, on_handle_closed);
-        return;
+        char reason[PROTO_MAX_STRING];
+        snprintf(reason, sizeof reason, "cannot start worker %s: %s", argv[0], uv_strerror(rc));
+        if (transient_spawn_error(rc)) {
+            start_later(d, id, user, reason);
+            return 1;
+        }
+        store_set_state(d->store, id, PROTO_STATE_FAILED, reason);
+        sched_done(d->sched, user);
+        req_job_ended(d, id);
+        return 0;
     }
+    R.delay_ms = WSUP_RETRY_MIN_MS;
     dlog(DLOG_INFO, "job %llu: started on slot %d, worker pid %d", (unsigned long long)id, s->index, s->proc.pid);
     store_set_running(d->store, id, store_now_ms(), s->proc.pid);
     uv_read_start((uv_stream_t *)&s->pipe, on_alloc, on_read);
     uv_update_time(d->loop);     /* the wall time counts from now, not the loop's cached time */
     uv_timer_start(&s->timer, on_timer, (uint64_t)d->conf.job_timeout_s * 1000, 0);
+    return 0;
 }
 
 static void wsup_schedule(mcd *d)
 {
-    if (d->draining)
+    if (d->draining || R.paused)
         return;
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
@@ -366,9 +462,8 @@ static void wsup_schedule(mcd *d)
             continue;
         char user[AUTH_MAX_USER];
         uint64_t id = sched_next(d->sched, user);
-        if (!id)
+        if (!id || slot_start(s, id, user))
             return;
-        slot_start(s, id, user);
     }
 }
 
@@ -413,6 +508,10 @@ static void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id
 
 static void wsup_close(mcd *d)
 {
+    if (R.open) {
+        R.open = 0;
+        uv_close((uv_handle_t *)&R.timer, NULL);
+    }
     if (!d->slots)
         return;
     for (int i = 0; i < d->conf.workers; i++) {

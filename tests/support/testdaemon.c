@@ -192,6 +192,74 @@ static int cmdline_has_job(pid_t pid, uint64_t id)
     return 0;
 }
 
+/* The --job argument of process pid into dir ("" none); its state letter. */
+static char job_dir_of(pid_t pid, char *dir, size_t sz)
+{
+    char path[64], cmd[8192], stat[512];
+    dir[0] = '\0';
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *fp = fopen(path, "r");
+    char state = '?';
+    if (!fp)
+        return state;
+    if (fgets(stat, sizeof stat, fp)) {
+        char *rp = strrchr(stat, ')');
+        if (rp && rp[1])
+            state = rp[2];
+    }
+    fclose(fp);
+    snprintf(path, sizeof path, "/proc/%d/cmdline", (int)pid);
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return state;
+    ssize_t n = read(fd, cmd, sizeof cmd - 1);
+    close(fd);
+    if (n <= 0)
+        return state;
+    cmd[n] = '\0';
+    for (ssize_t i = 0; i < n; i += (ssize_t)strlen(cmd + i) + 1)
+        if (strcmp(cmd + i, "--job") == 0 && i + 6 < n) {
+            snprintf(dir, sz, "%s", cmd + i + 6);
+            break;
+        }
+    return state;
+}
+
+/* Counts (and sends sig to, unless 0) every live process whose --job is in
+ * d's spool and, with id > 0, is job id's directory. */
+static int each_worker(const testdaemon *d, uint64_t id, int sig)
+{
+    char want[700], prefix[700], dir[4096];
+    snprintf(want, sizeof want, "%s/spool/%llu", d->state, (unsigned long long)id);
+    snprintf(prefix, sizeof prefix, "%s/spool/", d->state);
+    int n = 0;
+    DIR *dp = opendir("/proc");
+    struct dirent *de;
+    while (dp && (de = readdir(dp))) {
+        pid_t pid = (pid_t)atoi(de->d_name);
+        if (pid <= 0 || job_dir_of(pid, dir, sizeof dir) == 'Z' || !dir[0])
+            continue;
+        if (id ? strcmp(dir, want) == 0 : strncmp(dir, prefix, strlen(prefix)) == 0) {
+            n++;
+            if (sig)
+                kill(pid, sig);
+        }
+    }
+    if (dp)
+        closedir(dp);
+    return n;
+}
+
+int testdaemon_live_workers(const testdaemon *d, uint64_t id)
+{
+    return each_worker(d, id, 0);
+}
+
+int testdaemon_kill_workers(const testdaemon *d)
+{
+    return each_worker(d, 0, SIGKILL);
+}
+
 pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id)
 {
     for (int tries = 0; tries < 1000; tries++) {

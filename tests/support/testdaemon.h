@@ -48,6 +48,12 @@ int testdaemon_log_has(const testdaemon *d, const char *what);
 /* Pid of the meshcorr-worker the daemon runs for job id, or -1 (waits up to
  * 10 s for it to appear). */
 pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id);
+/* Live (not zombie) meshcorr-worker processes of job id of d's state
+ * directory, whoever their parent is (orphans of a killed daemon count). */
+int testdaemon_live_workers(const testdaemon *d, uint64_t id);
+/* SIGKILLs every process working in d's spool (cleanup of a test that
+ * leaves orphans behind); the number killed. */
+int testdaemon_kill_workers(const testdaemon *d);
 /* Polls STATUS until the job is in `state` (or, with state < 0, in any final
  * state); fails the test after timeout_s. Returns the state. */
 int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s);
