@@ -498,6 +498,23 @@ TEST(worker_refuses_beta_ramp_of_zero_iterations)
     expect_error(NULL, 1, PROTO_EBAD_PARAMS, "beta-ramp", NULL);
 }
 
+TEST(worker_refuses_rhm_alpha_out_of_range_naming_it_once)
+{
+    static const proto_landmark L[5] = { {0, 0}, {10, 10}, {20, 20}, {30, 30}, {40, 40} };
+    testjob j;
+    demo_job(&j, L, 5, 0);
+    j.msg.u.submit.params.rhm_alpha = 2;
+    save(&j);
+    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "RHM parameter alpha must be in (0, 1)", NULL);
+    proto_msg m;
+    unsigned char *file;
+    read_frame(job_dir(), "error.frame", &m, &file);
+    if (strstr(m.u.error.message, "RHM RHM"))
+        FAILF("doubled prefix: %s", m.u.error.message);
+    proto_msg_free(&m);
+    free(file);
+}
+
 TEST(worker_refuses_job_frame_with_corrupted_blob_checksum)
 {
     testjob j;

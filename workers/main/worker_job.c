@@ -51,7 +51,7 @@ static int map_params(const proto_params *w, const wrk_limits *lim, ectm_params 
     r->start = w->rhm_start;
     char detail[256];
     if (rhm_params_check(r, detail, sizeof detail))
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "RHM %s", detail);
+        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "%s", detail);   /* "RHM parameter ..." */
     ectm_params_init(p);
     /* backend: "" (cpu), "cpu", "opencl", "auto", optionally ":DEVICE" */
     if (w->backend[0]) {
