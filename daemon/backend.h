@@ -1,8 +1,9 @@
 /* backend.h — where meshcorrd's jobs run. A backend takes jobs from the
  * scheduler (sched_next), runs them against their spool directory with
- * meshcorr-worker (workers/WORKER.md), feeds their PROGRESS records to the
- * store and the watchers (bk_progress_take), and records their end in the
- * store (req_job_ended). Two of them, chosen by `backend =`:
+ * meshcorr-worker (workers/WORKER.md), feeds their PROGRESS records to
+ * job_progress (bk_progress_take), and reports each run's start and end to
+ * job.c (job_running, job_ended), which records them and tells the watchers;
+ * a backend decides only which state its worker's run ended in. Two of them, chosen by `backend =`:
  *
  *   local  wsup.c      worker processes on this machine (--workers slots)
  *   slurm  bk_slurm.c  one Slurm batch job per meshcorr job (sbatch, squeue,
@@ -54,11 +55,6 @@ void bk_note_change(int differs, const char *name, char *changed, size_t sz);
  * frame that is not a valid PROGRESS (in is then reset; the caller ignores
  * the rest of that stream). */
 #define BK_MAX_PROGRESS_FRAME 4096
-/* A worker's error.frame at path: its protocol error code and message
- * (msg); 0 when there is none, PROTO_EINTERNAL when it does not decode.
- * Loop thread only (one static buffer). */
-#define BK_MAX_ERROR_FRAME (1 << 20)
-int bk_error_frame(const char *path, char *msg, size_t msz);
 int bk_progress_take(mcd *d, uint64_t id, proto_buf *in);
 
 /* ---- bk_cmd.c: one external command, asynchronously ---------------------- */

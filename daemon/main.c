@@ -54,6 +54,7 @@ void mcd_drained(mcd *d)
     dlog(DLOG_INFO, "drained: no worker running, no request in the thread pool; closing");
     srv_close_all(d);
     bk_close(d);
+    job_close(d);
     snap_close(d);
     uv_close((uv_handle_t *)&d->sweep, NULL);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
@@ -109,6 +110,7 @@ int main(int argc, char **argv)
         dlog(DLOG_ERROR, "cannot rebuild the queue from the store");
         goto done;
     }
+    job_init(&d);
     if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
         (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.snap, &d.metrics, err, sizeof err))) {
@@ -137,6 +139,7 @@ done:
         /* a start-up failure: close whatever was opened */
         srv_stop_listening(&d);
         bk_close(&d);
+        job_close(&d);
         snap_close(&d);
         uv_run(d.loop, UV_RUN_NOWAIT);
     }

@@ -7,6 +7,7 @@
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
  *   wlock.c  wlock_  a job's worker lock: two workers of one job never run
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
+ *   job.c    job_    a running job's life: start, progress, end (both backends)
  *   backend.c bk_    where jobs run (backend.h): `local` or `slurm`
  *   wsup.c   wsup_   the local backend: worker processes, progress pipe, exit
  *   bk_slurm.c       the slurm backend: sbatch/squeue/scancel, re-attach
@@ -39,6 +40,7 @@
 #include <stdio.h>
 #include <uv.h>
 #include "proto.h"
+#include "spool.h"
 
 /* ---- conf_ ---------------------------------------------------------------- */
 #define CONF_MAX_LISTEN 8
@@ -193,8 +195,6 @@ const char *store_spool_path(const store *s, uint64_t id, const char *file, char
 int store_is_terminal(int state);
 
 /* ---- wlock_ --------------------------------------------------------------- */
-#define WLOCK_FILE "worker.lock"      /* in the job's spool directory */
-#define WLOCK_WORKER_FD 4             /* the worker's descriptor of the locked file */
 #define WLOCK_HELD 1
 #define WLOCK_RECOVER_WAIT_MS 5000    /* recovery: a killed orphan lets go within this */
 #define WLOCK_START_WAIT_MS 200       /* a start that finds an orphan: the loop waits at most this */
@@ -329,6 +329,22 @@ struct mcd {
     char devices[MCD_MAX_DEVICES][192];
     int ndevices;
 };
+
+/* ---- job_: one owner of a running job's life (job.c) --------------------- */
+void job_init(mcd *d);            /* before the backend starts */
+void job_close(mcd *d);           /* drained: ends not recorded yet are left to recovery */
+/* A backend started job id (pid: its worker's, 0 when not local). */
+void job_running(mcd *d, uint64_t id, long pid);
+/* A PROGRESS record of a running job: stored, fanned out to watchers. */
+void job_progress(mcd *d, const proto_progress *p);
+/* A run of job id (user's; counted: the scheduler counts it as running)
+ * ended in state: terminal, recorded (retried while the store refuses it),
+ * then END to the watchers; or PENDING: back to the scheduler. */
+void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, const char *reason);
+/* What the run's files say: result.frame is there; the state its
+ * error.frame gives (reason "CODE: message"), or -1 without one. */
+int job_has_result(mcd *d, uint64_t id);
+int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz);
 
 /* ---- dev_: the devices a worker sees, asked once of the worker program ---- */
 /* Runs `meshcorr-worker --list-devices` in the background; until it answers

@@ -649,7 +649,7 @@ static void on_result(conn *c, const proto_msg *m)
     r->request_id = m->request_id;
     r->job_id = j.id;
     r->what = q->what;
-    store_spool_path(d->store, j.id, "result.frame", r->path, sizeof r->path);
+    store_spool_path(d->store, j.id, SPOOL_RESULT_FRAME, r->path, sizeof r->path);
     int rc = work_start(d, c, &r->work, result_run, result_done);
     if (rc) {
         dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)j.id,

@@ -323,7 +323,7 @@ static int kill_orphan_workers(store *s, char *err, size_t errsz)
         unsigned long long id = strtoull(de->d_name, &e, 10);
         if (de->d_name[0] == '.' || *e != '\0' || id == 0)
             continue;
-        int n = wlock_kill_holders(store_spool_path(s, id, WLOCK_FILE, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
+        int n = wlock_kill_holders(store_spool_path(s, id, SPOOL_WORKER_LOCK, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
         if (n > 0)
             dlog(DLOG_WARN, "store: job %llu: killed %d worker process(es) a previous daemon left running", id, n);
         else if (n < 0)
@@ -349,7 +349,7 @@ static int adopt_results(store *s, int *adopted, char *err, size_t errsz)
     while (sqlite3_step(st) == SQLITE_ROW) {
         uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
         char path[CONF_PATH + 64];
-        if (access(store_spool_path(s, id, "result.frame", path, sizeof path), F_OK) != 0)
+        if (access(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), F_OK) != 0)
             continue;
         uint64_t *l = realloc(ids, (n + 1) * sizeof *l);
         if (l) {
@@ -439,7 +439,7 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     while (sqlite3_step(st) == SQLITE_ROW) {
         uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
         char path[CONF_PATH + 64];
-        if (access(store_spool_path(s, id, "job.frame", path, sizeof path), R_OK) != 0) {
+        if (access(store_spool_path(s, id, SPOOL_JOB_FRAME, path, sizeof path), R_OK) != 0) {
             uint64_t *l = realloc(lost, (nlost + 1) * sizeof *l);
             if (l) {
                 lost = l;
@@ -672,8 +672,10 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p)
 int store_clear_run(store *s, uint64_t id)
 {
     char path[CONF_PATH + 96];
-    static const char *files[] = {"result.frame", "result.frame.tmp", "error.frame", "error.frame.tmp",
-                                  "progress.frames", "progress.secret", "slurm.out"};
+    /* never SPOOL_WORKER_LOCK: a new file would let a second worker lock it (wlock.c) */
+    static const char *files[] = {SPOOL_RESULT_FRAME, SPOOL_RESULT_FRAME SPOOL_TMP_SUFFIX, SPOOL_ERROR_FRAME,
+                                  SPOOL_ERROR_FRAME SPOOL_TMP_SUFFIX, SPOOL_PROGRESS_FILE, SPOOL_SECRET_FILE,
+                                  SPOOL_SLURM_OUT};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         unlink(store_spool_path(s, id, files[i], path, sizeof path));
     return exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
@@ -682,7 +684,7 @@ int store_clear_run(store *s, uint64_t id)
 int store_result_ok(store *s, uint64_t id, char *why, size_t wsz)
 {
     char path[CONF_PATH + 64];
-    FILE *fp = fopen(store_spool_path(s, id, "result.frame", path, sizeof path), "rb");
+    FILE *fp = fopen(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), "rb");
     if (!fp)
         return errbuf_set(why, wsz, 0, "%s", strerror(errno)), 0;
     uint8_t *buf = NULL;

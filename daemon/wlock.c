@@ -4,7 +4,7 @@
  * DESIGN: two workers of one job never run at once, whatever happens to the
  * daemon. The local backend takes the lock (flock, exclusive, non-blocking)
  * before it starts a worker and hands the locked descriptor to the worker as
- * its descriptor WLOCK_WORKER_FD; the daemon closes its own copy once the
+ * its descriptor SPOOL_LOCK_FD; the daemon closes its own copy once the
  * spawn returned. A flock belongs to the open file, which the child shares
  * from the fork on, through the exec, until its exit; so the lock is held
  * exactly while a process of that run lives, whoever its parent is now (a
@@ -19,7 +19,8 @@
  * file open), not through a recorded pid: the daemon may have died before
  * writing one, and a child between fork and exec has no worker's command
  * line yet. The file is never removed while its job may run (only with the
- * job's spool directory), or a second worker could lock a new file. */
+ * job's spool directory), or a second worker could lock a new file.
+ * File name and descriptor: protocol/spool.h. */
 #include "mcd.h"
 
 #include <dirent.h>

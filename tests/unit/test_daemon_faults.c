@@ -2,15 +2,25 @@
  * real daemon, worker and client: the daemon SIGKILLed right after it
  * spawned workers, round after round, never leaves two live workers of one
  * job (nor more than --workers); a job whose worker finished while the
- * daemon was down is COMPLETED from its result.frame, not run again. */
+ * daemon was down is COMPLETED from its result.frame, not run again; a full
+ * state file system (a small tmpfs the test mounts in a mount namespace of
+ * its own) refuses SUBMIT with STORAGE and loses nothing acknowledged, and
+ * the daemon goes on answering STATUS, RESULT and LIST; a worker that could
+ * not store its answer (exit 4) is a passing condition, not a crash. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "meshcorr.h"
+#include "proto.h"
 
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -171,6 +181,161 @@ TEST_T(result_a_worker_finished_while_the_daemon_was_down_is_adopted_not_rerun, 
     CHECK_INT(mc_stats(c, &stats), 0);
     CHECK_INT(stats.completed, 1);
     mc_stats_free(&stats);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* Fills the file system of dir with one file: bytes written. */
+static long long fill_fs(const char *dir, char *path, size_t psz)
+{
+    snprintf(path, psz, "%s/filler", dir);
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0)
+        FAILF("%s: %s", path, strerror(errno));
+    static char chunk[65536];
+    memset(chunk, 0x5a, sizeof chunk);
+    long long total = 0;
+    for (size_t n = sizeof chunk; n >= 1; n /= 16) {
+        ssize_t w;
+        while ((w = write(fd, chunk, n)) > 0)
+            total += w;
+        if (w < 0 && errno != ENOSPC)
+            FAILF("filling %s: %s", path, strerror(errno));
+    }
+    close(fd);
+    return total;
+}
+
+/* spool/.new-* directories: SUBMITs being stored, or left by a failed one. */
+static int count_new_dirs(const char *spool)
+{
+    DIR *dp = opendir(spool);
+    if (!dp)
+        FAILF("%s: %s", spool, strerror(errno));
+    int n = 0;
+    struct dirent *de;
+    while ((de = readdir(dp)))
+        n += strncmp(de->d_name, ".new-", 5) == 0;
+    closedir(dp);
+    return n;
+}
+
+TEST_T(submit_on_a_full_disk_is_refused_as_storage_and_nothing_acknowledged_is_lost, 120)
+{
+    testdaemon_need_worker();
+    /* the state directory on an 8 MB tmpfs, in a mount namespace of this
+     * test process (and the daemon it starts) only */
+    if (unshare(CLONE_NEWNS) != 0)
+        SKIP("cannot make a mount namespace: %s (needs CAP_SYS_ADMIN)", strerror(errno));
+    CHECK_INT(mount(NULL, "/", NULL, MS_REC | MS_PRIVATE, NULL), 0);
+    char dir[700], state[800];
+    snprintf(dir, sizeof dir, "%s/full", harness_tmpdir());
+    snprintf(state, sizeof state, "%s/state", dir);
+    CHECK_INT(mkdir(dir, 0700), 0);
+    CHECK_INT(mkdir(state, 0700), 0);
+    if (mount("tmpfs", state, "tmpfs", MS_NOSUID | MS_NODEV, "size=8m,mode=0700") != 0)
+        SKIP("cannot mount a tmpfs: %s", strerror(errno));
+    static testdaemon d;
+    const char *args[] = {"--workers", "1", NULL};
+    testdaemon_start(&d, "full", args);
+    cleanup_daemon = &d;
+    atexit(kill_leftovers);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t done = submit_ok(c, 2, 0);
+    CHECK_INT(testdaemon_wait_state(c, done, -1, 60), MC_COMPLETED);
+    uint64_t running = submit_ok(c, 100000, 1);
+    testdaemon_wait_state(c, running, MC_RUNNING, 30);
+    uint64_t pending = submit_ok(c, 2, 0);
+    char filler[900];
+    long long filled = fill_fs(state, filler, sizeof filler);
+    /* every SUBMIT now: STORAGE, naming the full disk; nothing stored */
+    for (int i = 0; i < 5; i++) {
+        int rc;
+        uint64_t id = testdaemon_submit(c, 2, 0, 0, &rc);
+        if (rc != PROTO_ESTORAGE)
+            FAILF("SUBMIT %d on a full disk: %s (%s), job %llu", i, mc_strerror(rc), mc_errmsg(c),
+                  (unsigned long long)id);
+        CHECK_STR_HAS(mc_errmsg(c), "No space left on device");
+        CHECK_STR_HAS(mc_errmsg(c), "job not stored");
+    }
+    char spool[900];
+    snprintf(spool, sizeof spool, "%s/spool", state);
+    CHECK_INT(count_new_dirs(spool), 0);        /* the refused frames were removed */
+    /* still answering: STATUS, RESULT, LIST, STATS */
+    mc_job_status s;
+    CHECK_INT(mc_status(c, done, &s), 0);
+    CHECK_INT(s.state, MC_COMPLETED);
+    CHECK_INT(mc_status(c, running, &s), 0);
+    CHECK_INT(s.state, MC_RUNNING);
+    CHECK_INT(mc_status(c, pending, &s), 0);
+    CHECK_INT(s.state, MC_PENDING);
+    mc_job_result r;
+    CHECK_INT(mc_result(c, done, MC_WANT_P | MC_WANT_Q, &r), 0);
+    CHECK_INT(r.np, 162);
+    mc_result_free(&r);
+    mc_job_info *jobs = NULL;
+    uint32_t n = 0;
+    CHECK_INT(mc_list(c, NULL, 0, &jobs, &n), 0);
+    CHECK_INT(n, 3);
+    free(jobs);
+    mc_server_stats st;
+    CHECK_INT(mc_stats(c, &st), 0);
+    mc_stats_free(&st);
+    CHECK(testdaemon_log_has(&d, "No space left on device"));
+    /* a cancel while full: the end is recorded once the store can take it,
+     * and the pending job does not start a run whose answer has no room */
+    CHECK_INT(mc_cancel(c, running), 0);
+    char waiting[128];
+    snprintf(waiting, sizeof waiting, "job %llu: waiting to start: the state file system is full",
+             (unsigned long long)pending);
+    for (int i = 0; i < 500 && !testdaemon_log_has(&d, waiting); i++)
+        sleep_ms(20);
+    CHECK(testdaemon_log_has(&d, waiting));     /* (the store cannot take that reason now) */
+    CHECK_INT(mc_status(c, pending, &s), 0);
+    CHECK_INT(s.state, MC_PENDING);
+    /* space again: everything acknowledged runs on, and SUBMIT works */
+    CHECK_INT(unlink(filler), 0);
+    CHECK_INT(testdaemon_wait_state(c, running, -1, 30), MC_CANCELLED);
+    CHECK_INT(testdaemon_wait_state(c, pending, -1, 90), MC_COMPLETED);
+    uint64_t after = submit_ok(c, 2, 0);
+    CHECK_INT(testdaemon_wait_state(c, after, -1, 60), MC_COMPLETED);
+    printf("  %lld bytes filled the 8 MB tmpfs; 5 SUBMITs refused as STORAGE, 3 jobs kept;%s\n", filled,
+           testdaemon_log_has(&d, "cannot record its end") ? " the cancel's end was recorded once space came back"
+                                                            : " the cancel's end fitted in the store");
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+    umount2(state, MNT_DETACH);
+}
+
+/* A worker that exits 4 (WORKER.md: no answer could be stored, a full
+ * disk) has not crashed and the job has not failed: it goes back to the
+ * queue, starts pause for a while, and it is tried again, as often as it
+ * takes (here a script that always exits 4). */
+TEST_T(worker_that_cannot_store_its_answer_requeues_the_job_without_counting_a_crash, 60)
+{
+    char script[700];
+    snprintf(script, sizeof script, "%s/no-answer.sh", harness_tmpdir());
+    FILE *fp = fopen(script, "w");
+    CHECK(fp != NULL);
+    fprintf(fp, "#!/bin/sh\necho 'meshcorr-worker: cannot write result.frame: No space left on device' >&2\nexit 4\n");
+    fclose(fp);
+    CHECK_INT(chmod(script, 0755), 0);
+    testdaemon d;
+    const char *args[] = {"--worker", script, NULL};
+    testdaemon_start(&d, "noanswer", args);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_ok(c, 2, 0);
+    char started[64];
+    snprintf(started, sizeof started, "job %llu: started on slot", (unsigned long long)id);
+    for (int i = 0; i < 1500 && log_count(&d, started) < 3; i++)
+        sleep_ms(10);
+    CHECK(log_count(&d, started) >= 3);         /* two crashes would have failed it */
+    mc_job_status s;
+    CHECK_INT(mc_status(c, id, &s), 0);
+    if (s.state != MC_PENDING && s.state != MC_RUNNING)
+        FAILF("job %llu is %s: %s", (unsigned long long)id, mc_state_name(s.state), s.reason);
+    CHECK(testdaemon_log_has(&d, "re-queued: the worker could not store its answer"));
+    CHECK(!testdaemon_log_has(&d, "crash"));
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
