@@ -6,7 +6,8 @@
  * state file system (a small tmpfs the test mounts in a mount namespace of
  * its own) refuses SUBMIT with STORAGE and loses nothing acknowledged, and
  * the daemon goes on answering STATUS, RESULT and LIST; a worker that could
- * not store its answer (exit 4) is a passing condition, not a crash. */
+ * not store its answer (exit 4) is a passing condition, not a crash, and
+ * so is a worker start that fails for want of descriptors. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "meshcorr.h"
@@ -21,6 +22,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mount.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -336,6 +340,87 @@ TEST_T(worker_that_cannot_store_its_answer_requeues_the_job_without_counting_a_c
         FAILF("job %llu is %s: %s", (unsigned long long)id, mc_state_name(s.state), s.reason);
     CHECK(testdaemon_log_has(&d, "re-queued: the worker could not store its answer"));
     CHECK(!testdaemon_log_has(&d, "crash"));
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+static int open_fds(pid_t pid)
+{
+    char dir[64];
+    snprintf(dir, sizeof dir, "/proc/%d/fd", (int)pid);
+    DIR *dp = opendir(dir);
+    if (!dp)
+        return -1;
+    int n = 0;
+    struct dirent *de;
+    while ((de = readdir(dp)))
+        n += de->d_name[0] != '.';
+    closedir(dp);
+    return n;
+}
+
+/* A bare connection to the daemon's Unix socket that says nothing. */
+static int idle_connection(const testdaemon *d)
+{
+    struct sockaddr_un a = {.sun_family = AF_UNIX};
+    snprintf(a.sun_path, sizeof a.sun_path, "%s", d->unix_addr + strlen("unix:"));
+    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    CHECK(fd >= 0);
+    if (connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+#define IDLE_CONNS 60
+
+/* Idle clients hold every descriptor the daemon may open (its limit cut to
+ * what it has open plus 16). A queued job whose turn comes then cannot get
+ * its worker's pipe: that is a passing condition, so the job waits in the
+ * queue and runs once descriptors are free again, it never ends FAILED. */
+TEST_T(worker_start_without_descriptors_waits_and_the_job_completes_later, 90)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    const char *args[] = {"--workers", "1", NULL};
+    testdaemon_start(&d, "nofile", args);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t running = submit_ok(c, 100000, 1);
+    testdaemon_wait_state(c, running, MC_RUNNING, 30);
+    uint64_t queued = submit_ok(c, 2, 0);
+    int base = open_fds(d.pid);
+    CHECK(base > 0);
+    struct rlimit old, rl;
+    CHECK_INT(prlimit(d.pid, RLIMIT_NOFILE, NULL, &old), 0);
+    rl = (struct rlimit){(rlim_t)base + 16, old.rlim_max};       /* the soft limit */
+    CHECK_INT(prlimit(d.pid, RLIMIT_NOFILE, &rl, NULL), 0);
+    int idle[IDLE_CONNS], nidle = 0;
+    for (int i = 0; i < IDLE_CONNS; i++)
+        if ((idle[nidle] = idle_connection(&d)) >= 0)
+            nidle++;
+    for (int i = 0; i < 200 && open_fds(d.pid) < base + 16; i++)
+        sleep_ms(10);
+    int at_limit = open_fds(d.pid);
+    /* the running job ends: the queued one's turn, with no descriptor free */
+    CHECK_INT(mc_cancel(c, running), 0);
+    CHECK_INT(testdaemon_wait_state(c, running, -1, 30), MC_CANCELLED);
+    sleep_ms(1500);
+    mc_job_status s;
+    CHECK_INT(mc_status(c, queued, &s), 0);
+    if (s.state != MC_PENDING && s.state != MC_RUNNING && s.state != MC_COMPLETED)
+        FAILF("queued job %llu ended %s while descriptors ran out: %s", (unsigned long long)queued,
+              mc_state_name(s.state), s.reason);
+    int waited = testdaemon_log_has(&d, "waiting to start: cannot start worker");
+    for (int i = 0; i < nidle; i++)
+        close(idle[i]);
+    CHECK_INT(prlimit(d.pid, RLIMIT_NOFILE, &old, NULL), 0);
+    int end = testdaemon_wait_state(c, queued, -1, 60);
+    CHECK_INT(mc_status(c, queued, &s), 0);
+    if (end != MC_COMPLETED)
+        FAILF("queued job %llu ended %s: %s", (unsigned long long)queued, mc_state_name(end), s.reason);
+    printf("  daemon at %d of %d descriptors (%d idle clients); the queued job %s, then COMPLETED\n",
+           at_limit, base + 16, nidle, waited ? "waited for descriptors" : "found one");
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
