@@ -20,7 +20,7 @@ typedef struct bk_ops {
     int (*init)(mcd *d, char *err, size_t errsz);
     void (*schedule)(mcd *d);                  /* start what can start */
     int (*cancel)(mcd *d, uint64_t id);        /* 0 when the backend has the job and stops it */
-    void (*drain)(mcd *d);                     /* shutdown: mcd_drained() once busy() is 0 */
+    void (*drain)(mcd *d);                     /* shutdown: drain_check() once busy() is 0 */
     int (*busy)(const mcd *d);                 /* runs this daemon must wait for on shutdown */
     int (*nslots)(const mcd *d);               /* STATS slots */
     void (*slot_info)(const mcd *d, int i, uint8_t *state, uint64_t *job_id);

@@ -1,6 +1,8 @@
 /* job.c — one owner of a job's life once a backend runs it: its start, its
  * progress and its end are recorded here and nowhere else (the backends
- * decide from what their worker left and call these; backend.h).
+ * decide from what their worker left and call these; backend.h); and its
+ * last step, the deletion of a finished job result-ttl after its end (the
+ * expiry sweep).
  *
  * DESIGN: a job's end is recorded before anyone is told. job_ended writes
  * the state to the store, then sends END to the watchers; a run to do again
@@ -34,6 +36,7 @@ static struct {
     uv_timer_t timer;
     int open;
     unrecorded *ends;             /* ends the store has not taken yet, oldest first */
+    uv_timer_t sweep;             /* result expiry */
     uint64_t progress_failed;     /* job whose progress the store refused (logged once) */
 } J;
 
@@ -63,7 +66,31 @@ void job_init(mcd *d)
     memset(&J, 0, sizeof J);
     J.d = d;
     uv_timer_init(d->loop, &J.timer);
+    uv_timer_init(d->loop, &J.sweep);
     J.open = 1;
+}
+
+static int expire_one(void *ctx, const store_job *j)
+{
+    mcd *d = ctx;
+    dlog(DLOG_INFO, "job %llu: %s result older than %u s: deleted", (unsigned long long)j->id,
+         proto_state_name(j->state), d->conf.result_ttl_s);
+    store_delete(d->store, j->id);
+    return 0;
+}
+
+static void on_sweep(uv_timer_t *t)
+{
+    (void)t;
+    mcd *d = J.d;
+    store_each_expired(d->store, store_now_ms() - (int64_t)d->conf.result_ttl_s * 1000, expire_one, d);
+}
+
+void job_sweep_start(mcd *d)
+{
+    /* every minute, or every result-ttl when that is shorter */
+    uint64_t every = d->conf.result_ttl_s < 60 ? d->conf.result_ttl_s * 1000ull : 60000;
+    uv_timer_start(&J.sweep, on_sweep, 0, every);
 }
 
 void job_close(mcd *d)
@@ -79,8 +106,10 @@ void job_close(mcd *d)
     if (n)
         dlog(DLOG_WARN, "%d job end(s) never reached the store: the next start recovers those jobs"
              " (a result is adopted, else they run again)", n);
-    if (J.open)
+    if (J.open) {
         uv_close((uv_handle_t *)&J.timer, NULL);
+        uv_close((uv_handle_t *)&J.sweep, NULL);
+    }
     J.open = 0;
 }
 

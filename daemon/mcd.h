@@ -20,6 +20,7 @@
  *   mbus.c   mbus_   Modbus TCP input registers, in a thread of their own
  *   metrics.c metrics_ Prometheus text over HTTP (libmicrohttpd's thread)
  *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
+ *   drain.c  drain_  SIGTERM/SIGINT: the graceful shutdown
  *   reload.c reload_ SIGHUP: options and tokens read again
  *   main.c          main(): wires the above together
  *
@@ -311,11 +312,10 @@ struct mcd {
     req_watch *watches;           /* every live WATCH */
     req_submit *submits;          /* SUBMITs being stored in the thread pool */
     uint32_t work_inflight;       /* req_ work items queued and not yet done */
-    int drained;                  /* mcd_drained has closed everything */
+    int drained;                  /* drain_check has closed everything */
     uv_handle_t **listeners;
     int nlisteners;
     uv_signal_t sigterm, sigint;
-    uv_timer_t sweep;
     int draining;                 /* shutdown started: no new work */
     snap *snap;                   /* the status snapshot */
     mbus *mbus;                   /* NULL unless --modbus */
@@ -333,6 +333,10 @@ struct mcd {
 /* ---- job_: one owner of a running job's life (job.c) --------------------- */
 void job_init(mcd *d);            /* before the backend starts */
 void job_close(mcd *d);           /* drained: ends not recorded yet are left to recovery */
+/* (Re)starts the result-expiry sweep from d->conf.result_ttl_s: a sweep
+ * now, then every minute or every result-ttl if shorter (SIGHUP calls it
+ * again). */
+void job_sweep_start(mcd *d);
 /* A backend started job id (pid: its worker's, 0 when not local). */
 void job_running(mcd *d, uint64_t id, long pid);
 /* A PROGRESS record of a running job: stored, fanned out to watchers. */
@@ -402,16 +406,12 @@ int srv_conn_open(const conn *c);     /* not closed or closing: replies can go o
 /* Closed, or the client has hung up (EOF or an error waits on the socket). */
 int srv_conn_hung_up(conn *c);
 
-/* ---- main.c ---------------------------------------------------------------- */
-/* (Re)starts the result-expiry sweep from d->conf.result_ttl_s: a sweep
- * now, then every minute or every result-ttl if shorter (main.c; SIGHUP
- * calls it again). */
-void mcd_sweep_start(mcd *d);
-
+/* ---- drain_: the graceful shutdown (drain.c) ------------------------------ */
+void drain_start(mcd *d, int sig);    /* SIGTERM/SIGINT: stop accepting, hand the runs back */
 /* During a drain, once no worker runs (bk_busy) and no request is in the
  * thread pool (work_inflight): closes what is left so the loop ends. Called
  * when either may have become 0; does nothing before that, or twice. */
-void mcd_drained(mcd *d);
+void drain_check(mcd *d);
 
 /* ---- req_ ----------------------------------------------------------------- */
 /* Handles one decoded request; frame/len are its raw bytes (SUBMIT spools them). */

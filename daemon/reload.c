@@ -54,7 +54,7 @@ static void on_sighup(uv_signal_t *h, int sig)
         keep_restart_only(d, &n);
         d->conf = n;
         dlog_set_level(d->conf.log_level);
-        mcd_sweep_start(d);   /* result-ttl may have changed: sweep now, then at its period */
+        job_sweep_start(d);   /* result-ttl may have changed: sweep now, then at its period */
         dlog(DLOG_INFO, "reload: options applied");
     }
     auth_tokens *t = NULL;

@@ -21,7 +21,7 @@
  * replies in order, at most one work item per client) and its memory
  * outlives a close; a client that left gets no reply, but its SUBMIT, once
  * stored, is queued and runs. d->work_inflight counts the work items; a
- * drain closes the daemon only when it is 0 (mcd_drained). */
+ * drain closes the daemon only when it is 0 (drain_check). */
 #include "backend.h"
 
 #include <errno.h>
@@ -200,7 +200,7 @@ static void work_end(mcd *d, conn *c)
     srv_conn_release(c);
     d->work_inflight--;
     if (d->draining)
-        mcd_drained(d);
+        drain_check(d);
 }
 
 /* A SUBMIT being stored: everything store_submit needs, copied, so the

@@ -216,7 +216,7 @@ static void on_handle_closed(uv_handle_t *h)
     s->job_id = 0;
     mcd *d = s->d;
     if (d->draining) {
-        mcd_drained(d);               /* closes once nothing else runs either */
+        drain_check(d);               /* closes once nothing else runs either */
     } else {
         wsup_schedule(d);
     }
