@@ -55,9 +55,10 @@ struct wsup_slot {
 };
 
 /* Starts are paused after one failed for a passing reason (descriptors or
- * processes exhausted, an orphan still holding the job's lock): the job goes
- * back to the queue and starts resume after a delay that doubles, up to
- * WSUP_RETRY_MAX_MS, until a start succeeds. */
+ * processes exhausted, a full disk, an orphan still holding the job's lock)
+ * or a run that could not store its answer: the job goes back to the queue
+ * and starts resume after a delay that doubles, up to WSUP_RETRY_MAX_MS,
+ * until a run ends with an answer. */
 static struct {
     uv_timer_t timer;
     int open, paused;
@@ -280,13 +281,14 @@ static void slot_finish(wsup_slot *s)
     }
     job_ended(d, s->job_id, s->user, 1, state, reason);
     if (no_answer && state == PROTO_STATE_PENDING)
-        pause_starts();
+        pause_starts();             /* longer each time, until a run ends with an answer */
+    else
+        R.delay_ms = WSUP_RETRY_MIN_MS;
     if (!uv_is_closing((uv_handle_t *)&s->pipe))
         uv_close((uv_handle_t *)&s->pipe, on_handle_closed);
     if (!uv_is_closing((uv_handle_t *)&s->proc))
         uv_close((uv_handle_t *)&s->proc, on_handle_closed);
 }
-
 
 static void on_retry(uv_timer_t *t)
 {
@@ -448,7 +450,6 @@ static int slot_start(wsup_slot *s, uint64_t id, const char *user)
         job_ended(d, id, user, 1, PROTO_STATE_FAILED, reason);
         return 0;
     }
-    R.delay_ms = WSUP_RETRY_MIN_MS;
     dlog(DLOG_INFO, "job %llu: started on slot %d, worker pid %d", (unsigned long long)id, s->index, s->proc.pid);
     job_running(d, id, s->proc.pid);
     uv_read_start((uv_stream_t *)&s->pipe, on_alloc, on_read);
