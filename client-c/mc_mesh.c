@@ -7,6 +7,7 @@
 #include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +58,13 @@ int mc_encode_mesh_quantized(const double *v, int nv, const int *f, int nf, int 
                  MESH_MAX_FACES, nv, nf);
         return MC_EARG;
     }
+    /* the server refuses them anyway: say which one here */
+    for (long long i = 0; i < 3LL * nv; i++)
+        if (!isfinite(v[i])) {
+            snprintf(err, errsz, "vertex %lld: %c coordinate is %s", i / 3, "xyz"[i % 3],
+                     isnan(v[i]) ? "NaN" : "infinite");
+            return MC_EARG;
+        }
     char derr[512];
     int rc = dracob_encode(v, nv, f, nf, quantization_bits, bytes, len, derr, sizeof derr);
     if (rc) {

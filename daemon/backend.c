@@ -1,6 +1,6 @@
 /* backend.c — the bk_ dispatch (backend.h): picks the configured backend's
  * operations once at start and forwards to them; plus the PROGRESS decoding
- * both backends share. Knows nothing about how a backend runs a job. */
+ * both backends share (the records go to job_progress). Knows nothing about how a backend runs a job. */
 #include "backend.h"
 
 #include <string.h>
@@ -39,6 +39,22 @@ void bk_close(mcd *d)
         d->bk->close(d);
 }
 
+void bk_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
+{
+    changed[0] = '\0';
+    /* the backend itself is chosen once */
+    bk_note_change(strcmp(n->backend, d->conf.backend) != 0, "backend", changed, sz);
+    memcpy(n->backend, d->conf.backend, sizeof n->backend);
+    ops_of(d)->keep_on_reload(d, n, changed, sz);
+}
+
+void bk_note_change(int differs, const char *name, char *changed, size_t sz)
+{
+    size_t len = strlen(changed);
+    if (differs && len + 1 < sz)
+        snprintf(changed + len, sz - len, "%s%s", len ? ", " : "", name);
+}
+
 int bk_progress_take(mcd *d, uint64_t id, proto_buf *in)
 {
     int n = 0;
@@ -61,33 +77,8 @@ int bk_progress_take(mcd *d, uint64_t id, proto_buf *in)
         proto_msg_free(&m);
         proto_buf_consume(in, used);
         p.job_id = id;
-        if (store_add_progress(d->store, id, &p))
-            dlog(DLOG_ERROR, "job %llu: cannot store progress", (unsigned long long)id);
-        req_progress(d, &p);
+        job_progress(d, &p);
         n++;
     }
     return n;
-}
-
-int bk_error_frame(const char *path, char *msg, size_t msz)
-{
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return 0;
-    static uint8_t buf[BK_MAX_ERROR_FRAME];
-    size_t n = fread(buf, 1, sizeof buf, fp);
-    fclose(fp);
-    proto_msg m;
-    size_t used;
-    char err[256];
-    int code = PROTO_EINTERNAL;
-    if (proto_decode(buf, n, sizeof buf, &m, &used, err, sizeof err) == PROTO_READY &&
-        m.type == PROTO_MSG_ERROR) {
-        code = m.u.error.code;
-        snprintf(msg, msz, "%s", m.u.error.message);
-    } else {
-        snprintf(msg, msz, "worker wrote an unreadable error.frame");
-    }
-    proto_msg_free(&m);
-    return code;
 }

@@ -1,8 +1,9 @@
 /* backend.h — where meshcorrd's jobs run. A backend takes jobs from the
  * scheduler (sched_next), runs them against their spool directory with
- * meshcorr-worker (workers/WORKER.md), feeds their PROGRESS records to the
- * store and the watchers (bk_progress_take), and records their end in the
- * store (req_job_ended). Two of them, chosen by `backend =`:
+ * meshcorr-worker (workers/WORKER.md), feeds their PROGRESS records to
+ * job_progress (bk_progress_take), and reports each run's start and end to
+ * job.c (job_running, job_ended), which records them and tells the watchers;
+ * a backend decides only which state its worker's run ended in. Two of them, chosen by `backend =`:
  *
  *   local  wsup.c      worker processes on this machine (--workers slots)
  *   slurm  bk_slurm.c  one Slurm batch job per meshcorr job (sbatch, squeue,
@@ -19,12 +20,17 @@ typedef struct bk_ops {
     int (*init)(mcd *d, char *err, size_t errsz);
     void (*schedule)(mcd *d);                  /* start what can start */
     int (*cancel)(mcd *d, uint64_t id);        /* 0 when the backend has the job and stops it */
-    void (*drain)(mcd *d);                     /* shutdown: mcd_drained() once busy() is 0 */
+    void (*drain)(mcd *d);                     /* shutdown: drain_check() once busy() is 0 */
     int (*busy)(const mcd *d);                 /* runs this daemon must wait for on shutdown */
     int (*nslots)(const mcd *d);               /* STATS slots */
     void (*slot_info)(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
     int (*health)(const mcd *d, char *msg, size_t sz);  /* 1 usable, 0 not (msg says why) */
     void (*close)(mcd *d);                     /* closes its handles (the loop then ends) */
+    /* SIGHUP: n is the re-read configuration; puts back into n the running
+     * values of the options this backend applies only at start (its slot
+     * count above all: the snapshot and the dashboards are sized from it),
+     * and names those that differed in changed ("" none). */
+    void (*keep_on_reload)(const mcd *d, mcd_conf *n, char *changed, size_t sz);
 } bk_ops;
 
 extern const bk_ops bk_local, bk_slurm;
@@ -40,17 +46,15 @@ void bk_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
 int bk_health(const mcd *d, char *msg, size_t sz);
 const char *bk_name(const mcd *d);
 void bk_close(mcd *d);
+void bk_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz);
+/* Appends ", name" (or "name" first) to changed when the option differs. */
+void bk_note_change(int differs, const char *name, char *changed, size_t sz);
 
 /* Decodes the whole PROGRESS frames at the front of in, consumes them, and
  * stores and fans out each as job id's. Returns the number taken, or -1 at a
  * frame that is not a valid PROGRESS (in is then reset; the caller ignores
  * the rest of that stream). */
 #define BK_MAX_PROGRESS_FRAME 4096
-/* A worker's error.frame at path: its protocol error code and message
- * (msg); 0 when there is none, PROTO_EINTERNAL when it does not decode.
- * Loop thread only (one static buffer). */
-#define BK_MAX_ERROR_FRAME (1 << 20)
-int bk_error_frame(const char *path, char *msg, size_t msz);
 int bk_progress_take(mcd *d, uint64_t id, proto_buf *in);
 
 /* ---- bk_cmd.c: one external command, asynchronously ---------------------- */

@@ -181,7 +181,7 @@ static void set_err(char *slot, size_t sz, const char *fmt, const char *a, const
 static void read_progress_file(sjob *j)
 {
     char path[CONF_PATH + 64];
-    int fd = open(spool_file(j->id, "progress.frames", path, sizeof path), O_RDONLY | O_CLOEXEC);
+    int fd = open(spool_file(j->id, SPOOL_PROGRESS_FILE, path, sizeof path), O_RDONLY | O_CLOEXEC);
     if (fd < 0)
         return;
     proto_buf in;
@@ -205,12 +205,6 @@ static void read_progress_file(sjob *j)
 
 /* ---- a job's end ------------------------------------------------------------ */
 
-static int read_error_frame(uint64_t id, char *msg, size_t msz)
-{
-    char path[CONF_PATH + 64];
-    return bk_error_frame(spool_file(id, "error.frame", path, sizeof path), msg, msz);
-}
-
 static int is_terminal_slurm(const char *st)
 {
     static const char *t[] = {"COMPLETED", "FAILED", "CANCELLED", "TIMEOUT", "OUT_OF_MEMORY", "NODE_FAIL",
@@ -227,7 +221,7 @@ static int finish(sjob *j, const char *slurm_state, const char *sreason)
 {
     mcd *d = S.d;
     read_progress_file(j);
-    int has_result = has_file(j->id, "result.frame"), has_error = has_file(j->id, "error.frame");
+    int has_result = job_has_result(d, j->id), has_error = has_file(j->id, SPOOL_ERROR_FRAME);
     if (strcmp(slurm_state, "COMPLETED") == 0 && !has_result && !has_error) {
         int64_t now = store_now_ms();
         if (!j->result_wait_until)
@@ -237,7 +231,7 @@ static int finish(sjob *j, const char *slurm_state, const char *sreason)
     }
     char reason[PROTO_MAX_STRING + 1], emsg[PROTO_MAX_STRING + 1] = "";
     const char *why = sreason && sreason[0] && strcmp(sreason, "None") != 0 ? sreason : "";
-    int state, ecode, requeue = 0;
+    int state;
     if (has_result) {
         state = PROTO_STATE_COMPLETED;
         snprintf(reason, sizeof reason, "%s", "");
@@ -255,35 +249,21 @@ static int finish(sjob *j, const char *slurm_state, const char *sreason)
     } else if (strcmp(slurm_state, "NODE_FAIL") == 0 || strcmp(slurm_state, "PREEMPTED") == 0 ||
                strcmp(slurm_state, "BOOT_FAIL") == 0) {
         state = PROTO_STATE_PENDING;
-        requeue = 1;
         snprintf(reason, sizeof reason, "re-queued: Slurm job %s ended %s%s%s", j->slurm_id, slurm_state,
                  why[0] ? ": " : "", why);
-    } else if ((ecode = read_error_frame(j->id, emsg, sizeof emsg)) != 0) {
-        state = ecode == PROTO_ENOMEM ? PROTO_STATE_OUT_OF_MEMORY
-              : ecode == PROTO_ECANCELLED ? PROTO_STATE_CANCELLED : PROTO_STATE_FAILED;
-        snprintf(reason, sizeof reason, "%s: %s (Slurm job %s %s)", proto_err_name(ecode), emsg, j->slurm_id,
-                 slurm_state);
+    } else if ((state = job_error_end(d, j->id, emsg, sizeof emsg)) >= 0) {
+        snprintf(reason, sizeof reason, "%s (Slurm job %s %s)", emsg, j->slurm_id, slurm_state);
     } else if (strcmp(slurm_state, "CANCELLED") == 0) {
         state = PROTO_STATE_CANCELLED;
         snprintf(reason, sizeof reason, "Slurm job %s was cancelled outside meshcorrd%s%s", j->slurm_id,
                  why[0] ? ": " : "", why);
     } else {
         state = PROTO_STATE_FAILED;
-        snprintf(reason, sizeof reason, "Slurm job %s ended %s%s%s without a result (see spool/%llu/slurm.out)",
+        snprintf(reason, sizeof reason, "Slurm job %s ended %s%s%s without a result (see spool/%llu/" SPOOL_SLURM_OUT ")",
                  j->slurm_id, slurm_state, why[0] ? ": " : "", why, (unsigned long long)j->id);
     }
-    dlog(DLOG_INFO, "job %llu: %s%s%s", (unsigned long long)j->id, proto_state_name(state),
-         reason[0] ? ": " : "", reason);
     bk_prog_forget(S.prog, j->id);
-    if (store_set_state(d->store, j->id, state, reason))
-        dlog(DLOG_ERROR, "job %llu: cannot record its end", (unsigned long long)j->id);
-    if (j->counted)
-        sched_done(d->sched, j->user);
-    store_job row;
-    if (requeue && store_get(d->store, j->id, &row) == 0)
-        sched_add(d->sched, j->id, j->user, row.priority);
-    else
-        req_job_ended(d, j->id);
+    job_ended(d, j->id, j->user, j->counted, state, reason);
     drop_job(j);
     return 0;
 }
@@ -299,7 +279,7 @@ static void map_running(sjob *j, const char *sstate, const char *sreason)
         strcmp(sstate, "SIGNALING") == 0 || strcmp(sstate, "RESIZING") == 0) {
         if (!j->running) {
             j->running = 1;
-            store_set_running(d->store, j->id, store_now_ms(), 0);
+            job_running(d, j->id, 0);
             dlog(DLOG_INFO, "job %llu: RUNNING as Slurm job %s", (unsigned long long)j->id, j->slurm_id);
         }
         return;
@@ -329,7 +309,7 @@ static void adopt(uint64_t id, const char *sid, const char *sstate)
     sched_remove(S.d->sched, id);
     snprintf(j->slurm_id, sizeof j->slurm_id, "%s", sid);
     char path[CONF_PATH + 64];
-    FILE *fp = fopen(spool_file(id, "progress.secret", path, sizeof path), "r");
+    FILE *fp = fopen(spool_file(id, SPOOL_SECRET_FILE, path, sizeof path), "r");
     if (fp) {
         if (!fgets(j->secret, sizeof j->secret, fp))
             j->secret[0] = '\0';
@@ -438,7 +418,7 @@ static void sacct_done(void *ctx, int status, const char *out, const char *err)
         if (status == 0)
             sscanf(out, "%63[A-Z_]", st);
         if (!st[0])
-            snprintf(st, sizeof st, "%s", has_file(id, "result.frame") ? "COMPLETED" : "FAILED");
+            snprintf(st, sizeof st, "%s", has_file(id, SPOOL_RESULT_FRAME) ? "COMPLETED" : "FAILED");
         if (is_terminal_slurm(st))
             finish(j, st, status == 0 ? "" : "no longer known to squeue, no accounting");
         else
@@ -457,7 +437,7 @@ static int write_secret(sjob *j, char *err, size_t errsz)
     for (size_t i = 0; i < sizeof raw; i++)
         snprintf(j->secret + 2 * i, 3, "%02x", raw[i]);
     char path[CONF_PATH + 64];
-    spool_file(j->id, "progress.secret", path, sizeof path);
+    spool_file(j->id, SPOOL_SECRET_FILE, path, sizeof path);
     int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (fd < 0)
         return snprintf(err, errsz, "%.400s: %s", path, strerror(errno)), -1;
@@ -557,10 +537,10 @@ static int submit(uint64_t id, const char *user)
     const char *worker = cf->slurm_worker[0] ? cf->slurm_worker : wsup_worker_path(d, wbuf, sizeof wbuf);
     snprintf(dir, sizeof dir, "%s/%llu", S.node_spool, (unsigned long long)id);
     snprintf(name, sizeof name, "--job-name=meshcorr-%s-%llu", S.tag, (unsigned long long)id);
-    snprintf(out, sizeof out, "--output=%s/slurm.out", dir);
+    snprintf(out, sizeof out, "--output=%s/" SPOOL_SLURM_OUT, dir);
     snprintf(cpus, sizeof cpus, "--cpus-per-task=%d", cf->slurm_cpus);
     char secret_path[CONF_PATH + 96];
-    snprintf(secret_path, sizeof secret_path, "%s/progress.secret", dir);
+    snprintf(secret_path, sizeof secret_path, "%s/" SPOOL_SECRET_FILE, dir);
     shq(q_worker, sizeof q_worker, worker);
     shq(q_dir, sizeof q_dir, dir);
     shq(q_sec, sizeof q_sec, secret_path);
@@ -705,7 +685,7 @@ static int reattach(void *ctx, const store_job *row)
     j->running = row->state == PROTO_STATE_RUNNING;
     snprintf(j->reason, sizeof j->reason, "%.255s", row->reason);
     char path[CONF_PATH + 64];
-    FILE *fp = fopen(spool_file(row->id, "progress.secret", path, sizeof path), "r");
+    FILE *fp = fopen(spool_file(row->id, SPOOL_SECRET_FILE, path, sizeof path), "r");
     if (fp) {
         if (!fgets(j->secret, sizeof j->secret, fp))
             j->secret[0] = '\0';
@@ -815,7 +795,28 @@ static void slurm_close(mcd *d)
         drop_job(S.jobs);
 }
 
+/* slurm-max-jobs is the slot count (the snapshot, STATS and the Modbus
+ * registers are sized from it at start); the progress listener, the spool
+ * paths and the poll timer are set up once too. The sbatch options
+ * (partition, account, time, cpus, mem, extra, worker) are read at each
+ * submission: a reload applies them to the next one. */
+static void slurm_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
+{
+    const mcd_conf *o = &d->conf;
+    bk_note_change(n->slurm_max_jobs != o->slurm_max_jobs, "slurm-max-jobs", changed, sz);
+    bk_note_change(n->slurm_poll_ms != o->slurm_poll_ms, "slurm-poll-ms", changed, sz);
+    bk_note_change(strcmp(n->slurm_spool, o->slurm_spool) != 0, "slurm-spool", changed, sz);
+    bk_note_change(strcmp(n->slurm_progress, o->slurm_progress) != 0, "slurm-progress", changed, sz);
+    bk_note_change(strcmp(n->slurm_progress_host, o->slurm_progress_host) != 0, "slurm-progress-host",
+                   changed, sz);
+    n->slurm_max_jobs = o->slurm_max_jobs;
+    n->slurm_poll_ms = o->slurm_poll_ms;
+    memcpy(n->slurm_spool, o->slurm_spool, sizeof n->slurm_spool);
+    memcpy(n->slurm_progress, o->slurm_progress, sizeof n->slurm_progress);
+    memcpy(n->slurm_progress_host, o->slurm_progress_host, sizeof n->slurm_progress_host);
+}
+
 const bk_ops bk_slurm = {
     "slurm", slurm_init, slurm_schedule, slurm_cancel, slurm_drain, slurm_busy,
-    slurm_nslots, slurm_slot_info, slurm_health, slurm_close,
+    slurm_nslots, slurm_slot_info, slurm_health, slurm_close, slurm_keep_on_reload,
 };

@@ -5,7 +5,9 @@
  *   dlog.c   dlog_   leveled log lines on stderr
  *   auth.c   auth_   tokens file (TCP) and peer credentials (Unix socket)
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
+ *   wlock.c  wlock_  a job's worker lock: two workers of one job never run
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
+ *   job.c    job_    a running job's life: start, progress, end (both backends)
  *   backend.c bk_    where jobs run (backend.h): `local` or `slurm`
  *   wsup.c   wsup_   the local backend: worker processes, progress pipe, exit
  *   bk_slurm.c       the slurm backend: sbatch/squeue/scancel, re-attach
@@ -18,6 +20,7 @@
  *   mbus.c   mbus_   Modbus TCP input registers, in a thread of their own
  *   metrics.c metrics_ Prometheus text over HTTP (libmicrohttpd's thread)
  *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
+ *   drain.c  drain_  SIGTERM/SIGINT: the graceful shutdown
  *   reload.c reload_ SIGHUP: options and tokens read again
  *   main.c          main(): wires the above together
  *
@@ -38,6 +41,7 @@
 #include <stdio.h>
 #include <uv.h>
 #include "proto.h"
+#include "spool.h"
 
 /* ---- conf_ ---------------------------------------------------------------- */
 #define CONF_MAX_LISTEN 8
@@ -157,11 +161,13 @@ int64_t store_now_ms(void);
 int store_open(const char *dir, store **out, char *err, size_t errsz);
 /* NULL ok; never while a store_submit runs. */
 void store_close(store *s);
-/* After a restart: RUNNING jobs go back to PENDING (a leftover worker of the
- * previous daemon is killed), spool dirs without a row are removed, unfinished
- * rows without job.frame become FAILED. Unfinished jobs with a Slurm job id
- * are left as they are with keep_slurm (the Slurm backend re-attaches), else
- * they go back to PENDING too. */
+/* After a restart: every worker a previous daemon left running is killed
+ * (found by its job's worker lock, wlock_), an unfinished local job whose
+ * worker had written a valid result.frame is COMPLETED with it (adopted, not
+ * run again), other RUNNING jobs go back to PENDING, spool dirs without a
+ * row are removed, unfinished rows without job.frame become FAILED.
+ * Unfinished jobs with a Slurm job id are left as they are with keep_slurm
+ * (the Slurm backend re-attaches), else they go back to PENDING too. */
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
 /* Durable insert: spool/<id>/job.frame (fsynced) and the row, committed
  * together; *id is the committed row's. Any thread (it blocks on the disk:
@@ -179,6 +185,9 @@ int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progres
 int store_set_reason(store *s, uint64_t id, const char *reason);
 /* One more run of job id ended in a worker crash: the count after it. */
 int store_add_crash(store *s, uint64_t id, uint32_t *crashes);
+/* 1 when spool/<id>/result.frame is a whole, valid RESULT_OK frame of job id
+ * (CRCs checked); 0 otherwise, with why in why. Reads the whole file. */
+int store_result_ok(store *s, uint64_t id, char *why, size_t wsz);
 /* Drops a previous run's history and result files before a (re)run. */
 int store_clear_run(store *s, uint64_t id);
 int store_latest_progress(store *s, uint64_t id, proto_progress *out); /* 0 or NOT_FOUND */
@@ -197,6 +206,20 @@ void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *c
 /* <dir>/spool/<id>[/file] into buf. */
 const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz);
 int store_is_terminal(int state);
+
+/* ---- wlock_ --------------------------------------------------------------- */
+#define WLOCK_HELD 1
+#define WLOCK_RECOVER_WAIT_MS 5000    /* recovery: a killed orphan lets go within this */
+#define WLOCK_START_WAIT_MS 200       /* a start that finds an orphan: the loop waits at most this */
+/* Opens (creating) path and takes its lock: 0 with *fd (close-on-exec)
+ * locked, WLOCK_HELD when another process holds it, or -errno. */
+int wlock_take(const char *path, int *fd);
+/* The worker's pid into the locked file, for people (nothing reads it back). */
+void wlock_note_pid(int fd, long pid);
+/* SIGKILLs every process that holds path's lock and waits, at most wait_ms,
+ * until it is free: the number of processes killed (0: it was free), or -1
+ * when it is still held. Blocks the caller for that long. */
+int wlock_kill_holders(const char *path, int wait_ms);
 
 /* ---- sched_ --------------------------------------------------------------- */
 typedef struct sched sched;
@@ -231,7 +254,7 @@ typedef struct mcd_snapshot {
     uint32_t uptime_s;            /* since the daemon started */
     uint32_t queued, running, workers;
     uint64_t completed, failed, cancelled;
-    uint32_t nslots;              /* = workers */
+    uint32_t nslots;              /* the backend's slots: workers or slurm-max-jobs */
     snap_slot *slots;             /* nslots, owned by whoever allocated the snapshot */
 } mcd_snapshot;
 
@@ -242,7 +265,8 @@ typedef struct mcd mcd;
 
 /* Loop thread: the snapshot state and a timer publishing every SNAP_PERIOD_MS. */
 int snap_init(mcd *d, char *err, size_t errsz);
-/* Loop thread: the figures now; out->slots holds conf.workers entries. */
+/* Loop thread: the figures now; out->slots holds bk_nslots() entries (the
+ * backend's slot count, fixed at start), fewer if out has less room. */
 void snap_collect(mcd *d, mcd_snapshot *out);
 /* Loop thread: a worker's progress record (kept for its slot's figures). */
 void snap_progress(mcd *d, const proto_progress *p);
@@ -300,11 +324,10 @@ struct mcd {
     req_watch *watches;           /* every live WATCH */
     req_submit *submits;          /* SUBMITs being stored in the thread pool */
     uint32_t work_inflight;       /* req_ work items queued and not yet done */
-    int drained;                  /* mcd_drained has closed everything */
+    int drained;                  /* drain_check has closed everything */
     uv_handle_t **listeners;
     int nlisteners;
     uv_signal_t sigterm, sigint;
-    uv_timer_t sweep;
     int draining;                 /* shutdown started: no new work */
     snap *snap;                   /* the status snapshot */
     mbus *mbus;                   /* NULL unless --modbus */
@@ -318,6 +341,26 @@ struct mcd {
     char devices[MCD_MAX_DEVICES][192];
     int ndevices;
 };
+
+/* ---- job_: one owner of a running job's life (job.c) --------------------- */
+void job_init(mcd *d);            /* before the backend starts */
+void job_close(mcd *d);           /* drained: ends not recorded yet are left to recovery */
+/* (Re)starts the result-expiry sweep from d->conf.result_ttl_s: a sweep
+ * now, then every minute or every result-ttl if shorter (SIGHUP calls it
+ * again). */
+void job_sweep_start(mcd *d);
+/* A backend started job id (pid: its worker's, 0 when not local). */
+void job_running(mcd *d, uint64_t id, long pid);
+/* A PROGRESS record of a running job: stored, fanned out to watchers. */
+void job_progress(mcd *d, const proto_progress *p);
+/* A run of job id (user's; counted: the scheduler counts it as running)
+ * ended in state: terminal, recorded (retried while the store refuses it),
+ * then END to the watchers; or PENDING: back to the scheduler. */
+void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, const char *reason);
+/* What the run's files say: result.frame is there; the state its
+ * error.frame gives (reason "CODE: message"), or -1 without one. */
+int job_has_result(mcd *d, uint64_t id);
+int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz);
 
 /* ---- dev_: the devices a worker sees, asked once of the worker program ---- */
 /* Runs `meshcorr-worker --list-devices` in the background; until it answers
@@ -337,18 +380,7 @@ void notify_close(mcd *d);        /* stops the STATUS= timer */
 void reload_init(mcd *d, int argc, char **argv);  /* SIGHUP handler */
 void reload_close(mcd *d);
 
-/* ---- wsup_: the local backend (called through bk_, backend.h) ------------- */
-int wsup_init(mcd *d, char *err, size_t errsz);
-/* Starts pending jobs on idle slots while both exist. */
-void wsup_schedule(mcd *d);
-/* Sends SIGTERM to the worker running job id; 0, or -1 when none runs it. */
-int wsup_cancel(mcd *d, uint64_t id);
-/* Shutdown: SIGTERM every worker; their jobs return to PENDING. */
-void wsup_drain(mcd *d);
-int wsup_busy(const mcd *d);    /* slots not idle */
-/* Slot i's state (PROTO_SLOT_*) and job (0 = none). */
-void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
-void wsup_close(mcd *d);
+/* ---- wsup_: the local backend (its operations are bk_local, backend.h) -- */
 /* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
 const char *wsup_worker_path(const mcd *d, char *buf, size_t sz);
 /* The worker's --max-faces for the configured --max-vertices. */
@@ -409,16 +441,12 @@ int srv_conn_admit_user(conn *c, char *msg, size_t msgsz);
 /* Closed, or the client has hung up (EOF or an error waits on the socket). */
 int srv_conn_hung_up(conn *c);
 
-/* ---- main.c ---------------------------------------------------------------- */
-/* (Re)starts the result-expiry sweep from d->conf.result_ttl_s: a sweep
- * now, then every minute or every result-ttl if shorter (main.c; SIGHUP
- * calls it again). */
-void mcd_sweep_start(mcd *d);
-
+/* ---- drain_: the graceful shutdown (drain.c) ------------------------------ */
+void drain_start(mcd *d, int sig);    /* SIGTERM/SIGINT: stop accepting, hand the runs back */
 /* During a drain, once no worker runs (bk_busy) and no request is in the
  * thread pool (work_inflight): closes what is left so the loop ends. Called
  * when either may have become 0; does nothing before that, or twice. */
-void mcd_drained(mcd *d);
+void drain_check(mcd *d);
 
 /* ---- req_ ----------------------------------------------------------------- */
 /* Handles one decoded request; frame/len are its raw bytes (SUBMIT spools them). */

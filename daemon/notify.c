@@ -4,7 +4,7 @@
  * NOTIFY_STATUS_PERIOD_MS), RELOADING=1 / READY=1 around a SIGHUP reload and
  * STOPPING=1 when a drain starts. Without $NOTIFY_SOCKET every call is a
  * no-op (libsystemd's). Reads the daemon's figures, changes nothing. */
-#include "mcd.h"
+#include "backend.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -15,12 +15,26 @@
 
 static char last_status[256];
 
+/* Slots with a job, whatever the backend (the Slurm backend's slots are its
+ * jobs in Slurm). */
+static int slots_busy(const mcd *d)
+{
+    int n = 0;
+    for (int i = 0; i < bk_nslots(d); i++) {
+        uint8_t state;
+        uint64_t job;
+        bk_slot_info(d, i, &state, &job);
+        n += state != PROTO_SLOT_IDLE;
+    }
+    return n;
+}
+
 static void status_line(mcd *d, char *buf, size_t sz)
 {
     uint64_t completed = 0, failed = 0, cancelled = 0;
     store_counters(d->store, &completed, &failed, &cancelled);
     snprintf(buf, sz, "%u queued, %d of %d slot(s) busy; %llu completed, %llu failed, %llu cancelled",
-             sched_queued(d->sched), wsup_busy(d), d->conf.workers, (unsigned long long)completed,
+             sched_queued(d->sched), slots_busy(d), bk_nslots(d), (unsigned long long)completed,
              (unsigned long long)failed, (unsigned long long)cancelled);
 }
 
@@ -76,7 +90,7 @@ void notify_stopping(mcd *d)
 {
     char msg[160];
     snprintf(msg, sizeof msg, "STOPPING=1\nSTATUS=shutting down: %d running job(s) go back to the queue",
-             wsup_busy(d));
+             bk_busy(d));
     notify_send(msg);
 }
 

@@ -25,7 +25,7 @@
  * replies in order, at most one work item per client) and its memory
  * outlives a close; a client that left gets no reply, but its SUBMIT, once
  * stored, is queued and runs. d->work_inflight counts the work items; a
- * drain closes the daemon only when it is 0 (mcd_drained). */
+ * drain closes the daemon only when it is 0 (drain_check). */
 #include "backend.h"
 
 #include <errno.h>
@@ -181,7 +181,7 @@ static void work_end(mcd *d, conn *c)
     srv_conn_release(c);
     d->work_inflight--;
     if (d->draining)
-        mcd_drained(d);
+        drain_check(d);
 }
 
 /* A SUBMIT being stored: everything store_submit needs, copied, so the
@@ -637,7 +637,7 @@ static void on_result(conn *c, const proto_msg *m)
     r->request_id = m->request_id;
     r->job_id = j.id;
     r->what = q->what;
-    store_spool_path(d->store, j.id, "result.frame", r->path, sizeof r->path);
+    store_spool_path(d->store, j.id, SPOOL_RESULT_FRAME, r->path, sizeof r->path);
     int rc = work_start(d, c, &r->work, result_run, result_done);
     if (rc) {
         dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)j.id,

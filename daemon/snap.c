@@ -29,7 +29,8 @@ typedef struct slot_cache {
 
 struct snap {
     /* loop thread only */
-    slot_cache *cache;            /* bk_nslots */
+    uint32_t nslots;              /* bk_nslots at snap_init: every array here has this many */
+    slot_cache *cache;
     mcd_snapshot *scratch;
     uv_timer_t timer;
     int timer_open;
@@ -60,11 +61,11 @@ void snap_release(mcd_snapshot *m)
 }
 
 /* Brings slot i's cache to the job wsup runs there now. */
-static slot_cache *sync_slot(mcd *d, int i, uint8_t *state)
+static slot_cache *sync_slot(mcd *d, uint32_t i, uint8_t *state)
 {
     slot_cache *c = &d->snap->cache[i];
     uint64_t job;
-    bk_slot_info(d, i, state, &job);
+    bk_slot_info(d, (int)i, state, &job);
     if (c->job_id != job) {
         memset(c, 0, sizeof *c);
         c->job_id = job;
@@ -77,9 +78,20 @@ static slot_cache *sync_slot(mcd *d, int i, uint8_t *state)
     return c;
 }
 
+/* Slots a snapshot covers: the backend's count, which is fixed at start (a
+ * reload keeps it, bk_keep_on_reload); never more than the arrays hold. */
+static uint32_t slots_of(mcd *d, uint32_t room)
+{
+    uint32_t n = (uint32_t)bk_nslots(d);
+    if (n > d->snap->nslots)
+        n = d->snap->nslots;
+    return n < room ? n : room;
+}
+
 void snap_progress(mcd *d, const proto_progress *p)
 {
-    for (int i = 0; i < bk_nslots(d); i++) {
+    uint32_t n = slots_of(d, UINT32_MAX);
+    for (uint32_t i = 0; i < n; i++) {
         uint8_t state;
         slot_cache *c = sync_slot(d, i, &state);
         if (c->job_id == p->job_id) {
@@ -92,8 +104,8 @@ void snap_progress(mcd *d, const proto_progress *p)
 void snap_collect(mcd *d, mcd_snapshot *out)
 {
     int64_t now = store_now_ms();
-    uint32_t running = 0;
-    for (int i = 0; i < bk_nslots(d); i++) {
+    uint32_t running = 0, n = slots_of(d, out->nslots);
+    for (uint32_t i = 0; i < n; i++) {
         snap_slot *o = &out->slots[i];
         slot_cache *c = sync_slot(d, i, &o->state);
         o->job_id = c->job_id;
@@ -106,8 +118,8 @@ void snap_collect(mcd *d, mcd_snapshot *out)
         o->beta = c->has_progress ? c->p.beta : 0;
         o->elapsed_s = c->job_id && c->start_ms && now > c->start_ms ? (uint32_t)((now - c->start_ms) / 1000) : 0;
     }
-    out->nslots = (uint32_t)bk_nslots(d);
-    out->workers = (uint32_t)bk_nslots(d);
+    out->nslots = n;
+    out->workers = n;
     out->running = running;
     out->queued = sched_queued(d->sched);
     store_counters(d->store, &out->completed, &out->failed, &out->cancelled);
@@ -150,7 +162,7 @@ int snap_init(mcd *d, char *err, size_t errsz)
     d->snap = s;
     pthread_mutex_init(&s->mu, NULL);
     clock_gettime(CLOCK_MONOTONIC, &s->t0);
-    uint32_t n = (uint32_t)bk_nslots(d);
+    uint32_t n = s->nslots = (uint32_t)bk_nslots(d);
     if (!(s->cache = calloc(n, sizeof *s->cache)) || !(s->scratch = snap_alloc(n)) || !(s->board = snap_alloc(n)))
         return errbuf_set(err, errsz, -1, "out of memory for the snapshot");
     publish(d);

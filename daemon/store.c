@@ -35,7 +35,8 @@
  * (jobs ended per final state since the store was created). A job handed
  * to Slurm keeps its Slurm job id in its row until it ends, so a restarted
  * daemon re-attaches to it instead of running it again. The store never
- * talks to clients or workers. */
+ * talks to clients or workers; its recovery only ends the workers a dead
+ * daemon left, found by their jobs' worker locks (wlock.c). */
 #include "mcd.h"
 #include "util/errbuf.h"
 
@@ -305,29 +306,76 @@ void store_close(store *s)
     free(s);
 }
 
-/* The leftover worker of a previous daemon still running job id: its
- * /proc/<pid>/cmdline holds "--job-id" followed by the id. */
-static void kill_leftover_worker(long pid, uint64_t id)
+/* No worker a previous daemon started survives it: each job's worker lock
+ * (wlock.c) is held by whatever process of that job still runs, recorded
+ * in the row or not (a daemon killed between the spawn and the row's update
+ * left it PENDING). */
+static int kill_orphan_workers(store *s, char *err, size_t errsz)
 {
-    if (pid <= 0)
-        return;
-    char path[64], cmd[8192], want[32];
-    snprintf(path, sizeof path, "/proc/%ld/cmdline", pid);
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return;
-    ssize_t n = read(fd, cmd, sizeof cmd - 1);
-    close(fd);
-    if (n <= 0)
-        return;
-    cmd[n] = '\0';
-    snprintf(want, sizeof want, "%llu", (unsigned long long)id);
-    for (ssize_t i = 0; i < n; i += (ssize_t)strlen(cmd + i) + 1)
-        if (strcmp(cmd + i, "--job-id") == 0 && i + 9 < n && strcmp(cmd + i + 9, want) == 0) {
-            dlog(DLOG_WARN, "store: killing leftover worker %ld of job %s", pid, want);
-            kill((pid_t)pid, SIGKILL);
-            return;
+    char spool[CONF_PATH + 16];
+    snprintf(spool, sizeof spool, "%s/spool", s->dir);
+    DIR *dp = opendir(spool);
+    if (!dp)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
+    struct dirent *de;
+    while ((de = readdir(dp))) {
+        char *e, path[CONF_PATH + 64];
+        unsigned long long id = strtoull(de->d_name, &e, 10);
+        if (de->d_name[0] == '.' || *e != '\0' || id == 0)
+            continue;
+        int n = wlock_kill_holders(store_spool_path(s, id, SPOOL_WORKER_LOCK, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
+        if (n > 0)
+            dlog(DLOG_WARN, "store: job %llu: killed %d worker process(es) a previous daemon left running", id, n);
+        else if (n < 0)
+            dlog(DLOG_ERROR, "store: job %llu: a process still holds %s after %d ms: the job starts once it"
+                 " lets go", id, path, WLOCK_RECOVER_WAIT_MS);
+    }
+    closedir(dp);
+    return 0;
+}
+
+/* Unfinished local jobs whose worker finished while no daemon watched: the
+ * result is complete (the worker writes it atomically) and valid, so it is
+ * the job's answer; running the job again would only redo the work. */
+static int adopt_results(store *s, int *adopted, char *err, size_t errsz)
+{
+    sqlite3_stmt *st;
+    *adopted = 0;
+    if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs WHERE state IN ('PENDING', 'RUNNING') AND slurm_id = ''",
+                           -1, &st, NULL) != SQLITE_OK)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
+    uint64_t *ids = NULL;
+    size_t n = 0;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+        uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
+        char path[CONF_PATH + 64];
+        if (access(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), F_OK) != 0)
+            continue;
+        uint64_t *l = realloc(ids, (n + 1) * sizeof *l);
+        if (l) {
+            ids = l;
+            ids[n++] = id;
         }
+    }
+    sqlite3_finalize(st);
+    for (size_t i = 0; i < n; i++) {
+        char why[256];
+        if (!store_result_ok(s, ids[i], why, sizeof why)) {
+            dlog(DLOG_WARN, "store: job %llu: result.frame left by a worker is not usable (%s): runs again",
+                 (unsigned long long)ids[i], why);
+            continue;
+        }
+        if (store_set_state(s, ids[i], PROTO_STATE_COMPLETED, "finished while the daemon was down: result adopted")) {
+            free(ids);
+            return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot record job %llu's adopted result",
+                              (unsigned long long)ids[i]);
+        }
+        dlog(DLOG_INFO, "store: job %llu: COMPLETED: its worker finished while the daemon was down; result adopted",
+             (unsigned long long)ids[i]);
+        (*adopted)++;
+    }
+    free(ids);
+    return 0;
 }
 
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
@@ -344,14 +392,13 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
             dlog(DLOG_WARN, "store: %d job(s) handed to Slurm by an earlier run go back to the queue"
                  " (backend is not slurm)", sqlite3_changes(s->db));
     }
-    /* 1. RUNNING -> PENDING (the run was cut off by the daemon's end);
-     * Slurm runs go on without us and are re-attached by the backend. */
-    if (sqlite3_prepare_v2(s->db, "SELECT id, pid FROM jobs WHERE state = 'RUNNING' AND slurm_id = ''",
-                           -1, &st, NULL) != SQLITE_OK)
-        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
-    while (sqlite3_step(st) == SQLITE_ROW)
-        kill_leftover_worker((long)sqlite3_column_int64(st, 1), (uint64_t)sqlite3_column_int64(st, 0));
-    sqlite3_finalize(st);
+    /* 1. no worker of the previous daemon runs on; the results they
+     * finished are adopted; other RUNNING jobs go back to PENDING (the run
+     * was cut off by the daemon's end). Slurm runs go on without us and are
+     * re-attached by the backend. */
+    int adopted;
+    if ((rc = kill_orphan_workers(s, err, errsz)) || (rc = adopt_results(s, &adopted, err, errsz)))
+        return rc;
     if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
                      " energy = NULL WHERE state = 'RUNNING' AND slurm_id = ''", NULL)))
         return errbuf_set(err, errsz, rc, "recover: cannot re-queue running jobs");
@@ -392,7 +439,7 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     while (sqlite3_step(st) == SQLITE_ROW) {
         uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
         char path[CONF_PATH + 64];
-        if (access(store_spool_path(s, id, "job.frame", path, sizeof path), R_OK) != 0) {
+        if (access(store_spool_path(s, id, SPOOL_JOB_FRAME, path, sizeof path), R_OK) != 0) {
             uint64_t *l = realloc(lost, (nlost + 1) * sizeof *l);
             if (l) {
                 lost = l;
@@ -406,8 +453,8 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
         store_set_state(s, lost[i], PROTO_STATE_FAILED, "spool file job.frame missing after restart");
     }
     free(lost);
-    dlog(DLOG_INFO, "store: recovered: %d running job(s) re-queued, %d orphan spool dir(s) removed,"
-         " %zu job(s) without spool failed", requeued, removed, nlost);
+    dlog(DLOG_INFO, "store: recovered: %d result(s) adopted, %d running job(s) re-queued, %d orphan spool"
+         " dir(s) removed, %zu job(s) without spool failed", adopted, requeued, removed, nlost);
     return 0;
 }
 
@@ -625,11 +672,48 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p)
 int store_clear_run(store *s, uint64_t id)
 {
     char path[CONF_PATH + 96];
-    static const char *files[] = {"result.frame", "result.frame.tmp", "error.frame", "error.frame.tmp",
-                                  "progress.frames", "progress.secret", "slurm.out"};
+    /* never SPOOL_WORKER_LOCK: a new file would let a second worker lock it (wlock.c) */
+    static const char *files[] = {SPOOL_RESULT_FRAME, SPOOL_RESULT_FRAME SPOOL_TMP_SUFFIX, SPOOL_ERROR_FRAME,
+                                  SPOOL_ERROR_FRAME SPOOL_TMP_SUFFIX, SPOOL_PROGRESS_FILE, SPOOL_SECRET_FILE,
+                                  SPOOL_SLURM_OUT};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         unlink(store_spool_path(s, id, files[i], path, sizeof path));
     return exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
+}
+
+int store_result_ok(store *s, uint64_t id, char *why, size_t wsz)
+{
+    char path[CONF_PATH + 64];
+    FILE *fp = fopen(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), "rb");
+    if (!fp)
+        return errbuf_set(why, wsz, 0, "%s", strerror(errno)), 0;
+    uint8_t *buf = NULL;
+    long sz = -1;
+    size_t n = 0;
+    if (fseek(fp, 0, SEEK_END) == 0 && (sz = ftell(fp)) > 0 && (unsigned long)sz <= PROTO_MAX_FRAME &&
+        fseek(fp, 0, SEEK_SET) == 0 && (buf = malloc((size_t)sz)))
+        n = fread(buf, 1, (size_t)sz, fp);
+    fclose(fp);
+    if (!buf)
+        return errbuf_set(why, wsz, 0, "%s", sz <= 0 ? "empty or unreadable" : "too large or out of memory"), 0;
+    proto_msg m;
+    size_t used = 0;
+    int ok = 0, rc = proto_decode(buf, n, PROTO_MAX_FRAME, &m, &used, why, wsz);
+    if (rc == PROTO_READY) {
+        if (m.type != PROTO_MSG_RESULT_OK)
+            errbuf_set(why, wsz, 0, "a %s frame, not RESULT_OK", proto_type_name(m.type));
+        else if (m.u.result_ok.job_id != id)
+            errbuf_set(why, wsz, 0, "the result of job %llu", (unsigned long long)m.u.result_ok.job_id);
+        else if (used != n)
+            errbuf_set(why, wsz, 0, "%zu bytes after the frame", n - used);
+        else
+            ok = 1;
+        proto_msg_free(&m);
+    } else if (rc > 0) {
+        errbuf_set(why, wsz, 0, "truncated (%zu bytes)", n);
+    }
+    free(buf);
+    return ok;
 }
 
 static void read_progress(sqlite3_stmt *st, uint64_t id, proto_progress *p)

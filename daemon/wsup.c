@@ -5,8 +5,13 @@
  * DESIGN: a job's end is decided from what the worker left, never from a
  * guess: result.frame -> COMPLETED; our wall-time SIGTERM -> TIMEOUT;
  * exit 3 or a cancel we sent -> CANCELLED; error.frame -> FAILED with its
- * message (OUT_OF_MEMORY for NOMEM); a signal or a bare exit is a crash: the
- * job runs once more, a second crash fails it ("worker crashed twice").
+ * message (OUT_OF_MEMORY for NOMEM); exit 4 (no answer could be stored: a
+ * full disk) -> PENDING again, starts paused; a signal or a bare exit is a
+ * crash: the job runs once more, a second crash fails it ("worker crashed
+ * twice"). job.c records the end (job_ended). No job starts while the
+ * state file system has less than WSUP_MIN_FREE_BYTES free, nor while its
+ * worker lock is held (wlock.c); such a start, or a spawn failing for a
+ * passing reason, waits in the queue while starts pause.
  * During a shutdown drain a job without result.frame goes back to PENDING,
  * so it runs again on the next start: never lost. The worker is started
  * with uv_spawn (fork + exec at once: nothing of the daemon's state runs in
@@ -22,11 +27,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
-#define WSUP_PROGRESS_FD 3
 #define WSUP_EOF_GRACE_MS 2000      /* after exit, wait this long for the pipe's EOF */
 #define WSUP_MAX_CRASHES 2          /* worker crashes that fail a job */
+#define WSUP_RETRY_MIN_MS 500       /* a start failed for a passing reason: the first retry */
+#define WSUP_RETRY_MAX_MS 30000     /* ... and the longest wait between retries */
+#define WSUP_MIN_FREE_BYTES (1u << 20)  /* free in the state file system for a run's answer */
 
 struct wsup_slot {
     mcd *d;
@@ -46,7 +54,19 @@ struct wsup_slot {
     proto_buf in;
 };
 
+/* Starts are paused after one failed for a passing reason (descriptors or
+ * processes exhausted, a full disk, an orphan still holding the job's lock)
+ * or a run that could not store its answer: the job goes back to the queue
+ * and starts resume after a delay that doubles, up to WSUP_RETRY_MAX_MS,
+ * until a run ends with an answer. */
+static struct {
+    uv_timer_t timer;
+    int open, paused;
+    uint64_t delay_ms;
+} R;
+
 static void slot_finish(wsup_slot *s);
+static void wsup_schedule(mcd *d);
 
 const char *wsup_worker_path(const mcd *d, char *buf, size_t sz)
 {
@@ -69,7 +89,7 @@ unsigned long long wsup_max_faces(const mcd *d)
     return mf > 40000000 ? 40000000 : mf;
 }
 
-int wsup_init(mcd *d, char *err, size_t errsz)
+static int wsup_init(mcd *d, char *err, size_t errsz)
 {
     d->slots = calloc((size_t)d->conf.workers, sizeof *d->slots);
     if (!d->slots) {
@@ -85,6 +105,11 @@ int wsup_init(mcd *d, char *err, size_t errsz)
         uv_timer_init(d->loop, &s->timer);
         s->timer.data = s;
     }
+    uv_timer_init(d->loop, &R.timer);
+    R.timer.data = d;
+    R.open = 1;
+    R.paused = 0;
+    R.delay_ms = WSUP_RETRY_MIN_MS;
     char buf[PATH_MAX];
     const char *w = wsup_worker_path(d, buf, sizeof buf);
     if (access(w, X_OK) != 0)
@@ -192,18 +217,10 @@ static void on_handle_closed(uv_handle_t *h)
     s->job_id = 0;
     mcd *d = s->d;
     if (d->draining) {
-        mcd_drained(d);               /* closes once nothing else runs either */
+        drain_check(d);               /* closes once nothing else runs either */
     } else {
         wsup_schedule(d);
     }
-}
-
-/* Reads error.frame: its code and message; 0 when there is none. */
-static int read_error_frame(wsup_slot *s, char *msg, size_t msz)
-{
-    char path[CONF_PATH + 64];
-    store_spool_path(s->d->store, s->job_id, "error.frame", path, sizeof path);
-    return bk_error_frame(path, msg, msz);
 }
 
 /* The worker died without result.frame or error.frame: the first crash of a
@@ -218,7 +235,7 @@ static int crashed(wsup_slot *s, char *reason, size_t rsz)
     else
         snprintf(what, sizeof what, "worker exited with status %lld without a result",
                  (long long)s->exit_status);
-    uint32_t crashes = WSUP_MAX_CRASHES;
+    uint32_t crashes = 1;           /* uncounted (the store is failing): not held against the job */
     if (store_add_crash(s->d->store, s->job_id, &crashes))
         dlog(DLOG_ERROR, "job %llu: cannot count its crash", (unsigned long long)s->job_id);
     if (crashes < WSUP_MAX_CRASHES) {
@@ -229,6 +246,8 @@ static int crashed(wsup_slot *s, char *reason, size_t rsz)
     return PROTO_STATE_FAILED;
 }
 
+static void pause_starts(void);
+
 static void slot_finish(wsup_slot *s)
 {
     if (s->finished)
@@ -236,10 +255,9 @@ static void slot_finish(wsup_slot *s)
     s->finished = 1;
     mcd *d = s->d;
     uv_timer_stop(&s->timer);
-    char path[CONF_PATH + 64], reason[PROTO_MAX_STRING + 1] = "", emsg[PROTO_MAX_STRING + 1] = "";
-    int state, ecode;
-    int has_result = access(store_spool_path(d->store, s->job_id, "result.frame", path, sizeof path), R_OK) == 0;
-    if (has_result) {
+    char reason[PROTO_MAX_STRING + 1] = "";
+    int state, no_answer = s->term_signal == 0 && s->exit_status == SPOOL_EXIT_NO_ANSWER;
+    if (job_has_result(d, s->job_id)) {
         state = PROTO_STATE_COMPLETED;
     } else if (s->requeue) {
         state = PROTO_STATE_PENDING;
@@ -247,34 +265,115 @@ static void slot_finish(wsup_slot *s)
     } else if (s->timed_out) {
         state = PROTO_STATE_TIMEOUT;
         snprintf(reason, sizeof reason, "wall time limit of %u s exceeded", d->conf.job_timeout_s);
-    } else if (s->cancel_requested || (s->term_signal == 0 && s->exit_status == 3)) {
+    } else if (s->cancel_requested || (s->term_signal == 0 && s->exit_status == SPOOL_EXIT_CANCELLED)) {
         state = PROTO_STATE_CANCELLED;
         snprintf(reason, sizeof reason, "cancelled by request");
-    } else if ((ecode = read_error_frame(s, emsg, sizeof emsg)) != 0) {
-        state = ecode == PROTO_ENOMEM ? PROTO_STATE_OUT_OF_MEMORY : PROTO_STATE_FAILED;
-        snprintf(reason, sizeof reason, "%s: %s", proto_err_name(ecode), emsg);
+    } else if ((state = job_error_end(d, s->job_id, reason, sizeof reason)) >= 0) {
+        /* FAILED, OUT_OF_MEMORY or CANCELLED, as the error.frame says */
+    } else if (no_answer) {
+        /* the worker could not keep its answer (a full disk): a passing
+         * condition, not the job's fault and not a crash */
+        state = PROTO_STATE_PENDING;
+        snprintf(reason, sizeof reason, "re-queued: the worker could not store its answer (disk full or"
+                 " I/O error; its message is in the daemon's log)");
     } else {
         state = crashed(s, reason, sizeof reason);
     }
-    dlog(DLOG_INFO, "job %llu: %s%s%s", (unsigned long long)s->job_id, proto_state_name(state),
-         reason[0] ? ": " : "", reason);
-    if (store_set_state(d->store, s->job_id, state, reason))
-        dlog(DLOG_ERROR, "job %llu: cannot record its end", (unsigned long long)s->job_id);
-    sched_done(d->sched, s->user);
-    store_job j;
-    if (state == PROTO_STATE_PENDING && store_get(d->store, s->job_id, &j) == 0)
-        sched_add(d->sched, s->job_id, s->user, j.priority);
+    job_ended(d, s->job_id, s->user, 1, state, reason);
+    if (no_answer && state == PROTO_STATE_PENDING)
+        pause_starts();             /* longer each time, until a run ends with an answer */
     else
-        req_job_ended(d, s->job_id);
+        R.delay_ms = WSUP_RETRY_MIN_MS;
     if (!uv_is_closing((uv_handle_t *)&s->pipe))
         uv_close((uv_handle_t *)&s->pipe, on_handle_closed);
     if (!uv_is_closing((uv_handle_t *)&s->proc))
         uv_close((uv_handle_t *)&s->proc, on_handle_closed);
 }
 
-static void slot_start(wsup_slot *s, uint64_t id, const char *user)
+static void on_retry(uv_timer_t *t)
+{
+    R.paused = 0;
+    wsup_schedule(t->data);
+}
+
+static int transient_spawn_error(int uv_err)
+{
+    return uv_err == UV_EMFILE || uv_err == UV_ENFILE || uv_err == UV_EAGAIN || uv_err == UV_ENOMEM;
+}
+
+/* Job id could not start for a passing reason (why): back to the queue,
+ * with why as its reason, and starts paused for a while. */
+static void start_later(mcd *d, uint64_t id, const char *user, const char *why)
+{
+    char reason[PROTO_MAX_STRING + 1];
+    snprintf(reason, sizeof reason, "waiting to start: %s (retried in %.1f s)", why, (double)R.delay_ms / 1000);
+    dlog(DLOG_WARN, "job %llu: %s", (unsigned long long)id, reason);
+    sched_done(d->sched, user);
+    store_job j;
+    if (store_get(d->store, id, &j) == 0 && sched_add(d->sched, id, user, j.priority) == 0)
+        store_set_reason(d->store, id, reason);
+    else
+        dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue (it runs after the next restart)",
+             (unsigned long long)id);
+    pause_starts();
+}
+
+/* No start for R.delay_ms, which doubles for the next time. */
+static void pause_starts(void)
+{
+    R.paused = 1;
+    uv_timer_start(&R.timer, on_retry, R.delay_ms, 0);
+    R.delay_ms = R.delay_ms * 2 > WSUP_RETRY_MAX_MS ? WSUP_RETRY_MAX_MS : R.delay_ms * 2;
+}
+
+/* Takes job id's worker lock (wlock.c) into *fd: 0, or 1 when the job cannot
+ * start now (start_later was called). A holder can only be a worker some
+ * earlier daemon left that recovery could not end: it is killed first. */
+static int take_worker_lock(mcd *d, uint64_t id, const char *user, int *fd)
+{
+    char path[CONF_PATH + 64], why[PROTO_MAX_STRING];
+    store_spool_path(d->store, id, SPOOL_WORKER_LOCK, path, sizeof path);
+    int rc = wlock_take(path, fd);
+    if (rc == WLOCK_HELD) {
+        int n = wlock_kill_holders(path, WLOCK_START_WAIT_MS);
+        dlog(DLOG_WARN, "job %llu: a worker of an earlier daemon still held the job: %s",
+             (unsigned long long)id, n > 0 ? "killed" : "still alive");
+        rc = n >= 0 ? wlock_take(path, fd) : WLOCK_HELD;
+    }
+    if (rc == 0)
+        return 0;
+    if (rc == WLOCK_HELD)
+        snprintf(why, sizeof why, "a worker of an earlier daemon still runs it");
+    else
+        snprintf(why, sizeof why, "cannot lock %.900s: %s", path, strerror(-rc));
+    start_later(d, id, user, why);
+    return 1;
+}
+
+/* Starts job id on slot s: 0 when the slot took it (or it ended at once),
+ * 1 when starts are paused (start_later). */
+static int slot_start(wsup_slot *s, uint64_t id, const char *user)
 {
     mcd *d = s->d;
+    char why[256], dir[CONF_PATH + 64];
+    struct statvfs v;
+    /* a run on a full disk would compute for nothing: its answer has no room */
+    if (statvfs(store_spool_path(d->store, id, NULL, dir, sizeof dir), &v) == 0 &&
+        (unsigned long long)v.f_bavail * v.f_frsize < WSUP_MIN_FREE_BYTES) {
+        snprintf(why, sizeof why, "the state file system is full (%llu KiB free, at least %u KiB wanted)",
+                 (unsigned long long)v.f_bavail * v.f_frsize / 1024, WSUP_MIN_FREE_BYTES / 1024);
+        start_later(d, id, user, why);
+        return 1;
+    }
+    int lock_fd;
+    if (take_worker_lock(d, id, user, &lock_fd))
+        return 1;
+    if (store_result_ok(d->store, id, why, sizeof why)) {
+        /* a worker finished it while no daemon watched: the answer is there */
+        close(lock_fd);
+        job_ended(d, id, user, 1, PROTO_STATE_COMPLETED, "finished while the daemon was down: result adopted");
+        return 0;
+    }
     memset(&s->proc, 0, sizeof s->proc);
     s->job_id = id;
     snprintf(s->user, sizeof s->user, "%s", user);
@@ -286,10 +385,9 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     proto_buf_reset(&s->in);
     store_clear_run(d->store, id);
 
-    char wbuf[PATH_MAX], dir[CONF_PATH + 64], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16];
-    store_spool_path(d->store, id, NULL, dir, sizeof dir);
+    char wbuf[PATH_MAX], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16];
     snprintf(sid, sizeof sid, "%llu", (unsigned long long)id);
-    snprintf(fd, sizeof fd, "%d", WSUP_PROGRESS_FD);
+    snprintf(fd, sizeof fd, "%d", SPOOL_PROGRESS_FD);
     snprintf(thr, sizeof thr, "%d", d->conf.threads_per_worker);
     snprintf(maxv, sizeof maxv, "%u", d->conf.max_vertices);
     snprintf(maxf, sizeof maxf, "%llu", wsup_max_faces(d));
@@ -316,48 +414,53 @@ static void slot_start(wsup_slot *s, uint64_t id, const char *user)
     s->pipe.data = s;
     s->proc.data = s;
     s->open_handles = 2;
-    uv_stdio_container_t stdio[4];
+    uv_stdio_container_t stdio[SPOOL_LOCK_FD + 1];
     stdio[0].flags = UV_IGNORE;
     stdio[1].flags = UV_INHERIT_FD;    /* the worker's output joins our log */
     stdio[1].data.fd = 2;
     stdio[2].flags = UV_INHERIT_FD;
     stdio[2].data.fd = 2;
-    stdio[3].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
-    stdio[3].data.stream = (uv_stream_t *)&s->pipe;
+    stdio[SPOOL_PROGRESS_FD].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
+    stdio[SPOOL_PROGRESS_FD].data.stream = (uv_stream_t *)&s->pipe;
+    stdio[SPOOL_LOCK_FD].flags = UV_INHERIT_FD;   /* the job's lock, held from the fork on */
+    stdio[SPOOL_LOCK_FD].data.fd = lock_fd;
     uv_process_options_t opt;
     memset(&opt, 0, sizeof opt);
     opt.file = argv[0];
     opt.args = argv;
     opt.exit_cb = on_exit_cb;
     opt.stdio = stdio;
-    opt.stdio_count = 4;
+    opt.stdio_count = SPOOL_LOCK_FD + 1;
     int rc = uv_spawn(d->loop, &s->proc, &opt);
+    if (rc == 0)
+        wlock_note_pid(lock_fd, (long)s->proc.pid);
+    close(lock_fd);                    /* the worker holds the lock now, alone */
     if (rc) {
         dlog(DLOG_ERROR, "job %llu: cannot start %s: %s", (unsigned long long)id, argv[0], uv_strerror(rc));
-        store_set_running(d->store, id, store_now_ms(), 0);
-        /* finish as a crash with the reason below */
-        s->exited = s->eof = 1;
-        s->exit_status = 127;
-        s->finished = 1;
-        char reason[PROTO_MAX_STRING];
-        snprintf(reason, sizeof reason, "cannot start worker %s: %s", argv[0], uv_strerror(rc));
-        store_set_state(d->store, id, PROTO_STATE_FAILED, reason);
-        sched_done(d->sched, s->user);
-        req_job_ended(d, id);
+        /* no process: the slot is idle once both handles are closed */
+        s->exited = s->eof = s->finished = 1;
         uv_close((uv_handle_t *)&s->pipe, on_handle_closed);
         uv_close((uv_handle_t *)&s->proc, on_handle_closed);
-        return;
+        char reason[PROTO_MAX_STRING];
+        snprintf(reason, sizeof reason, "cannot start worker %s: %s", argv[0], uv_strerror(rc));
+        if (transient_spawn_error(rc)) {
+            start_later(d, id, user, reason);
+            return 1;
+        }
+        job_ended(d, id, user, 1, PROTO_STATE_FAILED, reason);
+        return 0;
     }
     dlog(DLOG_INFO, "job %llu: started on slot %d, worker pid %d", (unsigned long long)id, s->index, s->proc.pid);
-    store_set_running(d->store, id, store_now_ms(), s->proc.pid);
+    job_running(d, id, s->proc.pid);
     uv_read_start((uv_stream_t *)&s->pipe, on_alloc, on_read);
     uv_update_time(d->loop);     /* the wall time counts from now, not the loop's cached time */
     uv_timer_start(&s->timer, on_timer, (uint64_t)d->conf.job_timeout_s * 1000, 0);
+    return 0;
 }
 
-void wsup_schedule(mcd *d)
+static void wsup_schedule(mcd *d)
 {
-    if (d->draining)
+    if (d->draining || R.paused)
         return;
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
@@ -365,13 +468,12 @@ void wsup_schedule(mcd *d)
             continue;
         char user[AUTH_MAX_USER];
         uint64_t id = sched_next(d->sched, user);
-        if (!id)
+        if (!id || slot_start(s, id, user))
             return;
-        slot_start(s, id, user);
     }
 }
 
-int wsup_cancel(mcd *d, uint64_t id)
+static int wsup_cancel(mcd *d, uint64_t id)
 {
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
@@ -384,7 +486,7 @@ int wsup_cancel(mcd *d, uint64_t id)
     return -1;
 }
 
-void wsup_drain(mcd *d)
+static void wsup_drain(mcd *d)
 {
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
@@ -396,7 +498,7 @@ void wsup_drain(mcd *d)
     }
 }
 
-int wsup_busy(const mcd *d)
+static int wsup_busy(const mcd *d)
 {
     int n = 0;
     for (int i = 0; i < d->conf.workers; i++)
@@ -404,14 +506,18 @@ int wsup_busy(const mcd *d)
     return n;
 }
 
-void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id)
+static void wsup_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id)
 {
     *state = d->slots[i].state;
     *job_id = d->slots[i].job_id;
 }
 
-void wsup_close(mcd *d)
+static void wsup_close(mcd *d)
 {
+    if (R.open) {
+        R.open = 0;
+        uv_close((uv_handle_t *)&R.timer, NULL);
+    }
     if (!d->slots)
         return;
     for (int i = 0; i < d->conf.workers; i++) {
@@ -437,7 +543,14 @@ static int wsup_health(const mcd *d, char *msg, size_t sz)
     return 1;
 }
 
+/* The slots are allocated once. */
+static void wsup_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
+{
+    bk_note_change(n->workers != d->conf.workers, "workers", changed, sz);
+    n->workers = d->conf.workers;
+}
+
 const bk_ops bk_local = {
     "local", wsup_init, wsup_schedule, wsup_cancel, wsup_drain, wsup_busy,
-    wsup_nslots, wsup_slot_info, wsup_health, wsup_close,
+    wsup_nslots, wsup_slot_info, wsup_health, wsup_close, wsup_keep_on_reload,
 };

@@ -55,9 +55,7 @@ static double round_trips(const char *name, const char *const *args, testdaemon_
         testdaemon_wait_state(c, id, -1, 60);
     }
     mc_close(c);
-    int st = testdaemon_stop(d, SIGTERM);
-    if (st != 0)
-        FAILF("the daemon exited with wait status %d", st);
+    testdaemon_stop(d, SIGTERM);   /* fails unless the daemon exits 0 */
     return median(rt, NSUBMIT);
 }
 

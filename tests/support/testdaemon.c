@@ -97,24 +97,69 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     FAILF("meshcorrd did not write its port file; log %s", d->log);
 }
 
-int testdaemon_stop(testdaemon *d, int sig)
+/* "exit status N" / "killed by signal N (NAME)" for a wait status. */
+static const char *status_text(int st, char *buf, size_t sz)
 {
-    int st = 0;
-    if (d->pid <= 0)
-        return -1;
-    kill(d->pid, sig);
-    for (int i = 0; i < 2000; i++) {
+    if (WIFEXITED(st))
+        snprintf(buf, sz, "exit status %d", WEXITSTATUS(st));
+    else if (WIFSIGNALED(st))
+        snprintf(buf, sz, "killed by signal %d (%s)%s", WTERMSIG(st), strsignal(WTERMSIG(st)),
+                 WCOREDUMP(st) ? ", core dumped" : "");
+    else
+        snprintf(buf, sz, "wait status %#x", st);
+    return buf;
+}
+
+/* The daemon's wait status once it has exited, waiting at most ms; -1 if it
+ * still runs. */
+static int reap(testdaemon *d, int ms)
+{
+    int st;
+    for (int i = 0; i <= ms / 10; i++) {
         if (waitpid(d->pid, &st, WNOHANG) == d->pid) {
             d->pid = 0;
             return st;
         }
-        sleep_ms(10);
+        if (i < ms / 10)
+            sleep_ms(10);
     }
+    return -1;
+}
+
+void testdaemon_stop(testdaemon *d, int sig)
+{
+    char what[128];
+    if (d->pid <= 0)
+        FAILF("testdaemon_stop: meshcorrd is not running");
+    if (sig)
+        kill(d->pid, sig);
+    int st = reap(d, 20000);
+    if (st == -1) {
+        kill(d->pid, SIGKILL);
+        waitpid(d->pid, &st, 0);
+        d->pid = 0;
+        FAILF("meshcorrd did not exit within 20 s of signal %d; log %s", sig, d->log);
+    }
+    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0)
+        FAILF("meshcorrd stopped with signal %d ended with %s, not exit status 0; log %s", sig,
+              status_text(st, what, sizeof what), d->log);
+}
+
+void testdaemon_kill(testdaemon *d)
+{
+    char what[128];
+    if (d->pid <= 0)
+        FAILF("testdaemon_kill: meshcorrd is not running");
+    int st = reap(d, 0);
+    if (st != -1)
+        FAILF("meshcorrd had already ended (%s) before the test's SIGKILL; log %s",
+              status_text(st, what, sizeof what), d->log);
     kill(d->pid, SIGKILL);
     waitpid(d->pid, &st, 0);
     d->pid = 0;
-    FAILF("meshcorrd did not exit within 20 s of signal %d", sig);
-    return st;
+    if (!WIFSIGNALED(st) || WTERMSIG(st) != SIGKILL)
+        FAILF("meshcorrd ended with %s, not by the test's SIGKILL; log %s", status_text(st, what, sizeof what),
+              d->log);
 }
 
 mc_client *testdaemon_client(const testdaemon *d, const char *token)
@@ -145,6 +190,74 @@ static int cmdline_has_job(pid_t pid, uint64_t id)
         if (strcmp(cmd + i, "--job-id") == 0 && i + 9 < n && strcmp(cmd + i + 9, want) == 0)
             return 1;
     return 0;
+}
+
+/* The --job argument of process pid into dir ("" none); its state letter. */
+static char job_dir_of(pid_t pid, char *dir, size_t sz)
+{
+    char path[64], cmd[8192], stat[512];
+    dir[0] = '\0';
+    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+    FILE *fp = fopen(path, "r");
+    char state = '?';
+    if (!fp)
+        return state;
+    if (fgets(stat, sizeof stat, fp)) {
+        char *rp = strrchr(stat, ')');
+        if (rp && rp[1])
+            state = rp[2];
+    }
+    fclose(fp);
+    snprintf(path, sizeof path, "/proc/%d/cmdline", (int)pid);
+    int fd = open(path, O_RDONLY);
+    if (fd < 0)
+        return state;
+    ssize_t n = read(fd, cmd, sizeof cmd - 1);
+    close(fd);
+    if (n <= 0)
+        return state;
+    cmd[n] = '\0';
+    for (ssize_t i = 0; i < n; i += (ssize_t)strlen(cmd + i) + 1)
+        if (strcmp(cmd + i, "--job") == 0 && i + 6 < n) {
+            snprintf(dir, sz, "%s", cmd + i + 6);
+            break;
+        }
+    return state;
+}
+
+/* Counts (and sends sig to, unless 0) every live process whose --job is in
+ * d's spool and, with id > 0, is job id's directory. */
+static int each_worker(const testdaemon *d, uint64_t id, int sig)
+{
+    char want[700], prefix[700], dir[4096];
+    snprintf(want, sizeof want, "%s/spool/%llu", d->state, (unsigned long long)id);
+    snprintf(prefix, sizeof prefix, "%s/spool/", d->state);
+    int n = 0;
+    DIR *dp = opendir("/proc");
+    struct dirent *de;
+    while (dp && (de = readdir(dp))) {
+        pid_t pid = (pid_t)atoi(de->d_name);
+        if (pid <= 0 || job_dir_of(pid, dir, sizeof dir) == 'Z' || !dir[0])
+            continue;
+        if (id ? strcmp(dir, want) == 0 : strncmp(dir, prefix, strlen(prefix)) == 0) {
+            n++;
+            if (sig)
+                kill(pid, sig);
+        }
+    }
+    if (dp)
+        closedir(dp);
+    return n;
+}
+
+int testdaemon_live_workers(const testdaemon *d, uint64_t id)
+{
+    return each_worker(d, id, 0);
+}
+
+int testdaemon_kill_workers(const testdaemon *d)
+{
+    return each_worker(d, 0, SIGKILL);
 }
 
 pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id)

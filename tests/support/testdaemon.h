@@ -32,9 +32,14 @@ void testdaemon_need_worker(void);
  * until it listens; with the same name again, restarts on the same state.
  * Fails the test when it cannot. */
 void testdaemon_start(testdaemon *d, const char *name, const char *const *args);
-/* Sends sig and waits for the daemon's exit (at most 20 s, then SIGKILL);
- * returns its wait status. */
-int testdaemon_stop(testdaemon *d, int sig);
+/* Sends sig (0: none, the daemon is already shutting down) and waits for
+ * its exit, at most 20 s (then SIGKILL). Fails the test unless meshcorrd
+ * exited with status 0: a daemon that dies by a signal or exits non-zero at
+ * any point before it is stopped fails the test that stops it. */
+void testdaemon_stop(testdaemon *d, int sig);
+/* A crash: SIGKILLs the daemon and reaps it. Fails the test when it had
+ * already died (by a signal or an exit) before the SIGKILL. */
+void testdaemon_kill(testdaemon *d);
 /* A connected client: token NULL = the Unix socket (peer credentials), else
  * TCP with that token. Fails the test when it cannot connect. */
 mc_client *testdaemon_client(const testdaemon *d, const char *token);
@@ -43,6 +48,12 @@ int testdaemon_log_has(const testdaemon *d, const char *what);
 /* Pid of the meshcorr-worker the daemon runs for job id, or -1 (waits up to
  * 10 s for it to appear). */
 pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id);
+/* Live (not zombie) meshcorr-worker processes of job id of d's state
+ * directory, whoever their parent is (orphans of a killed daemon count). */
+int testdaemon_live_workers(const testdaemon *d, uint64_t id);
+/* SIGKILLs every process working in d's spool (cleanup of a test that
+ * leaves orphans behind); the number killed. */
+int testdaemon_kill_workers(const testdaemon *d);
 /* Polls STATUS until the job is in `state` (or, with state < 0, in any final
  * state); fails the test after timeout_s. Returns the state. */
 int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s);

@@ -113,6 +113,19 @@ TEST(in_memory_mesh_with_a_bad_index_is_refused_with_a_message)
     CHECK_INT(mc_encode_mesh(v, 2, f, 1, &buf, &len, err, sizeof err), MC_EARG);
 }
 
+TEST(in_memory_mesh_with_a_nan_is_refused_naming_the_vertex)
+{
+    double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const int f[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    v[3 * 2 + 1] = NAN;
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    char err[512] = "";
+    CHECK_INT(mc_encode_mesh(v, 4, f, 4, &buf, &len, err, sizeof err), MC_EARG);
+    CHECK(buf == NULL && len == 0);
+    CHECK_STR_HAS(err, "vertex 2: y coordinate is NaN");
+}
+
 static const char prog[] =
     "#include <meshcorr.h>\n"
     "#include <stdio.h>\n"

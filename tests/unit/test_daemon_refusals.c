@@ -157,7 +157,7 @@ TEST_T(meshes_and_landmarks_that_cannot_run_are_refused_naming_the_blob, 90)
     CHECK_INT(testdaemon_wait_state(c, 1, -1, 60), MC_COMPLETED);
     raw_close(&r);
     mc_close(c);
-    CHECK_INT(testdaemon_stop(&d, SIGTERM), 0);          /* exit status 0, no signal */
+    testdaemon_stop(&d, SIGTERM);          /* fails unless the daemon exits 0 */
 }
 
 TEST_T(parameters_out_of_range_are_refused_naming_the_field, 60)
@@ -188,7 +188,7 @@ TEST_T(parameters_out_of_range_are_refused_naming_the_field, 60)
     CHECK_INT(raw_send(c, &r), 0);                       /* 3 pairs are enough */
     raw_close(&r);
     mc_close(c);
-    CHECK_INT(testdaemon_stop(&d, SIGTERM), 0);
+    testdaemon_stop(&d, SIGTERM);
 }
 
 /* Pid of a `--validate` child of the daemon, or -1. */
@@ -283,5 +283,5 @@ TEST_T(other_clients_are_answered_while_a_submit_is_checked, 120)
     CHECK_INT(b.rc, PROTO_EBAD_LANDMARKS);              /* and then the SUBMIT was refused */
     mc_close(other);
     raw_close(&b.r);
-    CHECK_INT(testdaemon_stop(&d, SIGTERM), 0);
+    testdaemon_stop(&d, SIGTERM);
 }

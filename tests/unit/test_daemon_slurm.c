@@ -4,7 +4,8 @@
  * spool's progress.frames; the demo pair's map identical to the local
  * backend's; CANCEL as scancel; Slurm's time limit as TIMEOUT; meshcorrd
  * SIGKILLed and restarted while Slurm runs its jobs re-attaches without
- * submitting anything twice; a missing sbatch or an unreachable controller is
+ * submitting anything twice; SIGTERM under systemd (sd_notify) exits 0 and
+ * leaves the jobs in Slurm; a missing sbatch or an unreachable controller is
  * in STATS and the job stays PENDING.
  *
  * The binary re-executes itself inside a private pid + network namespace
@@ -21,10 +22,13 @@
 #include "mesh/mesh.h"
 #include "meshcorr.h"
 
+#include <poll.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -219,7 +223,7 @@ TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 
     testdaemon_wait_state(c, b, MC_RUNNING, 30);
     sleep_ms(500);
     mc_close(c);
-    testdaemon_stop(&d, SIGKILL);
+    testdaemon_kill(&d);
     /* the Slurm jobs run on without meshcorrd */
     char st[64];
     CHECK_STR_HAS(testslurm_state(&d, a, st, sizeof st), "RUNNING");
@@ -244,6 +248,136 @@ TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 
     }
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
+}
+
+/* Reads notify datagrams until one contains `want` (all text kept in log). */
+static int notify_wait(int fd, const char *want, char *log, size_t logsz, int timeout_ms)
+{
+    for (int waited = 0; waited < timeout_ms; waited += 50) {
+        struct pollfd p = {fd, POLLIN, 0};
+        if (poll(&p, 1, 50) <= 0)
+            continue;
+        char msg[1024];
+        ssize_t n = recv(fd, msg, sizeof msg - 1, 0);
+        if (n <= 0)
+            continue;
+        msg[n] = '\0';
+        size_t used = strlen(log);
+        snprintf(log + used, logsz - used, "%s|", msg);
+        if (strstr(msg, want))
+            return 1;
+    }
+    return 0;
+}
+
+/* The local backend's worker slots do not exist here: READY's STATUS= and
+ * the STOPPING=1 of a drain must count the Slurm backend's slots (they read
+ * the local pool's, which only the local backend allocates: SIGSEGV). */
+TEST_T(sigterm_of_a_slurm_daemon_under_systemd_exits_0_and_its_job_completes_after_restart, 120)
+{
+    testslurm_need();
+    char path[700];
+    snprintf(path, sizeof path, "%s/notify.sock", harness_tmpdir());
+    int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    CHECK(fd >= 0);
+    struct sockaddr_un a = {.sun_family = AF_UNIX};
+    CHECK(strlen(path) < sizeof a.sun_path);
+    strcpy(a.sun_path, path);
+    unlink(path);
+    CHECK_INT(bind(fd, (struct sockaddr *)&a, sizeof a), 0);
+    CHECK_INT(setenv("NOTIFY_SOCKET", path, 1), 0);
+    testdaemon d;
+    const char *args[] = {"--slurm-max-jobs", "3", NULL};
+    testslurm_daemon(&d, "term", args);
+    unsetenv("NOTIFY_SOCKET");
+    static char log[16384];
+    if (!notify_wait(fd, "READY=1", log, sizeof log, 5000))
+        FAILF("no READY=1: %s", log);
+    CHECK_STR_HAS(log, "STATUS=0 queued, 0 of 3 slot(s) busy");
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    uint64_t id = submit_demo(c, 25);           /* seconds */
+    testdaemon_wait_state(c, id, MC_RUNNING, 30);
+    if (!notify_wait(fd, "1 of 3 slot(s) busy", log, sizeof log, 5000))
+        FAILF("no STATUS= with the job in Slurm: %s", log);
+    mc_close(c);
+    CHECK_INT(kill(d.pid, SIGTERM), 0);
+    if (!notify_wait(fd, "STOPPING=1", log, sizeof log, 5000))
+        FAILF("no STOPPING=1: %s", log);
+    testdaemon_stop(&d, 0);                     /* exit status 0, no second signal */
+    close(fd);
+    char st[64];
+    CHECK_STR_HAS(testslurm_state(&d, id, st, sizeof st), "RUNNING");
+    testslurm_daemon(&d, "term", args);
+    c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    int end = -1;
+    char reason[1100];
+    CHECK_INT(mc_watch(c, id, 0, NULL, NULL, &end, reason, sizeof reason), 0);
+    if (end != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(end), reason);
+    CHECK_INT(testslurm_count(&d, id), 1);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *fp = fopen(path, "w");
+    if (!fp)
+        FAILF("cannot write %s", path);
+    fputs(text, fp);
+    fclose(fp);
+}
+
+/* slurm-max-jobs is the Slurm backend's slot count, and the status snapshot
+ * is sized from it at start: a SIGHUP raising it must keep the running value
+ * (with a warning), never let the snapshot index past its arrays. The daemon
+ * runs with glibc's malloc checks (a canary after every block, checked when
+ * it is freed), so a write past the snapshot ends it by SIGABRT. */
+TEST_T(sighup_raising_slurm_max_jobs_keeps_the_slot_count_and_writes_nothing_past_it, 120)
+{
+    testslurm_need();
+    static const char dbg[] = "/usr/lib/x86_64-linux-gnu/libc_malloc_debug.so.0";
+    if (access(dbg, R_OK) == 0) {
+        setenv("LD_PRELOAD", dbg, 1);
+        setenv("GLIBC_TUNABLES", "glibc.malloc.check=3", 1);
+    }
+    char conf[700];
+    snprintf(conf, sizeof conf, "%s/reload.conf", harness_tmpdir());
+    write_text(conf, "slurm-max-jobs = 2\n");
+    testdaemon d;
+    const char *args[] = {"--config", conf, NULL};
+    testslurm_daemon(&d, "reload", args);
+    unsetenv("LD_PRELOAD");
+    unsetenv("GLIBC_TUNABLES");
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_server_stats st;
+    CHECK_INT(mc_stats(c, &st), 0);
+    CHECK_INT(st.nslots, 2);
+    mc_stats_free(&st);
+    write_text(conf, "slurm-max-jobs = 64\n");
+    CHECK_INT(kill(d.pid, SIGHUP), 0);
+    for (int i = 0; i < 500 && !testdaemon_log_has(&d, "reload: options applied"); i++)
+        sleep_ms(10);
+    CHECK(testdaemon_log_has(&d, "reload: options applied"));
+    CHECK(testdaemon_log_has(&d, "slurm-max-jobs changed but take(s) effect at the next start only"));
+    uint64_t ids[4];
+    for (int i = 0; i < 4; i++)
+        ids[i] = submit_ok(c, 2, 0);
+    uint32_t most = 0;
+    for (int done = 0; !done;) {
+        CHECK_INT(mc_stats(c, &st), 0);
+        CHECK_INT(st.nslots, 2);            /* the slot count of the start */
+        if (st.running > most)
+            most = st.running;
+        done = st.completed + st.failed + st.cancelled == 4;
+        mc_stats_free(&st);
+        sleep_ms(100);
+    }
+    CHECK(most >= 1 && most <= 2);          /* still at most 2 jobs in Slurm at once */
+    for (int i = 0; i < 4; i++)
+        CHECK_INT(testdaemon_wait_state(c, ids[i], -1, 10), MC_COMPLETED);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);           /* exit 0: no canary was overwritten */
 }
 
 TEST_T(missing_sbatch_is_in_stats_and_the_job_stays_pending, 60)

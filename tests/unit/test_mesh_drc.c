@@ -277,3 +277,20 @@ TEST(drc_lossless_is_exact_on_a_real_mesh_float32_when_it_can_and_16_bits_smalle
     mesh_free(g);
     mesh_free(m);
 }
+
+TEST(drc_quantized_encoding_refuses_a_nan_naming_the_vertex_and_coordinate)
+{
+    mesh *m = testmesh_icosphere(1);
+    m->v[3 * 7 + 2] = NAN;
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    char err[512] = "";
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, 16, &buf, &len, err, sizeof err), DRACOB_EARG);
+    CHECK(buf == NULL);
+    CHECK_STR_HAS(err, "vertex 7: z coordinate is NaN");
+    m->v[3 * 7 + 2] = 0;
+    m->v[3 * 3] = INFINITY;
+    CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, 16, &buf, &len, err, sizeof err), DRACOB_EARG);
+    CHECK_STR_HAS(err, "vertex 3: x coordinate is infinite");
+    mesh_free(m);
+}

@@ -11,14 +11,17 @@
 #include "mesh/mesh.h"
 #include "mesh/draco_bridge.h"
 #include "proto.h"
+#include "spool.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <spawn.h>
 #include <string.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -495,6 +498,77 @@ TEST(worker_refuses_beta_ramp_of_zero_iterations)
     j.msg.u.submit.params.beta_ramp = 0;
     save(&j);
     expect_error(NULL, 1, PROTO_EBAD_PARAMS, "params.beta_ramp = 0 < 1", NULL);
+}
+
+TEST(worker_refuses_rhm_alpha_out_of_range_naming_it_once)
+{
+    static const proto_landmark L[5] = { {0, 0}, {10, 10}, {20, 20}, {30, 30}, {40, 40} };
+    testjob j;
+    demo_job(&j, L, 5, 0);
+    j.msg.u.submit.params.rhm_alpha = 2;
+    save(&j);
+    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "RHM parameter alpha must be in (0, 1)", NULL);
+    proto_msg m;
+    unsigned char *file;
+    read_frame(job_dir(), "error.frame", &m, &file);
+    if (strstr(m.u.error.message, "RHM RHM"))
+        FAILF("doubled prefix: %s", m.u.error.message);
+    proto_msg_free(&m);
+    free(file);
+}
+
+/* job_dir() on a 2 MB tmpfs of this test's own mount namespace, job.frame
+ * saved, then the rest of the file system filled. */
+static void job_on_a_full_disk(testjob *j)
+{
+    if (unshare(CLONE_NEWNS) != 0)
+        SKIP("cannot make a mount namespace: %s (needs CAP_SYS_ADMIN)", strerror(errno));
+    CHECK_INT(mount(NULL, "/", NULL, MS_REC | MS_PRIVATE, NULL), 0);
+    CHECK_INT(mkdir(job_dir(), 0700), 0);
+    if (mount("tmpfs", job_dir(), "tmpfs", MS_NOSUID | MS_NODEV, "size=2m,mode=0700") != 0)
+        SKIP("cannot mount a tmpfs: %s", strerror(errno));
+    save(j);
+    char path[600];
+    snprintf(path, sizeof path, "%s/filler", job_dir());
+    int fd = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0600);
+    CHECK(fd >= 0);
+    static char chunk[4096];
+    for (size_t n = sizeof chunk; n >= 1; n /= 8)
+        while (write(fd, chunk, n) > 0) {}
+    close(fd);
+}
+
+static void expect_no_answer(void)
+{
+    pid_t pid = spawn_worker(job_dir(), NULL, 0, NULL);
+    CHECK_INT(wait_exit(pid), SPOOL_EXIT_NO_ANSWER);
+    static const char *none[] = {SPOOL_RESULT_FRAME, SPOOL_ERROR_FRAME, SPOOL_RESULT_FRAME SPOOL_TMP_SUFFIX,
+                                 SPOOL_ERROR_FRAME SPOOL_TMP_SUFFIX};
+    for (size_t i = 0; i < sizeof none / sizeof none[0]; i++) {
+        char path[600];
+        snprintf(path, sizeof path, "%s/%s", job_dir(), none[i]);
+        if (access(path, F_OK) == 0)
+            FAILF("%s left on a full disk", path);
+    }
+}
+
+/* The job did not fail: its answer had no room. Exit 4, no frame at all
+ * (an error.frame would end the job; the daemon runs it again instead). */
+TEST_T(worker_whose_result_does_not_fit_on_the_disk_exits_4_without_a_frame, 60)
+{
+    testjob j;
+    demo_job(&j, NULL, 0, 1);
+    job_on_a_full_disk(&j);
+    expect_no_answer();
+}
+
+TEST(worker_whose_error_frame_does_not_fit_on_the_disk_exits_4)
+{
+    testjob j;
+    demo_job(&j, NULL, 0, 1);
+    j.msg.u.submit.params.alpha = -1;
+    job_on_a_full_disk(&j);
+    expect_no_answer();
 }
 
 TEST(worker_refuses_job_frame_with_corrupted_blob_checksum)

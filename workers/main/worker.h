@@ -11,17 +11,8 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "proto.h"
+#include "spool.h"        /* file names and exit statuses: SPOOL_* */
 #include "corr/corr.h"
-
-/* Exit statuses (WORKER.md). */
-#define WRK_EXIT_OK        0
-#define WRK_EXIT_JOB       1   /* error.frame written (or, if that failed, nothing) */
-#define WRK_EXIT_USAGE     2   /* bad command line or job directory; no error.frame */
-#define WRK_EXIT_CANCELLED 3   /* SIGTERM; error.frame holds CANCELLED */
-
-#define WRK_JOB_FRAME    "job.frame"
-#define WRK_RESULT_FRAME "result.frame"
-#define WRK_ERROR_FRAME  "error.frame"
 
 typedef struct wrk_limits {
     int max_vertices, max_faces;   /* per mesh, checked while decoding */
@@ -62,7 +53,6 @@ int wrk_frame_write(const char *dir, const char *name, const proto_msg *m, char 
  * appending them to DIR/progress.frames when it cannot be made or breaks.
  * fd < 0 and no file: no progress. A pipe's first write error closes it for
  * good (the daemon is gone); the job always carries on. */
-#define WRK_PROGRESS_FILE "progress.frames"
 #define WRK_PROGRESS_HELLO "MCPROGRESS"      /* daemon/backend.h, bk_prog_ */
 #define WRK_SECRET_MAX 128
 typedef struct wrk_progress {
@@ -94,8 +84,8 @@ void wrk_result_close(wrk_result *r);
 
 /* worker_validate.c — `--validate`: reads one SUBMIT frame from in_fd and
  * builds the job from it as a run would (wrk_job_from_submit), running
- * nothing. WRK_EXIT_OK when it would run; else one ERROR frame (the code and
- * the message naming the blob or field) on out_fd and WRK_EXIT_JOB. */
+ * nothing. SPOOL_EXIT_OK when it would run; else one ERROR frame (the code and
+ * the message naming the blob or field) on out_fd and SPOOL_EXIT_JOB. */
 int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim);
 
 /* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with

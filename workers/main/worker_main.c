@@ -44,7 +44,8 @@ static void usage(void)
         "       meshcorr-worker --validate [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
         "                       [--max-cpu-s N]   (a SUBMIT frame on stdin; refusal: ERROR on stdout)\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
-        "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage. See workers/WORKER.md.\n");
+        "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage; 4: neither could be written.\n"
+        "See workers/WORKER.md.\n");
 }
 
 /* Decimal in [lo, hi]; -1 (with a message) otherwise. */
@@ -110,10 +111,13 @@ static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
     text[n] = '\0';
     m.u.error.message = text;
     char err[1024];
-    if (wrk_frame_write(dir, WRK_ERROR_FRAME, &m, err, sizeof err))
+    int cancelled = code == PROTO_ECANCELLED;
+    if (wrk_frame_write(dir, SPOOL_ERROR_FRAME, &m, err, sizeof err)) {
         fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": cannot write %s: %s\n", job_id,
-                WRK_ERROR_FRAME, err);
-    return code == PROTO_ECANCELLED ? WRK_EXIT_CANCELLED : WRK_EXIT_JOB;
+                SPOOL_ERROR_FRAME, err);
+        return cancelled ? SPOOL_EXIT_CANCELLED : SPOOL_EXIT_NO_ANSWER;
+    }
+    return cancelled ? SPOOL_EXIT_CANCELLED : SPOOL_EXIT_JOB;
 }
 
 /* Sets resource limit res to v (soft and hard); -1 with a message. */
@@ -184,17 +188,17 @@ int main(int argc, char **argv)
         case 'L': list_devices = 1; break;
         case 'V': break;                       /* seen above */
         case 'C': bad |= parse_num("max-cpu-s", optarg, 1, 1ull << 20, &max_cpu_s) != 0; break;
-        case 'h': usage(); return WRK_EXIT_USAGE;
+        case 'h': usage(); return SPOOL_EXIT_USAGE;
         default: bad = 1;
         }
     }
     if (!bad && list_devices)
-        return wrk_list_devices(lim.threads) ? WRK_EXIT_USAGE : 0;
+        return wrk_list_devices(lim.threads) ? SPOOL_EXIT_USAGE : 0;
     if (!bad && validate) {
         if (dir || have_id || progress_fd >= 0 || progress_tcp || optind != argc) {
             fprintf(stderr, "meshcorr-worker: --validate takes limits only (the frame is on stdin)\n");
             usage();
-            return WRK_EXIT_USAGE;
+            return SPOOL_EXIT_USAGE;
         }
         /* the sandbox: bounded memory and CPU time, no files written, no
          * core dumped, few descriptors; set before any input is read */
@@ -207,7 +211,7 @@ int main(int argc, char **argv)
             (max_cpu_s && limit(RLIMIT_CPU, "--max-cpu-s", (rlim_t)max_cpu_s)) ||
             limit(RLIMIT_FSIZE, "file size", 0) || limit(RLIMIT_CORE, "core size", 0) ||
             limit(RLIMIT_NOFILE, "descriptors", 16))
-            return WRK_EXIT_USAGE;
+            return SPOOL_EXIT_USAGE;
         return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim);
     }
     if (!bad && (!dir || !have_id || optind != argc)) {
@@ -232,7 +236,7 @@ int main(int argc, char **argv)
         bad = 1;
     if (bad) {
         usage();
-        return WRK_EXIT_USAGE;
+        return SPOOL_EXIT_USAGE;
     }
 
     struct sigaction sa;
@@ -257,7 +261,7 @@ int main(int argc, char **argv)
     memset(&job, 0, sizeof job);
     memset(&res, 0, sizeof res);
     memset(&out, 0, sizeof out);
-    snprintf(path, sizeof path, "%s/%s", dir, WRK_JOB_FRAME);
+    snprintf(path, sizeof path, "%s/%s", dir, SPOOL_JOB_FRAME);
     int rc = wrk_frame_read(path, &frame, &sub, err, sizeof err);
     if (rc) {
         status = fail(dir, job_id, rc, err);
@@ -272,7 +276,7 @@ int main(int argc, char **argv)
     ctx.pg.total = job.params.iterations;
     ctx.t0 = t0;
     if (progress_tcp) {
-        snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, WRK_PROGRESS_FILE);
+        snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, SPOOL_PROGRESS_FILE);
         wrk_progress_connect(&ctx.pg, progress_tcp, secret_file);
     }
     corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0,
@@ -290,12 +294,19 @@ int main(int argc, char **argv)
         status = fail(dir, job_id, proto_code_of(rc), err);
         goto done;
     }
-    if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err)) ||
-        (rc = wrk_frame_write(dir, WRK_RESULT_FRAME, &out.msg, err, sizeof err))) {
+    if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err))) {
         status = fail(dir, job_id, rc, err);
         goto done;
     }
-    status = WRK_EXIT_OK;
+    if (wrk_frame_write(dir, SPOOL_RESULT_FRAME, &out.msg, err, sizeof err)) {
+        /* the job did not fail, its answer could not be kept (a full disk):
+         * no error.frame, which would end it; it runs again */
+        fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": cannot write %s: %s\n", job_id,
+                SPOOL_RESULT_FRAME, err);
+        status = SPOOL_EXIT_NO_ANSWER;
+        goto done;
+    }
+    status = SPOOL_EXIT_OK;
 done:
     if (progress_tcp && ctx.pg.fd >= 0)
         close(ctx.pg.fd);

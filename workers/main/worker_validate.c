@@ -104,9 +104,9 @@ done:
     proto_msg_free(&m);
     free(frame);
     if (rc == 0)
-        return WRK_EXIT_OK;
+        return SPOOL_EXIT_OK;
     if (write_error(out_fd, rc, err))
         fprintf(stderr, "meshcorr-worker --validate: %s: %s (and the answer could not be written)\n",
                 proto_err_name(rc), err);
-    return WRK_EXIT_JOB;
+    return SPOOL_EXIT_JOB;
 }

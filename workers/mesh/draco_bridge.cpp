@@ -8,6 +8,7 @@
 #include <draco/compression/encode.h>
 #include <draco/mesh/mesh.h>
 
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -251,6 +252,13 @@ extern "C" int dracob_encode(const double *v, int nv, const int *f, int nf,
         if (f[i] < 0 || f[i] >= nv)
             return fail(err, errsz, DRACOB_EARG, "face %lld: vertex index %d out of range [0, %d)",
                         i / 3, f[i], nv);
+    /* quantization maps positions onto a grid over their bounding box: a
+     * NaN or infinity has no place on it (Draco throws) */
+    for (long long i = 0; quantization_bits > 0 && i < 3LL * nv; i++)
+        if (!std::isfinite(v[i]))
+            return fail(err, errsz, DRACOB_EARG,
+                        "vertex %lld: %c coordinate is %s (a %d-bit quantized encoding needs finite positions)",
+                        i / 3, "xyz"[i % 3], std::isnan(v[i]) ? "NaN" : "infinite", quantization_bits);
     try {
         return encode(v, nv, f, nf, quantization_bits, buf, len, err, errsz);
     } catch (const std::bad_alloc &) {

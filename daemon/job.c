@@ -1,0 +1,216 @@
+/* job.c — one owner of a job's life once a backend runs it: its start, its
+ * progress and its end are recorded here and nowhere else (the backends
+ * decide from what their worker left and call these; backend.h); and its
+ * last step, the deletion of a finished job result-ttl after its end (the
+ * expiry sweep).
+ *
+ * DESIGN: a job's end is recorded before anyone is told. job_ended writes
+ * the state to the store, then sends END to the watchers; a run to do again
+ * (PENDING) goes back to the scheduler. When the store cannot take the end
+ * (a full disk: SQLite says SQLITE_FULL), the end is kept here and written
+ * again every JOB_RECORD_RETRY_MS until it is; meanwhile the store still
+ * says RUNNING and the watchers wait, so nobody is told an end the store
+ * does not have. A daemon that stops first loses nothing: the next start's
+ * recovery adopts the run's result.frame or runs the job again. What the
+ * files of a run say (result.frame; error.frame: FAILED, OUT_OF_MEMORY for
+ * NOMEM, CANCELLED for CANCELLED) is read here for both backends. */
+#include "backend.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define JOB_RECORD_RETRY_MS 1000
+#define JOB_MAX_ERROR_FRAME (1 << 20)  /* an error.frame is one ERROR: a short message */
+
+typedef struct unrecorded unrecorded;
+struct unrecorded {
+    uint64_t id;
+    int state;
+    char reason[PROTO_MAX_STRING + 1];
+    unrecorded *next;
+};
+
+static struct {
+    mcd *d;
+    uv_timer_t timer;
+    int open;
+    unrecorded *ends;             /* ends the store has not taken yet, oldest first */
+    uv_timer_t sweep;             /* result expiry */
+    uint64_t progress_failed;     /* job whose progress the store refused (logged once) */
+} J;
+
+static void on_retry(uv_timer_t *t)
+{
+    (void)t;
+    int left = 0;
+    for (unrecorded **pu = &J.ends; *pu;) {
+        unrecorded *u = *pu;
+        if (store_set_state(J.d->store, u->id, u->state, u->reason) != 0) {
+            left++;
+            pu = &u->next;
+            continue;
+        }
+        dlog(DLOG_INFO, "job %llu: %s recorded (the store takes writes again)", (unsigned long long)u->id,
+             proto_state_name(u->state));
+        *pu = u->next;
+        req_job_ended(J.d, u->id);
+        free(u);
+    }
+    if (!left)
+        uv_timer_stop(&J.timer);
+}
+
+void job_init(mcd *d)
+{
+    memset(&J, 0, sizeof J);
+    J.d = d;
+    uv_timer_init(d->loop, &J.timer);
+    uv_timer_init(d->loop, &J.sweep);
+    J.open = 1;
+}
+
+static int expire_one(void *ctx, const store_job *j)
+{
+    mcd *d = ctx;
+    dlog(DLOG_INFO, "job %llu: %s result older than %u s: deleted", (unsigned long long)j->id,
+         proto_state_name(j->state), d->conf.result_ttl_s);
+    store_delete(d->store, j->id);
+    return 0;
+}
+
+static void on_sweep(uv_timer_t *t)
+{
+    (void)t;
+    mcd *d = J.d;
+    store_each_expired(d->store, store_now_ms() - (int64_t)d->conf.result_ttl_s * 1000, expire_one, d);
+}
+
+void job_sweep_start(mcd *d)
+{
+    /* every minute, or every result-ttl when that is shorter */
+    uint64_t every = d->conf.result_ttl_s < 60 ? d->conf.result_ttl_s * 1000ull : 60000;
+    uv_timer_start(&J.sweep, on_sweep, 0, every);
+}
+
+void job_close(mcd *d)
+{
+    (void)d;
+    int n = 0;
+    while (J.ends) {
+        unrecorded *u = J.ends;
+        J.ends = u->next;
+        free(u);
+        n++;
+    }
+    if (n)
+        dlog(DLOG_WARN, "%d job end(s) never reached the store: the next start recovers those jobs"
+             " (a result is adopted, else they run again)", n);
+    if (J.open) {
+        uv_close((uv_handle_t *)&J.timer, NULL);
+        uv_close((uv_handle_t *)&J.sweep, NULL);
+    }
+    J.open = 0;
+}
+
+void job_running(mcd *d, uint64_t id, long pid)
+{
+    if (store_set_running(d->store, id, store_now_ms(), pid))
+        dlog(DLOG_ERROR, "job %llu: cannot record it RUNNING (the store is failing)", (unsigned long long)id);
+}
+
+void job_progress(mcd *d, const proto_progress *p)
+{
+    if (store_add_progress(d->store, p->job_id, p) == 0) {
+        if (J.progress_failed == p->job_id)
+            J.progress_failed = 0;
+    } else if (J.progress_failed != p->job_id) {
+        J.progress_failed = p->job_id;
+        dlog(DLOG_ERROR, "job %llu: cannot store its progress (more failures of this job's are not logged)",
+             (unsigned long long)p->job_id);
+    }
+    req_progress(d, p);
+}
+
+void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, const char *reason)
+{
+    dlog(DLOG_INFO, "job %llu: %s%s%s", (unsigned long long)id, proto_state_name(state),
+         reason[0] ? ": " : "", reason);
+    if (counted)
+        sched_done(d->sched, user);
+    if (!store_is_terminal(state)) {
+        /* runs again: the scheduler has it even if the store cannot say so */
+        store_job j;
+        if (store_set_state(d->store, id, PROTO_STATE_PENDING, reason))
+            dlog(DLOG_ERROR, "job %llu: cannot record it PENDING again", (unsigned long long)id);
+        if (store_get(d->store, id, &j) != 0 || sched_add(d->sched, id, user, j.priority) != 0)
+            dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue: it runs after the next restart",
+                 (unsigned long long)id);
+        return;
+    }
+    if (store_set_state(d->store, id, state, reason) == 0) {
+        req_job_ended(d, id);
+        return;
+    }
+    unrecorded *u = calloc(1, sizeof *u);
+    if (!u) {
+        dlog(DLOG_ERROR, "job %llu: cannot record its end, and out of memory to retry: the next start"
+             " recovers it", (unsigned long long)id);
+        return;
+    }
+    u->id = id;
+    u->state = state;
+    snprintf(u->reason, sizeof u->reason, "%s", reason);
+    unrecorded **pu = &J.ends;
+    while (*pu)
+        pu = &(*pu)->next;
+    *pu = u;
+    dlog(DLOG_ERROR, "job %llu: cannot record its end (%s): retried every %d ms; it reads RUNNING until then",
+         (unsigned long long)id, proto_state_name(state), JOB_RECORD_RETRY_MS);
+    if (!uv_is_active((uv_handle_t *)&J.timer))
+        uv_timer_start(&J.timer, on_retry, JOB_RECORD_RETRY_MS, JOB_RECORD_RETRY_MS);
+}
+
+/* A worker's error.frame at path: its protocol error code and message
+ * (msg); 0 when there is none, PROTO_EINTERNAL when it does not decode.
+ * Loop thread only (one static buffer). */
+static int read_error_frame(const char *path, char *msg, size_t msz)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return 0;
+    static uint8_t buf[JOB_MAX_ERROR_FRAME];
+    size_t n = fread(buf, 1, sizeof buf, fp);
+    fclose(fp);
+    proto_msg m;
+    size_t used;
+    char err[256];
+    int code = PROTO_EINTERNAL;
+    if (proto_decode(buf, n, sizeof buf, &m, &used, err, sizeof err) == PROTO_READY &&
+        m.type == PROTO_MSG_ERROR) {
+        code = m.u.error.code;
+        snprintf(msg, msz, "%s", m.u.error.message);
+    } else {
+        snprintf(msg, msz, "worker wrote an unreadable error.frame");
+    }
+    proto_msg_free(&m);
+    return code;
+}
+
+int job_has_result(mcd *d, uint64_t id)
+{
+    char path[CONF_PATH + 64];
+    return access(store_spool_path(d->store, id, SPOOL_RESULT_FRAME, path, sizeof path), R_OK) == 0;
+}
+
+int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz)
+{
+    char path[CONF_PATH + 64], emsg[PROTO_MAX_STRING + 1] = "";
+    int code = read_error_frame(store_spool_path(d->store, id, SPOOL_ERROR_FRAME, path, sizeof path),
+                              emsg, sizeof emsg);
+    if (!code)
+        return -1;
+    snprintf(reason, rsz, "%s: %s", proto_err_name(code), emsg);
+    return code == PROTO_ENOMEM ? PROTO_STATE_OUT_OF_MEMORY
+         : code == PROTO_ECANCELLED ? PROTO_STATE_CANCELLED : PROTO_STATE_FAILED;
+}
