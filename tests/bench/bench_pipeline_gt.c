@@ -310,17 +310,6 @@ static void print_rows(const pair_spec *ps, const pair_fig *f)
     }
 }
 
-static int wanted(const char *list, const char *label)
-{
-    if (!list)
-        return 1;
-    size_t n = strlen(label);
-    for (const char *p = list; (p = strstr(p, label)); p += n)
-        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
-            return 1;
-    return 0;
-}
-
 TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
 {
     if (!harness_data_dir())
@@ -347,7 +336,7 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     static pair_fig figs[NPAIRS];
     int ran[NPAIRS] = {0};
     for (int i = 0; i < NPAIRS; i++) {
-        if (!wanted(o_pairs, pairs[i].label))
+        if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
         pair_job job = { &pairs[i], iters, scale };
         char why[256];

@@ -64,6 +64,17 @@ const char *harness_option(const char *name)
     return NULL;
 }
 
+int harness_list_has(const char *list, const char *item)
+{
+    if (!list)
+        return 1;
+    size_t n = strlen(item);
+    for (const char *p = list; (p = strstr(p, item)); p += n)
+        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0'))
+            return 1;
+    return 0;
+}
+
 const char *harness_tmpdir(void)
 {
     static char dir[256];

@@ -49,6 +49,9 @@ const char *harness_data_path(const char *rel);
  * not given (benchmarks take their knobs this way; arguments without a
  * leading "--" name the tests to run). */
 const char *harness_option(const char *name);
+/* 1 when list (an option's value, "a,b,c") is NULL or names item among
+ * its comma-separated entries; else 0 (benchmarks' --pairs). */
+int harness_list_has(const char *list, const char *item);
 /* A fresh temporary directory for this test (removed by nobody: /tmp). */
 const char *harness_tmpdir(void);
 

@@ -135,3 +135,19 @@ mesh *testmesh_disk(int rings)
     m->nf = t;
     return m;
 }
+
+mesh *testmesh_mirrored(const mesh *m)
+{
+    mesh *r = mesh_new(m->nv, m->nf);
+    if (!r)
+        return NULL;
+    memcpy(r->v, m->v, sizeof(double) * 3 * (size_t)m->nv);
+    for (int v = 0; v < m->nv; v++)
+        r->v[3 * v] = -r->v[3 * v];
+    for (int t = 0; t < m->nf; t++) {
+        r->f[3 * t] = m->f[3 * t];
+        r->f[3 * t + 1] = m->f[3 * t + 2];
+        r->f[3 * t + 2] = m->f[3 * t + 1];
+    }
+    return r;
+}

@@ -12,6 +12,10 @@ mesh *testmesh_icosphere(int level);
 mesh *testmesh_torus(double R, double r, int nu, int nv);
 /* Flat disk in the z = 0 plane, rings concentric rings around the centre. */
 mesh *testmesh_disk(int rings);
+/* The mirror image of m through the plane x = 0 with every face's corner
+ * order reversed, so that the normals stay outward (a proper mesh, not an
+ * inside-out one); vertex i is vertex i of m reflected. */
+mesh *testmesh_mirrored(const mesh *m);
 /* Deterministic pseudo-random numbers in [0, 1) for tests (xorshift). */
 double testmesh_rand(unsigned long long *state);
 

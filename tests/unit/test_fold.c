@@ -86,15 +86,7 @@ TEST(planted_fold_is_found_and_relaxed_away)
 TEST(map_mirrored_as_a_whole_is_detected_and_left_unchanged)
 {
     mesh *m = testmesh_icosphere(3);
-    mesh *r = mesh_new(m->nv, m->nf);
-    memcpy(r->v, m->v, sizeof(double) * 3 * (size_t)m->nv);
-    for (int v = 0; v < m->nv; v++)
-        r->v[3 * v] = -r->v[3 * v];
-    for (int t = 0; t < m->nf; t++) {
-        r->f[3 * t] = m->f[3 * t];
-        r->f[3 * t + 1] = m->f[3 * t + 2];
-        r->f[3 * t + 2] = m->f[3 * t + 1];
-    }
+    mesh *r = testmesh_mirrored(m);
     double *img = malloc(sizeof(double) * 3 * (size_t)m->nv);
     memcpy(img, r->v, sizeof(double) * 3 * (size_t)m->nv);
     bmap *P = map_of_points(r, img, m->nv);

@@ -9,22 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The mirror image of m through the plane x = 0, faces reversed so that
- * the normals stay outward (a proper mesh, not an inside-out one). */
-static mesh *mirrored(const mesh *m)
-{
-    mesh *r = mesh_new(m->nv, m->nf);
-    memcpy(r->v, m->v, sizeof(double) * 3 * (size_t)m->nv);
-    for (int v = 0; v < m->nv; v++)
-        r->v[3 * v] = -r->v[3 * v];
-    for (int t = 0; t < m->nf; t++) {
-        r->f[3 * t] = m->f[3 * t];
-        r->f[3 * t + 1] = m->f[3 * t + 2];
-        r->f[3 * t + 2] = m->f[3 * t + 1];
-    }
-    return r;
-}
-
 TEST(flat_disk_gives_the_sine_of_the_angle_and_a_reflection_negates_it)
 {
     mesh *m = testmesh_disk(12);
@@ -42,7 +26,7 @@ TEST(flat_disk_gives_the_sine_of_the_angle_and_a_reflection_negates_it)
     for (int v = 0; v < m->nv; v++)
         CHECK_NEAR(o[v], up * 0.5, 1e-12);
     /* the same functions carried onto the mirror image: the sign flips */
-    mesh *r = mirrored(m);
+    mesh *r = testmesh_mirrored(m);
     double *orr = malloc(sizeof(double) * (size_t)m->nv);
     CHECK(geo_gradient_sine(r, f, 1, g, 1, orr) == 0);
     for (int v = 0; v < m->nv; v++)

@@ -507,7 +507,7 @@ TEST(worker_refuses_rhm_alpha_out_of_range_naming_it_once)
     demo_job(&j, L, 5, 0);
     j.msg.u.submit.params.rhm_alpha = 2;
     save(&j);
-    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "RHM parameter alpha must be in (0, 1)", NULL);
+    expect_error(NULL, 1, PROTO_EBAD_PARAMS, "params.rhm_alpha = 2 > 1", NULL);
     proto_msg m;
     unsigned char *file;
     read_frame(job_dir(), "error.frame", &m, &file);
