@@ -422,3 +422,19 @@ int testdaemon_log_has(const testdaemon *d, const char *what)
     fclose(fp);
     return found;
 }
+
+uint64_t testdaemon_submit_ok(mc_client *c, int iterations, int long_job, int32_t priority)
+{
+    int rc;
+    uint64_t id = testdaemon_submit(c, iterations, long_job, priority, &rc);
+    if (rc)
+        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
+    CHECK(id > 0);
+    return id;
+}
+
+void testdaemon_sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}

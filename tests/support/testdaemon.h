@@ -61,6 +61,10 @@ int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s);
  * bent a little), 6 identity landmarks; iterations outer iterations, no
  * early stop. long_job: level 3 (642 vertices), for jobs to cancel or kill. */
 uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc);
+/* testdaemon_submit that fails the test unless SUBMIT_OK came back with an id. */
+uint64_t testdaemon_submit_ok(mc_client *c, int iterations, int long_job, int32_t priority);
+/* Sleeps ms milliseconds. */
+void testdaemon_sleep_ms(int ms);
 
 /* The authors' demo pair 381 -> 390 with its HOT initial maps, as a client
  * sends it (spec: Draco bytes, maps P and Q, `iterations` outer iterations,

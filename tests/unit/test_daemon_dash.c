@@ -34,12 +34,6 @@ static double now_s(void)
     return (double)t.tv_sec + t.tv_nsec * 1e-9;
 }
 
-static void sleep_ms(int ms)
-{
-    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&ts, NULL);
-}
-
 static int free_port(void)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -314,7 +308,7 @@ static void dash_start(dash *x, const char *name)
 static void wait_iterating(dash *x)
 {
     mc_job_status st;
-    for (double t0 = now_s(); now_s() - t0 < 60; sleep_ms(50)) {
+    for (double t0 = now_s(); now_s() - t0 < 60; testdaemon_sleep_ms(50)) {
         CHECK_INT(mc_status(x->c, x->job, &st), 0);
         if (st.state >= MC_COMPLETED)
             FAILF("job ended %s: %s", mc_state_name(st.state), st.reason);
@@ -410,7 +404,7 @@ TEST_T(modbus_registers_follow_a_running_job_and_agree_with_stats, 90)
     CHECK(first_outer >= 1);
     double t0 = now_s();
     while (u32(r, 20) <= first_outer && now_s() - t0 < 60) {
-        sleep_ms(200);
+        testdaemon_sleep_ms(200);
         poll_regs(&x, r);
     }
     if (u32(r, 20) <= first_outer)
@@ -422,7 +416,7 @@ TEST_T(modbus_registers_follow_a_running_job_and_agree_with_stats, 90)
     /* cancelled: the counter moves in STATS and in the registers alike */
     CHECK_INT(mc_cancel(x.c, x.job), 0);
     testdaemon_wait_state(x.c, x.job, MC_CANCELLED, 30);
-    sleep_ms(2 * SNAP_PERIOD_MS);
+    testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
     poll_regs(&x, r);
     CHECK_INT(mc_stats(x.c, &st), 0);
     CHECK_INT(u32(r, 12), st.cancelled);
@@ -496,7 +490,7 @@ TEST_T(modbus_refuses_writes_and_junk_and_keeps_serving, 60)
     /* half an MBAP header held open: others are served meanwhile, then it is closed */
     int half = tcp_connect(x.modbus);
     CHECK(send(half, "\x00\x01\x00", 3, MSG_NOSIGNAL) == 3);
-    sleep_ms(100);
+    testdaemon_sleep_ms(100);
     double t0 = now_s(), served_ms;
     CHECK(served_within(x.modbus, 200, &served_ms));
     CHECK(mbpoll(x.modbus, "3", 1, 1, 1, v, out, sizeof out) == 1);
@@ -514,14 +508,14 @@ TEST_T(modbus_refuses_writes_and_junk_and_keeps_serving, 60)
     int held[MBUS_MAX_CLIENTS];
     for (int i = 0; i < MBUS_MAX_CLIENTS; i++)
         held[i] = tcp_connect(x.modbus);
-    sleep_ms(300);
+    testdaemon_sleep_ms(300);
     fd = tcp_connect(x.modbus);
     CHECK_INT(read_wait(fd, buf, sizeof buf, 2000), 0);
     close(fd);
     CHECK_INT(mc_ping(x.c), 0);
     for (int i = 0; i < MBUS_MAX_CLIENTS; i++)
         close(held[i]);
-    sleep_ms(300);
+    testdaemon_sleep_ms(300);
     CHECK(served_within(x.modbus, 1000, NULL));
     mc_close(x.c);
     testdaemon_stop(&x.d, SIGTERM);
@@ -624,7 +618,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     x.job = submit_demo(x.c, 20, 20);
     uint64_t queued = submit_demo(x.c, 2, 1);        /* waits behind the first: one worker */
     wait_iterating(&x);
-    sleep_ms(2 * SNAP_PERIOD_MS);
+    testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
     static char body[1 << 16];
     static sample s[256];
     CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
@@ -655,7 +649,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(mc_cancel(x.c, queued), 0);
     CHECK_INT(mc_cancel(x.c, x.job), 0);
     testdaemon_wait_state(x.c, x.job, MC_CANCELLED, 30);
-    sleep_ms(2 * SNAP_PERIOD_MS);
+    testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
     CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     CHECK_INT(mc_stats(x.c, &st), 0);
     n = parse_metrics(body, s, 256);

@@ -30,21 +30,6 @@
 #include <time.h>
 #include <unistd.h>
 
-static void sleep_ms(int ms)
-{
-    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&ts, NULL);
-}
-
-static uint64_t submit_ok(mc_client *c, int iterations, int long_job)
-{
-    int rc;
-    uint64_t id = testdaemon_submit(c, iterations, long_job, 0, &rc);
-    if (rc)
-        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
-    return id;
-}
-
 /* Orphans must not outlive a failed test (they would run for hours). */
 static testdaemon *cleanup_daemon;
 static void kill_leftovers(void)
@@ -54,7 +39,7 @@ static void kill_leftovers(void)
     if (cleanup_daemon->pid > 0)          /* first the daemon: it would start more */
         kill(cleanup_daemon->pid, SIGKILL);
     for (int i = 0; i < 100 && testdaemon_kill_workers(cleanup_daemon) > 0; i++)
-        sleep_ms(10);
+        testdaemon_sleep_ms(10);
 }
 
 /* Lines of the daemon's log containing what. */
@@ -90,7 +75,7 @@ TEST_T(daemon_killed_right_after_spawning_never_leaves_two_workers_of_one_job, 3
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
     uint64_t ids[SPAWN_JOBS];
     for (int i = 0; i < SPAWN_JOBS; i++)
-        ids[i] = submit_ok(c, 100000, 1);          /* hours each: they run through every round */
+        ids[i] = testdaemon_submit_ok(c, 100000, 1, 0);          /* hours each: they run through every round */
     mc_close(c);
     int most = 0;
     for (int round = 0; round < SPAWN_ROUNDS; round++) {
@@ -106,11 +91,11 @@ TEST_T(daemon_killed_right_after_spawning_never_leaves_two_workers_of_one_job, 3
                 FAILF("round %d: %d live workers with --workers 2", round, total);
             most = total > most ? total : most;
             if (k < 3)
-                sleep_ms(round % 8 / 3 + 1);
+                testdaemon_sleep_ms(round % 8 / 3 + 1);
         }
         testdaemon_kill(&d);
         testdaemon_start(&d, "spawnkill", args);
-        sleep_ms(round % 8);
+        testdaemon_sleep_ms(round % 8);
     }
     /* the last daemon runs two of them, once each */
     c = testdaemon_client(&d, TESTDAEMON_ALICE);
@@ -121,7 +106,7 @@ TEST_T(daemon_killed_right_after_spawning_never_leaves_two_workers_of_one_job, 3
         mc_stats_free(&st);
         if (running == 2)
             break;
-        sleep_ms(20);
+        testdaemon_sleep_ms(20);
     }
     int total = 0;
     for (int i = 0; i < SPAWN_JOBS; i++) {
@@ -149,7 +134,7 @@ TEST_T(result_a_worker_finished_while_the_daemon_was_down_is_adopted_not_rerun, 
     cleanup_daemon = &d;
     atexit(kill_leftovers);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 30, 0);
+    uint64_t id = testdaemon_submit_ok(c, 30, 0, 0);
     mc_job_status s;
     do {                                        /* into the optimisation */
         CHECK_INT(mc_status(c, id, &s), 0);
@@ -162,7 +147,7 @@ TEST_T(result_a_worker_finished_while_the_daemon_was_down_is_adopted_not_rerun, 
     struct stat st;
     snprintf(path, sizeof path, "%s/spool/%llu/result.frame", d.state, (unsigned long long)id);
     for (int i = 0; i < 3000 && testdaemon_live_workers(&d, id) > 0; i++)
-        sleep_ms(20);
+        testdaemon_sleep_ms(20);
     CHECK_INT(testdaemon_live_workers(&d, id), 0);
     if (stat(path, &st) != 0)
         FAILF("the orphan worker ended without %s", path);
@@ -246,11 +231,11 @@ TEST_T(submit_on_a_full_disk_is_refused_as_storage_and_nothing_acknowledged_is_l
     cleanup_daemon = &d;
     atexit(kill_leftovers);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t done = submit_ok(c, 2, 0);
+    uint64_t done = testdaemon_submit_ok(c, 2, 0, 0);
     CHECK_INT(testdaemon_wait_state(c, done, -1, 60), MC_COMPLETED);
-    uint64_t running = submit_ok(c, 100000, 1);
+    uint64_t running = testdaemon_submit_ok(c, 100000, 1, 0);
     testdaemon_wait_state(c, running, MC_RUNNING, 30);
-    uint64_t pending = submit_ok(c, 2, 0);
+    uint64_t pending = testdaemon_submit_ok(c, 2, 0, 0);
     char filler[900];
     long long filled = fill_fs(state, filler, sizeof filler);
     /* every SUBMIT now: STORAGE, naming the full disk; nothing stored */
@@ -294,7 +279,7 @@ TEST_T(submit_on_a_full_disk_is_refused_as_storage_and_nothing_acknowledged_is_l
     snprintf(waiting, sizeof waiting, "job %llu: waiting to start: the state file system is full",
              (unsigned long long)pending);
     for (int i = 0; i < 500 && !testdaemon_log_has(&d, waiting); i++)
-        sleep_ms(20);
+        testdaemon_sleep_ms(20);
     CHECK(testdaemon_log_has(&d, waiting));     /* (the store cannot take that reason now) */
     CHECK_INT(mc_status(c, pending, &s), 0);
     CHECK_INT(s.state, MC_PENDING);
@@ -302,7 +287,7 @@ TEST_T(submit_on_a_full_disk_is_refused_as_storage_and_nothing_acknowledged_is_l
     CHECK_INT(unlink(filler), 0);
     CHECK_INT(testdaemon_wait_state(c, running, -1, 30), MC_CANCELLED);
     CHECK_INT(testdaemon_wait_state(c, pending, -1, 90), MC_COMPLETED);
-    uint64_t after = submit_ok(c, 2, 0);
+    uint64_t after = testdaemon_submit_ok(c, 2, 0, 0);
     CHECK_INT(testdaemon_wait_state(c, after, -1, 60), MC_COMPLETED);
     printf("  %lld bytes filled the 8 MB tmpfs; 5 SUBMITs refused as STORAGE, 3 jobs kept;%s\n", filled,
            testdaemon_log_has(&d, "cannot record its end") ? " the cancel's end was recorded once space came back"
@@ -334,11 +319,11 @@ TEST_T(worker_that_cannot_store_its_answer_requeues_the_job_without_counting_a_c
     const char *args[] = {"--worker", script, NULL};
     testdaemon_start(&d, "noanswer", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 0);
+    uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
     char started[64];
     snprintf(started, sizeof started, "job %llu: started on slot", (unsigned long long)id);
     for (int i = 0; i < 1500 && log_count(&d, started) < 3; i++)
-        sleep_ms(10);
+        testdaemon_sleep_ms(10);
     CHECK(log_count(&d, started) >= 3);         /* two crashes would have failed it */
     mc_job_status s;
     CHECK_INT(mc_status(c, id, &s), 0);
@@ -392,9 +377,9 @@ TEST_T(worker_start_without_descriptors_waits_and_the_job_completes_later, 90)
     const char *args[] = {"--workers", "1", NULL};
     testdaemon_start(&d, "nofile", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t running = submit_ok(c, 100000, 1);
+    uint64_t running = testdaemon_submit_ok(c, 100000, 1, 0);
     testdaemon_wait_state(c, running, MC_RUNNING, 30);
-    uint64_t queued = submit_ok(c, 2, 0);
+    uint64_t queued = testdaemon_submit_ok(c, 2, 0, 0);
     int base = open_fds(d.pid);
     CHECK(base > 0);
     struct rlimit old, rl;
@@ -406,12 +391,12 @@ TEST_T(worker_start_without_descriptors_waits_and_the_job_completes_later, 90)
         if ((idle[nidle] = idle_connection(&d)) >= 0)
             nidle++;
     for (int i = 0; i < 200 && open_fds(d.pid) < base + 16; i++)
-        sleep_ms(10);
+        testdaemon_sleep_ms(10);
     int at_limit = open_fds(d.pid);
     /* the running job ends: the queued one's turn, with no descriptor free */
     CHECK_INT(mc_cancel(c, running), 0);
     CHECK_INT(testdaemon_wait_state(c, running, -1, 30), MC_CANCELLED);
-    sleep_ms(1500);
+    testdaemon_sleep_ms(1500);
     mc_job_status s;
     CHECK_INT(mc_status(c, queued, &s), 0);
     if (s.state != MC_PENDING && s.state != MC_RUNNING && s.state != MC_COMPLETED)

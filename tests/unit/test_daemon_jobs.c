@@ -35,23 +35,13 @@ static int on_progress(void *ctx, const mc_progress *p)
     return 0;
 }
 
-static uint64_t submit_ok(mc_client *c, int iterations, int long_job, int32_t priority)
-{
-    int rc;
-    uint64_t id = testdaemon_submit(c, iterations, long_job, priority, &rc);
-    if (rc)
-        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
-    CHECK(id > 0);
-    return id;
-}
-
 TEST_T(submitted_job_streams_energies_and_completes, 60)
 {
     testdaemon_need_worker();
     testdaemon d;
     testdaemon_start(&d, "quick", NULL);
     mc_client *c = testdaemon_client(&d, NULL);
-    uint64_t id = submit_ok(c, 3, 0, 0);
+    uint64_t id = testdaemon_submit_ok(c, 3, 0, 0);
     watch_log w = {0};
     int state = -1;
     char reason[1100];
@@ -198,7 +188,7 @@ TEST_T(acknowledged_job_survives_daemon_sigkill_and_completes_after_restart, 60)
     testdaemon d;
     testdaemon_start(&d, "sigkill", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 200, 0, 0);
+    uint64_t id = testdaemon_submit_ok(c, 200, 0, 0);
     testdaemon_wait_state(c, id, MC_RUNNING, 10);
     mc_close(c);
     testdaemon_kill(&d);
@@ -222,7 +212,7 @@ TEST_T(graceful_shutdown_requeues_the_running_job_and_next_start_completes_it, 6
     testdaemon d;
     testdaemon_start(&d, "drain", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 1000, 0, 0);
+    uint64_t id = testdaemon_submit_ok(c, 1000, 0, 0);
     testdaemon_wait_state(c, id, MC_RUNNING, 10);
     mc_job_status s;
     do {                                   /* let it get into the optimisation */
@@ -251,8 +241,8 @@ TEST_T(job_whose_worker_is_killed_twice_fails_as_crashed_twice_and_daemon_keeps_
     testdaemon d;
     testdaemon_start(&d, "crash", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 1000, 1, 0);
-    uint64_t next = submit_ok(c, 3, 0, 0);
+    uint64_t id = testdaemon_submit_ok(c, 1000, 1, 0);
+    uint64_t next = testdaemon_submit_ok(c, 3, 0, 0);
     testdaemon_wait_state(c, id, MC_RUNNING, 10);
     pid_t w = testdaemon_worker_pid(&d, id);
     CHECK(w > 0);
@@ -279,8 +269,8 @@ TEST_T(cancel_ends_running_and_pending_jobs_cancelled, 60)
     testdaemon d;
     testdaemon_start(&d, "cancel", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t run = submit_ok(c, 1000, 1, 0);
-    uint64_t wait = submit_ok(c, 1000, 1, 0);
+    uint64_t run = testdaemon_submit_ok(c, 1000, 1, 0);
+    uint64_t wait = testdaemon_submit_ok(c, 1000, 1, 0);
     testdaemon_wait_state(c, run, MC_RUNNING, 10);
     CHECK_INT(mc_cancel(c, wait), 0);          /* pending: at once */
     mc_job_status s;

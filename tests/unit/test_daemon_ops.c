@@ -20,21 +20,6 @@
 #include <time.h>
 #include <unistd.h>
 
-static void sleep_ms(int ms)
-{
-    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&ts, NULL);
-}
-
-static uint64_t submit_ok(mc_client *c, int iterations, int long_job)
-{
-    int rc;
-    uint64_t id = testdaemon_submit(c, iterations, long_job, 0, &rc);
-    if (rc)
-        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
-    return id;
-}
-
 static void write_file(const char *path, const char *text)
 {
     FILE *fp = fopen(path, "w");
@@ -51,7 +36,7 @@ TEST_T(job_over_the_wall_time_limit_ends_timeout_with_a_reason, 60)
     const char *args[] = {"--job-timeout", "2", NULL};
     testdaemon_start(&d, "timeout", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 1000, 1);
+    uint64_t id = testdaemon_submit_ok(c, 1000, 1, 0);
     CHECK_INT(testdaemon_wait_state(c, id, -1, 20), MC_TIMEOUT);
     mc_job_status s;
     CHECK_INT(mc_status(c, id, &s), 0);
@@ -68,12 +53,12 @@ TEST_T(finished_job_is_deleted_after_the_result_ttl, 60)
     const char *args[] = {"--result-ttl", "1", NULL};
     testdaemon_start(&d, "ttl", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 0);
+    uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
     CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_COMPLETED);
     mc_job_status s;
     int rc = 0;
     for (int i = 0; i < 100 && (rc = mc_status(c, id, &s)) == 0; i++)
-        sleep_ms(50);
+        testdaemon_sleep_ms(50);
     CHECK_INT(rc, MC_ENOT_FOUND);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
@@ -91,16 +76,16 @@ TEST_T(sighup_with_a_shorter_result_ttl_expires_finished_jobs, 60)
     const char *args[] = {"--config", conf, NULL};
     testdaemon_start(&d, "ttlhup", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 0);
+    uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
     CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_COMPLETED);
     mc_job_status s;
-    sleep_ms(1500);
+    testdaemon_sleep_ms(1500);
     CHECK_INT(mc_status(c, id, &s), 0);   /* kept: the ttl is a week */
     write_file(conf, "result-ttl = 1\n");
     CHECK_INT(kill(d.pid, SIGHUP), 0);
     int rc = 0;
     for (int i = 0; i < 100 && (rc = mc_status(c, id, &s)) == 0; i++)
-        sleep_ms(50);
+        testdaemon_sleep_ms(50);
     CHECK_INT(rc, MC_ENOT_FOUND);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
@@ -121,9 +106,9 @@ TEST_T(config_file_options_take_effect_and_an_unknown_key_names_file_and_line, 3
     CHECK_INT((int)st.workers, 1);
     mc_stats_free(&st);
     /* max-queue 1: with one job queued behind a running one, the next is refused */
-    uint64_t first = submit_ok(c, 1000, 1);
+    uint64_t first = testdaemon_submit_ok(c, 1000, 1, 0);
     testdaemon_wait_state(c, first, MC_RUNNING, 10);
-    submit_ok(c, 2, 0);
+    testdaemon_submit_ok(c, 2, 0, 0);
     int rc;
     testdaemon_submit(c, 2, 0, 0, &rc);
     CHECK_INT(rc, MC_EQUEUE_FULL);
@@ -170,14 +155,14 @@ TEST_T(sighup_reloads_tokens_and_a_bad_tokens_file_keeps_the_old_ones, 30)
     CHECK_INT(kill(d.pid, SIGHUP), 0);
     int rc = -1;
     for (int i = 0; i < 250 && (rc = try_connect(&d, "tok-carol-42")) != 0; i++)
-        sleep_ms(20);
+        testdaemon_sleep_ms(20);
     CHECK_INT(rc, 0);
     CHECK_INT(try_connect(&d, TESTDAEMON_ALICE), MC_EUNAUTHORIZED);
 
     write_file(tokens, "tok-dave-42 dave admin extra words\n");
     CHECK_INT(kill(d.pid, SIGHUP), 0);
     for (int i = 0; i < 250 && !testdaemon_log_has(&d, "keeping the previous tokens"); i++)
-        sleep_ms(20);
+        testdaemon_sleep_ms(20);
     CHECK(testdaemon_log_has(&d, "tokens:1: expected `token user [admin]`"));
     CHECK_INT(try_connect(&d, "tok-carol-42"), 0);
     CHECK_INT(try_connect(&d, "tok-dave-42"), MC_EUNAUTHORIZED);
@@ -226,7 +211,7 @@ TEST_T(sd_notify_says_ready_status_reloading_and_stopping, 60)
     CHECK(notify_wait(fd, "READY=1", log, sizeof log, 5000));
     CHECK_STR_HAS(log, "STATUS=0 queued, 0 of 1 slot(s) busy; 0 completed");
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 0);
+    uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
     CHECK_INT(testdaemon_wait_state(c, id, -1, 30), MC_COMPLETED);
     if (!notify_wait(fd, "1 completed", log, sizeof log, 5000))
         FAILF("no STATUS= after the job ended: %s", log);
@@ -256,7 +241,7 @@ TEST_T(worker_over_its_memory_limit_ends_the_job_out_of_memory_naming_the_memory
     const char *args[] = {"--worker-memory-mb", "64", NULL};
     testdaemon_start(&d, "memory", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 1);
+    uint64_t id = testdaemon_submit_ok(c, 2, 1, 0);
     int end = testdaemon_wait_state(c, id, -1, 30);
     mc_job_status s;
     CHECK_INT(mc_status(c, id, &s), 0);

@@ -37,12 +37,6 @@ __attribute__((constructor(101))) static void enter_slurm(int argc, char **argv)
     testslurm_enter(argc, argv);
 }
 
-static void sleep_ms(int ms)
-{
-    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
-    nanosleep(&ts, NULL);
-}
-
 typedef struct watch_log {
     int n;
     uint32_t last_outer;
@@ -59,15 +53,6 @@ static int on_progress(void *ctx, const mc_progress *p)
     w->last_outer = p->outer;
     w->n++;
     return 0;
-}
-
-static uint64_t submit_ok(mc_client *c, int iterations, int long_job)
-{
-    int rc;
-    uint64_t id = testdaemon_submit(c, iterations, long_job, 0, &rc);
-    if (rc)
-        FAILF("SUBMIT: %s (%s)", mc_strerror(rc), mc_errmsg(c));
-    return id;
 }
 
 /* The demo pair 381 -> 390 with its initial maps (no landmarks: ECTM only,
@@ -152,7 +137,7 @@ TEST_T(worker_that_cannot_reach_the_daemon_reports_through_the_progress_file, 90
     const char *args[] = {"--slurm-progress-host", "127.0.0.2", NULL};
     testslurm_daemon(&d, "file", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 4, 0);
+    uint64_t id = testdaemon_submit_ok(c, 4, 0, 0);
     watch_log w = {0, 0, 1, 1};
     int state = -1;
     char reason[1100];
@@ -173,7 +158,7 @@ TEST_T(cancel_of_a_running_slurm_job_is_scancel_and_ends_cancelled, 90)
     testdaemon d;
     testslurm_daemon(&d, "cancel", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 100000, 1);
+    uint64_t id = testdaemon_submit_ok(c, 100000, 1, 0);
     testdaemon_wait_state(c, id, MC_RUNNING, 30);
     char st[64];
     CHECK_STR_HAS(testslurm_state(&d, id, st, sizeof st), "RUNNING");
@@ -221,7 +206,7 @@ TEST_T(sigkilled_daemon_reattaches_to_its_slurm_jobs_and_submits_nothing_twice, 
     uint64_t a = submit_demo(c, 25), b = submit_demo(c, 25);   /* seconds each */
     testdaemon_wait_state(c, a, MC_RUNNING, 30);
     testdaemon_wait_state(c, b, MC_RUNNING, 30);
-    sleep_ms(500);
+    testdaemon_sleep_ms(500);
     mc_close(c);
     testdaemon_kill(&d);
     /* the Slurm jobs run on without meshcorrd */
@@ -357,12 +342,12 @@ TEST_T(sighup_raising_slurm_max_jobs_keeps_the_slot_count_and_writes_nothing_pas
     write_text(conf, "slurm-max-jobs = 64\n");
     CHECK_INT(kill(d.pid, SIGHUP), 0);
     for (int i = 0; i < 500 && !testdaemon_log_has(&d, "reload: options applied"); i++)
-        sleep_ms(10);
+        testdaemon_sleep_ms(10);
     CHECK(testdaemon_log_has(&d, "reload: options applied"));
     CHECK(testdaemon_log_has(&d, "slurm-max-jobs changed but take(s) effect at the next start only"));
     uint64_t ids[4];
     for (int i = 0; i < 4; i++)
-        ids[i] = submit_ok(c, 2, 0);
+        ids[i] = testdaemon_submit_ok(c, 2, 0, 0);
     uint32_t most = 0;
     for (int done = 0; !done;) {
         CHECK_INT(mc_stats(c, &st), 0);
@@ -371,7 +356,7 @@ TEST_T(sighup_raising_slurm_max_jobs_keeps_the_slot_count_and_writes_nothing_pas
             most = st.running;
         done = st.completed + st.failed + st.cancelled == 4;
         mc_stats_free(&st);
-        sleep_ms(100);
+        testdaemon_sleep_ms(100);
     }
     CHECK(most >= 1 && most <= 2);          /* still at most 2 jobs in Slurm at once */
     for (int i = 0; i < 4; i++)
@@ -391,8 +376,8 @@ TEST_T(missing_sbatch_is_in_stats_and_the_job_stays_pending, 60)
     testslurm_daemon(&d, "nosbatch", NULL);
     setenv("PATH", saved, 1);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 0);
-    sleep_ms(1500);                            /* five polls */
+    uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
+    testdaemon_sleep_ms(1500);                            /* five polls */
     mc_job_status s;
     CHECK_INT(mc_status(c, id, &s), 0);
     CHECK_INT(s.state, MC_PENDING);
@@ -423,12 +408,12 @@ TEST_T(unreachable_controller_is_in_stats_and_the_job_stays_pending, 90)
     testdaemon d;
     testslurm_daemon(&d, "noctld", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = submit_ok(c, 2, 0);
+    uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
     mc_server_stats stats = {0};
     for (int i = 0; i < 600 && !strstr(stats.backend_status, "squeue failed"); i++) {
         mc_stats_free(&stats);
         CHECK_INT(mc_stats(c, &stats), 0);
-        sleep_ms(100);
+        testdaemon_sleep_ms(100);
     }
     CHECK_INT(stats.backend_ok, 0);
     CHECK_STR_HAS(stats.backend_status, "squeue failed");
