@@ -130,7 +130,10 @@ static int send_all(mc_client *c, const void *data, size_t len)
                 return rc;
             continue;
         }
-        return fail(c, MC_EIO, "send: %s", w < 0 ? strerror(errno) : "connection closed");
+        int e = w < 0 ? errno : EPIPE;
+        int rc = fail(c, MC_EIO, "send: %s", w < 0 ? strerror(e) : "connection closed");
+        errno = e;                /* request() asks the server why (closed_reason) */
+        return rc;
     }
     return 0;
 }
@@ -191,6 +194,26 @@ static int read_frame(mc_client *c, proto_msg *m, int64_t deadline)
     return 0;
 }
 
+/* The server closed the connection while a request went out: it may have
+ * said why first (BUSY at its connection or descriptor limits, an idle
+ * timeout), and that ERROR waits unread. Its code and message, else the
+ * send's failure (rc, errmsg) as it was. */
+#define MC_CLOSED_REASON_MS 1000
+static int closed_reason(mc_client *c, int rc)
+{
+    char send_err[sizeof c->errmsg];
+    memcpy(send_err, c->errmsg, sizeof send_err);
+    proto_msg m;
+    int code = read_frame(c, &m, now_ms() + MC_CLOSED_REASON_MS);
+    if (code == 0) {
+        proto_msg_free(&m);        /* a reply to something else: not a reason */
+    } else if (code != MC_EIO && code != MC_ETIMEOUT && code != MC_EPROTO) {
+        return code;               /* the server's ERROR, its message in errmsg */
+    }
+    memcpy(c->errmsg, send_err, sizeof send_err);
+    return rc;
+}
+
 /* Sends req (request id assigned here) and reads the reply of type
  * want_type into reply. */
 static int request(mc_client *c, proto_msg *req, int want_type, proto_msg *reply)
@@ -211,7 +234,7 @@ static int request(mc_client *c, proto_msg *req, int want_type, proto_msg *reply
     rc = send_all(c, b.data, b.len);
     proto_buf_free(&b);
     if (rc)
-        return rc;
+        return rc == MC_EIO && (errno == EPIPE || errno == ECONNRESET) ? closed_reason(c, rc) : rc;
     if ((rc = read_frame(c, reply, deadline_of(c))))
         return rc;
     if (reply->type != want_type || reply->request_id != req->request_id) {

@@ -1,8 +1,8 @@
 /* backend.h — where meshcorrd's jobs run. A backend takes jobs from the
  * scheduler (sched_next), runs them against their spool directory with
  * meshcorr-worker (workers/WORKER.md), feeds their PROGRESS records to
- * job_progress (bk_progress_take), and reports each run's start and end to
- * job.c (job_running, job_ended), which records them and tells the watchers;
+ * job_progress_take, and reports each run's start and end to job.c
+ * (job_running, job_ended), which records them and tells the watchers;
  * a backend decides only which state its worker's run ended in. Two of them, chosen by `backend =`:
  *
  *   local  wsup.c      worker processes on this machine (--workers slots)
@@ -20,7 +20,9 @@ typedef struct bk_ops {
     int (*init)(mcd *d, char *err, size_t errsz);
     void (*schedule)(mcd *d);                  /* start what can start */
     int (*cancel)(mcd *d, uint64_t id);        /* 0 when the backend has the job and stops it */
-    void (*drain)(mcd *d);                     /* shutdown: drain_check() once busy() is 0 */
+    /* shutdown: stop or hand back the runs; then idle(d) each time one of
+     * those this daemon waits for (busy()) has ended */
+    void (*drain)(mcd *d, mcd_idle_fn idle);
     int (*busy)(const mcd *d);                 /* runs this daemon must wait for on shutdown */
     int (*nslots)(const mcd *d);               /* STATS slots */
     void (*slot_info)(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
@@ -39,7 +41,7 @@ extern const bk_ops bk_local, bk_slurm;
 int bk_init(mcd *d, char *err, size_t errsz);
 void bk_schedule(mcd *d);
 int bk_cancel(mcd *d, uint64_t id);
-void bk_drain(mcd *d);
+void bk_drain(mcd *d, mcd_idle_fn idle);
 int bk_busy(const mcd *d);
 int bk_nslots(const mcd *d);
 void bk_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id);
@@ -47,15 +49,6 @@ int bk_health(const mcd *d, char *msg, size_t sz);
 const char *bk_name(const mcd *d);
 void bk_close(mcd *d);
 void bk_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz);
-/* Appends ", name" (or "name" first) to changed when the option differs. */
-void bk_note_change(int differs, const char *name, char *changed, size_t sz);
-
-/* Decodes the whole PROGRESS frames at the front of in, consumes them, and
- * stores and fans out each as job id's. Returns the number taken, or -1 at a
- * frame that is not a valid PROGRESS (in is then reset; the caller ignores
- * the rest of that stream). */
-#define BK_MAX_PROGRESS_FRAME 4096
-int bk_progress_take(mcd *d, uint64_t id, proto_buf *in);
 
 /* ---- bk_cmd.c: one external command, asynchronously ---------------------- */
 #define BK_CMD_MAX_OUTPUT 65536   /* stdout and stderr kept, each */

@@ -2,7 +2,7 @@
  * to (backend.h, bk_prog_). A connection first sends one line,
  * "MCPROGRESS <job-id> <secret>\n" (at most BK_PROG_MAX_HELLO bytes); the
  * secret is checked in constant time against the one the backend wrote to
- * the job's spool; then its bytes are PROGRESS frames (bk_progress_take).
+ * the job's spool; then its bytes are PROGRESS frames (job_progress_take).
  *
  * DESIGN: nothing a connection sends can do more than add progress records
  * to the one job whose secret it knows. Before the hello line is accepted
@@ -130,7 +130,7 @@ static void on_read(uv_stream_t *st, ssize_t n, const uv_buf_t *buf)
             return;
         }
     }
-    if (bk_progress_take(c->p->d, c->job_id, &c->in) < 0)
+    if (job_progress_take(c->p->d, c->job_id, &c->in) < 0)
         conn_close(c);
 }
 

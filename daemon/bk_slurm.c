@@ -194,7 +194,7 @@ static void read_progress_file(sjob *j)
     close(fd);
     if (in.len) {
         size_t before = in.len;
-        int rc = bk_progress_take(S.d, j->id, &in);
+        int rc = job_progress_take(S.d, j->id, &in);
         /* a bad frame: skip what is there now */
         j->progress_off = start + (int64_t)(rc < 0 ? before : before - in.len);
         if (j->progress_off != start)
@@ -534,7 +534,7 @@ static int submit(uint64_t id, const char *user)
     }
     char wbuf[PATH_MAX], dir[CONF_PATH + 64], name[64], out[CONF_PATH + 96], cpus[32], opt[4][CONF_PATH + 32];
     char wrap[6 * PATH_MAX + 8 * CONF_PATH], q_worker[2 * PATH_MAX], q_dir[2 * CONF_PATH + 160], q_sec[2 * CONF_PATH + 200];
-    const char *worker = cf->slurm_worker[0] ? cf->slurm_worker : wsup_worker_path(d, wbuf, sizeof wbuf);
+    const char *worker = cf->slurm_worker[0] ? cf->slurm_worker : conf_worker_path(&d->conf, wbuf, sizeof wbuf);
     snprintf(dir, sizeof dir, "%s/%llu", S.node_spool, (unsigned long long)id);
     snprintf(name, sizeof name, "--job-name=meshcorr-%s-%llu", S.tag, (unsigned long long)id);
     snprintf(out, sizeof out, "--output=%s/" SPOOL_SLURM_OUT, dir);
@@ -547,7 +547,7 @@ static int submit(uint64_t id, const char *user)
     snprintf(wrap, sizeof wrap,
              "exec %s --job %s --job-id %llu --threads %d --max-vertices %u --max-faces %llu"
              " --progress-tcp %s:%d --secret-file %s",
-             q_worker, q_dir, (unsigned long long)id, cf->slurm_cpus, cf->max_vertices, wsup_max_faces(d),
+             q_worker, q_dir, (unsigned long long)id, cf->slurm_cpus, cf->max_vertices, conf_max_faces(&d->conf),
              S.prog_host, S.prog_port, q_sec);
     char *argv[BK_SLURM_MAX_ARGS];
     int k = 0, o = 0;
@@ -754,9 +754,10 @@ static int slurm_cancel(mcd *d, uint64_t id)
 }
 
 /* Slurm jobs run on without the daemon; the next start re-attaches. */
-static void slurm_drain(mcd *d)
+static void slurm_drain(mcd *d, mcd_idle_fn idle)
 {
     (void)d;
+    (void)idle;                   /* busy() is 0: nothing to wait for */
     if (S.njobs)
         dlog(DLOG_INFO, "slurm: %d job(s) stay in Slurm; the next start re-attaches to them", S.njobs);
 }
@@ -803,11 +804,11 @@ static void slurm_close(mcd *d)
 static void slurm_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
 {
     const mcd_conf *o = &d->conf;
-    bk_note_change(n->slurm_max_jobs != o->slurm_max_jobs, "slurm-max-jobs", changed, sz);
-    bk_note_change(n->slurm_poll_ms != o->slurm_poll_ms, "slurm-poll-ms", changed, sz);
-    bk_note_change(strcmp(n->slurm_spool, o->slurm_spool) != 0, "slurm-spool", changed, sz);
-    bk_note_change(strcmp(n->slurm_progress, o->slurm_progress) != 0, "slurm-progress", changed, sz);
-    bk_note_change(strcmp(n->slurm_progress_host, o->slurm_progress_host) != 0, "slurm-progress-host",
+    conf_note_change(n->slurm_max_jobs != o->slurm_max_jobs, "slurm-max-jobs", changed, sz);
+    conf_note_change(n->slurm_poll_ms != o->slurm_poll_ms, "slurm-poll-ms", changed, sz);
+    conf_note_change(strcmp(n->slurm_spool, o->slurm_spool) != 0, "slurm-spool", changed, sz);
+    conf_note_change(strcmp(n->slurm_progress, o->slurm_progress) != 0, "slurm-progress", changed, sz);
+    conf_note_change(strcmp(n->slurm_progress_host, o->slurm_progress_host) != 0, "slurm-progress-host",
                    changed, sz);
     n->slurm_max_jobs = o->slurm_max_jobs;
     n->slurm_poll_ms = o->slurm_poll_ms;

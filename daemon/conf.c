@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT };
 
@@ -252,4 +253,32 @@ int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
     if (strcmp(c->backend, "local") != 0 && strcmp(c->backend, "slurm") != 0)
         return errbuf_set(err, errsz, -1, "--backend: '%s' is not local or slurm", c->backend);
     return 0;
+}
+
+const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz)
+{
+    if (c->worker[0])
+        return c->worker;
+    /* meshcorr-worker next to meshcorrd */
+    static const char name[] = "meshcorr-worker";
+    ssize_t n = readlink("/proc/self/exe", buf, sz - sizeof name);
+    if (n <= 0)
+        return name;
+    buf[n] = '\0';
+    char *slash = strrchr(buf, '/');
+    memcpy(slash ? slash + 1 : buf, name, sizeof name);
+    return buf;
+}
+
+unsigned long long conf_max_faces(const mcd_conf *c)
+{
+    unsigned long long mf = 4ull * c->max_vertices;
+    return mf > 40000000 ? 40000000 : mf;
+}
+
+void conf_note_change(int differs, const char *name, char *changed, size_t sz)
+{
+    size_t len = strlen(changed);
+    if (differs && len + 1 < sz)
+        snprintf(changed + len, sz - len, "%s%s", len ? ", " : "", name);
 }

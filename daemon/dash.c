@@ -46,3 +46,16 @@ int dash_listen(const conf_endpoint *e, const char *what, char *err, size_t errs
     dlog(DLOG_INFO, "%s on %s:%d", what, e->host, e->port);
     return fd;
 }
+
+static void keep_endpoint(const conf_endpoint *o, conf_endpoint *n, const char *name, char *changed, size_t sz)
+{
+    conf_note_change(n->port != o->port || strcmp(n->host, o->host) != 0, name, changed, sz);
+    *n = *o;
+}
+
+/* The dashboard servers listen from the start to the end. */
+void dash_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz)
+{
+    keep_endpoint(&o->modbus, &n->modbus, "modbus", changed, sz);
+    keep_endpoint(&o->metrics, &n->metrics, "metrics", changed, sz);
+}

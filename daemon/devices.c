@@ -34,7 +34,7 @@ static void on_list(void *ctx, int status, const char *out, const char *err)
 void dev_probe(mcd *d)
 {
     char wbuf[CONF_PATH + 64], tbuf[32];
-    const char *w = wsup_worker_path(d, wbuf, sizeof wbuf);
+    const char *w = conf_worker_path(&d->conf, wbuf, sizeof wbuf);
     snprintf(tbuf, sizeof tbuf, "%d", d->conf.threads_per_worker);
     char *argv[] = { (char *)w, "--list-devices", "--threads", tbuf, NULL };
     d->ndevices = 0;

@@ -7,29 +7,12 @@
  *
  * DESIGN: nothing acknowledged is lost by a drain. The handles close only
  * once no worker runs (bk_busy) and no request is in the thread pool
- * (work_inflight), so no store_submit can run when the store closes; those
- * who can make either 0 call drain_check, which does nothing before then,
- * or twice. */
+ * (work_inflight), so no store_submit can run when the store closes; the
+ * backend and req.c call back (check) when either may have become 0, and
+ * check does nothing before then, or twice. */
 #include "backend.h"
 
-void drain_start(mcd *d, int sig)
-{
-    if (d->draining) {
-        dlog(DLOG_INFO, "signal %d: already shutting down", sig);
-        return;
-    }
-    d->draining = 1;
-    dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, bk_busy(d));
-    notify_stopping(d);
-    srv_stop_listening(d);
-    bk_drain(d);
-    if (d->work_inflight)
-        dlog(DLOG_INFO, "waiting for %u request(s) in the thread pool (SUBMITs being stored: their"
-             " SUBMIT_OK still goes out)", d->work_inflight);
-    drain_check(d);
-}
-
-void drain_check(mcd *d)
+static void check(mcd *d)
 {
     if (!d->draining || d->drained || bk_busy(d) || d->work_inflight)
         return;
@@ -43,4 +26,22 @@ void drain_check(mcd *d)
     uv_close((uv_handle_t *)&d->sigint, NULL);
     reload_close(d);
     notify_close(d);
+}
+
+void drain_start(mcd *d, int sig)
+{
+    if (d->draining) {
+        dlog(DLOG_INFO, "signal %d: already shutting down", sig);
+        return;
+    }
+    d->draining = 1;
+    dlog(DLOG_INFO, "signal %d: shutting down: %d running job(s) go back to the queue", sig, bk_busy(d));
+    notify_stopping(d);
+    srv_stop_listening(d);
+    bk_drain(d, check);
+    req_quiesce(d, check);
+    if (d->work_inflight)
+        dlog(DLOG_INFO, "waiting for %u request(s) in the thread pool (SUBMITs being stored: their"
+             " SUBMIT_OK still goes out)", d->work_inflight);
+    check(d);
 }

@@ -1,8 +1,10 @@
-/* job.c — one owner of a job's life once a backend runs it: its start, its
+/* job.c — one owner of a job's life once it is stored: its start, its
  * progress and its end are recorded here and nowhere else (the backends
- * decide from what their worker left and call these; backend.h); and its
- * last step, the deletion of a finished job result-ttl after its end (the
- * expiry sweep).
+ * decide from what their worker left and call these; backend.h), a pending
+ * job's cancel too; and its last step, the deletion of a finished job
+ * result-ttl after its end (the expiry sweep). It calls only the store and
+ * the scheduler; who tells the watchers (req.c) listens (job_listen), so no
+ * call goes back up.
  *
  * DESIGN: a job's end is recorded before anyone is told. job_ended writes
  * the state to the store, then sends END to the watchers; a run to do again
@@ -14,7 +16,7 @@
  * recovery adopts the run's result.frame or runs the job again. What the
  * files of a run say (result.frame; error.frame: FAILED, OUT_OF_MEMORY for
  * NOMEM, CANCELLED for CANCELLED) is read here for both backends. */
-#include "backend.h"
+#include "mcd.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -38,7 +40,14 @@ static struct {
     unrecorded *ends;             /* ends the store has not taken yet, oldest first */
     uv_timer_t sweep;             /* result expiry */
     uint64_t progress_failed;     /* job whose progress the store refused (logged once) */
+    job_listener l;               /* who tells the watchers (req.c) */
 } J;
+
+static void tell_ended(mcd *d, uint64_t id)
+{
+    if (J.l.ended)
+        J.l.ended(d, id);
+}
 
 static void on_retry(uv_timer_t *t)
 {
@@ -54,7 +63,7 @@ static void on_retry(uv_timer_t *t)
         dlog(DLOG_INFO, "job %llu: %s recorded (the store takes writes again)", (unsigned long long)u->id,
              proto_state_name(u->state));
         *pu = u->next;
-        req_job_ended(J.d, u->id);
+        tell_ended(J.d, u->id);
         free(u);
     }
     if (!left)
@@ -119,7 +128,13 @@ void job_running(mcd *d, uint64_t id, long pid)
         dlog(DLOG_ERROR, "job %llu: cannot record it RUNNING (the store is failing)", (unsigned long long)id);
 }
 
-void job_progress(mcd *d, const proto_progress *p)
+void job_listen(mcd *d, const job_listener *l)
+{
+    (void)d;
+    J.l = *l;
+}
+
+static void progress(mcd *d, const proto_progress *p)
 {
     if (store_add_progress(d->store, p->job_id, p) == 0) {
         if (J.progress_failed == p->job_id)
@@ -129,7 +144,36 @@ void job_progress(mcd *d, const proto_progress *p)
         dlog(DLOG_ERROR, "job %llu: cannot store its progress (more failures of this job's are not logged)",
              (unsigned long long)p->job_id);
     }
-    req_progress(d, p);
+    if (J.l.progress)
+        J.l.progress(d, p);
+}
+
+int job_progress_take(mcd *d, uint64_t id, proto_buf *in)
+{
+    int n = 0;
+    while (in->len) {
+        proto_msg m;
+        size_t used = 0;
+        char err[256];
+        int rc = proto_decode(in->data, in->len, JOB_MAX_PROGRESS_FRAME, &m, &used, err, sizeof err);
+        if (rc == PROTO_NEED_MORE)
+            return n;
+        if (rc != PROTO_READY || m.type != PROTO_MSG_PROGRESS) {
+            dlog(DLOG_WARN, "job %llu: bad progress frame from the worker (%s): ignoring its progress",
+                 (unsigned long long)id, rc ? err : proto_type_name(m.type));
+            if (rc == PROTO_READY)
+                proto_msg_free(&m);
+            proto_buf_reset(in);
+            return -1;
+        }
+        proto_progress p = m.u.progress;
+        proto_msg_free(&m);
+        proto_buf_consume(in, used);
+        p.job_id = id;
+        progress(d, &p);
+        n++;
+    }
+    return n;
 }
 
 void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, const char *reason)
@@ -149,7 +193,7 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
         return;
     }
     if (store_set_state(d->store, id, state, reason) == 0) {
-        req_job_ended(d, id);
+        tell_ended(d, id);
         return;
     }
     unrecorded *u = calloc(1, sizeof *u);
@@ -169,6 +213,16 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
          (unsigned long long)id, proto_state_name(state), JOB_RECORD_RETRY_MS);
     if (!uv_is_active((uv_handle_t *)&J.timer))
         uv_timer_start(&J.timer, on_retry, JOB_RECORD_RETRY_MS, JOB_RECORD_RETRY_MS);
+}
+
+int job_cancel_pending(mcd *d, uint64_t id)
+{
+    sched_remove(d->sched, id);
+    if (store_set_state(d->store, id, PROTO_STATE_CANCELLED, "cancelled by request before it ran"))
+        return PROTO_ESTORAGE;
+    dlog(DLOG_INFO, "job %llu: CANCELLED while pending", (unsigned long long)id);
+    tell_ended(d, id);
+    return 0;
 }
 
 /* A worker's error.frame at path: its protocol error code and message

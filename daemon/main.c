@@ -58,6 +58,7 @@ int main(int argc, char **argv)
         goto done;
     }
     job_init(&d);
+    req_init(&d);
     if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
         (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.snap, &d.metrics, err, sizeof err))) {

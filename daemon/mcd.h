@@ -7,7 +7,7 @@
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
  *   wlock.c  wlock_  a job's worker lock: two workers of one job never run
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
- *   job.c    job_    a running job's life: start, progress, end (both backends)
+ *   job.c    job_    a job's life once stored: start, progress, end, pending cancel
  *   backend.c bk_    where jobs run (backend.h): `local` or `slurm`
  *   wsup.c   wsup_   the local backend: worker processes, progress pipe, exit
  *   bk_slurm.c       the slurm backend: sbatch/squeue/scancel, re-attach
@@ -118,6 +118,13 @@ int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
 int conf_set(mcd_conf *c, const char *key, const char *value, char *err, size_t errsz);
 int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz);
 void conf_usage(FILE *fp);
+/* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
+const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz);
+/* The worker's --max-faces for the configured --max-vertices. */
+unsigned long long conf_max_faces(const mcd_conf *c);
+/* SIGHUP: appends ", name" (or "name" first) to changed when the option
+ * differs (a subsystem naming what it applies only at start). */
+void conf_note_change(int differs, const char *name, char *changed, size_t sz);
 
 /* ---- dlog_ ---------------------------------------------------------------- */
 enum { DLOG_ERROR, DLOG_WARN, DLOG_INFO, DLOG_DEBUG };
@@ -159,6 +166,8 @@ typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zer
 int64_t store_now_ms(void);
 /* Opens (creating) <dir>/jobs.db and <dir>/spool. */
 int store_open(const char *dir, store **out, char *err, size_t errsz);
+/* SIGHUP: keeps n's state-dir at the running one o (conf_note_change). */
+void store_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 /* NULL ok; never while a store_submit runs. */
 void store_close(store *s);
 /* After a restart: every worker a previous daemon left running is killed
@@ -283,6 +292,8 @@ void snap_release(mcd_snapshot *m);          /* NULL ok */
 /* A listening TCP socket (close-on-exec, non-blocking) on e: the fd, or -1
  * with the detail in err. */
 int dash_listen(const conf_endpoint *e, const char *what, char *err, size_t errsz);
+/* SIGHUP: keeps n's dashboard endpoints (modbus, metrics) at the running o. */
+void dash_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 
 /* ---- mbus_ ---------------------------------------------------------------- */
 /* MODBUS.md is the register map. 32-bit values: high word first. */
@@ -312,6 +323,8 @@ typedef struct wsup_slot wsup_slot;
 typedef struct req_watch req_watch;
 typedef struct req_submit req_submit;
 typedef struct bk_ops bk_ops;
+/* "Something you wait for may have finished" (a drain's callbacks). */
+typedef void (*mcd_idle_fn)(mcd *d);
 
 struct mcd {
     uv_loop_t *loop;
@@ -324,7 +337,7 @@ struct mcd {
     req_watch *watches;           /* every live WATCH */
     req_submit *submits;          /* SUBMITs being stored in the thread pool */
     uint32_t work_inflight;       /* req_ work items queued and not yet done */
-    int drained;                  /* drain_check has closed everything */
+    int drained;                  /* the drain has closed everything */
     uv_handle_t **listeners;
     int nlisteners;
     uv_signal_t sigterm, sigint;
@@ -342,17 +355,27 @@ struct mcd {
     int ndevices;
 };
 
-/* ---- job_: one owner of a running job's life (job.c) --------------------- */
+/* ---- job_: one owner of a job's life (job.c) ----------------------------- */
+/* Who hears of a job's progress and end (req.c: the watchers). */
+typedef struct job_listener {
+    void (*progress)(mcd *d, const proto_progress *p);
+    void (*ended)(mcd *d, uint64_t id);     /* its terminal state is in the store */
+} job_listener;
 void job_init(mcd *d);            /* before the backend starts */
+void job_listen(mcd *d, const job_listener *l);
 void job_close(mcd *d);           /* drained: ends not recorded yet are left to recovery */
 /* (Re)starts the result-expiry sweep from d->conf.result_ttl_s: a sweep
- * now, then every minute or every result-ttl if shorter (SIGHUP calls it
- * again). */
+ * now, then every minute (or every result-ttl when shorter). */
 void job_sweep_start(mcd *d);
 /* A backend started job id (pid: its worker's, 0 when not local). */
 void job_running(mcd *d, uint64_t id, long pid);
-/* A PROGRESS record of a running job: stored, fanned out to watchers. */
-void job_progress(mcd *d, const proto_progress *p);
+/* Decodes the whole PROGRESS frames at the front of in (a worker's pipe or
+ * connection, or a progress file), consumes them, and stores and fans out
+ * each as job id's. Returns the number taken, or -1 at a frame that is not
+ * a valid PROGRESS (in is then reset; the caller ignores the rest of that
+ * stream). */
+#define JOB_MAX_PROGRESS_FRAME 4096
+int job_progress_take(mcd *d, uint64_t id, proto_buf *in);
 /* A run of job id (user's; counted: the scheduler counts it as running)
  * ended in state: terminal, recorded (retried while the store refuses it),
  * then END to the watchers; or PENDING: back to the scheduler. */
@@ -361,6 +384,9 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
  * error.frame gives (reason "CODE: message"), or -1 without one. */
 int job_has_result(mcd *d, uint64_t id);
 int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz);
+/* A pending job (not handed to a backend) is cancelled: out of the queue,
+ * CANCELLED in the store, END to its watchers. 0 or PROTO_ESTORAGE. */
+int job_cancel_pending(mcd *d, uint64_t id);
 
 /* ---- dev_: the devices a worker sees, asked once of the worker program ---- */
 /* Runs `meshcorr-worker --list-devices` in the background; until it answers
@@ -379,12 +405,6 @@ void notify_close(mcd *d);        /* stops the STATUS= timer */
 /* ---- reload_ -------------------------------------------------------------- */
 void reload_init(mcd *d, int argc, char **argv);  /* SIGHUP handler */
 void reload_close(mcd *d);
-
-/* ---- wsup_: the local backend (its operations are bk_local, backend.h) -- */
-/* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
-const char *wsup_worker_path(const mcd *d, char *buf, size_t sz);
-/* The worker's --max-faces for the configured --max-vertices. */
-unsigned long long wsup_max_faces(const mcd *d);
 
 /* ---- val_: a SUBMIT checked in a sandboxed child (val.c) ------------------- */
 #define VAL_BASE_MEMORY_MB 1024u  /* plus 256 bytes per allowed vertex of both meshes */
@@ -409,6 +429,8 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
 int srv_listen(mcd *d, char *err, size_t errsz);
 void srv_stop_listening(mcd *d);
 void srv_close_all(mcd *d);
+/* SIGHUP: keeps n's listeners and port file at the running o. */
+void srv_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 /* Queues one encoded message; a connection over conf.max_output is paused
  * (replies) or, with drop_if_full (WATCH frames), dropped. 0 or -1 dropped. */
 int srv_send(conn *c, const proto_msg *m, int drop_if_full);
@@ -443,16 +465,14 @@ int srv_conn_hung_up(conn *c);
 
 /* ---- drain_: the graceful shutdown (drain.c) ------------------------------ */
 void drain_start(mcd *d, int sig);    /* SIGTERM/SIGINT: stop accepting, hand the runs back */
-/* During a drain, once no worker runs (bk_busy) and no request is in the
- * thread pool (work_inflight): closes what is left so the loop ends. Called
- * when either may have become 0; does nothing before that, or twice. */
-void drain_check(mcd *d);
 
 /* ---- req_ ----------------------------------------------------------------- */
 /* Handles one decoded request; frame/len are its raw bytes (SUBMIT spools them). */
 void req_handle(conn *c, const proto_msg *m, const void *frame, size_t len);
-void req_progress(mcd *d, const proto_progress *p);   /* fan out to watchers */
-void req_job_ended(mcd *d, uint64_t id);              /* END to watchers */
+void req_init(mcd *d);                                /* listens to job.c for the watchers */
+/* A drain: idle(d) is called each time one of the requests in the thread
+ * pool (d->work_inflight) finishes from now on. */
+void req_quiesce(mcd *d, mcd_idle_fn idle);
 void req_conn_closed(mcd *d, conn *c);                /* forget its watches */
 int req_conn_watching(const mcd *d, const conn *c);   /* 1: a WATCH of c is live */
 

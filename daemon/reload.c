@@ -9,33 +9,22 @@
 #include "backend.h"
 
 #include <signal.h>
-#include <string.h>
 
 /* Puts back the running values of what takes effect at the next start
- * only, asking the backend for its own, and warns naming what changed. */
+ * only, asking each subsystem that sets something up once, and warns naming
+ * what changed. */
 static void keep_restart_only(mcd *d, mcd_conf *n)
 {
-    char changed[512];
+    static void (*const keep[])(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz) = {
+        srv_keep_on_reload, store_keep_on_reload, dash_keep_on_reload,
+    };
+    char changed[512] = "";
+    for (size_t i = 0; i < sizeof keep / sizeof keep[0]; i++)
+        keep[i](&d->conf, n, changed, sizeof changed);
     bk_keep_on_reload(d, n, changed, sizeof changed);
-    int listen_changed = n->nlisten != d->conf.nlisten;
-    for (int i = 0; !listen_changed && i < n->nlisten; i++)
-        listen_changed = strcmp(n->listen[i], d->conf.listen[i]) != 0;
-    bk_note_change(listen_changed, "listen", changed, sizeof changed);
-    bk_note_change(strcmp(n->state_dir, d->conf.state_dir) != 0, "state-dir", changed, sizeof changed);
-    bk_note_change(strcmp(n->port_file, d->conf.port_file) != 0, "port-file", changed, sizeof changed);
-    bk_note_change(n->modbus.port != d->conf.modbus.port || strcmp(n->modbus.host, d->conf.modbus.host),
-                   "modbus", changed, sizeof changed);
-    bk_note_change(n->metrics.port != d->conf.metrics.port || strcmp(n->metrics.host, d->conf.metrics.host),
-                   "metrics", changed, sizeof changed);
     if (changed[0])
         dlog(DLOG_WARN, "reload: %s changed but take(s) effect at the next start only: keeping the running"
                         " value(s)", changed);
-    memcpy(n->listen, d->conf.listen, sizeof n->listen);
-    n->nlisten = d->conf.nlisten;
-    memcpy(n->state_dir, d->conf.state_dir, sizeof n->state_dir);
-    memcpy(n->port_file, d->conf.port_file, sizeof n->port_file);
-    n->modbus = d->conf.modbus;
-    n->metrics = d->conf.metrics;
 }
 
 static void on_sighup(uv_signal_t *h, int sig)

@@ -1,7 +1,8 @@
 /* req.c — one handler per request type (PROTOCOL.md, Messages) and the
  * WATCH registry. Handlers check the session, the job's visibility and state,
- * act through store_/sched_/bk_, and answer through srv_send. Never reads a
- * socket, never blocks on a client.
+ * act through store_/sched_/job_/bk_, and answer through srv_send. Never
+ * reads a socket, never blocks on a client. It hears of a running job's
+ * progress and end from job.c (req_init listens), and fans them out.
  *
  * DESIGN: visibility — a non-admin session sees only its user's jobs, and
  * any other job is NOT_FOUND, exactly like a job that never existed, so ids
@@ -25,7 +26,8 @@
  * replies in order, at most one work item per client) and its memory
  * outlives a close; a client that left gets no reply, but its SUBMIT, once
  * stored, is queued and runs. d->work_inflight counts the work items; a
- * drain closes the daemon only when it is 0 (drain_check). */
+ * drain closes the daemon only when it is 0 (req_quiesce: told at each
+ * work item's end). */
 #include "backend.h"
 
 #include <errno.h>
@@ -46,6 +48,7 @@ struct req_watch {
 };
 
 static int iterating;             /* fan-out in progress: unlink watches later */
+static mcd_idle_fn quiesced;      /* a drain waits for the work items */
 
 static void prune(mcd *d)
 {
@@ -180,8 +183,14 @@ static void work_end(mcd *d, conn *c)
 {
     srv_conn_release(c);
     d->work_inflight--;
-    if (d->draining)
-        drain_check(d);
+    if (quiesced)
+        quiesced(d);
+}
+
+void req_quiesce(mcd *d, mcd_idle_fn idle)
+{
+    (void)d;
+    quiesced = idle;
 }
 
 /* A SUBMIT being stored: everything store_submit needs, copied, so the
@@ -469,7 +478,7 @@ static void on_watch(conn *c, const proto_msg *m)
     d->watches = nw;
 }
 
-void req_progress(mcd *d, const proto_progress *p)
+static void on_job_progress(mcd *d, const proto_progress *p)
 {
     snap_progress(d, p);
     iterating = 1;
@@ -480,7 +489,7 @@ void req_progress(mcd *d, const proto_progress *p)
     prune(d);
 }
 
-void req_job_ended(mcd *d, uint64_t id)
+static void on_job_ended(mcd *d, uint64_t id)
 {
     store_job j;
     if (store_get(d->store, id, &j))
@@ -496,6 +505,12 @@ void req_job_ended(mcd *d, uint64_t id)
     prune(d);
 }
 
+void req_init(mcd *d)
+{
+    static const job_listener l = {on_job_progress, on_job_ended};
+    job_listen(d, &l);
+}
+
 static void on_cancel(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -506,14 +521,11 @@ static void on_cancel(conn *c, const proto_msg *m)
         /* the backend has it (running, or queued in Slurm) and stops it */
         dlog(DLOG_INFO, "job %llu: cancel requested from the %s backend", (unsigned long long)j.id, bk_name(d));
     } else if (j.state == PROTO_STATE_PENDING) {
-        sched_remove(d->sched, j.id);
-        if (store_set_state(d->store, j.id, PROTO_STATE_CANCELLED, "cancelled by request before it ran")) {
+        if (job_cancel_pending(d, j.id)) {
             srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure cancelling job %llu",
                            (unsigned long long)j.id);
             return;
         }
-        dlog(DLOG_INFO, "job %llu: CANCELLED while pending", (unsigned long long)j.id);
-        req_job_ended(d, j.id);
     } else {
         srv_send_error(c, m->request_id, PROTO_EBAD_STATE, "job %llu is %s: nothing to cancel",
                        (unsigned long long)j.id, proto_state_name(j.state));

@@ -728,3 +728,16 @@ void srv_close_all(mcd *d)
     while (d->conns)
         srv_close(d->conns);
 }
+
+/* The listeners are bound once, and the port file written once. */
+void srv_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz)
+{
+    int differs = n->nlisten != o->nlisten;
+    for (int i = 0; !differs && i < n->nlisten; i++)
+        differs = strcmp(n->listen[i], o->listen[i]) != 0;
+    conf_note_change(differs, "listen", changed, sz);
+    conf_note_change(strcmp(n->port_file, o->port_file) != 0, "port-file", changed, sz);
+    memcpy(n->listen, o->listen, sizeof n->listen);
+    n->nlisten = o->nlisten;
+    memcpy(n->port_file, o->port_file, sizeof n->port_file);
+}

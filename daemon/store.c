@@ -867,3 +867,10 @@ void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *c
     }
     sqlite3_finalize(st);
 }
+
+/* The store is opened once. */
+void store_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz)
+{
+    conf_note_change(strcmp(n->state_dir, o->state_dir) != 0, "state-dir", changed, sz);
+    memcpy(n->state_dir, o->state_dir, sizeof n->state_dir);
+}

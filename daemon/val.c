@@ -34,9 +34,9 @@ void val_conf_of(const mcd *d, val_conf *vc)
 {
     char buf[CONF_PATH + 64];
     memset(vc, 0, sizeof *vc);
-    snprintf(vc->worker, sizeof vc->worker, "%s", wsup_worker_path(d, buf, sizeof buf));
+    snprintf(vc->worker, sizeof vc->worker, "%s", conf_worker_path(&d->conf, buf, sizeof buf));
     vc->max_vertices = d->conf.max_vertices;
-    vc->max_faces = wsup_max_faces(d);
+    vc->max_faces = conf_max_faces(&d->conf);
     /* a decoded mesh is well under 256 bytes a vertex (Draco's buffers,
      * positions, faces, the check's tables); the worker's limit when set */
     vc->max_memory_mb = d->conf.worker_memory_mb

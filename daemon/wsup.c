@@ -63,31 +63,11 @@ static struct {
     uv_timer_t timer;
     int open, paused;
     uint64_t delay_ms;
+    mcd_idle_fn drained;          /* a drain waits: told when a slot is idle again */
 } R;
 
 static void slot_finish(wsup_slot *s);
 static void wsup_schedule(mcd *d);
-
-const char *wsup_worker_path(const mcd *d, char *buf, size_t sz)
-{
-    if (d->conf.worker[0])
-        return d->conf.worker;
-    /* meshcorr-worker next to meshcorrd */
-    static const char name[] = "meshcorr-worker";
-    ssize_t n = readlink("/proc/self/exe", buf, sz - sizeof name);
-    if (n <= 0)
-        return name;
-    buf[n] = '\0';
-    char *slash = strrchr(buf, '/');
-    memcpy(slash ? slash + 1 : buf, name, sizeof name);
-    return buf;
-}
-
-unsigned long long wsup_max_faces(const mcd *d)
-{
-    unsigned long long mf = 4ull * d->conf.max_vertices;
-    return mf > 40000000 ? 40000000 : mf;
-}
 
 static int wsup_init(mcd *d, char *err, size_t errsz)
 {
@@ -111,7 +91,7 @@ static int wsup_init(mcd *d, char *err, size_t errsz)
     R.paused = 0;
     R.delay_ms = WSUP_RETRY_MIN_MS;
     char buf[PATH_MAX];
-    const char *w = wsup_worker_path(d, buf, sizeof buf);
+    const char *w = conf_worker_path(&d->conf, buf, sizeof buf);
     if (access(w, X_OK) != 0)
         dlog(DLOG_WARN, "worker program %s is not executable: jobs will fail until it is", w);
     return 0;
@@ -167,7 +147,7 @@ static void take_progress(wsup_slot *s)
 {
     if (s->progress_bad)
         return;
-    int n = bk_progress_take(s->d, s->job_id, &s->in);
+    int n = job_progress_take(s->d, s->job_id, &s->in);
     if (n < 0)
         s->progress_bad = 1;
     else if (n > 0 && s->state == PROTO_SLOT_STARTING)
@@ -217,7 +197,8 @@ static void on_handle_closed(uv_handle_t *h)
     s->job_id = 0;
     mcd *d = s->d;
     if (d->draining) {
-        drain_check(d);               /* closes once nothing else runs either */
+        if (R.drained)
+            R.drained(d);             /* the drain closes once nothing else runs either */
     } else {
         wsup_schedule(d);
     }
@@ -390,10 +371,10 @@ static int slot_start(wsup_slot *s, uint64_t id, const char *user)
     snprintf(fd, sizeof fd, "%d", SPOOL_PROGRESS_FD);
     snprintf(thr, sizeof thr, "%d", d->conf.threads_per_worker);
     snprintf(maxv, sizeof maxv, "%u", d->conf.max_vertices);
-    snprintf(maxf, sizeof maxf, "%llu", wsup_max_faces(d));
+    snprintf(maxf, sizeof maxf, "%llu", conf_max_faces(&d->conf));
     char *argv[16];
     int k = 0;
-    argv[k++] = (char *)wsup_worker_path(d, wbuf, sizeof wbuf);
+    argv[k++] = (char *)conf_worker_path(&d->conf, wbuf, sizeof wbuf);
     argv[k++] = "--job";         argv[k++] = dir;
     argv[k++] = "--job-id";      argv[k++] = sid;
     argv[k++] = "--progress-fd"; argv[k++] = fd;
@@ -486,8 +467,9 @@ static int wsup_cancel(mcd *d, uint64_t id)
     return -1;
 }
 
-static void wsup_drain(mcd *d)
+static void wsup_drain(mcd *d, mcd_idle_fn idle)
 {
+    R.drained = idle;
     for (int i = 0; i < d->conf.workers; i++) {
         wsup_slot *s = &d->slots[i];
         if (s->state != PROTO_SLOT_IDLE && !s->finished) {
@@ -534,7 +516,7 @@ static int wsup_nslots(const mcd *d)
 static int wsup_health(const mcd *d, char *msg, size_t sz)
 {
     char buf[PATH_MAX];
-    const char *w = wsup_worker_path(d, buf, sizeof buf);
+    const char *w = conf_worker_path(&d->conf, buf, sizeof buf);
     if (access(w, X_OK) != 0) {
         snprintf(msg, sz, "worker program %s is not executable", w);
         return 0;
@@ -546,7 +528,7 @@ static int wsup_health(const mcd *d, char *msg, size_t sz)
 /* The slots are allocated once. */
 static void wsup_keep_on_reload(const mcd *d, mcd_conf *n, char *changed, size_t sz)
 {
-    bk_note_change(n->workers != d->conf.workers, "workers", changed, sz);
+    conf_note_change(n->workers != d->conf.workers, "workers", changed, sz);
     n->workers = d->conf.workers;
 }
 
