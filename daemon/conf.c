@@ -38,6 +38,7 @@ static const struct option_def {
     {"job-timeout", K_U32, OFF(job_timeout_s), 1, 100000000, "SECONDS of wall time per job"},
     {"result-ttl", K_U32, OFF(result_ttl_s), 1, 100000000, "SECONDS a finished job is kept"},
     {"max-output", K_U32, OFF(max_output), 4096, 1u << 31, "BYTES queued to one client before a watcher is dropped"},
+    {"max-request-memory", K_U32, OFF(max_request_memory), 65536, 0xFFFFFFFFu, "BYTES of request frames being received from all clients at once (default 1 GiB)"},
     {"max-connections", K_U32, OFF(max_connections), 1, 1000000, "N client connections in all (default 512)"},
     {"max-connections-per-user", K_U32, OFF(max_connections_per_user), 1, 1000000, "N sessions of one user, admins exempt (default 64)"},
     {"max-unauthenticated", K_U32, OFF(max_unauthenticated), 1, 1000000, "N connections before HELLO (default 64)"},
@@ -78,6 +79,7 @@ void conf_init(mcd_conf *c)
     c->job_timeout_s = CONF_DEFAULT_JOB_TIMEOUT_S;
     c->result_ttl_s = CONF_DEFAULT_RESULT_TTL_S;
     c->max_output = CONF_DEFAULT_MAX_OUTPUT;
+    c->max_request_memory = CONF_DEFAULT_MAX_REQUEST_MEMORY;
     c->max_connections = CONF_DEFAULT_MAX_CONNECTIONS;
     c->max_connections_per_user = CONF_DEFAULT_MAX_CONNECTIONS_PER_USER;
     c->max_unauthenticated = CONF_DEFAULT_MAX_UNAUTHENTICATED;

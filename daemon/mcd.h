@@ -63,6 +63,7 @@
 #define CONF_DEFAULT_HELLO_TIMEOUT_S 10           /* accept -> HELLO done */
 #define CONF_DEFAULT_REQUEST_TIMEOUT_S 300        /* first byte of a frame -> its last */
 #define CONF_DEFAULT_IDLE_TIMEOUT_S 600           /* a session with nothing going on */
+#define CONF_DEFAULT_MAX_REQUEST_MEMORY (1u << 30) /* bytes of request frames being received, all clients */
 #define CONF_FD_RESERVE_BASE 32                   /* --fd-reserve 0: this many ... */
 #define CONF_FD_RESERVE_PER_SLOT 4                /* ... plus this many per backend slot */
 
@@ -87,6 +88,7 @@ typedef struct mcd_conf {
     uint32_t max_jobs_per_user, max_queue;
     uint32_t job_timeout_s, result_ttl_s;
     uint32_t max_output;          /* output bytes queued per connection */
+    uint32_t max_request_memory;  /* bytes of frames being received, all connections */
     uint32_t max_connections, max_connections_per_user, max_unauthenticated;
     uint32_t hello_timeout_s, request_timeout_s, idle_timeout_s;   /* 0 = none */
     uint32_t fd_reserve;          /* descriptors kept free under RLIMIT_NOFILE; 0 = automatic */

@@ -34,7 +34,10 @@
  * --hello-timeout, a frame still incomplete --request-timeout after its
  * first byte, or a session with nothing going on (no request in flight, no
  * live WATCH, nothing unread, no byte from the client) for --idle-timeout;
- * each gets ERROR TIMED_OUT and a log line. */
+ * each gets ERROR TIMED_OUT and a log line. What clients have half sent is
+ * bounded in all: a frame counts against --max-request-memory from its
+ * header to its end (admit), one that does not fit is refused BUSY the
+ * same way, and a buffer grown for a large frame is freed once it is done. */
 #include "mcd.h"
 #include "backend.h"
 
@@ -67,11 +70,17 @@ struct conn {
     int holds;                /* srv_conn_hold not yet released: work in flight */
     size_t held_len;          /* bytes of in.data the held request's frame takes */
     int handle_closed;        /* uv_close finished: free once holds is 0 */
-    int refused;              /* accepted only to say BUSY: input dropped, closed soon */
+    int refused;              /* told BUSY: input dropped, closed soon */
+    uint64_t refused_ms;      /* loop time of the refusal */
     uint64_t accepted_ms;     /* loop time of the accept */
     uint64_t frame_ms;        /* when the incomplete frame in `in` began; 0: none */
     uint64_t active_ms;       /* last byte read, write done or request finished */
+    size_t admitted;          /* the incomplete frame's length, counted in admitted_total */
 };
+
+/* Bytes of the frames being received (admitted, not yet consumed), all
+ * connections: at most conf.max_request_memory (one loop). */
+static size_t admitted_total;
 
 static uv_timer_t sweep_timer;     /* the connection timeouts (one loop) */
 static int sweep_on;
@@ -90,8 +99,23 @@ static size_t queued(const conn *c)
     return c->inflight + c->out.len;
 }
 
+/* The frame at the front of c->in is consumed (or c is gone): its bytes
+ * leave the count, and a buffer grown for a large frame is given back. */
+#define SRV_KEEP_INPUT_CAP (1u << 20)
+static void frame_done(conn *c)
+{
+    admitted_total -= c->admitted;
+    c->admitted = 0;
+    if (c->in.len == 0 && c->in.cap > SRV_KEEP_INPUT_CAP) {
+        proto_buf_free(&c->in);
+        proto_buf_init(&c->in);
+    }
+}
+
 static void conn_free(conn *c)
 {
+    admitted_total -= c->admitted;
+    c->admitted = 0;
     proto_buf_free(&c->in);
     proto_buf_free(&c->out);
     free(c->wdata);
@@ -275,6 +299,34 @@ static void fatal_error(conn *c, uint32_t request_id, int code, const char *msg)
     srv_close_soon(c);
 }
 
+/* A frame's header is in and the rest is coming: its length counts
+ * against max-request-memory from now until it is consumed; a frame that
+ * does not fit is refused BUSY (the client may send it again later) and
+ * the connection closed, so what the daemon buffers stays bounded
+ * whatever the number of clients. */
+static void admit(conn *c, const proto_hdr *hdr)
+{
+    size_t flen = PROTO_HDR_SIZE + (size_t)hdr->payload_len, cap = c->d->conf.max_request_memory;
+    if (admitted_total + flen > cap) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "the server is receiving %zu bytes of requests already; this %zu-byte %s does"
+                 " not fit under max-request-memory %zu: send it again later", admitted_total, flen,
+                 proto_type_name(hdr->type), cap);
+        dlog(DLOG_WARN, "conn %lu (%s): BUSY: %s: closing", c->id, c->auth.authed ? c->auth.user : "-", msg);
+        srv_send_error(c, hdr->request_id, PROTO_EBUSY, "%s", msg);
+        /* like a refusal at accept: what else it sends is dropped until its
+         * EOF or the linger time, so it reads the ERROR rather than a reset */
+        c->refused = 1;
+        c->refused_ms = uv_now(c->d->loop);
+        c->frame_ms = 0;
+        proto_buf_free(&c->in);
+        proto_buf_init(&c->in);
+        return;
+    }
+    c->admitted = flen;
+    admitted_total += flen;
+}
+
 static void process_input(conn *c)
 {
     while (!c->closing && !c->close_after_write && !c->paused && !c->holds && c->in.len) {
@@ -282,8 +334,11 @@ static void process_input(conn *c)
         proto_hdr hdr;
         char err[512];
         int rc = proto_frame_scan(c->in.data, c->in.len, limit, &hdr, err, sizeof err);
-        if (rc == PROTO_NEED_MORE)
+        if (rc == PROTO_NEED_MORE) {
+            if (c->in.len >= PROTO_HDR_SIZE && !c->admitted)
+                admit(c, &hdr);
             return;
+        }
         if (rc < 0) {
             fatal_error(c, c->in.len >= PROTO_HDR_SIZE ? hdr.request_id : 0, rc, err);
             return;
@@ -305,6 +360,7 @@ static void process_input(conn *c)
             }
         }
         proto_buf_consume(&c->in, flen);
+        frame_done(c);
         c->frame_ms = c->in.len ? uv_now(c->d->loop) : 0;
     }
 }
@@ -331,6 +387,7 @@ void srv_conn_release(conn *c)
         return;                        /* on_closed frees it */
     proto_buf_consume(&c->in, c->held_len);
     c->held_len = 0;
+    frame_done(c);
     c->active_ms = uv_now(c->d->loop);
     c->frame_ms = c->in.len ? c->active_ms : 0;
     update_reading(c);
@@ -496,6 +553,7 @@ static void on_connection(uv_stream_t *server, int status)
     snprintf(what, sizeof what, "conn %lu (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
     log_refusal(d, kind, what, why);
     c->refused = 1;
+    c->refused_ms = c->accepted_ms;
     srv_send_error(c, 0, PROTO_EBUSY, "server busy: %s; retry later", why);
     if (left <= reserve / 2)
         srv_close(c);                  /* no descriptor to spare for lingering */
@@ -555,7 +613,7 @@ static void on_sweep(uv_timer_t *t)
         if (c->closing || c->close_after_write)
             continue;
         if (c->refused) {
-            if (now - c->accepted_ms >= SRV_REFUSE_LINGER_MS)
+            if (now - c->refused_ms >= SRV_REFUSE_LINGER_MS)
                 srv_close(c);
         } else if (!c->auth.authed && k->hello_timeout_s && now - c->accepted_ms >= 1000ull * k->hello_timeout_s) {
             time_out(c, "no HELLO within %u s (--hello-timeout)", k->hello_timeout_s);

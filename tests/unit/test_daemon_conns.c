@@ -345,3 +345,57 @@ TEST_T(silent_half_sent_and_idle_clients_are_cut_after_their_timeouts_and_a_quie
     close(watcher);
     testdaemon_stop(&d, SIGTERM);
 }
+
+/* SUBMIT header announcing payload bytes, and the first `sent` of them. */
+static void raw_partial_submit(int fd, uint32_t rid, uint32_t payload, size_t sent)
+{
+    static uint8_t frame[PROTO_HDR_SIZE + 4096];
+    proto_hdr h = {PROTO_VERSION, PROTO_MSG_SUBMIT, 0, rid, payload};
+    proto_frame_put_header(frame, &h);
+    raw_send(fd, frame, PROTO_HDR_SIZE + sent);
+}
+
+/* Frames being received count against --max-request-memory across all
+ * clients: a large SUBMIT that does not fit is refused BUSY naming the
+ * limit (with its request id) and logged, while small requests go on; the
+ * bytes of a client that leaves half-way are counted no more. */
+TEST_T(request_frames_being_received_are_capped_in_all, 60)
+{
+    static const char *const args[] = {"--max-request-memory", "1000000", NULL};
+    testdaemon d;
+    testdaemon_start(&d, "reqmem", args);
+    int a = raw_unix(&d), b = raw_unix(&d), e = raw_unix(&d);
+    raw_hello(a);
+    raw_hello(b);
+    raw_hello(e);
+    raw_partial_submit(a, 5, 600000, 1000);
+    expect_quiet(a, 0.3);                       /* admitted: 600020 of 1000000 bytes */
+    raw_partial_submit(b, 6, 600000, 1000);
+    proto_msg m;
+    uint8_t *buf;
+    raw_read_msg(b, &m, &buf, 10);
+    CHECK_INT(m.type, PROTO_MSG_ERROR);
+    CHECK_INT(m.u.error.code, PROTO_EBUSY);
+    CHECK_INT(m.request_id, 6);
+    CHECK_STR_HAS(m.u.error.message, "600020 bytes of requests already");
+    CHECK_STR_HAS(m.u.error.message, "max-request-memory 1000000");
+    printf("  refused: %s\n", m.u.error.message);
+    proto_msg_free(&m);
+    free(buf);
+    uint8_t byte;
+    CHECK_INT(raw_recv(b, &byte, 1, now_s() + 5), 1);   /* EOF follows */
+    CHECK(testdaemon_log_has(&d, "does not fit under max-request-memory 1000000"));
+    /* small requests still pass, and a client's status is answered */
+    mc_client *c = testdaemon_client(&d, NULL);
+    mc_server_stats st;
+    CHECK_INT(mc_stats(c, &st), 0);
+    /* a leaves half-way: its bytes are free again for e */
+    close(a);
+    usleep(300 * 1000);
+    raw_partial_submit(e, 7, 600000, 1000);
+    expect_quiet(e, 0.5);                       /* admitted */
+    mc_close(c);
+    close(b);
+    close(e);
+    testdaemon_stop(&d, SIGTERM);
+}
