@@ -409,6 +409,12 @@ static int job_request(mc_client *c, int type, int want, uint64_t id, proto_msg 
     return request(c, &req, want, rep);
 }
 
+const char *mc_quality_name(int verdict)
+{
+    static const char *const names[] = {"ok", "folded", "reversed"};
+    return verdict >= 0 && verdict <= MC_QUALITY_REVERSED ? names[verdict] : "unknown";
+}
+
 int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
 {
     proto_msg rep;
@@ -429,6 +435,7 @@ int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
     o->has_progress = s->has_progress;
     if (s->has_progress)
         copy_progress(&o->progress, &s->progress);
+    o->quality = (mc_quality){s->quality.verdict, s->quality.flipped, s->quality.collapsed};
     proto_msg_free(&rep);
     return 0;
 }
@@ -504,6 +511,7 @@ int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **j
             snprintf(o->label, sizeof o->label, "%s", s->label);
             o->outer = s->outer;
             o->total = s->total;
+            o->quality = (mc_quality){s->quality.verdict, s->quality.flipped, s->quality.collapsed};
             after = s->job_id;
         }
         *n += k;

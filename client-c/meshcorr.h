@@ -118,6 +118,18 @@ typedef struct mc_progress {
     double beta, gamma, elapsed_s;
 } mc_progress;
 
+/* How good a COMPLETED job's map is, as its worker measured it. */
+typedef struct mc_quality {
+    int verdict;               /* MC_QUALITY_*; MC_QUALITY_UNKNOWN before COMPLETED */
+    double flipped, collapsed; /* fractions of source faces; NaN when not known */
+} mc_quality;
+#define MC_QUALITY_UNKNOWN  (-1)
+#define MC_QUALITY_OK       0  /* neither of the below */
+#define MC_QUALITY_FOLDED   1  /* flipped + collapsed > 5 % */
+#define MC_QUALITY_REVERSED 2  /* more than 50 % flipped: orientation reversed */
+/* "unknown", "ok", "folded", "reversed". */
+const char *mc_quality_name(int verdict);
+
 typedef struct mc_job_status {
     uint64_t job_id;
     int state;
@@ -128,6 +140,7 @@ typedef struct mc_job_status {
     int64_t submit_ms, start_ms, end_ms;   /* Unix ms; 0 = not yet */
     int has_progress;
     mc_progress progress;      /* the latest, when has_progress */
+    mc_quality quality;        /* how good the map is, once COMPLETED */
 } mc_job_status;
 
 typedef struct mc_job_info {   /* one LIST row */
@@ -138,6 +151,7 @@ typedef struct mc_job_info {   /* one LIST row */
     char user[256];
     char label[1025];
     uint32_t outer, total;
+    mc_quality quality;
 } mc_job_info;
 
 typedef struct mc_job_result {

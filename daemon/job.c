@@ -176,6 +176,69 @@ int job_progress_take(mcd *d, uint64_t id, proto_buf *in)
     return n;
 }
 
+/* A terminal state into the store, then END to the watchers; kept and
+ * retried while the store refuses it. */
+static void record_end(mcd *d, uint64_t id, int state, const char *reason)
+{
+    if (store_set_state(d->store, id, state, reason) == 0) {
+        tell_ended(d, id);
+        return;
+    }
+    unrecorded *u = J.open ? calloc(1, sizeof *u) : NULL;
+    if (!u) {
+        dlog(DLOG_ERROR, "job %llu: cannot record its end%s: the next start recovers it", (unsigned long long)id,
+             J.open ? ", and out of memory to retry" : " (shutting down)");
+        return;
+    }
+    u->id = id;
+    u->state = state;
+    snprintf(u->reason, sizeof u->reason, "%s", reason);
+    unrecorded **pu = &J.ends;
+    while (*pu)
+        pu = &(*pu)->next;
+    *pu = u;
+    dlog(DLOG_ERROR, "job %llu: cannot record its end (%s): retried every %d ms; it reads RUNNING until then",
+         (unsigned long long)id, proto_state_name(state), JOB_RECORD_RETRY_MS);
+    if (!uv_is_active((uv_handle_t *)&J.timer))
+        uv_timer_start(&J.timer, on_retry, JOB_RECORD_RETRY_MS, JOB_RECORD_RETRY_MS);
+}
+
+/* A COMPLETED end waits for the map's quality, read from result.frame in
+ * the thread pool (it may be megabytes), so that the row says how good the
+ * map is from the moment it says COMPLETED (LIST, STATUS). */
+typedef struct quality_read {
+    uv_work_t work;
+    mcd *d;                       /* loop side only */
+    const store *store;
+    uint64_t id;
+    char reason[PROTO_MAX_STRING + 1];
+    int verdict;
+    double flipped, collapsed;
+} quality_read;
+
+static void quality_run(uv_work_t *w)     /* thread pool */
+{
+    quality_read *q = w->data;
+    proto_msg m;
+    uint8_t *buf;
+    char why[256];
+    if (store_result_read(q->store, q->id, &m, &buf, why, sizeof why) == 0) {
+        store_result_quality(&m, &q->verdict, &q->flipped, &q->collapsed);
+        proto_msg_free(&m);
+        free(buf);
+    }
+}
+
+static void quality_done(uv_work_t *w, int status)    /* loop */
+{
+    (void)status;
+    quality_read *q = w->data;
+    if (q->verdict >= 0 && store_set_quality(q->d->store, q->id, q->verdict, q->flipped, q->collapsed))
+        dlog(DLOG_WARN, "job %llu: cannot record its map's quality", (unsigned long long)q->id);
+    record_end(q->d, q->id, PROTO_STATE_COMPLETED, q->reason);
+    free(q);
+}
+
 void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, const char *reason)
 {
     dlog(DLOG_INFO, "job %llu: %s%s%s", (unsigned long long)id, proto_state_name(state),
@@ -192,27 +255,19 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
                  (unsigned long long)id);
         return;
     }
-    if (store_set_state(d->store, id, state, reason) == 0) {
-        tell_ended(d, id);
-        return;
+    quality_read *q = state == PROTO_STATE_COMPLETED ? calloc(1, sizeof *q) : NULL;
+    if (q) {
+        q->work.data = q;
+        q->d = d;
+        q->store = d->store;
+        q->id = id;
+        q->verdict = -1;
+        snprintf(q->reason, sizeof q->reason, "%s", reason);
+        if (uv_queue_work(d->loop, &q->work, quality_run, quality_done) == 0)
+            return;
+        free(q);
     }
-    unrecorded *u = calloc(1, sizeof *u);
-    if (!u) {
-        dlog(DLOG_ERROR, "job %llu: cannot record its end, and out of memory to retry: the next start"
-             " recovers it", (unsigned long long)id);
-        return;
-    }
-    u->id = id;
-    u->state = state;
-    snprintf(u->reason, sizeof u->reason, "%s", reason);
-    unrecorded **pu = &J.ends;
-    while (*pu)
-        pu = &(*pu)->next;
-    *pu = u;
-    dlog(DLOG_ERROR, "job %llu: cannot record its end (%s): retried every %d ms; it reads RUNNING until then",
-         (unsigned long long)id, proto_state_name(state), JOB_RECORD_RETRY_MS);
-    if (!uv_is_active((uv_handle_t *)&J.timer))
-        uv_timer_start(&J.timer, on_retry, JOB_RECORD_RETRY_MS, JOB_RECORD_RETRY_MS);
+    record_end(d, id, state, reason);
 }
 
 int job_cancel_pending(mcd *d, uint64_t id)

@@ -158,6 +158,8 @@ typedef struct store_job {
     uint32_t outer, total;        /* latest outer iteration, planned */
     char slurm_id[32];            /* Slurm job of the current run; "" none */
     int64_t progress_off;         /* bytes of spool/<id>/progress.frames already taken */
+    int verdict;                  /* the map's quality (metric_verdict), -1 not known */
+    double flipped, collapsed;    /* its fractions of flipped/collapsed faces; NaN not known */
 } store_job;
 typedef int (*store_job_fn)(void *ctx, const store_job *j);          /* non-zero stops */
 typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zero stops */
@@ -194,11 +196,21 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p);
 /* The Slurm job running it ("" none) and how much of progress.frames is read. */
 int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progress_off);
 int store_set_reason(store *s, uint64_t id, const char *reason);
+/* The returned map's quality, from its result.frame's metrics. */
+int store_set_quality(store *s, uint64_t id, int verdict, double flipped, double collapsed);
 /* One more run of job id ended in a worker crash: the count after it. */
 int store_add_crash(store *s, uint64_t id, uint32_t *crashes);
 /* 1 when spool/<id>/result.frame is a whole, valid RESULT_OK frame of job id
  * (CRCs checked); 0 otherwise, with why in why. Reads the whole file. */
 int store_result_ok(store *s, uint64_t id, char *why, size_t wsz);
+/* Any thread (reads the file only): spool/<id>/result.frame read and
+ * decoded into m, which points into *buf (the caller frees both): 0, or
+ * PROTO_EINTERNAL with why (nothing to free). */
+int store_result_read(const store *s, uint64_t id, proto_msg *m, uint8_t **buf, char *why, size_t wsz);
+/* The quality a decoded RESULT_OK's metrics give (the worker's
+ * quality_verdict, flipped_fraction, collapsed_fraction): -1 / NaN when
+ * absent. */
+void store_result_quality(const proto_msg *m, int *verdict, double *flipped, double *collapsed);
 /* Drops a previous run's history and result files before a (re)run. */
 int store_clear_run(store *s, uint64_t id);
 int store_latest_progress(store *s, uint64_t id, proto_progress *out); /* 0 or NOT_FOUND */

@@ -37,7 +37,6 @@
 #include <unistd.h>
 
 #define REQ_LIST_PAGE 1000
-#define REQ_MAX_RESULT_FILE ((size_t)PROTO_MAX_FRAME)
 
 struct req_watch {
     conn *c;                      /* NULL once the connection is gone */
@@ -339,6 +338,11 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     d->submits = w;
 }
 
+static proto_quality quality_of(const store_job *j)
+{
+    return (proto_quality){j->verdict, j->flipped, j->collapsed};
+}
+
 static void on_status(conn *c, const proto_msg *m)
 {
     store_job j;
@@ -358,6 +362,7 @@ static void on_status(conn *c, const proto_msg *m)
     s->start_ms = j.start_ms;
     s->end_ms = j.end_ms;
     s->has_progress = store_latest_progress(srv_conn_daemon(c)->store, j.id, &s->progress) == 0;
+    s->quality = quality_of(&j);
     reply(c, &r, m->request_id);
 }
 
@@ -402,7 +407,7 @@ static void on_list(conn *c, const proto_msg *m)
     for (uint32_t i = 0; i < l.n; i++)
         sum[i] = (proto_job_summary){l.jobs[i].id, (uint8_t)l.jobs[i].state, l.jobs[i].priority,
                                      l.jobs[i].submit_ms, l.jobs[i].user, l.jobs[i].label,
-                                     l.jobs[i].outer, l.jobs[i].total};
+                                     l.jobs[i].outer, l.jobs[i].total, quality_of(&l.jobs[i])};
     proto_msg r;
     memset(&r, 0, sizeof r);
     r.type = PROTO_MSG_LIST_OK;
@@ -542,8 +547,8 @@ typedef struct req_result {
     uint32_t request_id;
     uint64_t job_id;
     uint32_t what;                /* PROTO_WANT_* */
-    char path[CONF_PATH + 64];    /* spool/<id>/result.frame */
-    uint8_t *buf;                 /* its bytes; res may point into them */
+    const store *store;           /* store_result_read only (a file read) */
+    uint8_t *buf;                 /* result.frame's bytes; res may point into them */
     proto_msg res;                /* the decoded RESULT_OK when rc is 0 */
     int rc;
     char err[256];
@@ -552,36 +557,7 @@ typedef struct req_result {
 static void result_run(uv_work_t *w)      /* thread pool */
 {
     req_result *r = w->data;
-    r->rc = PROTO_EINTERNAL;
-    FILE *fp = fopen(r->path, "rb");
-    if (!fp) {
-        snprintf(r->err, sizeof r->err, "%s", strerror(errno));
-        return;
-    }
-    size_t n = 0;
-    long sz = -1;
-    if (fseek(fp, 0, SEEK_END) == 0 && (sz = ftell(fp)) > 0 && (size_t)sz <= REQ_MAX_RESULT_FILE &&
-        fseek(fp, 0, SEEK_SET) == 0 && (r->buf = malloc((size_t)sz)))
-        n = fread(r->buf, 1, (size_t)sz, fp);
-    fclose(fp);
-    if (!r->buf) {
-        snprintf(r->err, sizeof r->err, "%s",
-                 sz <= 0 ? "empty or unreadable" : (size_t)sz > REQ_MAX_RESULT_FILE ? "too large" : "out of memory");
-        return;
-    }
-    size_t used;
-    int rc = proto_decode(r->buf, n, PROTO_MAX_FRAME, &r->res, &used, r->err, sizeof r->err);
-    if (rc != PROTO_READY) {
-        if (rc >= 0)
-            snprintf(r->err, sizeof r->err, "truncated (%zu bytes)", n);
-        return;
-    }
-    if (r->res.type != PROTO_MSG_RESULT_OK) {
-        snprintf(r->err, sizeof r->err, "a %s frame, not RESULT_OK", proto_type_name(r->res.type));
-        proto_msg_free(&r->res);
-        return;
-    }
-    r->rc = 0;
+    r->rc = store_result_read(r->store, r->job_id, &r->res, &r->buf, r->err, sizeof r->err);
 }
 
 static void result_done(uv_work_t *w, int status)    /* loop */
@@ -649,7 +625,7 @@ static void on_result(conn *c, const proto_msg *m)
     r->request_id = m->request_id;
     r->job_id = j.id;
     r->what = q->what;
-    store_spool_path(d->store, j.id, SPOOL_RESULT_FRAME, r->path, sizeof r->path);
+    r->store = d->store;
     int rc = work_start(d, c, &r->work, result_run, result_done);
     if (rc) {
         dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)j.id,

@@ -43,6 +43,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -109,7 +110,9 @@ static const char schema[] =
     " pid INTEGER NOT NULL DEFAULT 0,"     /* worker of the current run */
     " slurm_id TEXT NOT NULL DEFAULT '',"  /* Slurm job of the current run ('' none) */
     " progress_off INTEGER NOT NULL DEFAULT 0," /* bytes of progress.frames taken */
-    " crashes INTEGER NOT NULL DEFAULT 0);" /* runs whose worker crashed */
+    " crashes INTEGER NOT NULL DEFAULT 0," /* runs whose worker crashed */
+    " verdict INTEGER NOT NULL DEFAULT -1," /* the map's quality_verdict; -1 not known */
+    " flipped REAL, collapsed REAL);"     /* its flipped and collapsed fractions */
     "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
     "CREATE TABLE IF NOT EXISTS history("
     " job INTEGER NOT NULL, stage INTEGER NOT NULL, outer_it INTEGER NOT NULL,"
@@ -123,7 +126,7 @@ static const char schema[] =
 #define HISTORY_COLS "stage, outer_it, total, inner0, inner1, membrane0, bending0, mismatch0," \
     " reverse0, energy0, membrane1, bending1, mismatch1, reverse1, energy1, beta, gamma, elapsed_s"
 #define JOB_COLS "id, user, label, priority, state, reason, submit_ms, start_ms, end_ms, outer_it, total," \
-    " slurm_id, progress_off"
+    " slurm_id, progress_off, verdict, flipped, collapsed"
 
 int64_t store_now_ms(void)
 {
@@ -273,6 +276,10 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
      * only says the column exists) */
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN slurm_id TEXT NOT NULL DEFAULT ''", NULL, NULL, NULL);
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN progress_off INTEGER NOT NULL DEFAULT 0", NULL, NULL, NULL);
+    /* and those from before the map quality */
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN verdict INTEGER NOT NULL DEFAULT -1", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN flipped REAL", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN collapsed REAL", NULL, NULL, NULL);
     /* a jobs.db from before the crash count gains the column */
     sqlite3_stmt *probe;
     if (sqlite3_prepare_v2(s->db, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, NULL) == SQLITE_OK) {
@@ -360,11 +367,20 @@ static int adopt_results(store *s, int *adopted, char *err, size_t errsz)
     sqlite3_finalize(st);
     for (size_t i = 0; i < n; i++) {
         char why[256];
-        if (!store_result_ok(s, ids[i], why, sizeof why)) {
+        proto_msg m;
+        uint8_t *buf;
+        if (store_result_read(s, ids[i], &m, &buf, why, sizeof why)) {
             dlog(DLOG_WARN, "store: job %llu: result.frame left by a worker is not usable (%s): runs again",
                  (unsigned long long)ids[i], why);
             continue;
         }
+        int verdict;
+        double flipped, collapsed;
+        store_result_quality(&m, &verdict, &flipped, &collapsed);
+        proto_msg_free(&m);
+        free(buf);
+        if (verdict >= 0)
+            store_set_quality(s, ids[i], verdict, flipped, collapsed);
         if (store_set_state(s, ids[i], PROTO_STATE_COMPLETED, "finished while the daemon was down: result adopted")) {
             free(ids);
             return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot record job %llu's adopted result",
@@ -558,6 +574,9 @@ static void read_job(sqlite3_stmt *st, store_job *j)
     j->total = (uint32_t)sqlite3_column_int64(st, 10);
     snprintf(j->slurm_id, sizeof j->slurm_id, "%s", (const char *)sqlite3_column_text(st, 11));
     j->progress_off = sqlite3_column_int64(st, 12);
+    j->verdict = (int)sqlite3_column_int64(st, 13);
+    j->flipped = sqlite3_column_type(st, 14) == SQLITE_NULL ? NAN : sqlite3_column_double(st, 14);
+    j->collapsed = sqlite3_column_type(st, 15) == SQLITE_NULL ? NAN : sqlite3_column_double(st, 15);
 }
 
 int store_get(store *s, uint64_t id, store_job *out)
@@ -583,6 +602,12 @@ int store_set_slurm(store *s, uint64_t id, const char *slurm_id, int64_t progres
 {
     return exec_v(s->db, "UPDATE jobs SET slurm_id = ?, progress_off = ? WHERE id = ?", "tii", slurm_id,
                   progress_off, (int64_t)id);
+}
+
+int store_set_quality(store *s, uint64_t id, int verdict, double flipped, double collapsed)
+{
+    return exec_v(s->db, "UPDATE jobs SET verdict = ?, flipped = ?, collapsed = ? WHERE id = ?", "iddi",
+                  (int64_t)verdict, flipped, collapsed, (int64_t)id);
 }
 
 int store_set_reason(store *s, uint64_t id, const char *reason)
@@ -681,12 +706,13 @@ int store_clear_run(store *s, uint64_t id)
     return exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
 }
 
-int store_result_ok(store *s, uint64_t id, char *why, size_t wsz)
+int store_result_read(const store *s, uint64_t id, proto_msg *m, uint8_t **bufp, char *why, size_t wsz)
 {
     char path[CONF_PATH + 64];
+    *bufp = NULL;
     FILE *fp = fopen(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), "rb");
     if (!fp)
-        return errbuf_set(why, wsz, 0, "%s", strerror(errno)), 0;
+        return errbuf_set(why, wsz, PROTO_EINTERNAL, "%s", strerror(errno));
     uint8_t *buf = NULL;
     long sz = -1;
     size_t n = 0;
@@ -695,25 +721,56 @@ int store_result_ok(store *s, uint64_t id, char *why, size_t wsz)
         n = fread(buf, 1, (size_t)sz, fp);
     fclose(fp);
     if (!buf)
-        return errbuf_set(why, wsz, 0, "%s", sz <= 0 ? "empty or unreadable" : "too large or out of memory"), 0;
-    proto_msg m;
+        return errbuf_set(why, wsz, PROTO_EINTERNAL, "%s",
+                          sz <= 0 ? "empty or unreadable" : "too large or out of memory");
     size_t used = 0;
-    int ok = 0, rc = proto_decode(buf, n, PROTO_MAX_FRAME, &m, &used, why, wsz);
+    int rc = proto_decode(buf, n, PROTO_MAX_FRAME, m, &used, why, wsz);
     if (rc == PROTO_READY) {
-        if (m.type != PROTO_MSG_RESULT_OK)
-            errbuf_set(why, wsz, 0, "a %s frame, not RESULT_OK", proto_type_name(m.type));
-        else if (m.u.result_ok.job_id != id)
-            errbuf_set(why, wsz, 0, "the result of job %llu", (unsigned long long)m.u.result_ok.job_id);
+        if (m->type != PROTO_MSG_RESULT_OK)
+            rc = errbuf_set(why, wsz, PROTO_EINTERNAL, "a %s frame, not RESULT_OK", proto_type_name(m->type));
+        else if (m->u.result_ok.job_id != id)
+            rc = errbuf_set(why, wsz, PROTO_EINTERNAL, "the result of job %llu",
+                            (unsigned long long)m->u.result_ok.job_id);
         else if (used != n)
-            errbuf_set(why, wsz, 0, "%zu bytes after the frame", n - used);
-        else
-            ok = 1;
-        proto_msg_free(&m);
+            rc = errbuf_set(why, wsz, PROTO_EINTERNAL, "%zu bytes after the frame", n - used);
+        else {
+            *bufp = buf;
+            return 0;
+        }
+        proto_msg_free(m);
     } else if (rc > 0) {
         errbuf_set(why, wsz, 0, "truncated (%zu bytes)", n);
     }
     free(buf);
-    return ok;
+    return PROTO_EINTERNAL;
+}
+
+int store_result_ok(store *s, uint64_t id, char *why, size_t wsz)
+{
+    proto_msg m;
+    uint8_t *buf;
+    if (store_result_read(s, id, &m, &buf, why, wsz))
+        return 0;
+    proto_msg_free(&m);
+    free(buf);
+    return 1;
+}
+
+void store_result_quality(const proto_msg *m, int *verdict, double *flipped, double *collapsed)
+{
+    *verdict = -1;
+    *flipped = *collapsed = NAN;
+    const proto_result_ok *r = &m->u.result_ok;
+    for (uint32_t i = 0; i < r->nmetrics; i++) {
+        const char *k = r->metrics[i].key;
+        double v = r->metrics[i].value;
+        if (!strcmp(k, "quality_verdict") && v >= 0 && v < 100)
+            *verdict = (int)v;
+        else if (!strcmp(k, "flipped_fraction"))
+            *flipped = v;
+        else if (!strcmp(k, "collapsed_fraction"))
+            *collapsed = v;
+    }
 }
 
 static void read_progress(sqlite3_stmt *st, uint64_t id, proto_progress *p)

@@ -300,6 +300,10 @@ typedef struct proto_progress {
     double beta, gamma, elapsed_s;
 } proto_progress;
 
+/* How good a COMPLETED job's map is (the worker's metrics, RESULT_OK):
+ * verdict 0 ok, 1 folded, 2 orientation reversed, -1 not known (not
+ * completed, or a result without them); the fractions NaN when not known. */
+typedef struct proto_quality { int32_t verdict; double flipped, collapsed; } proto_quality;
 typedef struct proto_job_summary {
     uint64_t job_id;
     uint8_t state;
@@ -307,6 +311,7 @@ typedef struct proto_job_summary {
     int64_t submit_ms;                /* Unix time in milliseconds */
     const char *user, *label;
     uint32_t outer, total;
+    proto_quality quality;
 } proto_job_summary;
 
 typedef struct proto_metric { const char *key; double value; } proto_metric;
@@ -331,6 +336,7 @@ typedef struct proto_status_ok {
     const char *user, *label, *reason;
     int64_t submit_ms, start_ms, end_ms;  /* 0 = not yet */
     uint8_t has_progress; proto_progress progress;
+    proto_quality quality;
 } proto_status_ok;
 typedef struct proto_list {
     uint32_t state_mask;              /* bit s = state s; 0 = every state */

@@ -326,6 +326,15 @@ static void io_progress(io *c, proto_progress *g)
 #define IO_PARAM_U32(c, f, name, max)  io_u32(c, f)
 #define IO_PARAM_F64(c, f, name, max)  io_f64(c, f)
 #define IO_PARAM_STR(c, f, name, max)  io_str(c, f, name)
+static void io_quality(io *c, proto_quality *q)
+{
+    io_i32(c, &q->verdict);
+    if (!c->err && (q->verdict < -1 || q->verdict > 2))
+        io_fail(c, PROTO_EBAD_FRAME, "quality verdict %d is not in [-1, 2]", (int)q->verdict);
+    io_f64(c, &q->flipped);
+    io_f64(c, &q->collapsed);
+}
+
 static void io_params(io *c, proto_params *p)
 {
 #define IO_PARAM(name, cli, type, dflt, lo, hi, ...) IO_PARAM_##type(c, &p->name, #name, hi);
@@ -334,7 +343,7 @@ static void io_params(io *c, proto_params *p)
 }
 
 /* Smallest wire sizes of list elements (strings empty), for io_count. */
-#define SUMMARY_MIN (8 + 1 + 4 + 8 + 5 + 5 + 4 + 4)
+#define SUMMARY_MIN (8 + 1 + 4 + 8 + 5 + 5 + 4 + 4 + 20)
 #define METRIC_MIN  (5 + 8)
 #define SLOT_MIN    (8 + 1)
 #define DEVICE_MIN  5
@@ -394,6 +403,7 @@ static void io_payload(io *c, proto_msg *m)
         io_enum(c, &s->has_progress, 1, "has_progress");
         if (s->has_progress)
             io_progress(c, &s->progress);
+        io_quality(c, &s->quality);
         break;
     }
     case PROTO_MSG_LIST: {
@@ -421,6 +431,7 @@ static void io_payload(io *c, proto_msg *m)
             io_str(c, &j->label, "label");
             io_u32(c, &j->outer);
             io_u32(c, &j->total);
+            io_quality(c, &j->quality);
         }
         break;
     }

@@ -14,6 +14,7 @@
 #include "meshcorr.h"
 
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -143,6 +144,14 @@ static void print_progress_text(const mc_progress *p)
            "beta %.2e %.1f s\n", (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total,
            p->energy[0] + p->energy[1], p->membrane[0] + p->membrane[1], p->bending[0] + p->bending[1],
            p->mismatch[0] + p->mismatch[1], p->reverse[0] + p->reverse[1], p->beta, p->elapsed_s);
+}
+
+/* ,"quality":..,"flipped":..,"collapsed":.. of a job (null when not known). */
+static void print_quality_json(const mc_quality *q)
+{
+    printf(",\"quality\":\"%s\",\"quality_verdict\":%d", mc_quality_name(q->verdict), q->verdict);
+    printf(isfinite(q->flipped) ? ",\"flipped\":%.9g" : ",\"flipped\":null", q->flipped);
+    printf(isfinite(q->collapsed) ? ",\"collapsed\":%.9g" : ",\"collapsed\":null", q->collapsed);
 }
 
 static void print_progress_json(const mc_progress *p)
@@ -436,6 +445,9 @@ int cli_status(int argc, char **argv)
     if (s.has_progress)
         printf("progress  %u/%u, energy %.10g, %.1f s\n", s.progress.outer, s.progress.total,
                s.progress.energy[0] + s.progress.energy[1], s.progress.elapsed_s);
+    if (s.quality.verdict != MC_QUALITY_UNKNOWN)
+        printf("quality   %s: %.2f %% flipped, %.2f %% collapsed\n", mc_quality_name(s.quality.verdict),
+               100 * s.quality.flipped, 100 * s.quality.collapsed);
     mc_close(c);
     return 0;
 }
@@ -643,6 +655,7 @@ int cli_list(int argc, char **argv)
             printf(",\"priority\":%d,\"submit_ms\":%lld,\"outer\":%u,\"total\":%u,\"label\":", jobs[i].priority,
                    (long long)jobs[i].submit_ms, jobs[i].outer, jobs[i].total);
             json_str(jobs[i].label);
+            print_quality_json(&jobs[i].quality);
             printf("}");
         }
         printf("]\n");
@@ -650,12 +663,14 @@ int cli_list(int argc, char **argv)
         mc_close(cl);
         return 0;
     }
-    printf("%-8s %-13s %-10s %4s %11s  %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "LABEL");
+    printf("%-8s %-13s %-10s %4s %11s %-8s  %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "QUALITY", "LABEL");
     for (uint32_t i = 0; i < n; i++) {
         char it[32];
         snprintf(it, sizeof it, "%u/%u", jobs[i].outer, jobs[i].total);
-        printf("%-8llu %-13s %-10s %4d %11s  %s\n", (unsigned long long)jobs[i].job_id,
-               mc_state_name(jobs[i].state), jobs[i].user, jobs[i].priority, it, jobs[i].label);
+        int v = jobs[i].quality.verdict;
+        printf("%-8llu %-13s %-10s %4d %11s %-8s  %s\n", (unsigned long long)jobs[i].job_id,
+               mc_state_name(jobs[i].state), jobs[i].user, jobs[i].priority, it,
+               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), jobs[i].label);
     }
     free(jobs);
     mc_close(cl);

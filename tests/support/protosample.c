@@ -119,6 +119,7 @@ void protosample_fill(int type, int v, proto_msg *m)
         u->has_progress = (uint8_t)!v;
         if (!v)
             fill_progress(&u->progress, v);
+        u->quality = v ? (proto_quality){-1, NAN, NAN} : (proto_quality){1, 0.0625, 1e-3};
         break;
     }
     case PROTO_MSG_LIST:
@@ -129,7 +130,7 @@ void protosample_fill(int type, int v, proto_msg *m)
         for (int i = 0; i < 5; i++)
             jobs[i] = (proto_job_summary){ 100u + (uint64_t)i, (uint8_t)(i % 7), i - 2,
                                            1700000000000 + i, i ? "carol" : max_string(), i == 3 ? "" : "run",
-                                           (uint32_t)i, 40 };
+                                           (uint32_t)i, 40, {i % 4 - 1, i ? 0.25 * i : NAN, 1e-4 * i} };
         m->u.list_ok = (proto_list_ok){ v ? NULL : jobs, v ? 0 : 5 };
         break;
     case PROTO_MSG_WATCH:
@@ -189,6 +190,13 @@ void protosample_fill(int type, int v, proto_msg *m)
 }
 
 #define DIFF(cond, name) do { if (cond) return name; } while (0)
+
+/* Bit for bit (NaN equals NaN). */
+static int quality_ne(const proto_quality *a, const proto_quality *b)
+{
+    return a->verdict != b->verdict || memcmp(&a->flipped, &b->flipped, sizeof a->flipped) ||
+           memcmp(&a->collapsed, &b->collapsed, sizeof a->collapsed);
+}
 
 static int str_ne(const char *a, const char *b)
 {
@@ -270,6 +278,7 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
         DIFF(x->submit_ms != y->submit_ms || x->start_ms != y->start_ms || x->end_ms != y->end_ms,
              "status_ok times");
         DIFF(x->has_progress != y->has_progress, "status_ok.has_progress");
+        DIFF(quality_ne(&x->quality, &y->quality), "status_ok.quality");
         return x->has_progress ? progress_diff(&x->progress, &y->progress) : NULL;
     }
     case PROTO_MSG_LIST: {
@@ -287,6 +296,7 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
                  x->submit_ms != y->submit_ms || x->outer != y->outer || x->total != y->total,
                  "list_ok job numbers");
             DIFF(str_ne(x->user, y->user) || str_ne(x->label, y->label), "list_ok job strings");
+            DIFF(quality_ne(&x->quality, &y->quality), "list_ok job quality");
         }
         return NULL;
     case PROTO_MSG_WATCH:

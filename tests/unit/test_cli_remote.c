@@ -191,6 +191,14 @@ TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
     CHECK_STR_HAS(out, want);
     CHECK_STR_HAS(out, "\"outer\":4,\"total\":4");
     CHECK_STR_HAS(out, "\"label\":\"a \\\"quoted\\\" label\"");
+    /* the map's quality: this small pair maps cleanly */
+    CHECK_STR_HAS(out, ",\"quality\":\"ok\",\"quality_verdict\":0,\"flipped\":");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr status %llu --server %s", (unsigned long long)id,
+                       d.unix_addr), 0);
+    CHECK_STR_HAS(out, "\nquality   ok: ");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s", d.unix_addr), 0);
+    CHECK_STR_HAS(out, " QUALITY ");
+    CHECK_STR_HAS(out, " ok ");
 
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr stats --json --server %s", d.unix_addr), 0);
     if (!testjson_valid(out))

@@ -100,6 +100,25 @@ TEST_T(submitted_job_streams_energies_and_completes, 60)
            100 * q[2], 100 * q[1], 100 * q[3], q[4]);
     int vp = metric_verdict(q[0], q[1]), vq = metric_verdict(q[2], q[3]);
     CHECK_INT(q[4], vp > vq ? vp : vq);
+    /* the job's row says the same from the moment it reads COMPLETED:
+     * STATUS and LIST carry the verdict and the source map's fractions */
+    mc_job_status st;
+    CHECK_INT(mc_status(c, id, &st), 0);
+    CHECK_INT(st.quality.verdict, (int)q[4]);
+    CHECK(st.quality.flipped == q[0] && st.quality.collapsed == q[1]);
+    mc_job_info *jobs;
+    uint32_t nj;
+    CHECK_INT(mc_list(c, NULL, 0, &jobs, &nj), 0);
+    CHECK_INT(nj, 1);
+    CHECK_INT(jobs[0].quality.verdict, (int)q[4]);
+    CHECK(jobs[0].quality.flipped == q[0] && jobs[0].quality.collapsed == q[1]);
+    free(jobs);
+    /* a job that has not completed has no quality yet */
+    uint64_t pending = testdaemon_submit_ok(c, 100000, 0, 0);
+    CHECK_INT(mc_status(c, pending, &st), 0);
+    CHECK_INT(st.quality.verdict, MC_QUALITY_UNKNOWN);
+    CHECK(isnan(st.quality.flipped));
+    CHECK_INT(mc_cancel(c, pending), 0);
     mc_result_free(&r);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
