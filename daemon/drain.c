@@ -12,6 +12,8 @@
  * check does nothing before then, or twice. */
 #include "backend.h"
 
+#include <signal.h>
+
 static void check(mcd *d)
 {
     if (!d->draining || d->drained || bk_busy(d) || d->work_inflight)
@@ -24,6 +26,11 @@ static void check(mcd *d)
     snap_close(d);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
     uv_close((uv_handle_t *)&d->sigint, NULL);
+    /* closing them put back the default action: another SIGTERM now (an
+     * impatient service manager) must not kill a daemon that is already
+     * closing cleanly; no process is started after this point */
+    signal(SIGTERM, SIG_IGN);
+    signal(SIGINT, SIG_IGN);
     reload_close(d);
     notify_close(d);
 }
