@@ -5,7 +5,8 @@
 #   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
 #   make demo       install deps, build, run the demo job on Debian's CGAL meshes
 #   make install    PREFIX=/usr/local DESTDIR=
-#   make doc-params PROTOCOL.md's parameter table from protocol/proto_params.h
+#   make doc-params PROTOCOL.md's parameter table and meshcorr(1)'s list from
+#                   protocol/proto_params.h
 PREFIX  ?= /usr/local
 DESTDIR ?=
 BUILD   ?= build
@@ -69,7 +70,7 @@ WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
 
-.PHONY: all test bench demo install install-lib clean doc-params
+.PHONY: all test bench demo install install-lib install-man clean doc-params
 # Objects built through pattern chains are kept (make would otherwise delete
 # them after the run and print that as the last line of `make test`).
 .SECONDARY:
@@ -146,6 +147,10 @@ doc-params: $(BUILD)/meshcorr
 	awk -v t=$(BUILD)/params.md '/<!-- params:end/ { while ((getline l < t) > 0) print l; skip = 0 } \
 	  !skip { print } /<!-- params:begin/ { skip = 1 }' protocol/PROTOCOL.md > $(BUILD)/PROTOCOL.md.tmp
 	mv $(BUILD)/PROTOCOL.md.tmp protocol/PROTOCOL.md
+	$(BUILD)/meshcorr params --mdoc > $(BUILD)/params.mdoc
+	awk -v t=$(BUILD)/params.mdoc '/^\.\\" params:end/ { while ((getline l < t) > 0) print l; skip = 0 } \
+	  !skip { print } /^\.\\" params:begin/ { skip = 1 }' deploy/man/meshcorr.1 > $(BUILD)/meshcorr.1.tmp
+	mv $(BUILD)/meshcorr.1.tmp deploy/man/meshcorr.1
 
 demo:
 	sh deploy/install-deps.sh
@@ -158,6 +163,13 @@ install: $(PROGRAMS)
 	sed 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	test -e $(DESTDIR)/etc/meshcorr/meshcorrd.conf || install -m 644 deploy/meshcorrd.conf $(DESTDIR)/etc/meshcorr/meshcorrd.conf
+
+# The man pages (deploy/man/NAME.SECTION), each into its section's folder.
+MAN_PAGES := $(wildcard deploy/man/*.[1-8])
+install: install-man
+install-man:
+	set -e; for p in $(MAN_PAGES); do d=$(DESTDIR)$(PREFIX)/share/man/man$${p##*.}; \
+	  install -d $$d; install -m 644 $$p $$d/; done
 
 # libmeshcorr: header, static and shared libraries, pkg-config file (the
 # engine and codec archives too: static users link them, see Libs.private).

@@ -3,10 +3,15 @@
  * thread. Other paths are 404, other methods 405. Each request formats the
  * latest published snapshot (snap_read); nothing here touches the daemon's
  * state. MHD bounds what a client can hold: MHD_OPTION_CONNECTION_LIMIT
- * connections, each closed after MHD_OPTION_CONNECTION_TIMEOUT idle seconds. */
+ * connections, each closed after MHD_OPTION_CONNECTION_TIMEOUT idle seconds.
+ * Names follow Prometheus' conventions (tests/support/promcheck.py checks
+ * them with Prometheus' own parser): counters end in _total, times are
+ * _seconds, every family has HELP and TYPE, and a slot's job is the label
+ * job_id (Prometheus itself puts `job`, the scrape job, on every series). */
 #include "mcd.h"
 #include "util/errbuf.h"
 
+#include <math.h>
 #include <microhttpd.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +31,18 @@ struct metrics {
 static void family(FILE *fp, const char *name, const char *type, const char *help)
 {
     fprintf(fp, "# HELP %s %s\n# TYPE %s %s\n", name, help, name, type);
+}
+
+/* v as the text format spells it: NaN, +Inf and -Inf (printf's nan and inf
+ * are not), else %.17g; then the line's end. */
+static void value(FILE *fp, double v)
+{
+    if (isnan(v))
+        fputs("NaN\n", fp);
+    else if (isinf(v))
+        fputs(v > 0 ? "+Inf\n" : "-Inf\n", fp);
+    else
+        fprintf(fp, "%.17g\n", v);
 }
 
 /* Per-slot gauges: field selects which figure; slots without progress are
@@ -50,7 +67,8 @@ static void slot_family(FILE *fp, const mcd_snapshot *s, const char *name, const
         case F_ELAPSED:  v = o->elapsed_s; break;
         case F_PROGRESS: v = o->total ? (double)(o->outer < o->total ? o->outer : o->total) / o->total : 0; break;
         }
-        fprintf(fp, "%s{slot=\"%u\",job=\"%llu\"} %.17g\n", name, i, (unsigned long long)o->job_id, v);
+        fprintf(fp, "%s{slot=\"%u\",job_id=\"%llu\"} ", name, i, (unsigned long long)o->job_id);
+        value(fp, v);
     }
 }
 
@@ -70,7 +88,7 @@ static void format(FILE *fp, const mcd_snapshot *s)
     fprintf(fp, "meshcorr_uptime_seconds %u\n", s->uptime_s);
     family(fp, "meshcorr_snapshots_total", "counter", "Status snapshots published (one every 200 ms).");
     fprintf(fp, "meshcorr_snapshots_total %u\n", s->seq);
-    slot_family(fp, s, "meshcorr_slot_state", "Worker slot state: 0 idle, 1 starting, 2 busy, 3 draining (job 0: none).", F_STATE);
+    slot_family(fp, s, "meshcorr_slot_state", "Worker slot state: 0 idle, 1 starting, 2 busy, 3 draining (job_id 0: none).", F_STATE);
     slot_family(fp, s, "meshcorr_slot_elapsed_seconds", "Wall time since the slot's job started.", F_ELAPSED);
     slot_family(fp, s, "meshcorr_slot_stage", "Stage of the latest progress: 0 start, 1 rhm, 2 ectm, 3 init.", F_STAGE);
     slot_family(fp, s, "meshcorr_slot_outer_iteration", "Outer iteration of the latest progress.", F_OUTER);

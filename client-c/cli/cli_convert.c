@@ -6,11 +6,16 @@
 #include "mesh/mesh_check.h"
 
 #include <stdio.h>
+#include <string.h>
 
 int cli_convert(int argc, char **argv)
 {
+    if (argc == 2 && strcmp(argv[1], "--help") == 0) {
+        fputs("usage: meshcorr convert IN OUT\n", stdout);
+        return 0;
+    }
     if (argc != 3) {
-        fprintf(stderr, "usage: meshcorr convert IN OUT\n");
+        fputs("usage: meshcorr convert IN OUT\n", stderr);
         return 2;
     }
     char err[1024];

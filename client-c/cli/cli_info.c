@@ -6,11 +6,16 @@
 #include "mesh/mesh_check.h"
 
 #include <stdio.h>
+#include <string.h>
 
 int cli_info(int argc, char **argv)
 {
+    if (argc == 2 && strcmp(argv[1], "--help") == 0) {
+        fputs("usage: meshcorr info MESH\n", stdout);
+        return 0;
+    }
     if (argc != 2) {
-        fprintf(stderr, "usage: meshcorr info MESH\n");
+        fputs("usage: meshcorr info MESH\n", stderr);
         return 2;
     }
     const char *path = argv[1];

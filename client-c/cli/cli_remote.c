@@ -396,12 +396,14 @@ static void print_time(const char *what, int64_t ms)
     printf("%-9s %s\n", what, buf);
 }
 
-/* Parses [--server A] [--token T] [extra...] ID for the one-id commands. */
-static int one_id(const char *cmd, int argc, char **argv, remote *r, uint64_t *id,
+/* Parses [--server A] [--token T] [extra...] ID for the one-id commands:
+ * 0 parsed; 1 --help (usage printed on stdout: exit 0); -1 bad usage
+ * (usage printed on stderr after the message: exit 2). */
+static int one_id(const char *cmd, const char *usage, int argc, char **argv, remote *r, uint64_t *id,
                   const struct option *extra, void (*on_extra)(int, void *), void *ctx)
 {
-    struct option opts[16] = {REMOTE_OPTS};
-    int n = REMOTE_NOPTS;
+    struct option opts[16] = {REMOTE_OPTS, {"help", no_argument, 0, 'h'}};
+    int n = REMOTE_NOPTS + 1;
     for (int i = 0; extra && extra[i].name && n < 15; i++)
         opts[n++] = extra[i];
     memset(&opts[n], 0, sizeof opts[n]);
@@ -411,23 +413,32 @@ static int one_id(const char *cmd, int argc, char **argv, remote *r, uint64_t *i
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         if (remote_opt(r, c))
             continue;
+        if (c == 'h') {
+            fputs(usage, stdout);
+            return 1;
+        }
         if (c == '?' || !on_extra)
-            return -1;
+            goto bad;
         on_extra(c, ctx);
     }
     if (argc - optind != 1) {
         fprintf(stderr, "meshcorr %s: need one job id\n", cmd);
-        return -1;
+        goto bad;
     }
-    return parse_id(cmd, argv[optind], id);
+    if (parse_id(cmd, argv[optind], id) == 0)
+        return 0;
+bad:
+    fputs(usage, stderr);
+    return -1;
 }
 
 int cli_status(int argc, char **argv)
 {
     remote r;
     uint64_t id;
-    if (one_id("status", argc, argv, &r, &id, NULL, NULL, NULL))
-        return 2;
+    int u = one_id("status", "usage: meshcorr status ID\n" REMOTE_USAGE, argc, argv, &r, &id, NULL, NULL, NULL);
+    if (u)
+        return u > 0 ? 0 : 2;
     mc_client *c = remote_connect("status", &r);
     if (!c)
         return 1;
@@ -459,10 +470,15 @@ int cli_watch(int argc, char **argv)
     remote r;
     uint64_t id;
     watch_opts w = {0, 0, 0};
-    if (one_id("watch", argc, argv, &r, &id, extra, watch_opt, &w) || w.bad || w.from < 0) {
-        fprintf(stderr, "usage: meshcorr watch ID [--from K] [--progress text|json]\n" REMOTE_USAGE
-                        "one line per iteration, each term summed over both directions;\n"
-                        "exit 0 when the job COMPLETED, 1 otherwise\n");
+    static const char usage[] = "usage: meshcorr watch ID [--from K] [--progress text|json]\n" REMOTE_USAGE
+                                "one line per iteration, each term summed over both directions;\n"
+                                "exit 0 when the job COMPLETED, 1 otherwise\n";
+    int u = one_id("watch", usage, argc, argv, &r, &id, extra, watch_opt, &w);
+    if (u > 0)
+        return 0;
+    if (u < 0 || w.bad || w.from < 0) {
+        if (!u)
+            fputs(usage, stderr);
         return 2;
     }
     mc_client *c = remote_connect("watch", &r);
@@ -509,9 +525,15 @@ int cli_result(int argc, char **argv)
     remote r;
     uint64_t id;
     result_opts o = {0};
-    if (one_id("result", argc, argv, &r, &id, extra, result_opt, &o) || (!o.out && !o.out_rev && !o.out_def)) {
-        fprintf(stderr, "usage: meshcorr result ID --out P.map [--out-reverse Q.map] [--out-deformed Y.ply]\n"
-                        "         [--target MESH (injective jobs: the target's vertex count for P.map)]\n");
+    static const char usage[] = "usage: meshcorr result ID --out P.map [--out-reverse Q.map] [--out-deformed Y.ply]\n"
+                                "         [--target MESH (injective jobs: the target's vertex count for P.map)]\n"
+                                REMOTE_USAGE;
+    int u = one_id("result", usage, argc, argv, &r, &id, extra, result_opt, &o);
+    if (u > 0)
+        return 0;
+    if (u < 0 || (!o.out && !o.out_rev && !o.out_def)) {
+        if (!u)
+            fputs(usage, stderr);
         return 2;
     }
     mc_client *c = remote_connect("result", &r);
@@ -586,12 +608,14 @@ done:
     return status;
 }
 
-static int simple(const char *cmd, int argc, char **argv, int (*fn)(mc_client *, uint64_t), const char *done)
+static int simple(const char *cmd, const char *usage, int argc, char **argv, int (*fn)(mc_client *, uint64_t),
+                  const char *done)
 {
     remote r;
     uint64_t id;
-    if (one_id(cmd, argc, argv, &r, &id, NULL, NULL, NULL))
-        return 2;
+    int u = one_id(cmd, usage, argc, argv, &r, &id, NULL, NULL, NULL);
+    if (u)
+        return u > 0 ? 0 : 2;
     mc_client *c = remote_connect(cmd, &r);
     if (!c)
         return 1;
@@ -603,14 +627,23 @@ static int simple(const char *cmd, int argc, char **argv, int (*fn)(mc_client *,
     return 0;
 }
 
-int cli_cancel(int argc, char **argv) { return simple("cancel", argc, argv, mc_cancel, "cancelled"); }
-int cli_delete(int argc, char **argv) { return simple("delete", argc, argv, mc_delete, "deleted"); }
+int cli_cancel(int argc, char **argv)
+{
+    return simple("cancel", "usage: meshcorr cancel ID\n" REMOTE_USAGE, argc, argv, mc_cancel, "cancelled");
+}
+
+int cli_delete(int argc, char **argv)
+{
+    return simple("delete", "usage: meshcorr delete ID\n" REMOTE_USAGE, argc, argv, mc_delete, "deleted");
+}
 
 int cli_list(int argc, char **argv)
 {
     static const struct option opts[] = {REMOTE_OPTS, {"state", required_argument, 0, 's'},
                                          {"user", required_argument, 0, 'u'}, {"json", no_argument, 0, 'j'},
-                                         {0, 0, 0, 0}};
+                                         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+    static const char usage[] = "usage: meshcorr list [--state S]... [--user U] [--json]\n" REMOTE_USAGE
+                                "--json: one array of job objects\n";
     remote r;
     remote_defaults(&r);
     int json = 0;
@@ -633,9 +666,8 @@ int cli_list(int argc, char **argv)
         } else if (c == 'j') {
             json = 1;
         } else {
-            fprintf(stderr, "usage: meshcorr list [--state S]... [--user U] [--json]\n" REMOTE_USAGE
-                            "--json: one array of job objects\n");
-            return 2;
+            fputs(usage, c == 'h' ? stdout : stderr);
+            return c == 'h' ? 0 : 2;
         }
     }
     mc_client *cl = remote_connect("list", &r);
@@ -679,7 +711,8 @@ int cli_list(int argc, char **argv)
 
 int cli_stats(int argc, char **argv)
 {
-    static const struct option opts[] = {REMOTE_OPTS, {"json", no_argument, 0, 'j'}, {0, 0, 0, 0}};
+    static const struct option opts[] = {REMOTE_OPTS, {"json", no_argument, 0, 'j'}, {"help", no_argument, 0, 'h'},
+                                         {0, 0, 0, 0}};
     remote r;
     remote_defaults(&r);
     int c, json = 0;
@@ -688,8 +721,8 @@ int cli_stats(int argc, char **argv)
         if (remote_opt(&r, c))
             continue;
         if (c != 'j') {
-            fprintf(stderr, "usage: meshcorr stats [--json]\n" REMOTE_USAGE);
-            return 2;
+            fputs("usage: meshcorr stats [--json]\n" REMOTE_USAGE, c == 'h' ? stdout : stderr);
+            return c == 'h' ? 0 : 2;
         }
         json = 1;
     }

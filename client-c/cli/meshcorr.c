@@ -15,7 +15,7 @@ static const struct {
     { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
     { "eval",    cli_eval,    "SOURCE TARGET P.map .. quality of a map (see meshcorr eval --help)" },
     { "devices", cli_devices, "                 list OpenCL devices for --backend opencl|auto" },
-    { "params",  cli_params,  "[--markdown]     the job parameters: options, defaults, ranges" },
+    { "params",  cli_params,  "[--markdown|--mdoc] the job parameters: options, defaults, ranges" },
     { "submit",  cli_submit,  "SOURCE TARGET .. send a job to meshcorrd; prints its id (--watch: then follow it)" },
     { "status",  cli_status,  "ID               a job's state, times and latest progress" },
     { "watch",   cli_watch,   "ID [--from K]    follow a job's energies; exit 0 if it COMPLETED" },

@@ -2,11 +2,16 @@
  * started with --modbus and --metrics on free 127.0.0.1 ports, running the
  * real 381 -> 390 job from the demo's initial maps, read by Debian's mbpoll
  * (an independent Modbus client), by raw Modbus frames and by a raw HTTP
- * GET, and compared with STATS/STATUS from libmeshcorr. Also the register
+ * GET, and compared with STATS/STATUS from libmeshcorr; /metrics, idle and
+ * with a job running, passes Prometheus' own parser and naming conventions
+ * (tests/support/promcheck.py with Debian's python3-prometheus-client,
+ * which also refuses texts that break them). Also the register
  * packing (floats and 32-bit values, high word first) against known bits and
  * a decoder written here from the IEEE-754 layout. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testfile.h"
+#include "support/testrun.h"
 #include "map/bmap.h"
 #include "mcd.h"
 #include "mesh/mesh.h"
@@ -635,7 +640,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(metric(s, n, "meshcorr_jobs_total", "state=\"cancelled\""), st.cancelled);
     CHECK(metric(s, n, "meshcorr_uptime_seconds", "") >= 0);
     char lab[64];
-    snprintf(lab, sizeof lab, "slot=\"0\",job=\"%llu\"", (unsigned long long)x.job);
+    snprintf(lab, sizeof lab, "slot=\"0\",job_id=\"%llu\"", (unsigned long long)x.job);
     CHECK_INT(metric(s, n, "meshcorr_slot_state", lab), st.slot_state[0]);
     CHECK_INT(st.slot_job[0], x.job);
     CHECK_INT(metric(s, n, "meshcorr_slot_stage", lab), PROTO_STAGE_ECTM);
@@ -657,7 +662,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(metric(s, n, "meshcorr_jobs_total", "state=\"cancelled\""), 2);
     CHECK_INT(metric(s, n, "meshcorr_queue_depth", ""), 0);
     CHECK_INT(metric(s, n, "meshcorr_running_jobs", ""), 0);
-    CHECK_INT(metric(s, n, "meshcorr_slot_state", "slot=\"0\",job=\"0\""), 0);
+    CHECK_INT(metric(s, n, "meshcorr_slot_state", "slot=\"0\",job_id=\"0\""), 0);
     mc_stats_free(&st);
 
     /* other paths and methods */
@@ -667,6 +672,82 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(http(x.metrics, "DELETE", "/metrics", body, sizeof body), 405);
     mc_close(x.c);
     testdaemon_stop(&x.d, SIGTERM);
+}
+
+/* Runs promcheck.py with Debian's python3 (the one with Debian's packages)
+ * on args; its exit status, its report in out. */
+static int promcheck(const char *args, char *out, size_t outsz)
+{
+    return testrunf(out, outsz, "/usr/bin/python3 tests/support/promcheck.py %s 2>&1", args);
+}
+
+TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
+{
+    testdaemon_need_worker();
+    static char body[1 << 16], report[1 << 14], files[2][600];
+    dash x;
+    dash_start(&x, "promparse");
+    testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
+    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    snprintf(files[0], sizeof files[0], "%s", testfile_text("idle.prom", body));
+
+    x.job = testdaemon_submit_ok(x.c, 1000, 1, 0);      /* runs until cancelled */
+    mc_job_status st;
+    for (int i = 0; i < 3000; i++) {                      /* up to 60 s */
+        CHECK_INT(mc_status(x.c, x.job, &st), 0);
+        if (st.state >= MC_COMPLETED)
+            FAILF("job ended %s: %s", mc_state_name(st.state), st.reason);
+        if (st.has_progress && st.progress.stage == PROTO_STAGE_ECTM)
+            break;
+        testdaemon_sleep_ms(20);
+    }
+    CHECK(st.has_progress && st.progress.stage == PROTO_STAGE_ECTM);
+    testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
+    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    snprintf(files[1], sizeof files[1], "%s", testfile_text("running.prom", body));
+    CHECK_STR_HAS(body, "meshcorr_slot_energy{");
+    CHECK_INT(mc_cancel(x.c, x.job), 0);
+    testdaemon_wait_state(x.c, x.job, MC_CANCELLED, 30);
+
+    char args[2048];
+    snprintf(args, sizeof args,
+             "%s %s --expect meshcorr_queue_depth --expect meshcorr_running_jobs --expect meshcorr_jobs_total"
+             " --expect meshcorr_workers --expect meshcorr_uptime_seconds --expect meshcorr_snapshots_total"
+             " --expect meshcorr_slot_state --expect meshcorr_slot_elapsed_seconds --expect meshcorr_slot_stage"
+             " --expect meshcorr_slot_outer_iteration --expect meshcorr_slot_total_iterations"
+             " --expect meshcorr_slot_progress_ratio --expect meshcorr_slot_energy --expect meshcorr_slot_beta",
+             files[0], files[1]);
+    int rc = promcheck(args, report, sizeof report);
+    if (rc != 0)
+        FAILF("promcheck.py (exit %d; python3-prometheus-client: deploy/install-deps.sh):\n%s", rc, report);
+    mc_close(x.c);
+    testdaemon_stop(&x.d, SIGTERM);
+}
+
+TEST(promcheck_refuses_texts_that_break_the_conventions)
+{
+    static char report[1 << 14];
+    static const struct { const char *text, *finding; } bad[] = {
+        {"# HELP meshcorr_jobs Jobs.\n# TYPE meshcorr_jobs counter\nmeshcorr_jobs 3\n", "does not end in _total"},
+        {"# TYPE meshcorr_queue_depth gauge\nmeshcorr_queue_depth 1\n", "has no HELP"},
+        {"# HELP meshcorr_queue_depth Jobs.\nmeshcorr_queue_depth 1\n", "has no TYPE"},
+        {"# HELP meshcorr_queue_total Jobs.\n# TYPE meshcorr_queue_total gauge\nmeshcorr_queue_total 1\n",
+         "the counters' suffix"},
+        {"# HELP meshcorr_uptime Up.\n# TYPE meshcorr_uptime gauge\nmeshcorr_uptime 1\n", "_seconds"},
+        {"# HELP meshcorr_slot_state S.\n# TYPE meshcorr_slot_state gauge\nmeshcorr_slot_state{job=\"1\"} 1\n",
+         "label 'job'"},
+        {"# HELP meshcorr_workers W.\n# TYPE meshcorr_workers gauge\nmeshcorr_workers one\n", "parser refuses"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        int rc = promcheck(testfile_text("bad.prom", bad[i].text), report, sizeof report);
+        if (rc != 1 || !strstr(report, bad[i].finding))
+            FAILF("promcheck.py on\n%s: exit %d, wanted 1 and \"%s\":\n%s", bad[i].text, rc, bad[i].finding, report);
+    }
+    const char *good = "# HELP meshcorr_jobs_total Jobs.\n# TYPE meshcorr_jobs_total counter\n"
+                       "meshcorr_jobs_total{state=\"failed\"} 0\n";
+    int rc = promcheck(testfile_text("good.prom", good), report, sizeof report);
+    if (rc != 0)
+        FAILF("promcheck.py refused a good text (exit %d):\n%s", rc, report);
 }
 
 TEST(dashboard_options_parse_host_and_port)
