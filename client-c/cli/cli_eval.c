@@ -43,11 +43,12 @@ static void usage(FILE *fp)
         "cumulative curve to 0.25). Pictures: --out-colors writes PREFIX.target.ply (the\n"
         "target coloured by position) and PREFIX.source.ply (the source coloured through the\n"
         "first map: same colour, same place); --out-png writes the same colours as a picture,\n"
-        "800 by 800 pixels: left the source through the map, right the target; top row seen\n"
-        "along the target's axis of least spread, bottom row from behind; the source turned\n"
-        "to face as its images on the target do, each shape centred in its panel\n"
-        "(--mark-folds hatches the source's flipped and collapsed triangles). --out-curve\n"
-        "and --out-csv write the cumulative error curves of every map (with a ground truth).\n");
+        "800 by 800 pixels: left the source through the map, right the target; top row the\n"
+        "target's widest side (the world axes of its longest and middle extents across and\n"
+        "up), bottom row from behind; the source turned to face as its images on the target\n"
+        "do, each shape centred in its panel (--mark-folds hatches the source's flipped and\n"
+        "collapsed triangles). --out-curve and --out-csv write the cumulative error curves\n"
+        "of every map (with a ground truth).\n");
 }
 
 /* lmk_read_ids with the message on stderr. */

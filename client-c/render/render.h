@@ -50,13 +50,13 @@ typedef struct render_view {
     double r[3][3];
 } render_view;
 
-/* The view of m along its axis of least spread (its widest silhouette):
- * screen x along the axis of greatest spread, screen y along the middle
- * one, each axis signed so that its largest world component is positive
- * (a mesh lying along the world axes keeps their directions), then turned
- * by az degrees about the screen's vertical and el degrees about its
- * horizontal (an oblique look). RENDER_EEIGEN when LAPACK fails. */
-int render_view_principal(const mesh *m, double az, double el, render_view *out);
+/* The view of m's widest side: screen x along the world axis (x, y or z)
+ * of m's greatest extent, screen y along the one of the middle extent,
+ * both in their positive directions (a shape modelled upright along its
+ * middle axis stays upright), looking along the third; then turned by az
+ * degrees about the screen's vertical and el degrees about its horizontal
+ * (an oblique look, from above for el > 0). */
+render_view render_view_widest(const mesh *m, double az, double el);
 /* v turned by deg degrees about its own screen vertical (180: from behind). */
 render_view render_view_turned(const render_view *v, double deg);
 
@@ -82,8 +82,8 @@ int render_mesh(const mesh *m, const unsigned char *rgb, const unsigned char *ma
  * (px in 16..RENDER_MAX_SIDE/2). Left column the source S in its colours
  * srgb (the target's colours pulled through the map), its faces with
  * smark[t] != 0 hatched (NULL: none); right column the target T in trgb.
- * Top row: the view of T's principal axes (render_view_principal, turned
- * 30 degrees and looking 20 degrees down); bottom row: the same view from
+ * Top row: the view of T's widest side (render_view_widest, turned 30
+ * degrees and looking 20 degrees down); bottom row: the same view from
  * behind. The source is first turned by the rotation that best takes its
  * vertices onto simg (nv by 3: their images on T, e.g. P·X̃), so that the
  * two shapes face the same way even when their files use other frames;

@@ -1,7 +1,7 @@
-/* render_view.c — see render.h. A view from a mesh's principal axes (the
- * eigenvectors of its vertices' covariance), and views turned from it. */
+/* render_view.c — see render.h. A view of a mesh's widest side, from the
+ * world axes of its bounding box (files put their shapes along the axes,
+ * up along one of them), and views turned from it. */
 #include "render/render.h"
-#include "embed/embed.h"
 
 #include <math.h>
 
@@ -24,28 +24,29 @@ render_view render_view_turned(const render_view *v, double deg)
     return t;
 }
 
-int render_view_principal(const mesh *m, double az, double el, render_view *out)
+render_view render_view_widest(const mesh *m, double az, double el)
 {
-    double mean[3] = {0, 0, 0}, cov[9] = {0}, w[3], V[9];
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < m->nv; i++)
-        for (int k = 0; k < 3; k++)
-            mean[k] += m->v[3 * i + k] / m->nv;
-    for (int i = 0; i < m->nv; i++)
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++)
-                cov[3 * a + b] += (m->v[3 * i + a] - mean[a]) * (m->v[3 * i + b] - mean[b]);
-    if (embed_top_eigenpairs(cov, 3, 3, w, V, NULL))
-        return RENDER_EEIGEN;
-    /* V's columns, descending spread, each with its largest entry positive */
-    render_view v;
-    for (int k = 0; k < 3; k++) {
-        v.r[0][k] = V[3 * k + 0];
-        v.r[1][k] = V[3 * k + 1];
-    }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], m->v[3 * i + k]);
+            hi[k] = fmax(hi[k], m->v[3 * i + k]);
+        }
+    int ax[3] = {0, 1, 2};   /* the world axes by extent, greatest first */
+    for (int a = 0; a < 3; a++)
+        for (int b = a + 1; b < 3; b++)
+            if (hi[ax[b]] - lo[ax[b]] > hi[ax[a]] - lo[ax[a]]) {
+                int t = ax[a];
+                ax[a] = ax[b];
+                ax[b] = t;
+            }
+    render_view v = {{{0}}};
+    v.r[0][ax[0]] = 1;
+    v.r[1][ax[1]] = 1;
     /* towards the viewer: x cross y, so the picture is never a mirror image */
     for (int k = 0; k < 3; k++)
         v.r[2][k] = v.r[0][(k + 1) % 3] * v.r[1][(k + 2) % 3] - v.r[0][(k + 2) % 3] * v.r[1][(k + 1) % 3];
-    *out = render_view_turned(&v, az);
-    turn_rows(out->r, 1, 2, -el);   /* y and z: about screen x, looking down */
-    return RENDER_OK;
+    render_view out = render_view_turned(&v, az);
+    turn_rows(out.r, 1, 2, -el);   /* y and z: about screen x, looking down */
+    return out;
 }
