@@ -1,5 +1,5 @@
 /* test_render.c — the pictures of client-c/render: the z-buffer keeps the
- * nearer face, the fitted rotation, the picture of a map (the identity of
+ * nearer face, marked faces hatched, the fitted rotation, the picture of a map (the identity of
  * a mesh onto itself gives two equal halves pixel for pixel, a mirrored
  * map does not), the PNG read back with libpng, and the same through
  * `meshcorr eval --out-png`. */
@@ -132,6 +132,31 @@ TEST(nearer_face_hides_the_farther_one_whichever_comes_first)
     mesh_free(m);
 }
 
+TEST(marked_faces_are_hatched_and_only_they)
+{
+    mesh *m = shape();
+    unsigned char *rgb = malloc(3 * (size_t)m->nv), *mark = calloc((size_t)m->nf, 1);
+    CHECK(rgb && mark);
+    viz_position_colors(m, rgb);
+    render_view view = render_view_widest(m, 30, 20);
+    long dark[2];
+    for (int marked = 0; marked < 2; marked++) {
+        for (int t = 0; t < m->nf; t++)
+            mark[t] = marked && t % 2 == 0;   /* every other face */
+        render_image *im = render_image_new(PANEL, PANEL, white);
+        CHECK_INT(render_mesh(m, rgb, mark, &view, im), RENDER_OK);
+        dark[marked] = 0;
+        for (int p = 0; p < PANEL * PANEL; p++)
+            dark[marked] += im->rgb[3 * p] == 20 && im->rgb[3 * p + 1] == 20 && im->rgb[3 * p + 2] == 20;
+        render_image_free(im);
+    }
+    CHECK_INT(dark[0], 0);
+    CHECK(dark[1] > PANEL * PANEL / 50);
+    free(rgb);
+    free(mark);
+    mesh_free(m);
+}
+
 TEST(rotation_fit_recovers_a_rotation_and_gives_the_identity_exactly)
 {
     mesh *m = shape();
@@ -210,12 +235,9 @@ TEST(png_reads_back_with_libpng_at_its_size_and_pixels)
     mesh_free(T);
 }
 
-/* meshcorr eval SOURCE TARGET P.map --out-png FILE; returns its exit code. */
-static int eval_png(const char *src, const char *tgt, const char *map, const char *png, char *out,
-                    size_t outsz)
+/* Runs cmd; its output in out; returns its exit code. */
+static int run(const char *cmd, char *out, size_t outsz)
 {
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --out-png %s 2>&1", src, tgt, map, png);
     FILE *p = popen(cmd, "r");
     CHECK(p);
     size_t n = fread(out, 1, outsz - 1, p);
@@ -224,12 +246,21 @@ static int eval_png(const char *src, const char *tgt, const char *map, const cha
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* meshcorr eval SOURCE TARGET P.map --out-png FILE; returns its exit code. */
+static int eval_png(const char *src, const char *tgt, const char *map, const char *png, char *out,
+                    size_t outsz)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --out-png %s 2>&1", src, tgt, map, png);
+    return run(cmd, out, outsz);
+}
+
 TEST(eval_out_png_of_identity_and_mirrored_maps)
 {
     mesh *T = shape(), *M = testmesh_mirrored(T);
     bmap *P = identity_map(T);
     const char *dir = harness_tmpdir();
-    char t[600], m[600], map[600], png[600], err[1024], out[8192];
+    char t[600], m[600], map[600], png[600], err[1024], out[8192], cmd[4096];
     snprintf(t, sizeof t, "%s/shape.off", dir);
     snprintf(m, sizeof m, "%s/mirror.off", dir);
     snprintf(map, sizeof map, "%s/id.map", dir);
@@ -248,6 +279,9 @@ TEST(eval_out_png_of_identity_and_mirrored_maps)
     rgb = png_read(png, &w, &h);
     CHECK(halves_differ(rgb, w, h) > 10000);
     free(rgb);
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --mark-folds 2>&1", t, t, map);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--mark-folds goes with --out-png");
     snprintf(png, sizeof png, "%s/no/such/dir/id.png", dir);
     CHECK_INT(eval_png(t, t, map, png, out, sizeof out), 1);
     CHECK_STR_HAS(out, "no/such/dir/id.png");
