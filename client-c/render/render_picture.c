@@ -28,8 +28,9 @@ int render_map_picture(const mesh *S, const unsigned char *srgb, const unsigned 
     *out = NULL;
     if (px < 16 || px > RENDER_MAX_SIDE / 2)
         return RENDER_ESIZE;
-    render_view front = render_view_widest(T, RENDER_AZIMUTH, RENDER_ELEVATION), views[2][2];
-    double R[3][3];   /* views[row][column] */
+    render_view front = render_view_widest(T, RENDER_AZIMUTH, RENDER_ELEVATION);
+    render_view views[2][2];   /* [row][column] */
+    double R[3][3];            /* turns the source to face as its images do */
     int rc = render_rotation_fit(S->v, simg, S->nv, R);
     if (rc)
         return rc;
