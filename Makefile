@@ -56,6 +56,15 @@ DAEMON_LIBS := $(shell pkg-config --libs libuv) -lsqlite3 -lmodbus -lmicrohttpd 
 CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
 
+# The CLI's pictures (client-c/render/: rasteriser and PNG writer): linked
+# into the CLI and the tests only, so libmeshcorr.so never needs libpng.
+RENDER_C    := $(wildcard client-c/render/*.c)
+RENDER_OBJ  := $(RENDER_C:%.c=$(BUILD)/obj/%.o)
+RENDER_LIB  := $(BUILD)/libmcrender.a
+RENDER_CFLAGS := $(shell pkg-config --cflags libpng)
+RENDER_LIBS := $(shell pkg-config --libs libpng)
+$(RENDER_OBJ): CPPFLAGS += $(RENDER_CFLAGS)
+
 TEST_SUPPORT_C   := $(wildcard tests/support/*.c)
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_C:%.c=$(BUILD)/obj/%.o)
 TEST_C    := $(wildcard tests/unit/test_*.c)
@@ -104,6 +113,10 @@ $(CLIENT_LIB): $(CLIENT_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
+$(RENDER_LIB): $(RENDER_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
 $(CLIENT_SO): $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) client-c/meshcorr.map
 	$(CC) $(CFLAGS) -shared -Wl,-soname,libmeshcorr.so.1 -Wl,--no-undefined \
 	  -Wl,--version-script=client-c/meshcorr.map -o $@ $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
@@ -113,8 +126,8 @@ $(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/meshcorr: $(CLI_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
-	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+$(BUILD)/meshcorr: $(CLI_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(RENDER_LIBS)
 
 $(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $< $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DAEMON_LIBS) $(LDLIBS)
@@ -122,9 +135,9 @@ $(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PRO
 $(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+$(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS)
+	$(CC) $(CPPFLAGS) $(RENDER_CFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS) $(RENDER_LIBS)
 
 $(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)

@@ -5,8 +5,8 @@
 # (a fresh state in BUILD/demo/state, Unix socket BUILD/demo/meshcorrd.sock,
 # one local worker), submits the job with the landmark pairs in deploy/demo/,
 # watches it, fetches the maps and the deformed cow, evaluates them with
-# coloured PLYs, and stops the daemon (also when a step fails). Installs
-# nothing.
+# coloured PLYs and a PNG picture, and stops the daemon (also when a step
+# fails). Installs nothing.
 set -eu
 build=${1:-build}
 here=$(dirname "$0")
@@ -61,11 +61,12 @@ echo "demo: submitted job $id"
 "$build/meshcorr" result "$id" --server "$server" \
     --out "$out/cow-camel.map" --out-reverse "$out/camel-cow.map" --out-deformed "$out/cow-deformed.ply"
 "$build/meshcorr" eval "$out/cow.off" "$out/camel.off" "$out/cow-camel.map" --reverse "$out/camel-cow.map" \
-    --out-colors "$out/cow-camel"
+    --out-colors "$out/cow-camel" --out-png "$out/cow-camel.png"
 stop_daemon
 
 echo "demo: maps in $out/cow-camel.map (cow -> camel) and $out/camel-cow.map (camel -> cow);"
 echo "demo: the cow deformed onto the camel in $out/cow-deformed.ply;"
 echo "demo: colours to compare: $out/cow-camel.target.ply (the camel coloured by position)"
 echo "demo: and $out/cow-camel.source.ply (the cow coloured through the map);"
+echo "demo: the same as a picture in $out/cow-camel.png (left the cow, right the camel; front, back);"
 echo "demo: the daemon's log in $out/meshcorrd.log, its state in $out/state"

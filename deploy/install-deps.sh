@@ -18,6 +18,7 @@ libmodbus-dev libmicrohttpd-dev mbpoll
 slurmctld slurmd slurm-client munge
 libsystemd-dev
 mandoc man-db python3-prometheus-client
+libpng-dev
 "
 
 SUDO=""

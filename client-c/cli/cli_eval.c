@@ -15,6 +15,7 @@
 #include "map/bmap.h"
 #include "mesh/mesh.h"
 #include "metric/metric.h"
+#include "render/render.h"
 #include "viz/viz.h"
 
 #include <getopt.h>
@@ -27,20 +28,27 @@
 #define EVAL_CURVE_MAX 0.25
 #define EVAL_MAX_GT_LINES 100000000
 #define EVAL_MAX_MAPS 8
+#define EVAL_PNG_PANEL 400       /* pixels per side of each of the 4 panels */
 
 static void usage(FILE *fp)
 {
     fprintf(fp,
         "usage: meshcorr eval SOURCE TARGET P.map [P2.map ...] [--reverse Q.map]\n"
         "         [--gt GT [--gt-target GT2] --gt-format vts-pair|vertex-list [--gt-base 0|1]]\n"
-        "         [--json] [--out-colors PREFIX] [--out-curve CURVES.svg] [--out-csv CURVES.csv]\n"
+        "         [--json] [--out-colors PREFIX] [--out-png FILE [--mark-folds]]\n"
+        "         [--out-curve CURVES.svg] [--out-csv CURVES.csv]\n"
         "Prints, for each map: conformal and area distortion, flipped and collapsed triangles,\n"
         "mean-curvature error, coverage of the target, the round trip with Q (one map only),\n"
         "and the geodesic error to a ground truth (divided by sqrt(target area); mean and\n"
         "cumulative curve to 0.25). Pictures: --out-colors writes PREFIX.target.ply (the\n"
         "target coloured by position) and PREFIX.source.ply (the source coloured through the\n"
-        "first map: same colour, same place); --out-curve and --out-csv write the cumulative\n"
-        "error curves of every map (with a ground truth).\n");
+        "first map: same colour, same place); --out-png writes the same colours as a picture,\n"
+        "800 by 800 pixels: left the source through the map, right the target; top row the\n"
+        "target's widest side (the world axes of its longest and middle extents across and\n"
+        "up), bottom row from behind; the source turned to face as its images on the target\n"
+        "do, each shape centred in its panel (--mark-folds hatches the source's flipped and\n"
+        "collapsed triangles). --out-curve and --out-csv write the cumulative error curves\n"
+        "of every map (with a ground truth).\n");
 }
 
 /* lmk_read_ids with the message on stderr. */
@@ -76,6 +84,38 @@ static int write_colors(const char *prefix, const mesh *S, const mesh *T, const 
 fail:
     fprintf(stderr, "meshcorr eval: %s\n", err);
 out:
+    free(trgb);
+    free(srgb);
+    return rc;
+}
+
+/* FILE: the source coloured through P beside the target coloured by
+ * position (render_map_picture), the source turned to face as its images
+ * P·X̃ do; folds: hatch P's flipped and collapsed source faces. */
+static int write_png(const char *path, const mesh *S, const mesh *T, const bmap *P, int folds)
+{
+    char err[1024];
+    int rc = RENDER_ENOMEM;
+    unsigned char *trgb = malloc(3 * (size_t)T->nv + 1), *srgb = malloc(3 * (size_t)S->nv + 1);
+    unsigned char *kind = folds ? malloc((size_t)S->nf + 1) : NULL;
+    double *img = malloc(sizeof(double) * 3 * (size_t)S->nv + 1);
+    render_image *im = NULL;
+    if (!trgb || !srgb || !img || (folds && (!kind || metric_fold_faces(S, T, P, kind) < 0)))
+        goto fail;
+    viz_position_colors(T, trgb);
+    viz_pull_colors(P, T->f, trgb, srgb);
+    bmap_apply(P, T->f, T->v, 3, img);
+    if ((rc = render_map_picture(S, srgb, kind, img, T, trgb, EVAL_PNG_PANEL, &im)))
+        goto fail;
+    if ((rc = render_png_write(im, path, err, sizeof err)))
+        fprintf(stderr, "meshcorr eval: %s\n", err);
+    goto out;
+fail:
+    fprintf(stderr, "meshcorr eval: %s: %s\n", path, render_strerror(rc));
+out:
+    render_image_free(im);
+    free(img);
+    free(kind);
     free(trgb);
     free(srgb);
     return rc;
@@ -128,11 +168,12 @@ int cli_eval(int argc, char **argv)
         {"gt-target", required_argument, 0, 't'}, {"gt-format", required_argument, 0, 'f'},
         {"gt-base", required_argument, 0, 'b'},  {"json", no_argument, 0, 'j'},
         {"out-colors", required_argument, 0, 'c'}, {"out-curve", required_argument, 0, 's'},
-        {"out-csv", required_argument, 0, 'v'},  {"help", no_argument, 0, 'h'},
+        {"out-csv", required_argument, 0, 'v'},  {"out-png", required_argument, 0, 'p'},
+        {"mark-folds", no_argument, 0, 'm'},     {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0}};
     const char *rev = NULL, *gt = NULL, *gt2 = NULL, *fmt = NULL;
-    const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL;
-    int base = -1, json = 0, c, bad = 0;
+    const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL, *out_png = NULL;
+    int base = -1, json = 0, folds = 0, c, bad = 0;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
@@ -151,6 +192,8 @@ int cli_eval(int argc, char **argv)
         case 'c': out_colors = optarg; break;
         case 's': out_curve = optarg; break;
         case 'v': out_csv = optarg; break;
+        case 'p': out_png = optarg; break;
+        case 'm': folds = 1; break;
         case 'h': usage(stdout); return 0;
         default: bad = 1;
         }
@@ -167,6 +210,10 @@ int cli_eval(int argc, char **argv)
     }
     if (!bad && (out_curve || out_csv) && !gt) {
         fprintf(stderr, "meshcorr eval: --out-curve and --out-csv need a ground truth (--gt)\n");
+        bad = 1;
+    }
+    if (!bad && folds && !out_png) {
+        fprintf(stderr, "meshcorr eval: --mark-folds goes with --out-png\n");
         bad = 1;
     }
     if (!bad && gt && !pair && !list) {
@@ -288,6 +335,8 @@ int cli_eval(int argc, char **argv)
         }
     }
     if (out_colors && write_colors(out_colors, S, T, maps[0]))
+        goto done;
+    if (out_png && write_png(out_png, S, T, maps[0], folds))
         goto done;
     if (out_curve || out_csv) {
         const double *cv[EVAL_MAX_MAPS];
