@@ -220,3 +220,152 @@ int fmap_vertex_map(const lbo_basis *b1, const lbo_basis *b2, const double *C, i
         return errbuf_set(err, errsz, FMAP_ENOMEM, "vertex map: out of memory");
     return FMAP_OK;
 }
+
+/* The normal equations' operator of fmap_from_descriptors_normal:
+ * H(X) = X G + mu (D / dn) o X + w (N1 R - R N2), R = N1 X - X N2; tmp: k1 by k2. */
+typedef struct normal_system {
+    int k1, k2;
+    const double *G, *D, *N1, *N2;
+    double mu, w;
+    double *tmp, *tmp2;
+} normal_system;
+
+static void mat_mul(const double *A, const double *B, int n, int m, int p, double *out)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < p; j++) {
+            double s = 0;
+            for (int q = 0; q < m; q++)
+                s += A[(size_t)i * m + q] * B[(size_t)q * p + j];
+            out[(size_t)i * p + j] = s;
+        }
+}
+
+static void normal_apply(const normal_system *ns, const double *X, double *out)
+{
+    int k1 = ns->k1, k2 = ns->k2, n = k1 * k2;
+    mat_mul(X, ns->G, k1, k2, k2, out);
+    for (int q = 0; q < n; q++)
+        out[q] += ns->mu * ns->D[q] * X[q];
+    mat_mul(ns->N1, X, k1, k1, k2, ns->tmp);        /* R = N1 X - X N2 */
+    mat_mul(X, ns->N2, k1, k2, k2, ns->tmp2);
+    for (int q = 0; q < n; q++)
+        ns->tmp[q] -= ns->tmp2[q];
+    mat_mul(ns->N1, ns->tmp, k1, k1, k2, ns->tmp2);   /* out += w (N1 R - R N2) */
+    for (int q = 0; q < n; q++)
+        out[q] += ns->w * ns->tmp2[q];
+    mat_mul(ns->tmp, ns->N2, k1, k2, k2, ns->tmp2);
+    for (int q = 0; q < n; q++)
+        out[q] -= ns->w * ns->tmp2[q];
+}
+
+static double frob(const double *A, int n)
+{
+    double s = 0;
+    for (int q = 0; q < n; q++)
+        s += A[q] * A[q];
+    return sqrt(s);
+}
+
+int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const double *F1,
+                                 const double *N1, const lbo_basis *b2, const double *m2,
+                                 const double *F2, const double *N2, int nd, int k1, int k2,
+                                 double mu, double mu_n, double *C, int *iterations, char *err,
+                                 size_t errsz)
+{
+    if (iterations)
+        *iterations = 0;
+    if (!(mu_n >= 0) || !isfinite(mu_n))
+        return errbuf_set(err, errsz, FMAP_EINVAL, "functional map: D_N weight %g", mu_n);
+    int rc = fmap_from_descriptors(b1, m1, F1, b2, m2, F2, nd, k1, k2, mu, C, err, errsz);
+    if (rc != FMAP_OK || mu_n == 0)
+        return rc;
+    int n = k1 * k2;
+    double *A1 = malloc((size_t)k1 * nd * sizeof *A1), *A2 = malloc((size_t)k2 * nd * sizeof *A2);
+    double *G = malloc((size_t)k2 * k2 * sizeof *G), *D = malloc((size_t)n * sizeof *D);
+    double *B = malloc((size_t)n * sizeof *B), *r = malloc((size_t)n * sizeof *r);
+    double *p = malloc((size_t)n * sizeof *p), *Hp = malloc((size_t)n * sizeof *Hp);
+    double *t1 = malloc((size_t)n * sizeof *t1), *t2 = malloc((size_t)n * sizeof *t2);
+    rc = FMAP_ENOMEM;
+    if (!A1 || !A2 || !G || !D || !B || !r || !p || !Hp || !t1 || !t2 ||
+        !coefficients(b1, m1, F1, nd, k1, A1) || !coefficients(b2, m2, F2, nd, k2, A2)) {
+        errbuf_set(err, errsz, FMAP_ENOMEM, "functional map: out of memory (%d descriptors)", nd);
+        goto out;
+    }
+    for (int a = 0; a < k2; a++)
+        for (int c = 0; c < k2; c++) {
+            double s = 0;
+            for (int q = 0; q < nd; q++)
+                s += A2[(size_t)a * nd + q] * A2[(size_t)c * nd + q];
+            G[(size_t)a * k2 + c] = s;
+        }
+    double dn = 0;
+    for (int a = 0; a < k1; a++)
+        for (int c = 0; c < k2; c++) {
+            double d = b1->lambda[a] - b2->lambda[c];
+            D[(size_t)a * k2 + c] = d * d;
+            dn += d * d * d * d;
+        }
+    dn = dn > 0 ? sqrt(dn) : 1;
+    for (int q = 0; q < n; q++)
+        D[q] /= dn;
+    for (int a = 0; a < k1; a++)      /* B = A1 A2^T */
+        for (int c = 0; c < k2; c++) {
+            double s = 0;
+            for (int q = 0; q < nd; q++)
+                s += A1[(size_t)a * nd + q] * A2[(size_t)c * nd + q];
+            B[(size_t)a * k2 + c] = s;
+        }
+    double nn = frob(N1, k1 * k1) * frob(N2, k2 * k2);
+    normal_system ns = {k1, k2, G, D, N1, N2, mu, nn > 0 ? mu_n / nn : 0, t1, t2};
+    normal_apply(&ns, C, Hp);          /* conjugate gradients from the Laplacian-only C */
+    double rr = 0, bnorm = frob(B, n);
+    for (int q = 0; q < n; q++) {
+        r[q] = B[q] - Hp[q];
+        p[q] = r[q];
+        rr += r[q] * r[q];
+    }
+    int it = 0;
+    while (sqrt(rr) > FMAP_CG_TOL * bnorm && it < FMAP_CG_MAX_ITER) {
+        normal_apply(&ns, p, Hp);
+        double pHp = 0;
+        for (int q = 0; q < n; q++)
+            pHp += p[q] * Hp[q];
+        if (!(pHp > 0)) {
+            rc = errbuf_set(err, errsz, FMAP_ESOLVE,
+                            "functional map with D_N: the system is not positive definite");
+            goto out;
+        }
+        double alpha = rr / pHp, rr2 = 0;
+        for (int q = 0; q < n; q++) {
+            C[q] += alpha * p[q];
+            r[q] -= alpha * Hp[q];
+            rr2 += r[q] * r[q];
+        }
+        for (int q = 0; q < n; q++)
+            p[q] = r[q] + rr2 / rr * p[q];
+        rr = rr2;
+        it++;
+    }
+    if (iterations)
+        *iterations = it;
+    if (sqrt(rr) > FMAP_CG_TOL * bnorm) {
+        rc = errbuf_set(err, errsz, FMAP_ESOLVE,
+                        "functional map with D_N: %d conjugate-gradient steps left residual %.3g",
+                        it, sqrt(rr) / bnorm);
+        goto out;
+    }
+    rc = FMAP_OK;
+out:
+    free(A1);
+    free(A2);
+    free(G);
+    free(D);
+    free(B);
+    free(r);
+    free(p);
+    free(Hp);
+    free(t1);
+    free(t2);
+    return rc;
+}

@@ -33,6 +33,7 @@
 #define FMAP_H
 #include "lbo/lbo.h"
 #include "lmk/lmk.h"
+#include "mesh/mesh.h"
 
 #include <stddef.h>
 
@@ -62,11 +63,52 @@ int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F
                           const lbo_basis *b2, const double *m2, const double *F2, int nd,
                           int k1, int k2, double mu, double *C, char *err, size_t errsz);
 
+/* The same objective plus D_N commutativity (seed 2017, §8.1):
+ *   + mu_n ||N1 C - C N2||_F^2 / (||N1||_F ||N2||_F),
+ * N1 (k1 by k1) and N2 (k2 by k2) the reduced normal operators
+ * (fmap_normal_operator). No longer row-separable: conjugate gradients on
+ * the normal equations in the k1 k2 entries of C, started from the
+ * Laplacian-only solution, until the residual is below FMAP_CG_TOL of the
+ * right-hand side (at most FMAP_CG_MAX_ITER steps; *iterations, may be
+ * NULL). mu_n = 0 gives fmap_from_descriptors' result. */
+/* D_N weight: the best of 0.01, 0.1, 1 on FAUST 000 -> 001, 002 -> 007 and
+ * 000 -> 020 (5 landmarks, k = 50; test_fmap.c has the figures); larger
+ * values were not tried. */
+#define FMAP_MU_NORMAL_DEFAULT 1.0
+#define FMAP_CG_TOL 1e-10
+#define FMAP_CG_MAX_ITER 5000
+int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const double *F1,
+                                 const double *N1, const lbo_basis *b2, const double *m2,
+                                 const double *F2, const double *N2, int nd, int k1, int k2,
+                                 double mu, double mu_n, double *C, int *iterations, char *err,
+                                 size_t errsz);
+
 /* *F1 (n1 by *nd) and *F2 (n2 by *nd), malloc()ed, caller frees:
  * *nd = ne * (1 + L->n) columns (WKS, then each landmark's WKM). */
 int fmap_landmark_descriptors(const lbo_basis *b1, const lbo_basis *b2, const lmk_set *L,
                               int ne, double **F1, double **F2, int *nd, char *err,
                               size_t errsz);
+
+/* The functional deformation field of an extrinsic vector field V (seed
+ * functional-deformation-fields-2017, §4 and §6), reduced to the first k
+ * basis functions: D (k by k, symmetric) = Psi^T W_V Psi, where
+ *   f^T W_V h = sum_t area_t (L_V g)_t(grad f, grad h),
+ *   (L_V g)(X, Y) = <dV X, Y> + <dV Y, X>,
+ * the Lie derivative of the metric, per triangle with dV the (constant)
+ * differential of V's linear interpolant on the mesh's own triangles and
+ * grad f that of f's. (The seed's text lost its formulas; this follows its
+ * definition: per-edge finite differences of V, which is what dV is on a
+ * triangle.) Checks the tests make: V = positions gives L_V g = 2 g, so D =
+ * 2 Psi^T L_cotan Psi; V = a rigid motion gives D = 0. With V the unit
+ * vertex normals (fmap_normal_operator) L_N g = 2 II with II(X, Y) =
+ * <dN X, Y> (on the unit sphere with outward normals II = g): D_N carries
+ * the second fundamental form. V: nv by 3. Degenerate faces contribute
+ * nothing. FMAP_EINVAL for k out of the basis or a basis of another size. */
+int fmap_deformation_operator(const mesh *m, const double *V, const lbo_basis *b, int k,
+                              double *D, char *err, size_t errsz);
+/* fmap_deformation_operator of the area-weighted unit vertex normals. */
+int fmap_normal_operator(const mesh *m, const lbo_basis *b, int k, double *D, char *err,
+                         size_t errsz);
 
 /* map: n1 vertices of M2. */
 int fmap_vertex_map(const lbo_basis *b1, const lbo_basis *b2, const double *C, int k1, int k2,
