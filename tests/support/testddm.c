@@ -2,7 +2,12 @@
  * testddm.h. */
 #include "support/testddm.h"
 
+#include "support/harness.h"
+#include "lmk/lmk.h"
+#include "metric/metric.h"
+
 #include <math.h>
+#include <stdlib.h>
 
 /* |x - b|^2 for x = (1 - s - t) a0 + s a1 + t a2 in R^k. */
 double testddm_dist2(const double *a0, const double *a1, const double *a2, double s, double t,
@@ -62,4 +67,39 @@ double testddm_row_cost(const bmap *P, int i, const double *A, int k, const mesh
     const double *w = P->w + 3 * i;
     return testddm_dist2(A + (size_t)fv[0] * k, A + (size_t)fv[1] * k, A + (size_t)fv[2] * k,
                          w[1], w[2], b, k);
+}
+
+bmap *testddm_vertex_map(const char *path, int base, const mesh *S, const mesh *T)
+{
+    char err[256] = "";
+    int *ids = NULL, n = 0;
+    if (lmk_read_ids(path, base, T->nv, S->nv, &ids, &n, err, sizeof err))
+        FAILF("%s", err);
+    if (n != S->nv)
+        FAILF("%s: %d lines for %d source vertices", path, n, S->nv);
+    bmap *P = bmap_new(S->nv, T->nv);
+    int *vf = malloc(3 * (size_t)T->nv * sizeof *vf);
+    for (int q = 3 * T->nf - 1; q >= 0; q--)
+        vf[T->f[q]] = q;
+    for (int i = 0; i < n; i++) {
+        P->face[i] = vf[ids[i]] / 3;
+        for (int c = 0; c < 3; c++)
+            P->w[3 * i + c] = c == vf[ids[i]] % 3;
+    }
+    free(vf);
+    free(ids);
+    return P;
+}
+
+double testddm_mean_error(geod_solver *sT, const mesh *T, const bmap *P, const int *src,
+                          const int *tgt, int n)
+{
+    double *e = malloc(n * sizeof *e), m = 0;
+    const bmap *maps[1] = {P};
+    if (metric_geodesic_errors(sT, T, maps, 1, src, tgt, n, e))
+        FAILF("geodesic errors failed");
+    for (int p = 0; p < n; p++)
+        m += e[p] / n;
+    free(e);
+    return m;
 }

@@ -56,4 +56,15 @@ int ddm_deblur(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const
                const double *C, int k1, int k2, bmap *P, ddm_stats *stats, char *err,
                size_t errsz);
 
+/* DDM denoising (thesis §2.1.2, eq. 2.5): a given map P0 (n1 rows onto
+ * T: barycentric, or a vertex map written as weight 1 at one corner)
+ * blurred to C = Psi1^T M1 P0 Psi2 (k1 by k2: its projection on the
+ * smoothest k1 functions of M1; Psi1^+ = Psi1^T M1) and deblurred into P by
+ * ddm_deblur. k1 sets the smoothing: fewer functions, smoother map.
+ * m1 is required here. Errors as ddm_deblur, and DDM_EINVAL for P0 of
+ * another size or a face out of range. */
+int ddm_denoise(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const mesh *T,
+                const bmap *P0, int k1, int k2, bmap *P, ddm_stats *stats, char *err,
+                size_t errsz);
+
 #endif
