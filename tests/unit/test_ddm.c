@@ -1,7 +1,7 @@
 /* test_ddm.c — DDM deblurring: on every row of a real pair (SHREC'07
- * glasses 52 -> 58, functional map from the BIM landmarks) the precise map's point is as near
- * to the row of Psi1 C as the best point of every face of M2 found by brute
- * force (written here independently: explicit vectors in R^k, every
+ * glasses 52 -> 58, functional map from the BIM landmarks) the precise
+ * map's point is as near to the row of Psi1 C as the best point of every
+ * face of M2 found by brute force (written here independently: explicit vectors in R^k, every
  * candidate of the triangle problem); the share of faces solved; the
  * objective never above the vertex map's; C = I on a mesh onto itself gives
  * the identity; denoising the published BIM and BCICP maps of TOSCA
