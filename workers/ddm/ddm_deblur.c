@@ -1,0 +1,204 @@
+/* ddm_deblur.c — DDM's precise map from a functional map: per vertex of
+ * M1, the exact nearest point of M2 embedded in R^k2, with App. A.2's
+ * candidate-face bound; see ddm.h. */
+#include "ddm/ddm.h"
+#include "util/errbuf.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *ddm_strerror(int code)
+{
+    switch (code) {
+#define DDM_STR(name, val, msg) case name: return msg;
+        DDM_ERRORS(DDM_STR)
+#undef DDM_STR
+    }
+    return "unknown DDM error";
+}
+
+/* Per face of M2, in R^k2 with corners A0, A1, A2 and e1 = A1 - A0,
+ * e2 = A2 - A0: the Gram entries a = e1.e1, h = e1.e2, c = e2.e2, the
+ * products p1 = e1.A0, p2 = e2.A0, and the longest edge. */
+typedef struct face_pre {
+    double a, h, c, p1, p2, lmax;
+} face_pre;
+
+static double dot(const double *x, const double *y, int k)
+{
+    double s = 0;
+    for (int j = 0; j < k; j++)
+        s += x[j] * y[j];
+    return s;
+}
+
+/* Q(s, t) = a s^2 + 2 h s t + c t^2 + 2 D s + 2 E t + F on the triangle
+ * s, t >= 0, s + t <= 1: the minimum value, its (s, t) in *s, *t. */
+static double triangle_min(const face_pre *f, double D, double E, double F, double *s, double *t)
+{
+    double a = f->a, h = f->h, c = f->c, det = a * c - h * h;
+    if (det > 1e-14 * a * c) {
+        double ss = (h * E - c * D) / det, tt = (h * D - a * E) / det;
+        if (ss >= 0 && tt >= 0 && ss + tt <= 1) {
+            *s = ss;
+            *t = tt;
+            return a * ss * ss + 2 * h * ss * tt + c * tt * tt + 2 * D * ss + 2 * E * tt + F;
+        }
+    }
+    /* the minimum is on the boundary: the best of the three edges */
+    double cand[3][2], best = INFINITY;
+    double u = a > 0 ? -D / a : 0;
+    cand[0][0] = u < 0 ? 0 : u > 1 ? 1 : u;               /* t = 0 */
+    cand[0][1] = 0;
+    u = c > 0 ? -E / c : 0;
+    cand[1][0] = 0;                                        /* s = 0 */
+    cand[1][1] = u < 0 ? 0 : u > 1 ? 1 : u;
+    double den = a + c - 2 * h;                            /* s + t = 1 */
+    u = den > 0 ? (a - h + D - E) / den : 0;
+    u = u < 0 ? 0 : u > 1 ? 1 : u;
+    cand[2][0] = 1 - u;
+    cand[2][1] = u;
+    for (int q = 0; q < 3; q++) {
+        double ss = cand[q][0], tt = cand[q][1];
+        double v = a * ss * ss + 2 * h * ss * tt + c * tt * tt + 2 * D * ss + 2 * E * tt + F;
+        if (v < best) {
+            best = v;
+            *s = ss;
+            *t = tt;
+        }
+    }
+    return best;
+}
+
+int ddm_deblur(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const mesh *T,
+               const double *C, int k1, int k2, bmap *P, ddm_stats *stats, char *err,
+               size_t errsz)
+{
+    if (k1 < 1 || k1 > b1->k || k2 < 1 || k2 > b2->k)
+        return errbuf_set(err, errsz, DDM_EINVAL,
+                          "deblurring: basis sizes %d, %d (the bases hold %d, %d)", k1, k2,
+                          b1->k, b2->k);
+    if (T->nv != b2->nv || P->n != b1->nv || P->nt != T->nv)
+        return errbuf_set(err, errsz, DDM_EINVAL,
+                          "deblurring: target of %d vertices for a basis of %d; map %d by %d "
+                          "for %d by %d", T->nv, b2->nv, P->n, P->nt, b1->nv, T->nv);
+    int n2 = T->nv, nf = T->nf, rc = DDM_ENOMEM;
+    if (nf < 1)
+        return errbuf_set(err, errsz, DDM_EINVAL, "deblurring: the target has no faces");
+    for (int q = 0; q < 3 * nf; q++)
+        if (T->f[q] < 0 || T->f[q] >= n2)
+            return errbuf_set(err, errsz, DDM_EINVAL, "deblurring: face %d has vertex %d of %d",
+                              q / 3, T->f[q], n2);
+    double *A = malloc((size_t)n2 * k2 * sizeof *A), *norm2 = malloc((size_t)n2 * sizeof *norm2);
+    face_pre *fp = malloc((size_t)nf * sizeof *fp);
+    int *vface = malloc((size_t)n2 * sizeof *vface);
+    long long solved = 0;
+    double cost = 0;
+    int fail = 0;
+    if (!A || !norm2 || !fp || !vface) {
+        errbuf_set(err, errsz, DDM_ENOMEM, "deblurring: out of memory (%d vertices)", n2);
+        goto out;
+    }
+    for (int j = 0; j < n2; j++) {
+        memcpy(A + (size_t)j * k2, b2->phi + (size_t)j * b2->k, (size_t)k2 * sizeof *A);
+        norm2[j] = dot(A + (size_t)j * k2, A + (size_t)j * k2, k2);
+        vface[j] = -1;
+    }
+    for (int f = nf - 1; f >= 0; f--)            /* lowest face with corner j, and which corner */
+        for (int q = 0; q < 3; q++)
+            vface[T->f[3 * f + q]] = 3 * f + q;
+    for (int f = 0; f < nf; f++) {
+        const double *a0 = A + (size_t)T->f[3 * f] * k2, *a1 = A + (size_t)T->f[3 * f + 1] * k2;
+        const double *a2 = A + (size_t)T->f[3 * f + 2] * k2;
+        double a = 0, h = 0, c = 0, p1 = 0, p2 = 0;
+        for (int j = 0; j < k2; j++) {
+            double e1 = a1[j] - a0[j], e2 = a2[j] - a0[j];
+            a += e1 * e1;
+            h += e1 * e2;
+            c += e2 * e2;
+            p1 += e1 * a0[j];
+            p2 += e2 * a0[j];
+        }
+        double l = fmax(fmax(a, c), a + c - 2 * h);
+        fp[f] = (face_pre){a, h, c, p1, p2, sqrt(fmax(l, 0))};
+    }
+#pragma omp parallel reduction(+ : solved, cost)
+    {
+        double *g = malloc((size_t)n2 * sizeof *g), *d2 = malloc((size_t)n2 * sizeof *d2);
+        double *b = malloc((size_t)k2 * sizeof *b);
+        if (!g || !d2 || !b) {
+#pragma omp atomic write
+            fail = 1;
+        }
+#pragma omp for schedule(dynamic, 16)
+        for (int i = 0; i < b1->nv; i++) {
+            if (!g || !d2 || !b)
+                continue;
+            const double *p = b1->phi + (size_t)i * b1->k;
+            for (int c = 0; c < k2; c++)
+                b[c] = 0;
+            for (int a = 0; a < k1; a++)
+                for (int c = 0; c < k2; c++)
+                    b[c] += p[a] * C[(size_t)a * k2 + c];
+            double bb = dot(b, b, k2), best = INFINITY;
+            int vbest = 0;
+            for (int j = 0; j < n2; j++) {
+                g[j] = dot(A + (size_t)j * k2, b, k2);
+                d2[j] = fmax(norm2[j] - 2 * g[j] + bb, 0);
+                if (d2[j] < best && vface[j] >= 0) {
+                    best = d2[j];
+                    vbest = j;
+                }
+            }
+            /* the nearest vertex (Delta_min), as a point of its lowest face */
+            int bf = vface[vbest] / 3, corner = vface[vbest] % 3;
+            double bw[3] = {corner == 0, corner == 1, corner == 2};
+            double rbest = sqrt(best);
+            for (int f = 0; f < nf; f++) {   /* the bound, squared: dmin^2 > (rbest + lmax)^2 */
+                const int *fv = T->f + 3 * f;
+                double dmin2 = fmin(fmin(d2[fv[0]], d2[fv[1]]), d2[fv[2]]), r = rbest + fp[f].lmax;
+                if (dmin2 > r * r)
+                    continue;
+                solved++;
+                double D = fp[f].p1 - (g[fv[1]] - g[fv[0]]), E = fp[f].p2 - (g[fv[2]] - g[fv[0]]);
+                double s = 0, t = 0, v = triangle_min(fp + f, D, E, d2[fv[0]], &s, &t);
+                if (v < best) {
+                    best = fmax(v, 0);
+                    rbest = sqrt(best);
+                    bf = f;
+                    bw[0] = 1 - s - t;
+                    bw[1] = s;
+                    bw[2] = t;
+                }
+            }
+            P->face[i] = bf;
+            double ws = 0;
+            for (int q = 0; q < 3; q++)
+                ws += bw[q] = bw[q] < 0 ? 0 : bw[q];
+            for (int q = 0; q < 3; q++)
+                P->w[3 * i + q] = bw[q] / ws;
+            if (m1)
+                cost += m1[i] * best;
+        }
+        free(g);
+        free(d2);
+        free(b);
+    }
+    if (fail) {
+        errbuf_set(err, errsz, DDM_ENOMEM, "deblurring: out of memory for a row's work");
+        goto out;
+    }
+    if (stats) {
+        stats->faces_solved = solved;
+        stats->faces_total = (long long)b1->nv * nf;
+        stats->cost = cost;
+    }
+    rc = DDM_OK;
+out:
+    free(A);
+    free(norm2);
+    free(fp);
+    free(vface);
+    return rc;
+}

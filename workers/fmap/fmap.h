@@ -1,0 +1,117 @@
+/* fmap.h — functional maps between two meshes from landmarks and spectral
+ * descriptors (Ovsjanikov et al. 2012), in the convention of the thesis'
+ * chapter 2 (DDM):
+ *
+ *   C (k1 by k2) carries coefficients on M2 to coefficients on M1, so that
+ *   Psi1 C ~ P Psi2 for the pointwise map P (n1 by n2, f1 = P f2), and for
+ *   isometries C is nearly orthogonal and nearly commutes with the
+ *   eigenvalues: Lambda1 C ~ C Lambda2.
+ *
+ * Least squares: with A1 = Psi1^T M1 F1 (k1 by nd), A2 = Psi2^T M2 F2
+ * (k2 by nd) the coefficients of corresponding descriptor columns,
+ *   C = argmin ||C A2 - A1||_F^2 + mu ||Lambda1 C - C Lambda2||_F^2.
+ * The Laplacian term is sum_ab D_ab C_ab^2 with D_ab = (lambda1_a -
+ * lambda2_b)^2, here divided by ||D||_F (pyFM's scaling, so mu does not
+ * depend on the meshes' scale), and the problem separates by rows of C:
+ * row a solves (A2 A2^T + mu diag(D_a.)) c_a^T = A2 A1_a.^T (k2 by k2,
+ * LAPACK Cholesky). Each descriptor column is first divided by its M-norm
+ * on its own shape (pyFM's normalisation).
+ *
+ * Descriptors from landmarks (fmap_landmark_descriptors): the WKS at ne
+ * energies and, per landmark pair, the wave kernel map of the landmark at
+ * the same energies (desc.h), energies taken from M1's spectrum and used on
+ * both shapes; both meshes should be at unit area.
+ *
+ * The vertex map (fmap_vertex_map): each vertex i of M1 goes to the vertex
+ * j of M2 whose spectral coordinates (row j of Psi2, first k2 columns) are
+ * nearest to row i of Psi1 C, by exhaustive search (exact; n1 n2 k2 work).
+ *
+ * Shapes are row-major. Errors: FMAP_EINVAL (a k above a basis' size or
+ * below 1, nd < 1, mu < 0), FMAP_ESOLVE (a row's system not positive
+ * definite: too few descriptors and mu = 0), FMAP_ENOMEM; detail in err. */
+#ifndef FMAP_H
+#define FMAP_H
+#include "lbo/lbo.h"
+#include "lmk/lmk.h"
+#include "mesh/mesh.h"
+
+#include <stddef.h>
+
+/* Weight of the Laplacian term. pyFM's 1e-3 left FAUST 000 -> 001 at 0.38
+ * mean geodesic error with k = 50 (our descriptor term is not pyFM's);
+ * 0.1 gave 0.053, and was also the best of 1e-3, 1e-2, 0.1 on FAUST
+ * 002 -> 007 and TOSCA wolf0 -> wolf2 for k = 30, 50, 80. */
+#define FMAP_MU_LAP_DEFAULT 0.1
+#define FMAP_ENERGIES_DEFAULT 50   /* WKS / WKM energies */
+
+#define FMAP_ERRORS(X)                                                      \
+    X(FMAP_OK,      0, "ok")                                                \
+    X(FMAP_ENOMEM, -1, "out of memory")                                     \
+    X(FMAP_EINVAL, -2, "invalid argument")                                  \
+    X(FMAP_ESOLVE, -3, "least-squares system singular")
+
+enum fmap_error {
+#define FMAP_ENUM(name, val, msg) name = val,
+    FMAP_ERRORS(FMAP_ENUM)
+#undef FMAP_ENUM
+};
+const char *fmap_strerror(int code);
+
+/* F1: n1 by nd, F2: n2 by nd (corresponding columns), m1, m2 the lumped
+ * masses; C: k1 by k2. */
+int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F1,
+                          const lbo_basis *b2, const double *m2, const double *F2, int nd,
+                          int k1, int k2, double mu, double *C, char *err, size_t errsz);
+
+/* The same objective plus D_N commutativity (seed 2017, §8.1):
+ *   + mu_n ||N1 C - C N2||_F^2 / (||N1||_F ||N2||_F),
+ * N1 (k1 by k1) and N2 (k2 by k2) the reduced normal operators
+ * (fmap_normal_operator). No longer row-separable: conjugate gradients on
+ * the normal equations in the k1 k2 entries of C, started from the
+ * Laplacian-only solution, until the residual is below FMAP_CG_TOL of the
+ * right-hand side (at most FMAP_CG_MAX_ITER steps; *iterations, may be
+ * NULL). mu_n = 0 gives fmap_from_descriptors' result. */
+/* D_N weight: the best of 0.01, 0.1, 1 on FAUST 000 -> 001, 002 -> 007 and
+ * 000 -> 020 (5 landmarks, k = 50; test_fmap.c has the figures); larger
+ * values were not tried. */
+#define FMAP_MU_NORMAL_DEFAULT 1.0
+#define FMAP_CG_TOL 1e-10
+#define FMAP_CG_MAX_ITER 5000
+int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const double *F1,
+                                 const double *N1, const lbo_basis *b2, const double *m2,
+                                 const double *F2, const double *N2, int nd, int k1, int k2,
+                                 double mu, double mu_n, double *C, int *iterations, char *err,
+                                 size_t errsz);
+
+/* *F1 (n1 by *nd) and *F2 (n2 by *nd), malloc()ed, caller frees:
+ * *nd = ne * (1 + L->n) columns (WKS, then each landmark's WKM). */
+int fmap_landmark_descriptors(const lbo_basis *b1, const lbo_basis *b2, const lmk_set *L,
+                              int ne, double **F1, double **F2, int *nd, char *err,
+                              size_t errsz);
+
+/* The functional deformation field of an extrinsic vector field V (seed
+ * functional-deformation-fields-2017, §4 and §6), reduced to the first k
+ * basis functions: D (k by k, symmetric) = Psi^T W_V Psi, where
+ *   f^T W_V h = sum_t area_t (L_V g)_t(grad f, grad h),
+ *   (L_V g)(X, Y) = <dV X, Y> + <dV Y, X>,
+ * the Lie derivative of the metric, per triangle with dV the (constant)
+ * differential of V's linear interpolant on the mesh's own triangles and
+ * grad f that of f's. (The seed's text lost its formulas; this follows its
+ * definition: per-edge finite differences of V, which is what dV is on a
+ * triangle.) Checks the tests make: V = positions gives L_V g = 2 g, so D =
+ * 2 Psi^T L_cotan Psi; V = a rigid motion gives D = 0. With V the unit
+ * vertex normals (fmap_normal_operator) L_N g = 2 II with II(X, Y) =
+ * <dN X, Y> (on the unit sphere with outward normals II = g): D_N carries
+ * the second fundamental form. V: nv by 3. Degenerate faces contribute
+ * nothing. FMAP_EINVAL for k out of the basis or a basis of another size. */
+int fmap_deformation_operator(const mesh *m, const double *V, const lbo_basis *b, int k,
+                              double *D, char *err, size_t errsz);
+/* fmap_deformation_operator of the area-weighted unit vertex normals. */
+int fmap_normal_operator(const mesh *m, const lbo_basis *b, int k, double *D, char *err,
+                         size_t errsz);
+
+/* map: n1 vertices of M2. */
+int fmap_vertex_map(const lbo_basis *b1, const lbo_basis *b2, const double *C, int k1, int k2,
+                    int *map, char *err, size_t errsz);
+
+#endif
