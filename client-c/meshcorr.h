@@ -104,6 +104,28 @@ typedef struct mc_job_spec {
  * meshes, no landmarks. */
 void mc_job_spec_init(mc_job_spec *s);
 
+/* The parameter list as data, for callers that walk it at run time (the
+ * Python package) rather than compile against PROTO_PARAMS: rows 0 to
+ * mc_param_count() - 1 in list order; NULL (type -1) out of range. The
+ * strings are static. */
+enum mc_param_type { MC_PARAM_ENUM, MC_PARAM_BOOL, MC_PARAM_U32, MC_PARAM_F64, MC_PARAM_STR };
+int mc_param_count(void);
+const char *mc_param_name(int i);              /* "inner_iterations": the member's name */
+const char *mc_param_cli(int i);               /* "inner-iterations": meshcorr's --option */
+int mc_param_type(int i);                      /* enum mc_param_type */
+const char *mc_param_values(int i);            /* ENUM, STR: "bijective|injective"; else "" */
+const char *mc_param_help(int i);
+/* sizeof(mc_job_spec): a binding that lays the struct out from the list
+ * checks its layout against it. */
+size_t mc_job_spec_size(void);
+/* Sets the member named name (or its option name) from text as `meshcorr
+ * submit --OPTION text` parses it: a number, a value name of an ENUM
+ * ("injective"), "0"/"1" for a BOOL; a STR keeps the pointer, so text must
+ * outlive s. Only parses: the server checks ranges at mc_submit (a bad
+ * value is refused there with its message). An unknown name or a value
+ * that does not parse: MC_EARG, detail in err. */
+int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
+
 enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1 };
 enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
 
@@ -209,6 +231,12 @@ int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, ch
  * mc_submit has returned. Bad sizes or indices: MC_EARG. */
 int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
                    char *err, size_t errsz);
+
+/* Draco bytes (a result's deformed mesh) as arrays: *v nv by 3 doubles,
+ * *f nf by 3 0-based indices, both malloc()ed, free() them. Bytes that do
+ * not decode to a triangle mesh: MC_EFILE. */
+int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, int **f, int *nf, char *err,
+                   size_t errsz);
 
 /* Position coding of the two calls below: MC_QUANTIZATION_LOSSLESS (what
  * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate
