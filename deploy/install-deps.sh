@@ -17,6 +17,7 @@ libsqlite3-dev
 libmodbus-dev libmicrohttpd-dev mbpoll
 slurmctld slurmd slurm-client munge
 libsystemd-dev
+python3 python3-numpy
 "
 
 SUDO=""

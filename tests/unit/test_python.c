@@ -3,10 +3,13 @@
  * tokens), writes the icosphere pair and runs one case of
  * tests/python/test_meshcorr.py with Debian's /usr/bin/python3 over
  * build/libmeshcorr.so.1. A case fails when the script exits non-zero, and
- * the test fails when the daemon died or exits non-zero. */
+ * the test fails when the daemon died or exits non-zero. Last, `make
+ * install-python PREFIX=tmp` and README's example script run from
+ * PYTHONPATH against the installed library, whose ldd is slim. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testfile.h"
+#include "support/testldd.h"
 #include "support/testmesh.h"
 #include "support/testrun.h"
 #include "mesh/mesh.h"
@@ -14,6 +17,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define PYTHON "/usr/bin/python3"
 
@@ -99,4 +103,50 @@ TEST_T(over_tcp_other_users_jobs_are_invisible_and_a_bad_token_is_refused, 120)
 TEST_T(bad_mesh_landmarks_and_parameters_are_refused_with_the_message, 120)
 {
     run_case("bad_input_refused");
+}
+
+TEST_T(installed_package_runs_the_readme_example_against_meshcorrd, 240)
+{
+    testdaemon_need_worker();
+    need_python();
+    char *readme = (char *)testfile_read("README.md", &(size_t){0});
+    CHECK_STR_HAS(readme, "make install-python PREFIX=");
+    CHECK_STR_HAS(readme, "client-c/python/examples/submit_pair.py");
+    free(readme);
+    char dest[600], repo[512], path[800], site[800];
+    CHECK(getcwd(repo, sizeof repo));
+    snprintf(dest, sizeof dest, "%s/inst", harness_tmpdir());
+    int rc = testrunf(out, sizeof out, "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s install-python PREFIX=%s 2>&1",
+                      dest);
+    if (rc)
+        FAILF("make install-python failed (%d):\n%s", rc, out);
+    snprintf(path, sizeof path, "%s/lib/libmeshcorr.so.1", dest);
+    testldd_check_slim(path);
+    CHECK_INT(testrunf(out, sizeof out, "ls -d %s/lib/python3*/dist-packages", dest), 0);
+    snprintf(site, sizeof site, "%.*s", (int)strcspn(out, "\n"), out);
+
+    testdaemon d;
+    testdaemon_start(&d, "py-inst", NULL);
+    write_inputs(&d);
+    /* from elsewhere than the source tree, without MESHCORR_LIB: the
+     * installed package and the library its _libpath.py names */
+    char env[2000];
+    snprintf(env, sizeof env, "cd %s && env -u MESHCORR_LIB PYTHONDONTWRITEBYTECODE=1 MESHCORR_SERVER=%s "
+             "PYTHONPATH=%s " PYTHON, harness_tmpdir(), d.unix_addr, site);
+    CHECK_INT(testrunf(out, sizeof out, "%s -c 'import meshcorr, meshcorr._lib as l; "
+                       "print(meshcorr.__file__); print(l.lib._name)' 2>&1", env), 0);
+    CHECK_STR_HAS(out, site);
+    CHECK_STR_HAS(out, path);
+    char map[700];
+    snprintf(map, sizeof map, "%s/example.map", harness_tmpdir());
+    rc = testrunf(out, sizeof out, "%s %s/client-c/python/examples/submit_pair.py %s %s %s %s 3 2>&1", env, repo,
+                  getenv("MESHCORR_TEST_SRC"), getenv("MESHCORR_TEST_TGT"), getenv("MESHCORR_TEST_LMK"), map);
+    if (rc)
+        FAILF("submit_pair.py exited %d:\n%s", rc, out);
+    CHECK_STR_HAS(out, "\nectm    3/3 energy ");
+    CHECK_STR_HAS(out, "COMPLETED: 162 rows written to ");
+    char *text = (char *)testfile_read(map, &(size_t){0});
+    CHECK_STR_HAS(text, "# meshcorr-map 1\n# meshcorrd job 1\n162 162\n");
+    free(text);
+    testdaemon_stop(&d, SIGTERM);
 }
