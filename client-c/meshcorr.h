@@ -12,8 +12,9 @@
  * Errors: every function returns 0 or a negative code. Codes from -1 to -99
  * are the server's refusals (the protocol's error list: MC_ENOT_FOUND is
  * PROTO_ENOT_FOUND, ...); -100 and below are this library's own (MC_E* below).
- * mc_strerror names any code; mc_errmsg(client) gives the detail of the
- * client's last failed call (the server's message, or the system error).
+ * mc_strerror describes any code, mc_err_name names it; mc_errmsg(client)
+ * gives the detail of the client's last failed call (the server's message,
+ * or the system error).
  *
  * Ownership: mc_connect returns a client freed by mc_close (NULL ok).
  * Arrays a call fills are malloc()ed and released with one call each:
@@ -53,6 +54,9 @@ enum mc_error {
 #undef MC_ENUM
 };
 const char *mc_strerror(int code);
+/* The code's name: "BAD_PARAMS" (the protocol's name of a server code), "MC_EARG"
+ * (this library's); "UNKNOWN" for others. */
+const char *mc_err_name(int code);
 
 /* Job states (Slurm's names) and stages, as in the protocol. */
 enum mc_state { MC_PENDING, MC_RUNNING, MC_COMPLETED, MC_FAILED, MC_CANCELLED, MC_TIMEOUT,

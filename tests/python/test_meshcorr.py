@@ -31,11 +31,11 @@ def read_off(path):
     return V, F[:, 1:]
 
 
-def expect_error(code, fn, *args, has=None, **kw):
+def expect_error(code, name, fn, *args, has=None, **kw):
     try:
         fn(*args, **kw)
     except meshcorr.MeshcorrError as e:
-        assert e.code == code, "code %d, expected %d: %s" % (e.code, code, e)
+        assert (e.code, e.name) == (code, name), "%d %s, expected %d %s: %s" % (e.code, e.name, code, name, e)
         assert has is None or has in e.message, "message %r lacks %r" % (e.message, has)
         return e
     raise AssertionError("no MeshcorrError %d from %s" % (code, fn.__name__))
@@ -91,7 +91,7 @@ def case_files_watch_result_same_as_cli():
     s = c.stats()
     assert s["completed"] >= 2 and s["workers"] >= 1, s
     job.delete()
-    expect_error(-15, job.status)
+    expect_error(-15, "NOT_FOUND", job.status)
 
 
 def case_arrays_same_map_as_files():
@@ -119,7 +119,7 @@ def case_cancel():
             break
     assert job.wait() == "CANCELLED", job.state
     assert job.status()["state"] == "CANCELLED"
-    expect_error(-16, job.result)           # BAD_STATE: no maps of a cancelled job
+    expect_error(-16, "BAD_STATE", job.result)           # BAD_STATE: no maps of a cancelled job
 
 
 def case_tokens_over_tcp():
@@ -128,11 +128,10 @@ def case_tokens_over_tcp():
     job = alice.submit(SRC, TGT, landmarks=LANDMARKS, **JOB)
     assert job.id in [j["id"] for j in alice.list()]
     assert job.id not in [j["id"] for j in bob.list()]
-    e = expect_error(-15, bob.job(job.id).status)
-    assert e.name
-    expect_error(-15, bob.job(job.id).cancel)
+    expect_error(-15, "NOT_FOUND", bob.job(job.id).status)
+    expect_error(-15, "NOT_FOUND", bob.job(job.id).cancel)
     assert job.wait() == "COMPLETED"
-    expect_error(-13, meshcorr.Client, TCP, "not-a-token")
+    expect_error(-13, "UNAUTHORIZED", meshcorr.Client, TCP, "not-a-token")
     os.environ["MESHCORR_SERVER"], os.environ["MESHCORR_TOKEN"] = TCP, BOB
     assert meshcorr.Client().user == "bob"     # the CLI's defaults
 
@@ -144,13 +143,15 @@ def case_bad_input_refused():
     # one more face on an existing edge: three faces meet there
     Vb = np.vstack([V, [[2.0, 0, 0]]])
     Fb = np.vstack([F, [[F[0, 0], F[0, 1], nv]]])
-    expect_error(-19, c.submit, (Vb, Fb), SRC, landmarks=LANDMARKS, **JOB, has="non-manifold")
-    expect_error(-20, c.submit, SRC, TGT, landmarks=[[0, 0], [1, 1], [2, 500]], **JOB, has="500")
-    expect_error(-21, c.submit, SRC, TGT, landmarks=LANDMARKS, inner_iterations=500000,
+    expect_error(-19, "BAD_MESH", c.submit, (Vb, Fb), SRC, landmarks=LANDMARKS, **JOB, has="non-manifold")
+    expect_error(-20, "BAD_LANDMARKS", c.submit, SRC, TGT, landmarks=[[0, 0], [1, 1], [2, 500]], **JOB, has="500")
+    expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, inner_iterations=500000,
                  has="inner_iterations")
-    expect_error(-100, c.submit, SRC, TGT, landmarks=LANDMARKS, model="sideways", has="sideways")
-    expect_error(-100, c.submit, SRC, TGT, landmarks=LANDMARKS, no_such_option=1, has="no_such_option")
-    expect_error(-100, c.submit, (V, np.array([[0, 1, nv + 5]])), TGT, landmarks=LANDMARKS)
+    expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, iterations=0,
+                 has="params.iterations = 0 < 1")
+    expect_error(-100, "MC_EARG", c.submit, SRC, TGT, landmarks=LANDMARKS, model="sideways", has="sideways")
+    expect_error(-100, "MC_EARG", c.submit, SRC, TGT, landmarks=LANDMARKS, no_such_option=1, has="no_such_option")
+    expect_error(-100, "MC_EARG", c.submit, (V, np.array([[0, 1, nv + 5]])), TGT, landmarks=LANDMARKS)
     assert c.list() == []
 
 

@@ -210,6 +210,15 @@ TEST(parameter_list_as_data_sets_each_member_as_the_cli_parses_its_option)
     CHECK_INT(s.model, MC_INJECTIVE);
 }
 
+TEST(error_codes_have_the_protocols_names_and_the_librarys)
+{
+    CHECK(strcmp(mc_err_name(MC_ENOT_FOUND), "NOT_FOUND") == 0);
+    CHECK(strcmp(mc_err_name(-21), "BAD_PARAMS") == 0);
+    CHECK(strcmp(mc_err_name(MC_EARG), "MC_EARG") == 0);
+    CHECK(strcmp(mc_err_name(MC_EFILE), "MC_EFILE") == 0);
+    CHECK(strcmp(mc_err_name(-99), "UNKNOWN") == 0);
+}
+
 TEST(shared_library_links_no_engine_library)
 {
     testldd_check_slim("build/libmeshcorr.so.1");

@@ -136,6 +136,7 @@ c_err = ctypes.c_char_p
 PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(Progress))
 
 _declare("mc_strerror", ctypes.c_char_p, ctypes.c_int)
+_declare("mc_err_name", ctypes.c_char_p, ctypes.c_int)
 _declare("mc_state_name", ctypes.c_char_p, ctypes.c_int)
 _declare("mc_state_parse", ctypes.c_int, ctypes.c_char_p)
 _declare("mc_job_spec_init", None, ctypes.POINTER(JobSpec))
@@ -179,4 +180,4 @@ def check(rc, detail):
     if rc:
         if isinstance(detail, (bytes, bytearray)):
             detail = detail.decode(errors="replace")
-        raise MeshcorrError(rc, lib.mc_strerror(rc).decode(), detail)
+        raise MeshcorrError(rc, lib.mc_err_name(rc).decode(), lib.mc_strerror(rc).decode(), detail)

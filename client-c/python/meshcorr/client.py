@@ -16,7 +16,6 @@ from .map import Map, read_map
 STAGES = ("start", "rhm", "ectm", "init")
 _WANT_P, _WANT_Q, _WANT_DEFORMED, _WANT_METRICS = 1, 2, 4, 8
 _PARAM_NAMES = {p.name: p for p in _lib.PARAMS}
-MC_EARG = -100
 
 
 def _default_server():
@@ -28,7 +27,7 @@ def _default_server():
 
 def _text(value):
     """A keyword's value as the text `meshcorr submit --option` takes."""
-    if isinstance(value, bool):
+    if isinstance(value, (bool, np.bool_)):
         return "1" if value else "0"
     if isinstance(value, float):
         return "%.17g" % value
@@ -289,8 +288,6 @@ class Job:
             stop.set()
         t.join()
         rc, err, state, reason = r
-        if rc == 1 and stop.is_set():
-            return
         check(rc, err)
         self.state = lib.mc_state_name(state).decode() if lib.mc_state_name(state) else str(state)
         self.reason = reason

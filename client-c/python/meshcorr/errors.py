@@ -4,11 +4,13 @@
 
 
 class MeshcorrError(Exception):
-    """code: the negative error code (MC_ENOT_FOUND = -15 ...); name: what
-    mc_strerror calls it; message: the server's message or the local detail."""
+    """code: the negative error code (-15 ...); name: mc_err_name's
+    ("NOT_FOUND", "BAD_PARAMS", "MC_EARG"); description: mc_strerror's
+    ("no such job"); message: the server's message or the local detail."""
 
-    def __init__(self, code, name, message):
+    def __init__(self, code, name, description, message):
         self.code = code
         self.name = name
-        self.message = message or name
+        self.description = description
+        self.message = message or description
         super().__init__("%s (%d): %s" % (name, code, self.message))
