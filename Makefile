@@ -4,7 +4,7 @@
 #   make test       unit tests + gradient checks + integration (tests/run-tests.sh)
 #   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
 #   make demo       install deps, build, run the demo job on Debian's CGAL meshes
-#   make install    PREFIX=/usr/local DESTDIR=
+#   make install    PREFIX=/usr/local DESTDIR= (install-lib install-python: the client part)
 #   make doc-params PROTOCOL.md's parameter table and meshcorr(1)'s list from
 #                   protocol/proto_params.h
 PREFIX  ?= /usr/local
@@ -79,7 +79,7 @@ WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
 
-.PHONY: all test bench demo install install-lib install-man clean doc-params
+.PHONY: all test bench demo install install-lib install-man install-python clean doc-params
 # Objects built through pattern chains are kept (make would otherwise delete
 # them after the run and print that as the last line of `make test`).
 .SECONDARY:
@@ -196,6 +196,19 @@ install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_LIB) $(PROTO_LIB)
 	ln -sf libmeshcorr.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr.so
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(strip $(LDLIBS))|' client-c/meshcorr.pc.in \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/meshcorr.pc
+
+# The Python package (client-c/python/meshcorr) where Debian's python3 finds
+# it: /usr/lib/python3/dist-packages for PREFIX=/usr, else
+# PREFIX/lib/python3.X/dist-packages (/usr/local's is on Debian's path);
+# _libpath.py names the installed libmeshcorr.so.1 ($MESHCORR_LIB overrides).
+PYTHON_SITE ?= $(if $(filter /usr,$(PREFIX)),$(PREFIX)/lib/python3/dist-packages,$(PREFIX)/lib/$(shell \
+  /usr/bin/python3 -c 'import sys; print("python%d.%d" % sys.version_info[:2])' 2>/dev/null || echo python3)/dist-packages)
+install: install-python
+install-python: install-lib
+	install -d $(DESTDIR)$(PYTHON_SITE)/meshcorr
+	install -m 644 client-c/python/meshcorr/*.py $(DESTDIR)$(PYTHON_SITE)/meshcorr/
+	printf '"""_libpath.py — written by make install: the installed libmeshcorr."""\nLIBMESHCORR = "%s"\n' \
+	  '$(PREFIX)/lib/libmeshcorr.so.1' > $(DESTDIR)$(PYTHON_SITE)/meshcorr/_libpath.py
 
 clean:
 	rm -rf $(BUILD)

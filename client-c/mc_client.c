@@ -41,6 +41,16 @@ const char *mc_strerror(int code)
     }
 }
 
+const char *mc_err_name(int code)
+{
+    switch (code) {
+#define MC_NAME(name, val, msg) case val: return #name;
+    MC_ERRORS(MC_NAME)
+#undef MC_NAME
+    default: return proto_err_name(code);
+    }
+}
+
 const char *mc_state_name(int state) { return proto_state_name(state); }
 
 int mc_state_parse(const char *name)

@@ -2,7 +2,7 @@
  * arrays in memory, as the Draco bytes a job carries, with the engine's
  * order-preserving encoder (landmarks and maps use the file's vertex order),
  * positions lossless unless the caller asks for quantization. A .drc file is
- * sent as it is. */
+ * sent as it is. And back: Draco bytes (a result's deformed mesh) as arrays. */
 #include "meshcorr.h"
 #include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
@@ -108,4 +108,23 @@ int mc_encode_mesh_file_quantized(const char *path, int quantization_bits, unsig
 int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, char *err, size_t errsz)
 {
     return mc_encode_mesh_file_quantized(path, MC_QUANTIZATION_LOSSLESS, bytes, len, err, errsz);
+}
+
+int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, int **f, int *nf, char *err,
+                   size_t errsz)
+{
+    *v = NULL;
+    *f = NULL;
+    *nv = *nf = 0;
+    if (!bytes || !len) {
+        snprintf(err, errsz, "no Draco bytes");
+        return MC_EARG;
+    }
+    char derr[512];
+    int rc = dracob_decode(bytes, len, MESH_MAX_VERTICES, MESH_MAX_FACES, v, nv, f, nf, derr, sizeof derr);
+    if (rc) {
+        snprintf(err, errsz, "%s", derr);
+        return rc == DRACOB_ENOMEM ? MC_ENOMEM : MC_EFILE;
+    }
+    return 0;
 }

@@ -12,8 +12,9 @@
  * Errors: every function returns 0 or a negative code. Codes from -1 to -99
  * are the server's refusals (the protocol's error list: MC_ENOT_FOUND is
  * PROTO_ENOT_FOUND, ...); -100 and below are this library's own (MC_E* below).
- * mc_strerror names any code; mc_errmsg(client) gives the detail of the
- * client's last failed call (the server's message, or the system error).
+ * mc_strerror describes any code, mc_err_name names it; mc_errmsg(client)
+ * gives the detail of the client's last failed call (the server's message,
+ * or the system error).
  *
  * Ownership: mc_connect returns a client freed by mc_close (NULL ok).
  * Arrays a call fills are malloc()ed and released with one call each:
@@ -53,6 +54,9 @@ enum mc_error {
 #undef MC_ENUM
 };
 const char *mc_strerror(int code);
+/* The code's name: "BAD_PARAMS" (the protocol's name of a server code), "MC_EARG"
+ * (this library's); "UNKNOWN" for others. */
+const char *mc_err_name(int code);
 
 /* Job states (Slurm's names) and stages, as in the protocol. */
 enum mc_state { MC_PENDING, MC_RUNNING, MC_COMPLETED, MC_FAILED, MC_CANCELLED, MC_TIMEOUT,
@@ -103,6 +107,28 @@ typedef struct mc_job_spec {
 /* Every parameter its default (the list's, those of `meshcorr match`); no
  * meshes, no landmarks. */
 void mc_job_spec_init(mc_job_spec *s);
+
+/* The parameter list as data, for callers that walk it at run time (the
+ * Python package) rather than compile against PROTO_PARAMS: rows 0 to
+ * mc_param_count() - 1 in list order; NULL (type -1) out of range. The
+ * strings are static. */
+enum mc_param_type { MC_PARAM_ENUM, MC_PARAM_BOOL, MC_PARAM_U32, MC_PARAM_F64, MC_PARAM_STR };
+int mc_param_count(void);
+const char *mc_param_name(int i);              /* "inner_iterations": the member's name */
+const char *mc_param_cli(int i);               /* "inner-iterations": meshcorr's --option */
+int mc_param_type(int i);                      /* enum mc_param_type */
+const char *mc_param_values(int i);            /* ENUM, STR: "bijective|injective"; else "" */
+const char *mc_param_help(int i);
+/* sizeof(mc_job_spec): a binding that lays the struct out from the list
+ * checks its layout against it. */
+size_t mc_job_spec_size(void);
+/* Sets the member named name (or its option name) from text as `meshcorr
+ * submit --OPTION text` parses it: a number, a value name of an ENUM
+ * ("injective"), "0"/"1" for a BOOL; a STR keeps the pointer, so text must
+ * outlive s. Only parses: the server checks ranges at mc_submit (a bad
+ * value is refused there with its message). An unknown name or a value
+ * that does not parse: MC_EARG, detail in err. */
+int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
 
 enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1 };
 enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
@@ -223,6 +249,12 @@ int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, ch
  * mc_submit has returned. Bad sizes or indices: MC_EARG. */
 int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char **bytes, size_t *len,
                    char *err, size_t errsz);
+
+/* Draco bytes (a result's deformed mesh) as arrays: *v nv by 3 doubles,
+ * *f nf by 3 0-based indices, both malloc()ed, free() them. Bytes that do
+ * not decode to a triangle mesh: MC_EFILE. */
+int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, int **f, int *nf, char *err,
+                   size_t errsz);
 
 /* Position coding of the two calls below: MC_QUANTIZATION_LOSSLESS (what
  * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate

@@ -19,6 +19,7 @@ slurmctld slurmd slurm-client munge
 libsystemd-dev
 mandoc man-db python3-prometheus-client
 libpng-dev
+python3 python3-numpy
 "
 
 SUDO=""

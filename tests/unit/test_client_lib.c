@@ -1,11 +1,14 @@
 /* test_client_lib.c — libmeshcorr as a user gets it: in-memory meshes encoded
- * with their vertex order and positions kept (or quantized on request), and `make install` (the library part, into a
+ * with their vertex order and positions kept (or quantized on request) and
+ * decoded back, the parameter list as data, a shared library that links no
+ * engine library, and `make install` (the library part, into a
  * temporary DESTDIR) giving a header, static and shared libraries and a
  * pkg-config file that a small program builds with and talks to a real
  * meshcorrd through. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testfile.h"
+#include "support/testldd.h"
 #include "support/testmesh.h"
 #include "support/testrun.h"
 #include "mesh/draco_bridge.h"
@@ -147,6 +150,80 @@ static const char prog[] =
     "    return rc != 0;\n"
     "}\n";
 
+TEST(draco_bytes_decode_back_to_the_arrays_and_junk_is_refused)
+{
+    mesh *m = testmesh_icosphere(1);
+    CHECK(m);
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    char err[512];
+    CHECK_INT(mc_encode_mesh(m->v, m->nv, m->f, m->nf, &buf, &len, err, sizeof err), 0);
+    double *v = NULL;
+    int *f = NULL, nv = 0, nf = 0;
+    CHECK_INT(mc_decode_mesh(buf, len, &v, &nv, &f, &nf, err, sizeof err), 0);
+    CHECK_INT(nv, m->nv);
+    CHECK_INT(nf, m->nf);
+    CHECK(memcmp(v, m->v, sizeof(double) * 3 * (size_t)nv) == 0);
+    free(v);
+    free(f);
+    CHECK_INT(mc_decode_mesh(buf, len / 2, &v, &nv, &f, &nf, err, sizeof err), MC_EFILE);
+    CHECK(!v && !f && err[0]);
+    free(buf);
+    mesh_free(m);
+}
+
+TEST(parameter_list_as_data_sets_each_member_as_the_cli_parses_its_option)
+{
+#define COUNT_ROW(...) +1
+    CHECK_INT(mc_param_count(), 0 PROTO_PARAMS(COUNT_ROW));
+#undef COUNT_ROW
+    CHECK_INT(mc_job_spec_size(), sizeof(mc_job_spec));
+    CHECK(strcmp(mc_param_name(0), "model") == 0 && strcmp(mc_param_values(0), "bijective|injective") == 0);
+    CHECK_INT(mc_param_type(0), MC_PARAM_ENUM);
+    int last = mc_param_count() - 1;
+    CHECK(strcmp(mc_param_name(last), "backend") == 0 && mc_param_type(last) == MC_PARAM_STR);
+    CHECK(mc_param_name(last + 1) == NULL && mc_param_type(-1) == -1);
+    for (int i = 0; i <= last; i++)
+        CHECK(mc_param_cli(i) && mc_param_help(i)[0] && mc_param_values(i));
+
+    mc_job_spec s;
+    mc_job_spec_init(&s);
+    char err[256];
+    CHECK_INT(mc_job_spec_set(&s, "model", "injective", err, sizeof err), 0);
+    CHECK_INT(s.model, MC_INJECTIVE);
+    CHECK_INT(mc_job_spec_set(&s, "inner-iterations", "77", err, sizeof err), 0);   /* the option's name */
+    CHECK_INT(s.inner_iterations, 77);
+    CHECK_INT(mc_job_spec_set(&s, "partial", "1", err, sizeof err), 0);
+    CHECK_INT(s.partial, 1);
+    CHECK_INT(mc_job_spec_set(&s, "beta0", "1234.5", err, sizeof err), 0);
+    CHECK(s.beta0 == 1234.5);
+    const char *backend = "opencl:gpu";
+    CHECK_INT(mc_job_spec_set(&s, "backend", backend, err, sizeof err), 0);
+    CHECK(s.backend == backend);
+    CHECK(s.alpha == 20 && s.iterations == 300);                 /* the others keep their defaults */
+    CHECK_INT(mc_job_spec_set(&s, "model", "sideways", err, sizeof err), MC_EARG);
+    CHECK_STR_HAS(err, "sideways");
+    CHECK_INT(mc_job_spec_set(&s, "iterations", "many", err, sizeof err), MC_EARG);
+    CHECK_STR_HAS(err, "iterations");
+    CHECK_INT(mc_job_spec_set(&s, "no_such", "1", err, sizeof err), MC_EARG);
+    CHECK_STR_HAS(err, "'no_such' is not a job parameter");
+    CHECK_INT(s.model, MC_INJECTIVE);
+}
+
+TEST(error_codes_have_the_protocols_names_and_the_librarys)
+{
+    CHECK(strcmp(mc_err_name(MC_ENOT_FOUND), "NOT_FOUND") == 0);
+    CHECK(strcmp(mc_err_name(-21), "BAD_PARAMS") == 0);
+    CHECK(strcmp(mc_err_name(MC_EARG), "MC_EARG") == 0);
+    CHECK(strcmp(mc_err_name(MC_EFILE), "MC_EFILE") == 0);
+    CHECK(strcmp(mc_err_name(-99), "UNKNOWN") == 0);
+}
+
+TEST(shared_library_links_no_engine_library)
+{
+    testldd_check_slim("build/libmeshcorr.so.1");
+}
+
 TEST_T(installed_library_builds_a_program_with_pkg_config_that_talks_to_meshcorrd, 240)
 {
     testdaemon_need_worker();
@@ -168,6 +245,8 @@ TEST_T(installed_library_builds_a_program_with_pkg_config_that_talks_to_meshcorr
     free(pc);
     CHECK_INT(testrunf(out, sizeof out, "readelf -d %s/opt/mc/lib/libmeshcorr.so.1", dest), 0);
     CHECK_STR_HAS(out, "Library soname: [libmeshcorr.so.1]");
+    snprintf(path, sizeof path, "%s/opt/mc/lib/libmeshcorr.so.1", dest);
+    testldd_check_slim(path);
 
     const char *src = testfile_text("prog.c", prog);
     char bin[700];

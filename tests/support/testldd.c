@@ -1,0 +1,30 @@
+/* testldd.c — see testldd.h. */
+#include "support/testldd.h"
+#include "support/harness.h"
+#include "support/testrun.h"
+
+#include <string.h>
+
+static const char *const allowed[] = {"linux-vdso.so.", "libc.so.", "libm.so.", "libdraco.so.",
+                                      "libstdc++.so.", "libgcc_s.so.", "/lib64/ld-linux", "ld-linux"};
+
+void testldd_check_slim(const char *path)
+{
+    static char out[1 << 14];
+    int rc = testrunf(out, sizeof out, "ldd '%s' 2>&1", path);
+    if (rc != 0)
+        FAILF("ldd %s exited %d:\n%s", path, rc, out);
+    int n = 0;
+    for (char *line = strtok(out, "\n"); line; line = strtok(NULL, "\n")) {
+        line += strspn(line, " \t");
+        if (strstr(line, "not found"))
+            FAILF("ldd %s: %s", path, line);
+        size_t k = 0;
+        while (k < sizeof allowed / sizeof *allowed && strncmp(line, allowed[k], strlen(allowed[k])))
+            k++;
+        if (k == sizeof allowed / sizeof *allowed)
+            FAILF("ldd %s lists %s: only libc, libm, libdraco and the C++ runtime may be linked", path, line);
+        n++;
+    }
+    CHECK(n >= 3);                          /* libc, libdraco, the loader at least */
+}
