@@ -4,7 +4,7 @@
 #   make test       unit tests + gradient checks + integration (tests/run-tests.sh)
 #   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
 #   make demo       install deps, build, run the demo job on Debian's CGAL meshes
-#   make install    PREFIX=/usr/local DESTDIR= (install-lib install-python: the client part)
+#   make install    PREFIX=/usr/local DESTDIR= SYSCONFDIR= (install-lib install-python: the client part)
 #   make doc-params PROTOCOL.md's parameter table and meshcorr(1)'s list from
 #                   protocol/proto_params.h
 PREFIX  ?= /usr/local
@@ -170,12 +170,17 @@ demo:
 	$(MAKE) all
 	sh deploy/demo.sh $(BUILD)
 
+# The daemon's config: /etc for PREFIX=/usr (a package), else $(PREFIX)/etc,
+# so an install into a folder of one's own needs no root.
+SYSCONFDIR ?= $(if $(filter /usr,$(PREFIX)),/etc,$(PREFIX)/etc)
 install: $(PROGRAMS)
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/systemd/system $(DESTDIR)/etc/meshcorr
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/systemd/system $(DESTDIR)$(SYSCONFDIR)/meshcorr
 	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
-	sed 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
+	sed -e 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' -e 's|/etc/meshcorr/|$(SYSCONFDIR)/meshcorr/|' \
+	  deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
-	test -e $(DESTDIR)/etc/meshcorr/meshcorrd.conf || install -m 644 deploy/meshcorrd.conf $(DESTDIR)/etc/meshcorr/meshcorrd.conf
+	test -e $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf || \
+	  install -m 644 deploy/meshcorrd.conf $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf
 
 # The man pages (deploy/man/NAME.SECTION), each into its section's folder.
 MAN_PAGES := $(wildcard deploy/man/*.[1-8])

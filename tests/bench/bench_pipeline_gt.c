@@ -45,7 +45,7 @@
  *   --pairs=A,B,...       only these pairs (labels as in the table)
  *   --scale=S             multiply both meshes' coordinates by S first
  *                         (a check of scale invariance)
- *   --rhm-start=NAME      distances (the default) or voronoi
+ *   --rhm-start=NAME      distances (the default), voronoi or fmap
  * Each pair runs in its own process (support/testapart.h): a crash or an
  * error becomes that pair's row, and the other pairs still run. The rhm
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold

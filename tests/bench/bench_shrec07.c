@@ -27,7 +27,8 @@
  * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm
  * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for
  * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
- * the default, for comparing). Each pair runs in
+ * the default, for comparing), --rhm-start=NAME (a start map of
+ * proto_params.h's rhm_start list instead of the default). Each pair runs in
  * its own process (support/testapart.h). Prints figures, never fails on
  * quality. */
 #include "support/harness.h"
@@ -70,6 +71,7 @@ typedef struct pair_job {
     int last;               /* the last stage to run (--stop) */
     const char *out_dir;    /* --out-dir: each stage's map is written there */
     double eta;             /* --eta: ECTM's bending weight, 0: the default */
+    int start;              /* --rhm-start: RHM_START_*, -1: the default */
 } pair_job;
 
 static double now(void)
@@ -177,6 +179,8 @@ static void run_pair(const void *arg, void *out)
         goto out;
     rhm_params rp;
     rhm_params_init(&rp);
+    if (job->start >= 0)
+        rp.start = job->start;
     ectm_params ep;
     ectm_params_init(&ep);
     if (job->ectm_iterations > 0)
@@ -347,6 +351,13 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     const char *o_it = harness_option("ectm-iterations"), *o_pairs = harness_option("pairs");
     const char *o_stop = harness_option("stop"), *o_out = harness_option("out-dir");
     double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
+    const char *o_start = harness_option("rhm-start");
+    proto_params w;                      /* the start's names are the list's */
+    char perr[256];
+    proto_params_init(&w);
+    if (o_start && proto_param_parse(&w, PROTO_P_rhm_start, o_start, perr, sizeof perr))
+        FAILF("--rhm-start: %s", perr);
+    int start = o_start ? (int)w.rhm_start : -1;
     int iters = o_it ? atoi(o_it) : 0, last = ECTM;
     if (o_stop)
         last = !strcmp(o_stop, "start") ? START : !strcmp(o_stop, "rhm") ? RHM : -1;
@@ -364,7 +375,7 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     for (int i = 0; i < NPAIRS; i++) {
         if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
-        pair_job job = { &pairs[i], iters, last, o_out, eta };
+        pair_job job = { &pairs[i], iters, last, o_out, eta, start };
         char why[256];
         if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
             snprintf(figs[i].why, sizeof figs[i].why, "%s", why);

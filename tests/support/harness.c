@@ -1,4 +1,5 @@
-/* harness.c — runs each registered test in a forked child under alarm();
+/* harness.c — runs each registered test in a forked child, in a process
+ * group of its own (what it leaves running is killed after it), under alarm();
  * prints "PASS|FAIL|SKIP <binary>.<test>" lines. Holds no test logic. */
 #include "support/harness.h"
 #include "util/ompenv.h"
@@ -96,13 +97,19 @@ static int run_one(const char *prog, int i)
         return 1;
     }
     if (pid == 0) {
+        setpgid(0, 0);
         alarm((unsigned)tests[i].timeout);
         tests[i].fn();
         fflush(stdout);
         _exit(0);
     }
+    setpgid(pid, pid);               /* the test's own process group (either side may win) */
     int st = 0;
     while (waitpid(pid, &st, 0) < 0) {}
+    /* What the test left running (a worker of a daemon that a failed test
+     * never stopped: workers outlive their daemon by design) goes with it,
+     * so it cannot spin through the tests after it. */
+    kill(-pid, SIGKILL);
     if (WIFEXITED(st) && WEXITSTATUS(st) == 0) {
         printf("PASS %s.%s\n", prog, tests[i].name);
         return 0;

@@ -114,6 +114,25 @@ TEST_T(rhm_then_ectm_from_faust_landmarks_against_ground_truth, 300)
     CHECK(ge[2] <= ge[1] * 1.02);
 }
 
+/* The functional-map start (landmark WKS/WKM descriptors, Δ + D_N
+ * commutativity, DDM deblurring) on the same FAUST pair and 12 landmarks:
+ * a map onto the target's faces that RHM refines about as far as from the
+ * distances start. Seen: start 0.0316, RHM 0.0226 (16.8 % flipped),
+ * RHM + ECTM 0.0215; the distances start 0.0258, 0.0216 (6.1 %), 0.0207.
+ * On SHREC'07 (bench_shrec07 --rhm-start=fmap) it is worse on most
+ * classes but finds the plier's parts (RHM error 0.028 against 0.54),
+ * mirrored (59 % flipped): an option, not the default. */
+TEST_T(fmap_start_gives_rhm_a_usable_start_on_faust, 300)
+{
+    double gf[3];
+    metric_summary mf[3];
+    faust_pipeline(RHM_START_FMAP, gf, mf);
+    CHECK(gf[0] < 0.05);
+    CHECK(gf[1] < 0.03 && gf[1] < gf[0]);
+    CHECK(gf[2] <= gf[1] * 1.02);
+    CHECK(mf[1].flipped_fraction < 0.5 && mf[1].collapsed_fraction < 0.2);
+}
+
 /* A problem on the FAUST pair after the start of kind `start` and `iters`
  * full iterations (so that maps and split variables are generic). */
 static rhm__problem *faust_problem_from(testgt *g, int iters, int start)

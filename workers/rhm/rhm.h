@@ -74,7 +74,8 @@ const char *rhm_strerror(int code);
 
 typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
-    RHM_START_VORONOI = 1      /* the thesis' geodesic Voronoi map          */
+    RHM_START_VORONOI = 1,     /* the thesis' geodesic Voronoi map          */
+    RHM_START_FMAP = 2         /* functional map (Δ + D_N) deblurred by DDM */
 } rhm_start;
 /* Their names are the values of rhm_start in PROTO_PARAMS (proto_params.h):
  * proto_param_value_name, proto_param_parse. */

@@ -1,10 +1,15 @@
 /* rhm_init.c — RHM's start from landmarks (rhm.h): P12 and P21 by
- * projection in the space of geodesic distances to the landmarks, or the
- * thesis' geodesic Voronoi map (§3.3.2) with its nearest-neighbour reverse;
- * then X_ij = P_ij X_j. Builds maps only; no optimisation. */
+ * projection in the space of geodesic distances to the landmarks, the
+ * thesis' geodesic Voronoi map (§3.3.2) with its nearest-neighbour reverse,
+ * or a functional map from the landmarks' wave-kernel descriptors (Δ and
+ * D_N commutativity) made precise by DDM deblurring (thesis §2.4); then
+ * X_ij = P_ij X_j. Builds maps only; no optimisation. */
 #include "rhm/rhm__problem.h"
+#include "ddm/ddm.h"
+#include "fmap/fmap.h"
 #include "geo/geo_orient.h"
 #include "geod/geod_voronoi.h"
+#include "lbo/lbo.h"
 #include "util/errbuf.h"
 
 #include <math.h>
@@ -163,6 +168,66 @@ out:
     return rc;
 }
 
+/* Basis size of the functional-map start (the k of fmap's tests and
+ * figures), capped by what a small mesh has. */
+#define RHM__FMAP_K 50
+
+/* Both directions: C_ij from side i's and side j's landmark descriptors,
+ * Psi_i C_ij ~ P_ij Psi_j, deblurred row by row onto side j (ddm.h). */
+static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
+{
+    rhm__side *s = pb->side;
+    int k = RHM__FMAP_K, rc = RHM_ENOMEM, nl = pb->nl;
+    for (int i = 0; i < 2; i++)
+        if (k > s[i].n - 2)
+            k = s[i].n - 2;
+    lbo_basis b[2];
+    memset(b, 0, sizeof b);
+    double *F[2] = {NULL, NULL}, *N[2] = {NULL, NULL}, *C = malloc(sizeof(double) * (size_t)k * k);
+    int nd = 0, lrc = 0;
+    char detail[512] = "";
+    lmk_set L = {nl, s[0].lmk, s[1].lmk}, R = {nl, s[1].lmk, s[0].lmk};
+    for (int i = 0; i < 2 && !lrc; i++)
+        lrc = lbo_eigenpairs(geod_solver_laplacian(s[i].geod), geod_solver_mass(s[i].geod), s[i].n, k, &b[i],
+                             detail, sizeof detail);
+    if (lrc) {
+        rc = errbuf_set(err, errsz, RHM_ENUMERIC, "the functional-map start: eigenpairs: %s", detail);
+        goto out;
+    }
+    for (int i = 0; i < 2; i++)
+        if (!(N[i] = malloc(sizeof(double) * (size_t)k * k)))
+            goto nomem;
+    for (int i = 0; i < 2 && !lrc; i++)
+        lrc = fmap_normal_operator(s[i].m, &b[i], k, N[i], detail, sizeof detail);
+    for (int i = 0; i < 2 && !lrc; i++) {
+        int j = 1 - i;
+        free(F[0]);
+        free(F[1]);
+        F[0] = F[1] = NULL;
+        lrc = fmap_landmark_descriptors(&b[i], &b[j], i ? &R : &L, FMAP_ENERGIES_DEFAULT, &F[0], &F[1], &nd,
+                                        detail, sizeof detail);
+        if (!lrc)
+            lrc = fmap_from_descriptors_normal(&b[i], geod_solver_mass(s[i].geod), F[0], N[i], &b[j],
+                                               geod_solver_mass(s[j].geod), F[1], N[j], nd, k, k,
+                                               FMAP_MU_LAP_DEFAULT, FMAP_MU_NORMAL_DEFAULT, C, NULL, detail,
+                                               sizeof detail);
+        if (!lrc)
+            lrc = ddm_deblur(&b[i], NULL, &b[j], s[j].m, C, k, k, s[i].P, NULL, detail, sizeof detail);
+    }
+    rc = lrc ? errbuf_set(err, errsz, RHM_ENUMERIC, "the functional-map start: %s", detail) : RHM_OK;
+    goto out;
+nomem:
+    rc = errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+out:
+    for (int i = 0; i < 2; i++) {
+        lbo_basis_close(&b[i]);
+        free(F[i]);
+        free(N[i]);
+    }
+    free(C);
+    return rc;
+}
+
 int rhm__init_start(rhm__problem *pb, char *err, size_t errsz)
 {
     rhm__side *a = &pb->side[0], *b = &pb->side[1];
@@ -173,6 +238,7 @@ int rhm__init_start(rhm__problem *pb, char *err, size_t errsz)
     if (!a->P || !b->P)
         return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
     int rc = pb->p.start == RHM_START_VORONOI ? start_voronoi(pb, err, errsz)
+           : pb->p.start == RHM_START_FMAP    ? start_fmap(pb, err, errsz)
                                               : start_distances(pb, err, errsz);
     if (rc)
         return rc;
