@@ -130,7 +130,7 @@ size_t mc_job_spec_size(void);
  * that does not parse: MC_EARG, detail in err. */
 int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
 
-enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1 };
+enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1, MC_RHM_START_FMAP = 2 };
 enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
 
 /* For stages start and rhm the five terms are RHM's (PROTOCOL.md,

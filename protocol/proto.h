@@ -125,7 +125,7 @@ enum proto_slot_state {
 /* values of the ENUM parameters model and rhm_start (their names: proto_params.h) */
 enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1 };
 /* RHM's start map from the landmarks (workers/rhm/rhm.h) */
-enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1 };
+enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1, PROTO_RHM_START_FMAP = 2 };
 
 /* Energy terms reported per direction in PROGRESS (index into terms[d][]). */
 enum proto_term {

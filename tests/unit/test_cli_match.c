@@ -138,7 +138,7 @@ TEST(match_refuses_bad_option_value)
     snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --rhm-start cells",
              s381, s390, p0);
     CHECK_INT(run(cmd, out, sizeof out), 2);
-    CHECK_STR_HAS(out, "--rhm-start: 'cells' is not distances or voronoi");
+    CHECK_STR_HAS(out, "--rhm-start: 'cells' is not distances, voronoi or fmap");
 }
 
 TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)
