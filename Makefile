@@ -147,7 +147,7 @@ $(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) 
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-test: $(PROGRAMS) $(TEST_BIN) $(FUZZ_BIN)
+test: $(PROGRAMS) $(CLIENT_SO) $(TEST_BIN) $(FUZZ_BIN)
 	@sh tests/run-tests.sh $(TEST_BIN) $(FUZZ_BIN)
 
 bench: $(PROGRAMS) $(BENCH_BIN)
