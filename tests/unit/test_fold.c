@@ -97,7 +97,7 @@ TEST(map_mirrored_as_a_whole_is_detected_and_left_unchanged)
     bmap *before = map_of_points(r, img, m->nv);
     fold_params fp;
     fold_params_init(&fp);
-    fp.iterations = 50;
+    fp.passes = 2;
     fold_report rep;
     CHECK_INT(fold_repair(m, r, NULL, 0, &fp, P, &rep), FOLD_OK);
     CHECK(!rep.accepted);
@@ -121,7 +121,7 @@ TEST(refuses_bad_arguments)
     CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
     bmap_free(P);
     P = bmap_new(m->nv, m->nv);
-    fp.iterations = 0;
+    fp.passes = 0;
     CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
     bmap_free(P);
     mesh_free(m);

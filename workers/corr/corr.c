@@ -100,7 +100,7 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char
         rc = fold_repair(in->T, in->S, in->L ? in->L->tgt : NULL, n, &fp, Q, &rep[1]);
     if (rc)
         return errbuf_set(err, errsz, rc == FOLD_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
-                          "repairing the folds of the initial maps: %s", fold_strerror(rc));
+                          "repairing the folds of the maps: %s", fold_strerror(rc));
     return CORR_OK;
 }
 
@@ -158,6 +158,15 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
     }
     rc = ectm_run(in->S, in->T, P0, Q0, p, relay_ectm, &rl, out, err, errsz);
     rhm_result_close(&init);
+    if (rc == ECTM_OK) {
+        /* ECTM's projection folds where its deformed surface passes a thin
+         * part at an angle: the same repair, on the maps it returns */
+        fold_report rep[2];
+        if ((rc = corr_repair(in, out->P, out->Q, rep, err, errsz))) {
+            ectm_result_close(out);
+            return rc;
+        }
+    }
     switch (rc) {
     case ECTM_OK: return CORR_OK;
     case ECTM_ECANCELED: return CORR_ECANCELED;

@@ -5,7 +5,8 @@
  *   initial maps: the uploaded P (and Q), or from landmarks: geodesic
  *     start map (rhm.h), then Reversible Harmonic Maps giving P and Q,
  *     whose folds are then repaired (corr_repair, fold.h)
- *   ECTM refinement
+ *   ECTM refinement, then the same fold repair of the maps it returns
+ *     (the rows of bad regions change; out->Y stays ECTM's deformation)
  *
  * Stages report progress through one callback; a non-zero return cancels.
  * This module reads no files and knows no sockets: callers load meshes,
@@ -72,7 +73,7 @@ typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
-/* The fold repair the pipeline applies to RHM's maps: fold_repair of P
+/* The fold repair the pipeline applies to RHM's maps and to ECTM's: fold_repair of P
  * (S -> T) and, when Q is not NULL, of Q (T -> S), the landmarks fixed
  * (in->L may be NULL), with fold_params_init's values. rep[0], rep[1]:
  * P's and Q's reports. CORR_OK, CORR_ENOMEM or CORR_EINIT. */

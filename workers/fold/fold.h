@@ -1,23 +1,30 @@
 /* fold.h — repair of the folds of a map: the flipped and collapsed
  * triangles (metric_fold_faces' rule) of a barycentric map P from S onto T
- * are relaxed away, in the spirit of the thesis' one-ring relaxation
- * (§3.4.7):
+ * are re-mapped, region by region, by a harmonic map between two disks
+ * (in the spirit of the thesis' one-ring relaxation, §3.4.7, made
+ * fold-free by Tutte's theorem):
  *
- *   region  the vertices of the bad faces, grown by `rings` rings of faces;
- *   relax   each region vertex's image y_v (a point of T) <- the mean of
- *           its neighbours' images (uniform weights: on a flat patch with
- *           a fixed convex boundary, Tutte's theorem makes the result
- *           fold-free), then projected back onto T (closest point, exact,
- *           proj.h); `iterations` times, the images outside the region
- *           fixed;
- *   accept  the relaxed rows replace P's only when the map then has fewer
- *           bad faces than before, so a repair never makes a map worse.
+ *   region  the bad faces grown by `rings` rings, split into components,
+ *           each with its holes filled (a ring of bad faces round a limb
+ *           takes the limb's end with it), kept when it is a disk;
+ *   chart   the target faces P sends the region's vertices into, grown by
+ *           two rings and hole-filled, a disk too, placed in the unit disk
+ *           by its harmonic map (boundary on the circle by arc length);
+ *   remap   the region's boundary stays where P sends it (its points in
+ *           the chart); its inner vertices are placed by the region's own
+ *           harmonic map inside that boundary and read back through the
+ *           chart as points of T. A limb end turned about its axis is
+ *           untwisted this way: its boundary ring is only rotated, and the
+ *           harmonic map inside a rotated ring does not fold;
+ *   accept  a region's new rows are kept only when its faces then have
+ *           fewer bad ones; `passes` passes, each growing the regions of
+ *           what is left by two rings more. A repair never makes a map
+ *           worse.
  *
  * Landmark source vertices (when given) stay where P sends them. What it
  * cannot undo: a part mirrored as a whole (its boundary is mapped the
- * wrong way round, so no relaxation inside it is fold-free) and a thin tip
- * whose image collapsed onto its base (the relaxation keeps it collapsed).
- * Reads no files. */
+ * wrong way round, so the harmonic map inside it is flipped throughout),
+ * and regions that are not disks on either side. Reads no files. */
 #ifndef FOLD_H
 #define FOLD_H
 #include <stddef.h>
@@ -28,7 +35,7 @@
     X(FOLD_OK,      0, "ok")                                                 \
     X(FOLD_EINVAL, -1, "invalid argument (map, meshes or parameters)")       \
     X(FOLD_ENOMEM, -2, "out of memory")                                      \
-    X(FOLD_EPROJ,  -3, "projection onto the target failed")
+    X(FOLD_EMESH,  -3, "a mesh is not manifold (its edge table failed)")
 
 enum fold_error {
 #define FOLD_ENUM(name, val, msg) name = val,
@@ -38,21 +45,22 @@ enum fold_error {
 const char *fold_strerror(int code);
 
 typedef struct fold_params {
-    int rings;        /* growth of the region around the bad faces  (>= 0) */
-    int iterations;   /* relaxation sweeps                          (>= 1) */
+    int rings;        /* growth of the regions around the bad faces (>= 0) */
+    int passes;       /* passes over what is left, 2 rings more each (>= 1) */
 } fold_params;
-/* rings = 2, iterations = 400. */
+/* rings = 2, passes = 4. */
 void fold_params_init(fold_params *p);
 
 typedef struct fold_report {
     int bad_before, bad_after;   /* flipped + collapsed faces             */
-    int region;                  /* vertices relaxed                       */
+    int region;                  /* source vertices re-mapped (accepted)   */
+    int regions;                 /* regions accepted, over all passes      */
     int accepted;                /* 1: P was changed                        */
 } fold_report;
 
 /* Repairs P (S -> T) in place. fixed: nfixed source vertices that keep
  * their rows (landmarks), or NULL. Returns FOLD_OK (rep filled; P unchanged
- * unless rep->accepted), FOLD_EINVAL, FOLD_ENOMEM or FOLD_EPROJ (P
+ * unless rep->accepted), FOLD_EINVAL, FOLD_ENOMEM or FOLD_EMESH (P
  * unchanged). */
 int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
                 const fold_params *p, bmap *P, fold_report *rep);

@@ -1,18 +1,20 @@
-/* fold_repair.c — see fold.h: the region of bad faces, its relaxation with
- * re-projection onto the target, and the accept-if-better rule. */
+/* fold_repair.c — see fold.h: the regions of bad faces, each re-mapped
+ * through a chart of the target by harmonic maps (fold__patch.h), and the
+ * accept-if-better rule per region. */
 #include "fold/fold.h"
+#include "fold/fold__patch.h"
 #include "metric/metric.h"
-#include "proj/proj.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* The fraction of the way to the neighbours' mean a sweep moves an image:
- * short steps keep it near the surface, so the projection does not jump
- * to the far side of a thin part (a paw's sole onto its top). */
-#ifndef FOLD__STEP
-#define FOLD__STEP 0.5
-#endif
+/* A region (hole-filled) may take at most this share of the source's
+ * faces, and its chart this share of the target's: beyond that the map is
+ * wrong on a whole part, which a local repair cannot decide. */
+#define FOLD__MAX_REGION 0.25
+#define FOLD__MAX_CHART 0.5
+#define FOLD__CHART_RINGS 2
 
 const char *fold_strerror(int code)
 {
@@ -27,50 +29,327 @@ const char *fold_strerror(int code)
 void fold_params_init(fold_params *p)
 {
     p->rings = 2;
-    p->iterations = 400;
+    p->passes = 4;
 }
 
-/* Vertex adjacency of m as CSR (start: nv + 1, nbr): each edge once per
- * side, so an edge shared by two faces is listed twice (a weight of 2 for
- * interior edges, 1 on a boundary: uniform enough). */
-static int adjacency(const mesh *m, int **start, int **nbr)
+/* What one repair call works with. */
+typedef struct ctx {
+    const mesh *S, *T;
+    geo_edges ES, ET;
+    const unsigned char *fixed;   /* S->nv: landmark vertices */
+    bmap *R;                      /* the map being repaired */
+    unsigned char *tin, *tmark;   /* T->nf, T->nv scratch */
+    int *tcomp, *tloc, *sloc;     /* T->nf, T->nv (-1), S->nv (-1) */
+} ctx;
+
+/* The chart: patch pT of T placed in the unit disk (uvT, 2 per vertex),
+ * oriented as T. Returns 0, 1 when it is no disk or too large, -1 (memory). */
+static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
 {
-    *start = calloc((size_t)m->nv + 1, sizeof(int));
-    *nbr = malloc(sizeof(int) * (size_t)m->nf * 6 + 1);
-    if (!*start || !*nbr)
+    const mesh *T = c->T;
+    *uvT = NULL;
+    memset(c->tin, 0, (size_t)T->nf);
+    for (int i = 0; i < pS->nv; i++)
+        c->tin[c->R->face[pS->verts[i]]] = 1;
+    fold__grow(T, c->tin, FOLD__CHART_RINGS, c->tmark);
+    int n = fold__components(&c->ET, c->tin, c->tcomp);
+    if (n < 0)
         return -1;
-    for (int t = 0; t < m->nf; t++)
-        for (int k = 0; k < 3; k++)
-            (*start)[m->f[3 * t + k] + 1] += 2;
-    for (int v = 0; v < m->nv; v++)
-        (*start)[v + 1] += (*start)[v];
-    int *at = malloc(sizeof(int) * ((size_t)m->nv + 1));
-    if (!at)
+    int *votes = calloc((size_t)n + 1, sizeof(int));
+    if (!votes)
         return -1;
-    memcpy(at, *start, sizeof(int) * (size_t)m->nv);
-    for (int t = 0; t < m->nf; t++)
-        for (int k = 0; k < 3; k++) {
-            int v = m->f[3 * t + k];
-            (*nbr)[at[v]++] = m->f[3 * t + (k + 1) % 3];
-            (*nbr)[at[v]++] = m->f[3 * t + (k + 2) % 3];
-        }
-    free(at);
+    for (int i = 0; i < pS->nv; i++)
+        votes[c->tcomp[c->R->face[pS->verts[i]]]]++;
+    int best = 0;
+    for (int k = 1; k < n; k++)
+        if (votes[k] > votes[best])
+            best = k;
+    int all = votes[best] == pS->nv;
+    free(votes);
+    if (!all)
+        return 1;                  /* the region's images lie apart */
+    for (int t = 0; t < T->nf; t++)
+        c->tin[t] = c->tcomp[t] == best;
+    int size = fold__fill_holes(&c->ET, c->tin);
+    if (size < 0)
+        return -1;
+    if (size > FOLD__MAX_CHART * T->nf)
+        return 1;
+    int rc = fold__disk(T, &c->ET, c->tin, c->tloc, pT);
+    if (rc)
+        return rc;
+    double *uv = calloc(2 * (size_t)pT->nv + 1, sizeof(double));
+    unsigned char *pin = calloc((size_t)pT->nv + 1, 1);
+    if (!uv || !pin) {
+        free(uv);
+        free(pin);
+        fold__patch_close(pT);
+        return -1;
+    }
+    /* the loop on the circle by arc length */
+    double len = 0, s = 0;
+    for (int i = 0; i < pT->nb; i++) {
+        const double *a = T->v + 3 * pT->verts[i], *b = T->v + 3 * pT->verts[(i + 1) % pT->nb];
+        len += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                    (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    for (int i = 0; i < pT->nb; i++) {
+        double th = len > 0 ? 2 * M_PI * s / len : 2 * M_PI * i / pT->nb;
+        uv[2 * i] = cos(th);
+        uv[2 * i + 1] = sin(th);
+        pin[i] = 1;
+        const double *a = T->v + 3 * pT->verts[i], *b = T->v + 3 * pT->verts[(i + 1) % pT->nb];
+        s += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                  (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    rc = fold__harmonic(T, &c->ET, pT, pin, c->tloc, uv);
+    free(pin);
+    if (rc) {
+        free(uv);
+        fold__patch_close(pT);
+        return -1;
+    }
+    *uvT = uv;
     return 0;
+}
+
+/* Signed area of the triangle a, b, c of the plane, doubled. */
+static double area2(const double *a, const double *b, const double *c)
+{
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* Re-maps the inner vertices of region pS (see fold.h) in c->R. Returns 0,
+ * 1 when it cannot (no chart), -1 when out of memory. */
+static int remap(ctx *c, const fold__patch *pS)
+{
+    const mesh *T = c->T;
+    fold__patch pT;
+    double *uvT;
+    int rc = chart(c, pS, &pT, &uvT);
+    if (rc)
+        return rc;
+    rc = -1;
+    double *uv = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
+    unsigned char *pin = malloc((size_t)pS->nv + 1);
+    int *corner = malloc(sizeof(int) * 3 * ((size_t)pT.nf + 1));
+    if (!uv || !pin || !corner)
+        goto out;
+    for (int i = 0; i < pT.nv; i++)
+        c->tloc[pT.verts[i]] = i;
+    for (int q = 0; q < pT.nf; q++)
+        for (int k = 0; k < 3; k++)
+            corner[3 * q + k] = c->tloc[T->f[3 * pT.faces[q] + k]];
+    /* the chart is oriented as T when its faces have positive area */
+    double sa = 0;
+    for (int q = 0; q < pT.nf; q++)
+        sa += area2(uvT + 2 * corner[3 * q], uvT + 2 * corner[3 * q + 1], uvT + 2 * corner[3 * q + 2]);
+    if (sa < 0)
+        for (int i = 0; i < pT.nv; i++)
+            uvT[2 * i + 1] = -uvT[2 * i + 1];
+    /* every vertex's image in the chart; the boundary and landmarks pinned */
+    for (int i = 0; i < pS->nv; i++) {
+        int v = pS->verts[i], f = c->R->face[v];
+        uv[2 * i] = uv[2 * i + 1] = 0;
+        for (int k = 0; k < 3; k++) {
+            int j = c->tloc[T->f[3 * f + k]];
+            uv[2 * i] += c->R->w[3 * v + k] * uvT[2 * j];
+            uv[2 * i + 1] += c->R->w[3 * v + k] * uvT[2 * j + 1];
+        }
+        pin[i] = i < pS->nb || c->fixed[v];
+    }
+    for (int i = 0; i < pT.nv; i++)
+        c->tloc[pT.verts[i]] = -1;
+    if (fold__harmonic(c->S, &c->ES, pS, pin, c->sloc, uv))
+        goto out;
+    /* read the inner vertices back through the chart: the chart face whose
+     * smallest barycentric coordinate is largest (inside when >= 0) */
+    for (int i = 0; i < pS->nv; i++) {
+        if (pin[i])
+            continue;
+        const double *x = uv + 2 * i;
+        int bf = -1;
+        double bw[3] = {1, 0, 0}, bmin = -INFINITY;
+        for (int q = 0; q < pT.nf; q++) {
+            const double *a = uvT + 2 * corner[3 * q], *b = uvT + 2 * corner[3 * q + 1],
+                         *d = uvT + 2 * corner[3 * q + 2];
+            double A = area2(a, b, d);
+            if (!(fabs(A) > 0))
+                continue;
+            double w[3] = { area2(x, b, d) / A, area2(a, x, d) / A, area2(a, b, x) / A };
+            double m = fmin(w[0], fmin(w[1], w[2]));
+            if (m > bmin) {
+                bmin = m;
+                bf = q;
+                memcpy(bw, w, sizeof bw);
+                if (m >= 0)
+                    break;
+            }
+        }
+        if (bf < 0)
+            continue;
+        double sum = 0;
+        for (int k = 0; k < 3; k++)
+            sum += bw[k] = fmax(bw[k], 0);
+        int v = pS->verts[i];
+        c->R->face[v] = pT.faces[bf];
+        for (int k = 0; k < 3; k++)
+            c->R->w[3 * v + k] = bw[k] / sum;
+    }
+    rc = 0;
+out:
+    free(uv);
+    free(pin);
+    free(corner);
+    free(uvT);
+    fold__patch_close(&pT);
+    return rc;
+}
+
+/* One region taken in a pass: its patch and the rows it had. */
+typedef struct taken {
+    fold__patch p;
+    int *face;
+    double *w;
+} taken;
+
+static int count_bad(const fold__patch *p, const unsigned char *kind)
+{
+    int n = 0;
+    for (int q = 0; q < p->nf; q++)
+        n += kind[p->faces[q]] != 0;
+    return n;
+}
+
+/* One pass with regions grown by `rings`: returns the new number of bad
+ * faces (kind updated), or -1 when out of memory. */
+static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *rep)
+{
+    const mesh *S = c->S;
+    int nf = S->nf, nv = S->nv, rc = -1, ntaken = 0;
+    unsigned char *in = malloc((size_t)nf + 1), *cin = malloc((size_t)nf + 1);
+    unsigned char *mark = malloc((size_t)nv + 1), *claimed = calloc((size_t)nv + 1, 1);
+    unsigned char *kind2 = malloc((size_t)nf + 1);
+    int *comp = malloc(sizeof(int) * ((size_t)nf + 1));
+    taken *tk = NULL;
+    if (!in || !cin || !mark || !claimed || !kind2 || !comp)
+        goto out;
+    for (int t = 0; t < nf; t++)
+        in[t] = kind[t] != 0;
+    fold__grow(S, in, rings, mark);
+    int n = fold__components(&c->ES, in, comp);
+    if (n < 0 || !(tk = calloc((size_t)n + 1, sizeof(taken))))
+        goto out;
+    for (int k = 0; k < n; k++) {
+        for (int t = 0; t < nf; t++)
+            cin[t] = comp[t] == k;
+        int size = fold__fill_holes(&c->ES, cin);
+        if (size < 0)
+            goto out;
+        if (size > FOLD__MAX_REGION * nf)
+            continue;
+        taken *r = tk + ntaken;
+        int d = fold__disk(S, &c->ES, cin, c->sloc, &r->p);
+        if (d < 0)
+            goto out;
+        if (d)
+            continue;
+        int clash = 0;
+        for (int i = 0; i < r->p.nv && !clash; i++)
+            clash = claimed[r->p.verts[i]];
+        if (clash) {             /* overlaps a region taken already: next pass */
+            fold__patch_close(&r->p);
+            continue;
+        }
+        r->face = malloc(sizeof(int) * ((size_t)r->p.nv + 1));
+        r->w = malloc(sizeof(double) * 3 * ((size_t)r->p.nv + 1));
+        if (!r->face || !r->w) {
+            ntaken++;
+            goto out;
+        }
+        for (int i = 0; i < r->p.nv; i++) {
+            int v = r->p.verts[i];
+            r->face[i] = c->R->face[v];
+            memcpy(r->w + 3 * i, c->R->w + 3 * v, 3 * sizeof(double));
+        }
+        ntaken++;
+        int m = remap(c, &r->p);
+        if (m < 0)
+            goto out;
+        for (int i = 0; i < r->p.nv; i++)
+            claimed[r->p.verts[i]] = 1;
+    }
+    if (metric_fold_faces(S, c->T, c->R, kind2) < 0)
+        goto out;
+    /* keep a region's rows only where its faces got better */
+    for (int k = 0; k < ntaken; k++) {
+        taken *r = tk + k;
+        int before = count_bad(&r->p, kind), after = count_bad(&r->p, kind2);
+        if (after < before) {
+            rep->regions++;
+            rep->region += r->p.nv - r->p.nb;
+            continue;
+        }
+        for (int i = 0; i < r->p.nv; i++) {
+            int v = r->p.verts[i];
+            c->R->face[v] = r->face[i];
+            memcpy(c->R->w + 3 * v, r->w + 3 * i, 3 * sizeof(double));
+        }
+        for (int q = 0; q < r->p.nf; q++)
+            kind2[r->p.faces[q]] = kind[r->p.faces[q]];
+    }
+    bad = 0;
+    for (int t = 0; t < nf; t++)
+        bad += (kind[t] = kind2[t]) != 0;
+    rc = bad;
+out:
+    if (tk)
+        for (int k = 0; k < ntaken; k++) {
+            fold__patch_close(&tk[k].p);
+            free(tk[k].face);
+            free(tk[k].w);
+        }
+    free(tk);
+    free(in);
+    free(cin);
+    free(mark);
+    free(claimed);
+    free(kind2);
+    free(comp);
+    return rc;
 }
 
 int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
                 const fold_params *p, bmap *P, fold_report *rep)
 {
     memset(rep, 0, sizeof *rep);
-    if (!S || !T || !P || !p || P->n != S->nv || p->rings < 0 || p->iterations < 1 || nfixed < 0)
+    if (!S || !T || !P || !p || P->n != S->nv || P->nt != T->nv || p->rings < 0 ||
+        p->passes < 1 || nfixed < 0)
         return FOLD_EINVAL;
-    int nv = S->nv, nf = S->nf, rc = FOLD_ENOMEM;
-    unsigned char *kind = malloc((size_t)nf + 1), *in = calloc((size_t)nv + 1, 1);
-    int *start = NULL, *nbr = NULL, *list = NULL, *face = NULL;
-    double *Y = NULL, *Yn = NULL, *w = NULL;
-    proj_tree *tree = NULL;
-    if (!kind || !in)
+    for (int v = 0; v < P->n; v++)
+        if (P->face[v] < 0 || P->face[v] >= T->nf)
+            return FOLD_EINVAL;
+    ctx c = { .S = S, .T = T };
+    int rc = FOLD_ENOMEM;
+    unsigned char *kind = malloc((size_t)S->nf + 1), *fx = calloc((size_t)S->nv + 1, 1);
+    c.tin = malloc((size_t)T->nf + 1);
+    c.tmark = malloc((size_t)T->nv + 1);
+    c.tcomp = malloc(sizeof(int) * ((size_t)T->nf + 1));
+    c.tloc = malloc(sizeof(int) * ((size_t)T->nv + 1));
+    c.sloc = malloc(sizeof(int) * ((size_t)S->nv + 1));
+    c.R = bmap_new(P->n, P->nt);
+    if (!kind || !fx || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
         goto out;
+    for (int v = 0; v < T->nv; v++)
+        c.tloc[v] = -1;
+    for (int v = 0; v < S->nv; v++)
+        c.sloc[v] = -1;
+    for (int k = 0; k < nfixed; k++)
+        if (fixed[k] >= 0 && fixed[k] < S->nv)
+            fx[fixed[k]] = 1;
+    c.fixed = fx;
+    memcpy(c.R->face, P->face, sizeof(int) * (size_t)P->n);
+    memcpy(c.R->w, P->w, sizeof(double) * 3 * (size_t)P->n);
     int bad = metric_fold_faces(S, T, P, kind);
     if (bad < 0)
         goto out;
@@ -78,100 +357,32 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     rc = FOLD_OK;
     if (bad == 0)
         goto out;
-    rc = FOLD_ENOMEM;
-    /* the region: vertices of bad faces, then `rings` rings of faces */
-    for (int t = 0; t < nf; t++)
-        if (kind[t])
-            for (int k = 0; k < 3; k++)
-                in[S->f[3 * t + k]] = 1;
-    for (int r = 0; r < p->rings; r++) {
-        for (int t = 0; t < nf; t++) {
-            const int *f = S->f + 3 * t;
-            if (in[f[0]] == 1 || in[f[1]] == 1 || in[f[2]] == 1)
-                for (int k = 0; k < 3; k++)
-                    if (!in[f[k]])
-                        in[f[k]] = 2;
-        }
-        for (int v = 0; v < nv; v++)
-            in[v] = in[v] ? 1 : 0;
-    }
-    for (int k = 0; k < nfixed; k++)
-        if (fixed[k] >= 0 && fixed[k] < nv)
-            in[fixed[k]] = 0;
-    int n = 0;
-    if (!(list = malloc(sizeof(int) * (size_t)nv)))
-        goto out;
-    for (int v = 0; v < nv; v++)
-        if (in[v])
-            list[n++] = v;
-    rep->region = n;
-    Y = malloc(sizeof(double) * 3 * (size_t)nv);
-    Yn = malloc(sizeof(double) * 3 * (size_t)n + 1);
-    face = malloc(sizeof(int) * (size_t)n + 1);
-    w = malloc(sizeof(double) * 3 * (size_t)n + 1);
-    if (!Y || !Yn || !face || !w || adjacency(S, &start, &nbr))
-        goto out;
-    if (!(tree = proj_tree_new(T, NULL, 0))) {
-        rc = FOLD_EPROJ;
+    char err[128];
+    if (geo_edges_build(S, &c.ES, err, sizeof err) || geo_edges_build(T, &c.ET, err, sizeof err)) {
+        rc = FOLD_EMESH;
         goto out;
     }
-    bmap_apply(P, T->f, T->v, 3, Y);
-    for (int k = 0; k < n; k++)
-        face[k] = P->face[list[k]];
-    for (int it = 0; it < p->iterations; it++) {
-        for (int k = 0; k < n; k++) {
-            int v = list[k];
-            double s[3] = {0, 0, 0};
-            for (int q = start[v]; q < start[v + 1]; q++)
-                for (int d = 0; d < 3; d++)
-                    s[d] += Y[3 * (size_t)nbr[q] + d];
-            int deg = start[v + 1] - start[v];
-            for (int d = 0; d < 3; d++) {
-                double y = Y[3 * (size_t)v + d];
-                Yn[3 * k + d] = deg ? y + FOLD__STEP * (s[d] / deg - y) : y;
-            }
-        }
-        if (proj_closest(tree, 3, T->v, 1, n, Yn, face, w, NULL)) {
-            rc = FOLD_EPROJ;
+    for (int k = 0; k < p->passes && bad > 0; k++)
+        if ((bad = pass(&c, p->rings + 2 * k, kind, bad, rep)) < 0) {
+            rc = FOLD_ENOMEM;
             goto out;
         }
-        for (int k = 0; k < n; k++) {
-            const int *tf = T->f + 3 * face[k];
-            for (int d = 0; d < 3; d++)
-                Y[3 * (size_t)list[k] + d] = w[3 * k] * T->v[3 * tf[0] + d] +
-                                             w[3 * k + 1] * T->v[3 * tf[1] + d] +
-                                             w[3 * k + 2] * T->v[3 * tf[2] + d];
-        }
-    }
-    /* accept when better: try the relaxed rows on a copy */
-    bmap *R = bmap_new(P->n, P->nt);
-    if (!R)
-        goto out;
-    memcpy(R->face, P->face, sizeof(int) * (size_t)P->n);
-    memcpy(R->w, P->w, sizeof(double) * 3 * (size_t)P->n);
-    for (int k = 0; k < n; k++) {
-        R->face[list[k]] = face[k];
-        memcpy(R->w + 3 * (size_t)list[k], w + 3 * k, 3 * sizeof(double));
-    }
-    int after = metric_fold_faces(S, T, R, kind);
-    if (after >= 0 && after < bad) {
-        memcpy(P->face, R->face, sizeof(int) * (size_t)P->n);
-        memcpy(P->w, R->w, sizeof(double) * 3 * (size_t)P->n);
-        rep->bad_after = after;
+    if (bad < rep->bad_before) {
+        memcpy(P->face, c.R->face, sizeof(int) * (size_t)P->n);
+        memcpy(P->w, c.R->w, sizeof(double) * 3 * (size_t)P->n);
+        rep->bad_after = bad;
         rep->accepted = 1;
     }
-    bmap_free(R);
-    rc = after < 0 ? FOLD_ENOMEM : FOLD_OK;
 out:
-    proj_tree_free(tree);
+    geo_edges_close(&c.ES);
+    geo_edges_close(&c.ET);
+    bmap_free(c.R);
     free(kind);
-    free(in);
-    free(start);
-    free(nbr);
-    free(list);
-    free(face);
-    free(Y);
-    free(Yn);
-    free(w);
+    free(fx);
+    free(c.tin);
+    free(c.tmark);
+    free(c.tcomp);
+    free(c.tloc);
+    free(c.sloc);
     return rc;
 }
