@@ -8,6 +8,7 @@
 #include "metric/metric.h"
 #include "proj/proj.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -123,6 +124,57 @@ TEST(refuses_bad_arguments)
     P = bmap_new(m->nv, m->nv);
     fp.passes = 0;
     CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
+    bmap_free(P);
+    mesh_free(m);
+}
+
+/* The identity of a sphere onto itself with the vertices of a polar cap
+ * (z > 0.75) sent to scattered points all over the sphere, as a map that
+ * jumped does: the cap's faces are flipped or stretched across the
+ * sphere, its images lie in many places, and only its boundary ring is
+ * still right. The repair re-maps the cap inside that ring: no bad face is
+ * left and every cap vertex lands back on the cap, near where it belongs. */
+TEST(cap_whose_images_jumped_is_re_mapped_inside_its_boundary)
+{
+    mesh *m = testmesh_icosphere(4);
+    int nv = m->nv, moved = 0;
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, m->v, sizeof(double) * 3 * (size_t)nv);
+    unsigned s = 12345;
+    for (int v = 0; v < nv; v++)
+        if (m->v[3 * v + 2] > 0.75) {
+            s = s * 1103515245u + 12345u;
+            int u = (int)((s >> 8) % (unsigned)nv);
+            memcpy(img + 3 * v, m->v + 3 * u, 3 * sizeof(double));
+            moved++;
+        }
+    bmap *P = map_of_points(m, img, nv);
+    int bad = count_bad(m, m, P, METRIC_FACE_FLIPPED) + count_bad(m, m, P, METRIC_FACE_COLLAPSED);
+    printf("  %d cap vertices scattered: %d of %d faces bad\n", moved, bad, m->nf);
+    CHECK(bad > 50);
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_OK);
+    printf("  bad faces %d -> %d, %d vertices re-mapped in %d regions\n", rep.bad_before,
+           rep.bad_after, rep.region, rep.regions);
+    CHECK(rep.accepted);
+    CHECK_INT(rep.bad_after, 0);
+    CHECK_INT(count_bad(m, m, P, METRIC_FACE_FLIPPED) + count_bad(m, m, P, METRIC_FACE_COLLAPSED), 0);
+    double *y = malloc(sizeof(double) * 3 * (size_t)nv), worst = 0;
+    bmap_apply(P, m->f, m->v, 3, y);
+    for (int v = 0; v < nv; v++)
+        if (m->v[3 * v + 2] > 0.75) {
+            double d = 0;
+            for (int k = 0; k < 3; k++)
+                d += (y[3 * v + k] - m->v[3 * v + k]) * (y[3 * v + k] - m->v[3 * v + k]);
+            if (sqrt(d) > worst)
+                worst = sqrt(d);
+        }
+    printf("  farthest cap vertex from its place: %.3f (the cap's radius is about 0.66)\n", worst);
+    CHECK(worst < 0.2);
+    free(y);
+    free(img);
     bmap_free(P);
     mesh_free(m);
 }

@@ -10,8 +10,9 @@
  *   chart   the target faces P sends the region's vertices into, grown by
  *           two rings and hole-filled, a disk too, placed in the unit disk
  *           by its harmonic map (boundary on the circle by arc length);
- *   remap   the region's boundary stays where P sends it (its points in
- *           the chart); its inner vertices are placed by the region's own
+ *   remap   the region's boundary, its landmarks and its filled holes
+ *           (faces that were not bad) stay where P sends them (their
+ *           points in the chart); its other vertices are placed by its own
  *           harmonic map inside that boundary and read back through the
  *           chart as points of T. A limb end turned about its axis is
  *           untwisted this way: its boundary ring is only rotated, and the

@@ -14,7 +14,8 @@
  * wrong on a whole part, which a local repair cannot decide. */
 #define FOLD__MAX_REGION 0.25
 #define FOLD__MAX_CHART 0.5
-#define FOLD__CHART_RINGS 2
+#define FOLD__CHART_RINGS 2       /* rings round the boundary image, at least */
+#define FOLD__CHART_MAX_RINGS 6   /* ... and at most */
 
 const char *fold_strerror(int code)
 {
@@ -37,10 +38,23 @@ typedef struct ctx {
     const mesh *S, *T;
     geo_edges ES, ET;
     const unsigned char *fixed;   /* S->nv: landmark vertices */
+    unsigned char *keep;          /* S->nv: the region's vertices that keep
+                                     their rows (those of its filled holes) */
     bmap *R;                      /* the map being repaired */
     unsigned char *tin, *tmark;   /* T->nf, T->nv scratch */
     int *tcomp, *tloc, *sloc;     /* T->nf, T->nv (-1), S->nv (-1) */
 } ctx;
+
+/* Whether the region's vertex i stays where it is mapped: its boundary,
+ * the landmarks, and the holes filled in (their faces were not bad: a
+ * limb's end beyond a bad band round it keeps its map, and only the band
+ * is re-mapped, so the harmonic map never crowds a long tube's end into a
+ * point). */
+static int pinned(const ctx *c, const fold__patch *pS, int i)
+{
+    int v = pS->verts[i];
+    return i < pS->nb || c->fixed[v] || c->keep[v];
+}
 
 /* The chart: patch pT of T placed in the unit disk (uvT, 2 per vertex),
  * oriented as T. Returns 0, 1 when it is no disk or too large, -1 (memory). */
@@ -48,26 +62,32 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
 {
     const mesh *T = c->T;
     *uvT = NULL;
+    /* the faces the boundary (and the landmarks) land in, grown until they
+     * are one piece: a band round the boundary's image, whose holes then
+     * fill with what lies inside it. Inner vertices' images do not count:
+     * those that jumped elsewhere are re-mapped anyway. */
     memset(c->tin, 0, (size_t)T->nf);
     for (int i = 0; i < pS->nv; i++)
-        c->tin[c->R->face[pS->verts[i]]] = 1;
-    fold__grow(T, c->tin, FOLD__CHART_RINGS, c->tmark);
-    int n = fold__components(&c->ET, c->tin, c->tcomp);
-    if (n < 0)
-        return -1;
-    int *votes = calloc((size_t)n + 1, sizeof(int));
-    if (!votes)
-        return -1;
-    for (int i = 0; i < pS->nv; i++)
-        votes[c->tcomp[c->R->face[pS->verts[i]]]]++;
-    int best = 0;
-    for (int k = 1; k < n; k++)
-        if (votes[k] > votes[best])
-            best = k;
-    int all = votes[best] == pS->nv;
-    free(votes);
-    if (!all)
-        return 1;                  /* the region's images lie apart */
+        if (pinned(c, pS, i))
+            c->tin[c->R->face[pS->verts[i]]] = 1;
+    int n = 0, best = 0;
+    for (int r = 0; r < FOLD__CHART_MAX_RINGS; r++) {
+        fold__grow(T, c->tin, 1, c->tmark);
+        if (r + 1 < FOLD__CHART_RINGS)
+            continue;
+        if ((n = fold__components(&c->ET, c->tin, c->tcomp)) < 0)
+            return -1;
+        best = c->tcomp[c->R->face[pS->verts[0]]];
+        int one = 1;
+        for (int i = 0; i < pS->nv && one; i++)
+            if (pinned(c, pS, i))
+                one = c->tcomp[c->R->face[pS->verts[i]]] == best;
+        if (one)
+            break;
+        best = -1;
+    }
+    if (best < 0)
+        return 1;                  /* the boundary's image is torn apart */
     for (int t = 0; t < T->nf; t++)
         c->tin[t] = c->tcomp[t] == best;
     int size = fold__fill_holes(&c->ET, c->tin);
@@ -147,16 +167,19 @@ static int remap(ctx *c, const fold__patch *pS)
     if (sa < 0)
         for (int i = 0; i < pT.nv; i++)
             uvT[2 * i + 1] = -uvT[2 * i + 1];
-    /* every vertex's image in the chart; the boundary and landmarks pinned */
+    /* the images in the chart (an inner vertex's outside it starts at 0);
+     * the boundary and the landmarks pinned there */
     for (int i = 0; i < pS->nv; i++) {
         int v = pS->verts[i], f = c->R->face[v];
         uv[2 * i] = uv[2 * i + 1] = 0;
+        pin[i] = pinned(c, pS, i);
+        if (c->tloc[T->f[3 * f]] < 0)
+            continue;
         for (int k = 0; k < 3; k++) {
             int j = c->tloc[T->f[3 * f + k]];
             uv[2 * i] += c->R->w[3 * v + k] * uvT[2 * j];
             uv[2 * i + 1] += c->R->w[3 * v + k] * uvT[2 * j + 1];
         }
-        pin[i] = i < pS->nb || c->fixed[v];
     }
     for (int i = 0; i < pT.nv; i++)
         c->tloc[pT.verts[i]] = -1;
@@ -243,6 +266,11 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     for (int k = 0; k < n; k++) {
         for (int t = 0; t < nf; t++)
             cin[t] = comp[t] == k;
+        memset(c->keep, 1, (size_t)nv);
+        for (int t = 0; t < nf; t++)
+            if (cin[t])
+                for (int j = 0; j < 3; j++)
+                    c->keep[S->f[3 * t + j]] = 0;
         int size = fold__fill_holes(&c->ES, cin);
         if (size < 0)
             goto out;
@@ -332,13 +360,14 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     ctx c = { .S = S, .T = T };
     int rc = FOLD_ENOMEM;
     unsigned char *kind = malloc((size_t)S->nf + 1), *fx = calloc((size_t)S->nv + 1, 1);
+    c.keep = malloc((size_t)S->nv + 1);
     c.tin = malloc((size_t)T->nf + 1);
     c.tmark = malloc((size_t)T->nv + 1);
     c.tcomp = malloc(sizeof(int) * ((size_t)T->nf + 1));
     c.tloc = malloc(sizeof(int) * ((size_t)T->nv + 1));
     c.sloc = malloc(sizeof(int) * ((size_t)S->nv + 1));
     c.R = bmap_new(P->n, P->nt);
-    if (!kind || !fx || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
+    if (!kind || !fx || !c.keep || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
         goto out;
     for (int v = 0; v < T->nv; v++)
         c.tloc[v] = -1;
@@ -379,6 +408,7 @@ out:
     bmap_free(c.R);
     free(kind);
     free(fx);
+    free(c.keep);
     free(c.tin);
     free(c.tmark);
     free(c.tcomp);
