@@ -18,9 +18,9 @@
  *           untwisted this way: its boundary ring is only rotated, and the
  *           harmonic map inside a rotated ring does not fold;
  *   accept  a region's new rows are kept only when its faces then have
- *           fewer bad ones; `passes` passes, each growing the regions of
- *           what is left by two rings more. A repair never makes a map
- *           worse.
+ *           no more collapsed ones and fewer bad ones; `passes` passes,
+ *           each growing the regions of what is left by two rings more. A
+ *           repair never makes a map worse.
  *
  * Landmark source vertices (when given) keep their rows. What it
  * cannot undo: a part mirrored as a whole (its boundary is mapped the

@@ -271,11 +271,14 @@ static int remap_all(ctx *c, taken *tk, int ntaken, int pin_landmarks)
     return 0;
 }
 
-static int count_bad(const fold__patch *p, const unsigned char *kind)
+/* The region's bad faces, a collapsed one counted as more than all the
+ * faces it has: a remap that trades flips for collapse (a harmonic map
+ * crowding a long part into a point) never counts as better. */
+static long badness(const fold__patch *p, const unsigned char *kind)
 {
-    int n = 0;
+    long n = 0;
     for (int q = 0; q < p->nf; q++)
-        n += kind[p->faces[q]] != 0;
+        n += kind[p->faces[q]] == METRIC_FACE_COLLAPSED ? p->nf + 1 : kind[p->faces[q]] != 0;
     return n;
 }
 
@@ -351,8 +354,8 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
         goto out;
     for (int k = 0; k < ntaken; k++) {
         taken *r = tk + k;
-        int before = count_bad(&r->p, kind), pinned_ = count_bad(&r->p, kind2),
-            free_ = count_bad(&r->p, kind3);
+        long before = badness(&r->p, kind), pinned_ = badness(&r->p, kind2),
+             free_ = badness(&r->p, kind3);
         const unsigned char *won = kind3;
         if (pinned_ < free_) {
             rows(c->R, &r->p, r->pface, r->pw, 0);
