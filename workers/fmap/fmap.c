@@ -391,7 +391,8 @@ int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const 
         }
     double nn = mu_n > 0 ? frob(N1, k1 * k1) * frob(N2, k2 * k2) : 0;
     for (int d = 0; d < no; d++) {   /* each operator pair at mu_o / no / (||O1_d|| ||O2_d||) */
-        double on = frob(O1 + (size_t)d * k1 * k1, k1 * k1) * frob(O2 + (size_t)d * k2 * k2, k2 * k2);
+        double on = frob(O1 + (size_t)d * k1 * k1, k1 * k1) *
+                    frob(O2 + (size_t)d * k2 * k2, k2 * k2);
         wo[d] = on > 0 ? mu_o / no / on : 0;
     }
     normal_system ns = {k1, k2, no, G, D, N1, N2, O1, O2, wo, mu, nn > 0 ? mu_n / nn : 0, t1, t2};

@@ -37,8 +37,9 @@
  * nearest to row i of Psi1 C, by exhaustive search (exact; n1 n2 k2 work).
  *
  * Shapes are row-major. Errors: FMAP_EINVAL (a k above a basis' size or
- * below 1, nd < 1, a negative weight), FMAP_ESOLVE (a row's system not positive
- * definite: too few descriptors and mu = 0), FMAP_ENOMEM; detail in err. */
+ * below 1, nd < 1, a negative weight), FMAP_ESOLVE (a row's system not
+ * positive definite: too few descriptors and mu = 0), FMAP_ENOMEM; detail
+ * in err. */
 #ifndef FMAP_H
 #define FMAP_H
 #include "lbo/lbo.h"
@@ -77,10 +78,11 @@ int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F
  *   + mu_n ||N1 C - C N2||_F^2 / (||N1||_F ||N2||_F),
  * N1 (k1 by k1) and N2 (k2 by k2) the reduced normal operators
  * (fmap_normal_operator). No longer row-separable: conjugate gradients on
- * the normal equations in the k1 k2 entries of C, started from the
- * Laplacian-only solution, until the residual is below FMAP_CG_TOL of the
- * right-hand side (at most FMAP_CG_MAX_ITER steps; *iterations, may be
- * NULL). mu_n = 0 gives fmap_from_descriptors' result. */
+ * the normal equations in the k1 k2 entries of C (preconditioned by their
+ * diagonal), started from the Laplacian-only solution, until the residual
+ * is below FMAP_CG_TOL of the right-hand side (at most FMAP_CG_MAX_ITER
+ * steps; *iterations, may be NULL). mu_n = 0 gives fmap_from_descriptors'
+ * result. */
 /* D_N weight: the best of 0.01, 0.1, 1 on FAUST 000 -> 001, 002 -> 007 and
  * 000 -> 020 (5 landmarks, k = 50; test_fmap.c has the figures); larger
  * values were not tried. */
@@ -106,7 +108,12 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
  * no = 0 gives fmap_from_descriptors_normal's result bit for bit. */
 /* Orientation weight and the descriptors it uses: per block of
  * fmap_landmark_descriptors' columns (the WKS, each landmark's WKM) the
- * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. */
+ * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. mu_o = 3
+ * was the best of 1, 3, 10 on bench_shrec07 --rhm-start=fmap --stop=rhm
+ * over plier, glasses, airplane, hand, fish, ant (after RHM: mean flipped
+ * 7.8 / 6.3 / 6.9 %, mean held-out error without the hand 0.0266 / 0.0257
+ * / 0.0273; without the term 21.5 % and 0.0259) and the smallest of them
+ * that keeps the mirrored plier of test_fmap below 10 % flipped. */
 #define FMAP_MU_ORIENT_DEFAULT 3.0
 #define FMAP_ORIENT_ENERGIES 5
 int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const double *F1,

@@ -188,7 +188,8 @@ static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
     double *F[2] = {NULL, NULL}, *N[2] = {NULL, NULL}, *C = malloc(sizeof(double) * (size_t)k * k);
     double *O[2] = {NULL, NULL};
     int nd = 0, lrc = 0, *cols = malloc(sizeof(int) * (size_t)(1 + nl) * FMAP_ORIENT_ENERGIES);
-    int no = cols ? fmap_orientation_columns(FMAP_ENERGIES_DEFAULT, nl, FMAP_ORIENT_ENERGIES, cols) : 0;
+    int no = cols ? fmap_orientation_columns(FMAP_ENERGIES_DEFAULT, nl, FMAP_ORIENT_ENERGIES, cols)
+                  : 0;
     char detail[512] = "";
     lmk_set L = {nl, s[0].lmk, s[1].lmk}, R = {nl, s[1].lmk, s[0].lmk};
     for (int i = 0; i < 2 && !lrc; i++)
@@ -213,14 +214,16 @@ static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
         F[0] = F[1] = NULL;
         lrc = fmap_landmark_descriptors(&b[i], &b[j], i ? &R : &L, FMAP_ENERGIES_DEFAULT, &F[0], &F[1], &nd,
                                         detail, sizeof detail);
-        for (int q = 0; q < 2 && !lrc; q++)
-            lrc = fmap_orientation_operators(s[q ? j : i].m, &b[q ? j : i], F[q], nd, cols, no, k, O[q],
-                                             detail, sizeof detail);
+        for (int q = 0; q < 2 && !lrc; q++) {
+            int side = q ? j : i;
+            lrc = fmap_orientation_operators(s[side].m, &b[side], F[q], nd, cols, no, k, O[q], detail,
+                                             sizeof detail);
+        }
         if (!lrc)
-            lrc = fmap_from_descriptors_oriented(&b[i], geod_solver_mass(s[i].geod), F[0], N[i], O[0], &b[j],
-                                                 geod_solver_mass(s[j].geod), F[1], N[j], O[1], nd, no, k, k,
-                                                 FMAP_MU_LAP_DEFAULT, FMAP_MU_NORMAL_DEFAULT, FMAP_MU_ORIENT_DEFAULT, C, NULL,
-                                                 detail, sizeof detail);
+            lrc = fmap_from_descriptors_oriented(&b[i], geod_solver_mass(s[i].geod), F[0], N[i], O[0],
+                                                 &b[j], geod_solver_mass(s[j].geod), F[1], N[j], O[1], nd,
+                                                 no, k, k, FMAP_MU_LAP_DEFAULT, FMAP_MU_NORMAL_DEFAULT,
+                                                 FMAP_MU_ORIENT_DEFAULT, C, NULL, detail, sizeof detail);
         if (!lrc)
             lrc = ddm_deblur(&b[i], NULL, &b[j], s[j].m, C, k, k, s[i].P, NULL, detail, sizeof detail);
     }
