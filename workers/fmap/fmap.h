@@ -22,13 +22,24 @@
  * the same energies (desc.h), energies taken from M1's spectrum and used on
  * both shapes; both meshes should be at unit area.
  *
+ * Commutativity with operators (fmap_from_descriptors_normal, _oriented):
+ * for an operator on functions reduced to the bases, X1 (k1 by k1) on M1
+ * and X2 (k2 by k2) on M2, the term ||X1 C - C X2||_F^2 (C carries a
+ * function's coefficients from M2 to M1, so applying X2 then C equals C
+ * then X1). Δ and D_N (fmap_normal_operator) are preserved by isometries,
+ * reflections included; the orientation operators of Ren et al. 2018
+ * (fmap_orientation_operators: F_f(g) = <n, grad f x grad g> for each of a
+ * few descriptors f) change sign under a reflection, so their term tells
+ * a map from its mirror image.
+ *
  * The vertex map (fmap_vertex_map): each vertex i of M1 goes to the vertex
  * j of M2 whose spectral coordinates (row j of Psi2, first k2 columns) are
  * nearest to row i of Psi1 C, by exhaustive search (exact; n1 n2 k2 work).
  *
  * Shapes are row-major. Errors: FMAP_EINVAL (a k above a basis' size or
- * below 1, nd < 1, mu < 0), FMAP_ESOLVE (a row's system not positive
- * definite: too few descriptors and mu = 0), FMAP_ENOMEM; detail in err. */
+ * below 1, nd < 1, a negative weight), FMAP_ESOLVE (a row's system not
+ * positive definite: too few descriptors and mu = 0), FMAP_ENOMEM; detail
+ * in err. */
 #ifndef FMAP_H
 #define FMAP_H
 #include "lbo/lbo.h"
@@ -67,10 +78,11 @@ int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F
  *   + mu_n ||N1 C - C N2||_F^2 / (||N1||_F ||N2||_F),
  * N1 (k1 by k1) and N2 (k2 by k2) the reduced normal operators
  * (fmap_normal_operator). No longer row-separable: conjugate gradients on
- * the normal equations in the k1 k2 entries of C, started from the
- * Laplacian-only solution, until the residual is below FMAP_CG_TOL of the
- * right-hand side (at most FMAP_CG_MAX_ITER steps; *iterations, may be
- * NULL). mu_n = 0 gives fmap_from_descriptors' result. */
+ * the normal equations in the k1 k2 entries of C (preconditioned by their
+ * diagonal), started from the Laplacian-only solution, until the residual
+ * is below FMAP_CG_TOL of the right-hand side (at most FMAP_CG_MAX_ITER
+ * steps; *iterations, may be NULL). mu_n = 0 gives fmap_from_descriptors'
+ * result. */
 /* D_N weight: the best of 0.01, 0.1, 1 on FAUST 000 -> 001, 002 -> 007 and
  * 000 -> 020 (5 landmarks, k = 50; test_fmap.c has the figures); larger
  * values were not tried. */
@@ -82,6 +94,62 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
                                  const double *F2, const double *N2, int nd, int k1, int k2,
                                  double mu, double mu_n, double *C, int *iterations, char *err,
                                  size_t errsz);
+
+/* The same objective plus orientation-preserving commutativity (Ren,
+ * Poulenard, Wonka, Ovsjanikov 2018):
+ *   + mu_o / no sum_d ||O1_d C - C O2_d||_F^2 / (||O1_d||_F ||O2_d||_F),
+ * O1 (no by k1 by k1) and O2 (no by k2 by k2) the reduced orientation
+ * operators of corresponding descriptors (fmap_orientation_operators). Δ
+ * and D_N are blind to a reflection; O_f changes sign under one, so a
+ * mirrored C (O1 C ~ -C O2) pays about 4 mu_o. The normal equations gain
+ * sum_d (O1_d^T R_d - R_d O2_d^T) (O is not symmetric); same conjugate
+ * gradients, tolerance and errors as fmap_from_descriptors_normal (N1, N2
+ * may be NULL when mu_n = 0, O1, O2 when no = 0 or mu_o = 0). mu_o = 0 or
+ * no = 0 gives fmap_from_descriptors_normal's result bit for bit. */
+/* Orientation weight and the descriptors it uses: per block of
+ * fmap_landmark_descriptors' columns (the WKS, each landmark's WKM) the
+ * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. mu_o = 3
+ * was the best of 1, 3, 10 on bench_shrec07 --rhm-start=fmap --stop=rhm
+ * over plier, glasses, airplane, hand, fish, ant (after RHM: mean flipped
+ * 7.8 / 6.3 / 6.9 %, mean held-out error without the hand 0.0266 / 0.0257
+ * / 0.0273; without the term 21.5 % and 0.0259) and the smallest of them
+ * that keeps the mirrored plier of test_fmap below 10 % flipped. */
+#define FMAP_MU_ORIENT_DEFAULT 3.0
+#define FMAP_ORIENT_ENERGIES 5
+int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const double *F1,
+                                   const double *N1, const double *O1, const lbo_basis *b2,
+                                   const double *m2, const double *F2, const double *N2,
+                                   const double *O2, int nd, int no, int k1, int k2, double mu,
+                                   double mu_n, double mu_o, double *C, int *iterations,
+                                   char *err, size_t errsz);
+
+/* The orientation-aware operator of a descriptor f (Ren et al. 2018, §4),
+ *   F_f(g) = <n, grad f x grad g>   (= <J grad f, grad g>, J the rotation
+ *   by +90 degrees about the outward unit normal n),
+ * per face with n the face's unit normal (the right-hand rule on its
+ * corner order: outward for an outward-oriented mesh) and grad f, grad g
+ * the gradients of the linear interpolants, reduced to the first k basis
+ * functions: O_f (k by k) = Psi^T M F_f Psi with the per-face values
+ * integrated exactly, (O_f)_ab = sum_t area_t mean_{c in t}(psi_a) (F_f
+ * psi_b)_t (the same as taking F_f psi_b to the vertices by area-weighted
+ * averaging and weighting by the lumped mass). Properties the tests check:
+ * on a closed mesh O_f is antisymmetric (J grad f is divergence-free), its
+ * row and column of the constant vanish, and reflecting the mesh (faces
+ * reversed so that normals stay outward) negates it; per face area_t
+ * <n, grad f x grad phi_c> = (f_{c+2} - f_{c+1}) / 2 for the hat function
+ * phi_c of corner c, so O_f depends on the mesh only through its faces'
+ * orientation and the basis. F: nv by nd (row-major), cols: the no columns
+ * f to use; O: no by k by k. Degenerate faces contribute nothing.
+ * FMAP_EINVAL for k out of the basis, a basis of another size, no < 0 or a
+ * column out of range. */
+int fmap_orientation_operators(const mesh *m, const lbo_basis *b, const double *F, int nd,
+                               const int *cols, int no, int k, double *O, char *err,
+                               size_t errsz);
+/* The columns of fmap_landmark_descriptors(ne energies, nl landmarks) the
+ * orientation term uses: in each of the 1 + nl blocks, per energies
+ * evenly spaced energy indices (all ne when per >= ne). cols: room for
+ * (1 + nl) min(per, ne); returns the count. */
+int fmap_orientation_columns(int ne, int nl, int per, int *cols);
 
 /* *F1 (n1 by *nd) and *F2 (n2 by *nd), malloc()ed, caller frees:
  * *nd = ne * (1 + L->n) columns (WKS, then each landmark's WKM). */

@@ -172,8 +172,10 @@ out:
  * figures), capped by what a small mesh has. */
 #define RHM__FMAP_K 50
 
-/* Both directions: C_ij from side i's and side j's landmark descriptors,
- * Psi_i C_ij ~ P_ij Psi_j, deblurred row by row onto side j (ddm.h). */
+/* Both directions: C_ij from side i's and side j's landmark descriptors
+ * with Δ, D_N and orientation commutativity (the orientation operators of
+ * FMAP_ORIENT_ENERGIES columns per descriptor block, fmap.h), Psi_i C_ij ~
+ * P_ij Psi_j, deblurred row by row onto side j (ddm.h). */
 static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
 {
     rhm__side *s = pb->side;
@@ -184,7 +186,10 @@ static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
     lbo_basis b[2];
     memset(b, 0, sizeof b);
     double *F[2] = {NULL, NULL}, *N[2] = {NULL, NULL}, *C = malloc(sizeof(double) * (size_t)k * k);
-    int nd = 0, lrc = 0;
+    double *O[2] = {NULL, NULL};
+    int nd = 0, lrc = 0, *cols = malloc(sizeof(int) * (size_t)(1 + nl) * FMAP_ORIENT_ENERGIES);
+    int no = cols ? fmap_orientation_columns(FMAP_ENERGIES_DEFAULT, nl, FMAP_ORIENT_ENERGIES, cols)
+                  : 0;
     char detail[512] = "";
     lmk_set L = {nl, s[0].lmk, s[1].lmk}, R = {nl, s[1].lmk, s[0].lmk};
     for (int i = 0; i < 2 && !lrc; i++)
@@ -194,8 +199,11 @@ static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
         rc = errbuf_set(err, errsz, RHM_ENUMERIC, "the functional-map start: eigenpairs: %s", detail);
         goto out;
     }
+    if (!C || !cols)
+        goto nomem;
     for (int i = 0; i < 2; i++)
-        if (!(N[i] = malloc(sizeof(double) * (size_t)k * k)))
+        if (!(N[i] = malloc(sizeof(double) * (size_t)k * k)) ||
+            !(O[i] = malloc(sizeof(double) * (size_t)k * k * (no > 0 ? no : 1))))
             goto nomem;
     for (int i = 0; i < 2 && !lrc; i++)
         lrc = fmap_normal_operator(s[i].m, &b[i], k, N[i], detail, sizeof detail);
@@ -206,11 +214,16 @@ static int start_fmap(rhm__problem *pb, char *err, size_t errsz)
         F[0] = F[1] = NULL;
         lrc = fmap_landmark_descriptors(&b[i], &b[j], i ? &R : &L, FMAP_ENERGIES_DEFAULT, &F[0], &F[1], &nd,
                                         detail, sizeof detail);
+        for (int q = 0; q < 2 && !lrc; q++) {
+            int side = q ? j : i;
+            lrc = fmap_orientation_operators(s[side].m, &b[side], F[q], nd, cols, no, k, O[q], detail,
+                                             sizeof detail);
+        }
         if (!lrc)
-            lrc = fmap_from_descriptors_normal(&b[i], geod_solver_mass(s[i].geod), F[0], N[i], &b[j],
-                                               geod_solver_mass(s[j].geod), F[1], N[j], nd, k, k,
-                                               FMAP_MU_LAP_DEFAULT, FMAP_MU_NORMAL_DEFAULT, C, NULL, detail,
-                                               sizeof detail);
+            lrc = fmap_from_descriptors_oriented(&b[i], geod_solver_mass(s[i].geod), F[0], N[i], O[0],
+                                                 &b[j], geod_solver_mass(s[j].geod), F[1], N[j], O[1], nd,
+                                                 no, k, k, FMAP_MU_LAP_DEFAULT, FMAP_MU_NORMAL_DEFAULT,
+                                                 FMAP_MU_ORIENT_DEFAULT, C, NULL, detail, sizeof detail);
         if (!lrc)
             lrc = ddm_deblur(&b[i], NULL, &b[j], s[j].m, C, k, k, s[i].P, NULL, detail, sizeof detail);
     }
@@ -223,7 +236,9 @@ out:
         lbo_basis_close(&b[i]);
         free(F[i]);
         free(N[i]);
+        free(O[i]);
     }
+    free(cols);
     free(C);
     return rc;
 }
