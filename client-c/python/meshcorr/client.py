@@ -13,7 +13,7 @@ from . import _lib
 from ._lib import lib, check, errbuf
 from .map import Map, read_map
 
-STAGES = ("start", "rhm", "ectm", "init")
+STAGES = ("start", "rhm", "ectm", "init", "ddm")
 _WANT_P, _WANT_Q, _WANT_DEFORMED, _WANT_METRICS = 1, 2, 4, 8
 _PARAM_NAMES = {p.name: p for p in _lib.PARAMS}
 
