@@ -72,6 +72,18 @@ static int on_progress(void *ctx, const corr_progress *cp)
         fflush(stderr);
         return 0;
     }
+    if (cp->ddm) {               /* directions denoised of total, each one's objective */
+        const corr_ddm_report *d = cp->ddm;
+        if (ps->mode == PROGRESS_JSON)
+            fprintf(stderr, "{\"stage\":\"ddm\",\"done\":%d,\"total\":%d,\"k\":%d,"
+                    "\"objective\":[%.17g,%.17g],\"elapsed\":%.3f}\n", d->done, d->total, d->k,
+                    d->cost[0], d->cost[1], cp->elapsed);
+        else if (ps->mode != PROGRESS_NONE)
+            fprintf(stderr, "ddm %d/%d (k %d) objective %.6g  %.1f s\n", d->done, d->total, d->k,
+                    d->done ? d->cost[d->done - 1] : 0.0, cp->elapsed);
+        fflush(stderr);
+        return 0;
+    }
     if (cp->stage != CORR_STAGE_ECTM) {
         if (ps->mode == PROGRESS_JSON)
             fprintf(stderr, "{\"stage\":\"%s\",\"elapsed\":%.3f}\n", corr_stage_name(cp->stage), cp->elapsed);
