@@ -149,7 +149,8 @@ class Client:
         quantization: bits per coordinate (0 lossless); device: an OpenCL
         device name part (backend "opencl:DEVICE"); params: the job
         parameters of `meshcorr params` by name (model="injective",
-        iterations=5, beta0=1e3, partial=True, backend="cpu", ...). A bad
+        iterations=5, beta0=1e3, partial=True, backend="cpu",
+        stages="ddm,ectm", ...). A bad
         value is refused with the server's message."""
         qbits = int(quantization)
         sb, sn = _encode(source, qbits)
@@ -268,7 +269,7 @@ class Job:
         """Yields a progress dict per record (replayed from outer iteration
         from_outer, then live) until the job ends; then self.state and
         self.reason tell how it ended. A dict: job, stage (start, rhm, ectm,
-        init), outer, total, beta, gamma, elapsed (s), membrane, bending,
+        init, ddm), outer, total, beta, gamma, elapsed (s), membrane, bending,
         mismatch, reverse, energy (both directions summed), and source,
         target: each direction's terms and inner iterations. It follows the
         job on a connection of its own."""
