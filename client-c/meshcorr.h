@@ -91,7 +91,8 @@ typedef struct mc_job_spec {
      * inner_iterations, tolerance, stop_change, rhm_iterations, rhm_dim,
      * rhm_alpha, rhm_landmark_weight, rhm_start (MC_RHM_START_*), backend
      * (NULL or "" = the server's default; "cpu", "opencl", "auto",
-     * optionally ":DEVICE", a platform or device name part). */
+     * optionally ":DEVICE", a platform or device name part), stages
+     * (MC_STAGES_*), ddm_k. */
 #define MC_PARAM_CTYPE_ENUM int
 #define MC_PARAM_CTYPE_BOOL int
 #define MC_PARAM_CTYPE_U32  uint32_t
@@ -131,13 +132,17 @@ size_t mc_job_spec_size(void);
 int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
 
 enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1, MC_RHM_START_FMAP = 2 };
-enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3 };
+enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3, MC_STAGE_DDM = 4 };
+/* Values of the stages parameter (PROTO_PARAMS; `meshcorr submit --stages`). */
+enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM = 3,
+       MC_STAGES_DDM_ECTM = 4, MC_STAGES_DDM_RHM = 5, MC_STAGES_DDM_RHM_ECTM = 6,
+       MC_STAGES_RHM_ECTM = 7 };
 
 /* For stages start and rhm the five terms are RHM's (PROTOCOL.md,
  * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */
 typedef struct mc_progress {
     uint64_t job_id;
-    int stage;                 /* MC_STAGE_*: 0 start, 1 rhm, 2 ectm, 3 init */
+    int stage;                 /* MC_STAGE_*: 0 start, 1 rhm, 2 ectm, 3 init, 4 ddm */
     uint32_t outer, total;     /* outer iteration, planned */
     uint32_t inner[2];         /* L-BFGS iterations: [0] source side, [1] target side */
     double membrane[2], bending[2], mismatch[2], reverse[2], energy[2];

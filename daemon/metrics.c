@@ -90,7 +90,7 @@ static void format(FILE *fp, const mcd_snapshot *s)
     fprintf(fp, "meshcorr_snapshots_total %u\n", s->seq);
     slot_family(fp, s, "meshcorr_slot_state", "Worker slot state: 0 idle, 1 starting, 2 busy, 3 draining (job_id 0: none).", F_STATE);
     slot_family(fp, s, "meshcorr_slot_elapsed_seconds", "Wall time since the slot's job started.", F_ELAPSED);
-    slot_family(fp, s, "meshcorr_slot_stage", "Stage of the latest progress: 0 start, 1 rhm, 2 ectm, 3 init.", F_STAGE);
+    slot_family(fp, s, "meshcorr_slot_stage", "Stage of the latest progress: 0 start, 1 rhm, 2 ectm, 3 init, 4 ddm.", F_STAGE);
     slot_family(fp, s, "meshcorr_slot_outer_iteration", "Outer iteration of the latest progress.", F_OUTER);
     slot_family(fp, s, "meshcorr_slot_total_iterations", "Outer iterations planned.", F_TOTAL);
     slot_family(fp, s, "meshcorr_slot_progress_ratio", "Outer iteration over iterations planned (0 to 1).", F_PROGRESS);

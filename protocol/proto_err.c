@@ -48,7 +48,7 @@ const char *proto_state_name(int state)
 
 const char *proto_stage_name(int stage)
 {
-    static const char *const names[] = { "start", "rhm", "ectm", "init" };
+    static const char *const names[] = { "start", "rhm", "ectm", "init", "ddm" };
     return stage >= 0 && stage <= PROTO_STAGE_LAST ? names[stage] : NULL;
 }
 

@@ -37,6 +37,7 @@
 #define PROTO_MAX_LANDMARKS 65536   /* landmark pairs (the codec's count limit too) */
 #define PROTO_MAX_DEVICE    127      /* bytes of ":DEVICE" in backend, the colon excluded */
 #define PROTO_RHM_MAX_DIM   64       /* rhm_dim's max: the embedding's (EMBED_MAX_DIM) */
+#define PROTO_DDM_MAX_K     300      /* ddm_k's max: the eigenpairs' (LBO_MAX_K) */
 
 #define PROTO_PARAM_OPEN_MIN     1u
 #define PROTO_PARAM_OPEN_MAX     2u
@@ -81,6 +82,13 @@
       "functional map from landmark descriptors made precise by DDM")                            \
     X(backend, "backend", STR, 0, 0, 0, 0, NONE, backend, "cpu|opencl|auto",                     \
       "elastic energy on the CPU, an OpenCL device, or auto (a GPU, else the CPU); "             \
-      "\"\" = the server's default (cpu); on the wire optionally :DEVICE")
+      "\"\" = the server's default (cpu); on the wire optionally :DEVICE")                     \
+    X(stages, "stages", ENUM, 0, 0, 7, 0, NONE, stages,                                          \
+      "all|rhm|ectm|ddm|ddm,ectm|ddm,rhm|ddm,rhm,ectm|rhm,ectm",                                 \
+      "stages run, always in the order ddm, rhm, ectm: all = RHM then ECTM from landmarks, "     \
+      "ECTM alone on a given map; ddm (denoising through the map's functional map) needs a "     \
+      "given map; rhm starts from landmarks or from the given (or denoised) map")                \
+    X(ddm_k, "ddm-k", U32, 0, 0, PROTO_DDM_MAX_K, 0, NONE, ddm_k, "",                            \
+      "DDM basis size: eigenfunctions per mesh (0: min(100, vertices - 2); at most vertices - 2)")
 
 #endif

@@ -1,6 +1,7 @@
 /* cli_eval.c — `meshcorr eval`: the quality figures of a map between two
  * mesh files (workers/metric), optionally against a ground truth and with
- * the reverse map. Reads files and prints; computes nothing itself.
+ * the reverse map. Reads files and prints; computes nothing itself. Maps
+ * are meshcorr-map 1 files or vertex maps (map/vmap.h, base --map-base).
  *
  * Ground-truth formats:
  *   vts-pair     --gt A --gt-target B: line k of A (source vertex) <-> line
@@ -13,6 +14,7 @@
 #include "geod/geod.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
+#include "map/vmap.h"
 #include "mesh/mesh.h"
 #include "metric/metric.h"
 #include "render/render.h"
@@ -35,8 +37,10 @@ static void usage(FILE *fp)
     fprintf(fp,
         "usage: meshcorr eval SOURCE TARGET P.map [P2.map ...] [--reverse Q.map]\n"
         "         [--gt GT [--gt-target GT2] --gt-format vts-pair|vertex-list [--gt-base 0|1]]\n"
-        "         [--json] [--out-colors PREFIX] [--out-png FILE [--mark-folds]]\n"
+        "         [--map-base 0|1|auto] [--json] [--out-colors PREFIX] [--out-png FILE [--mark-folds]]\n"
         "         [--out-curve CURVES.svg] [--out-csv CURVES.csv]\n"
+        "Maps: meshcorr-map 1 files, or vertex maps (one target vertex per source vertex a line,\n"
+        "as BCICP and BIM write them; --map-base as match's --init-base, default auto).\n"
         "Prints, for each map: conformal and area distortion, flipped and collapsed triangles,\n"
         "mean-curvature error, coverage of the target, the round trip with Q (one map only),\n"
         "and the geodesic error to a ground truth (divided by sqrt(target area); mean and\n"
@@ -169,11 +173,12 @@ int cli_eval(int argc, char **argv)
         {"gt-base", required_argument, 0, 'b'},  {"json", no_argument, 0, 'j'},
         {"out-colors", required_argument, 0, 'c'}, {"out-curve", required_argument, 0, 's'},
         {"out-csv", required_argument, 0, 'v'},  {"out-png", required_argument, 0, 'p'},
-        {"mark-folds", no_argument, 0, 'm'},     {"help", no_argument, 0, 'h'},
+        {"mark-folds", no_argument, 0, 'm'},     {"map-base", required_argument, 0, 'B'},
+        {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0}};
     const char *rev = NULL, *gt = NULL, *gt2 = NULL, *fmt = NULL;
     const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL, *out_png = NULL;
-    int base = -1, json = 0, folds = 0, c, bad = 0;
+    int base = -1, json = 0, folds = 0, c, bad = 0, map_base = VMAP_BASE_AUTO;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
@@ -187,6 +192,13 @@ int cli_eval(int argc, char **argv)
                 bad = 1;
             }
             base = optarg[0] - '0';
+            break;
+        case 'B':
+            if (strcmp(optarg, "0") && strcmp(optarg, "1") && strcmp(optarg, "auto")) {
+                fprintf(stderr, "meshcorr eval: --map-base: '%s' is not 0, 1 or auto\n", optarg);
+                bad = 1;
+            }
+            map_base = strcmp(optarg, "auto") ? optarg[0] - '0' : VMAP_BASE_AUTO;
             break;
         case 'j': json = 1; break;
         case 'c': out_colors = optarg; break;
@@ -240,12 +252,12 @@ int cli_eval(int argc, char **argv)
     double *gerr = NULL;
     geod_solver *gs = NULL;
     if (mesh_read(spath, &S, err, sizeof err) || mesh_read(tpath, &T, err, sizeof err) ||
-        (rev && bmap_read(rev, T, S, &Q, err, sizeof err))) {
+        (rev && vmap_read_any(rev, map_base, T, S, &Q, err, sizeof err))) {
         fprintf(stderr, "meshcorr eval: %s\n", err);
         goto done;
     }
     for (int a = 0; a < nmaps; a++)
-        if (bmap_read(ppaths[a], S, T, &maps[a], err, sizeof err)) {
+        if (vmap_read_any(ppaths[a], map_base, S, T, &maps[a], err, sizeof err)) {
             fprintf(stderr, "meshcorr eval: %s\n", err);
             goto done;
         }

@@ -12,9 +12,15 @@ void cli_job_usage(FILE *fp)
 {
     fprintf(fp,
         "  inputs:  --landmarks PAIRS | --source-landmarks A --target-landmarks B [--one-based]\n"
-        "           | --init P.map [--init-reverse Q.map]\n"
+        "           | --init P.map [--init-reverse Q.map] [--init-base 0|1|auto] [landmarks]\n"
         "           (landmarks: at least %d pairs; without --init the initial maps come from\n"
         "           them: a start map (--rhm-start), then Reversible Harmonic Maps)\n"
+        "           --init files: meshcorr-map 1, or a vertex map (one target vertex per\n"
+        "           source vertex a line, as BCICP and BIM write them); its base: --init-base,\n"
+        "           else auto: a 0 among the indices -> 0-based, else the target's vertex\n"
+        "           count among them -> 1-based, else refused as ambiguous\n"
+        "  --stages: what runs, in the order ddm, rhm, ectm, e.g. --init P.map --stages\n"
+        "           ddm,rhm,ectm (ddm: denoising of the given map through its functional map)\n"
         "  --preset release|paper  the weights of the authors' released code (the defaults\n"
         "           below) or of the paper's text (eta 1e-3, beta 1e3 -> 2e5, gamma 2e4)\n"
         "  --device NAME           with --backend opencl|auto: an OpenCL device with fp64 whose\n"
@@ -50,6 +56,7 @@ void cli_job_init(cli_job *j, int argc, char **argv)
 {
     memset(j, 0, sizeof *j);
     proto_params_init(&j->w);
+    j->init_base = VMAP_BASE_AUTO;
     for (int i = 1; i < argc; i++)
         if (strcmp(argv[i], "--preset=paper") == 0 ||
             (i + 1 < argc && strcmp(argv[i], "--preset") == 0 && strcmp(argv[i + 1], "paper") == 0)) {
@@ -65,6 +72,15 @@ int cli_job_option(cli_job *j, const char *cmd, int c, const char *arg)
     if (c >= CLI_O_PARAM && c < CLI_O_PARAM + PROTO_NPARAMS) {
         int i = c - CLI_O_PARAM;
         const proto_param_info *f = &proto_param_infos[i];
+        if (i == PROTO_P_stages) {          /* a chain: say why one is not */
+            corr_stages s;
+            if (corr_stages_parse(arg, &s, err, sizeof err)) {
+                fprintf(stderr, "meshcorr %s: --%s: %s\n", cmd, f->cli, err);
+                return -1;
+            }
+            j->w.stages = (uint8_t)s;
+            return 1;
+        }
         if (proto_param_parse(&j->w, i, f->type == PROTO_PARAM_BOOL ? "1" : arg, err, sizeof err)) {
             fprintf(stderr, "meshcorr %s: --%s: %s\n", cmd, f->cli, err);
             return -1;
@@ -74,6 +90,15 @@ int cli_job_option(cli_job *j, const char *cmd, int c, const char *arg)
     switch (c) {
     case CLI_O_INIT: j->init = arg; return 1;
     case CLI_O_INIT_REVERSE: j->init_rev = arg; return 1;
+    case CLI_O_INIT_BASE:
+        if (strcmp(arg, "0") == 0) j->init_base = 0;
+        else if (strcmp(arg, "1") == 0) j->init_base = 1;
+        else if (strcmp(arg, "auto") == 0) j->init_base = VMAP_BASE_AUTO;
+        else {
+            fprintf(stderr, "meshcorr %s: --init-base: '%s' is not 0, 1 or auto\n", cmd, arg);
+            return -1;
+        }
+        return 1;
     case CLI_O_LANDMARKS: j->lmk_pairs = arg; return 1;
     case CLI_O_SOURCE_LANDMARKS: j->lmk_src = arg; return 1;
     case CLI_O_TARGET_LANDMARKS: j->lmk_tgt = arg; return 1;
@@ -107,6 +132,18 @@ int cli_job_check(cli_job *j, const char *cmd)
     }
     if (j->w.model == PROTO_MODEL_INJECTIVE && j->init_rev) {
         fprintf(stderr, "meshcorr %s: --init-reverse needs the bijective model\n", cmd);
+        return -1;
+    }
+    unsigned run = corr_stages_run((corr_stages)j->w.stages, !!j->init);
+    char sname[64] = "";
+    proto_param_value_name(PROTO_P_stages, j->w.stages, sname, sizeof sname);
+    if (run && !j->init && !(run & CORR_RUN_RHM)) {
+        fprintf(stderr, "meshcorr %s: --stages %s needs --init\n", cmd, sname);
+        return -1;
+    }
+    if (run && !j->init && (run & CORR_RUN_DDM)) {
+        fprintf(stderr, "meshcorr %s: --stages %s needs --init (DDM denoises a given map)\n", cmd,
+                sname);
         return -1;
     }
     if (j->device) {
@@ -148,12 +185,12 @@ int cli_job_load(const cli_job *j, const char *cmd, const mesh *S, const mesh *T
     *P0 = *Q0 = NULL;
     int rc = 0;
     if (j->init)
-        rc = bmap_read(j->init, S, T, P0, err, sizeof err);
+        rc = vmap_read_any(j->init, j->init_base, S, T, P0, err, sizeof err);
     if (!rc && j->init_rev)
-        rc = bmap_read(j->init_rev, T, S, Q0, err, sizeof err);
-    if (!rc && !j->init && j->lmk_pairs)
+        rc = vmap_read_any(j->init_rev, j->init_base, T, S, Q0, err, sizeof err);
+    if (!rc && j->lmk_pairs)
         rc = lmk_read_pairs(j->lmk_pairs, j->one_based, S, T, L, err, sizeof err);
-    else if (!rc && !j->init)
+    else if (!rc && j->lmk_src && j->lmk_tgt)
         rc = lmk_read_lists(j->lmk_src, j->lmk_tgt, j->one_based, S, T, L, err, sizeof err);
     if (rc) {
         fprintf(stderr, "meshcorr %s: %s\n", cmd, err);

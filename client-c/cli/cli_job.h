@@ -13,11 +13,12 @@
 #include "ectm/ectm.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
+#include "map/vmap.h"
 #include "rhm/rhm.h"
 
 enum cli_job_code {
     CLI_O_INIT = 2000, CLI_O_INIT_REVERSE, CLI_O_LANDMARKS, CLI_O_SOURCE_LANDMARKS,
-    CLI_O_TARGET_LANDMARKS, CLI_O_ONE_BASED, CLI_O_PRESET, CLI_O_DEVICE,
+    CLI_O_TARGET_LANDMARKS, CLI_O_ONE_BASED, CLI_O_PRESET, CLI_O_DEVICE, CLI_O_INIT_BASE,
     CLI_O_PARAM = 2100          /* + PROTO_P_*: one option per row of PROTO_PARAMS */
 };
 
@@ -33,6 +34,7 @@ enum cli_job_code {
     PROTO_PARAMS(CLI_JOB_PARAM_OPTION)                                                      \
     {"init", required_argument, 0, CLI_O_INIT},                                             \
     {"init-reverse", required_argument, 0, CLI_O_INIT_REVERSE},                             \
+    {"init-base", required_argument, 0, CLI_O_INIT_BASE},                                   \
     {"landmarks", required_argument, 0, CLI_O_LANDMARKS},                                   \
     {"source-landmarks", required_argument, 0, CLI_O_SOURCE_LANDMARKS},                     \
     {"target-landmarks", required_argument, 0, CLI_O_TARGET_LANDMARKS},                     \
@@ -51,6 +53,7 @@ typedef struct cli_job {
     const char *init, *init_rev;             /* initial map files, or NULL */
     const char *lmk_pairs, *lmk_src, *lmk_tgt; /* landmark files, or NULL  */
     int one_based;
+    int init_base;                           /* vertex-map --init files: 0, 1, VMAP_BASE_AUTO */
 } cli_job;
 
 /* Defaults; --preset paper anywhere in argv applies first, so explicit
@@ -67,7 +70,10 @@ int cli_job_check(cli_job *j, const char *cmd);
  * message when they are out of range (not after cli_job_check). */
 int cli_job_engine(const cli_job *j, const char *cmd, int threads, ectm_params *p, rhm_params *r);
 /* Reads the landmark set (or NULL) and the initial maps (or NULL) against
- * the two meshes; -1 with the reader's message printed. */
+ * the two meshes; -1 with the reader's message printed. An initial map is
+ * a meshcorr-map 1 file or a vertex map (vmap.h; base --init-base, else
+ * vmap.h's rule); landmarks given with a map are read too (RHM's weak
+ * landmark term and fold repair use them). */
 int cli_job_load(const cli_job *j, const char *cmd, const mesh *S, const mesh *T,
                  lmk_set **L, bmap **P0, bmap **Q0);
 

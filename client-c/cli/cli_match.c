@@ -1,6 +1,6 @@
 /* cli_match.c — `meshcorr match`: the in-process engine on two mesh files.
- * Reads and validates the inputs, runs the pipeline (workers/corr: RHM from
- * landmarks, then ECTM), writes the maps and optional meshes, and shows
+ * Reads and validates the inputs, runs the pipeline (workers/corr: the
+ * stages of --stages: DDM, RHM, ECTM), writes the maps and optional meshes, and shows
  * progress (bar on a terminal, text lines, or JSON lines on stderr). Holds
  * no numerics. */
 #include "cli/cli.h"
@@ -23,10 +23,11 @@ static void usage(FILE *fp)
 {
     fprintf(fp,
         "usage: meshcorr match SOURCE TARGET INPUTS --out P.map [--out-reverse Q.map]\n"
-        "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--stages all|rhm|ectm]\n"
+        "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--stages CHAIN]\n"
         "         [--log-eps E] [--threads N] [--progress auto|text|json|none] [job options]\n"
         "--stages rhm stops after RHM and writes its maps; --stages ectm runs ECTM alone\n"
-        "(needs --init). Job options:\n");
+        "(needs --init); --init P.map --stages ddm,ectm denoises the given map by DDM, then\n"
+        "refines it by ECTM. Job options:\n");
     cli_job_usage(fp);
 }
 
@@ -68,6 +69,18 @@ static int on_progress(void *ctx, const corr_progress *cp)
     progress_state *ps = ctx;
     if (cp->rhm) {
         rhm_progress(ps, cp);
+        fflush(stderr);
+        return 0;
+    }
+    if (cp->ddm) {               /* directions denoised of total, each one's objective */
+        const corr_ddm_report *d = cp->ddm;
+        if (ps->mode == PROGRESS_JSON)
+            fprintf(stderr, "{\"stage\":\"ddm\",\"done\":%d,\"total\":%d,\"k\":%d,"
+                    "\"objective\":[%.17g,%.17g],\"elapsed\":%.3f}\n", d->done, d->total, d->k,
+                    d->cost[0], d->cost[1], cp->elapsed);
+        else if (ps->mode != PROGRESS_NONE)
+            fprintf(stderr, "ddm %d/%d (k %d) objective %.6g  %.1f s\n", d->done, d->total, d->k,
+                    d->done ? d->cost[d->done - 1] : 0.0, cp->elapsed);
         fflush(stderr);
         return 0;
     }
@@ -138,18 +151,17 @@ static int write_mesh_with(const char *path, const mesh *faces_of, const double 
 
 int cli_match(int argc, char **argv)
 {
-    enum { O_OUT = 1, O_OUT_REVERSE, O_OUT_DEFORMED, O_OUT_REMESHED, O_STAGES, O_LOG_EPS,
+    enum { O_OUT = 1, O_OUT_REVERSE, O_OUT_DEFORMED, O_OUT_REMESHED, O_LOG_EPS,
            O_THREADS, O_PROGRESS };
     static const struct option opts[] = {
         CLI_JOB_OPTIONS,
         {"out", required_argument, 0, O_OUT},        {"out-reverse", required_argument, 0, O_OUT_REVERSE},
         {"out-deformed", required_argument, 0, O_OUT_DEFORMED},
         {"out-remeshed", required_argument, 0, O_OUT_REMESHED},
-        {"stages", required_argument, 0, O_STAGES}, {"log-eps", required_argument, 0, O_LOG_EPS},
+        {"log-eps", required_argument, 0, O_LOG_EPS},
         {"threads", required_argument, 0, O_THREADS}, {"progress", required_argument, 0, O_PROGRESS},
         {"help", no_argument, 0, 'h'},              {0, 0, 0, 0}};
     const char *out = NULL, *out_rev = NULL, *out_def = NULL, *out_rem = NULL;
-    corr_stages stages = CORR_STAGES_ALL;
     cli_job job;
     cli_job_init(&job, argc, argv);
     ectm_params pe;
@@ -193,12 +205,6 @@ int cli_match(int argc, char **argv)
             else if (strcmp(optarg, "none") == 0) ps.mode = PROGRESS_NONE;
             else { fprintf(stderr, "meshcorr match: --progress: '%s' is not auto, text, json or none\n", optarg); bad = 1; }
             break;
-        case O_STAGES:
-            if (strcmp(optarg, "all") == 0) stages = CORR_STAGES_ALL;
-            else if (strcmp(optarg, "rhm") == 0) stages = CORR_STAGES_RHM;
-            else if (strcmp(optarg, "ectm") == 0) stages = CORR_STAGES_ECTM;
-            else { fprintf(stderr, "meshcorr match: --stages: '%s' is not all, rhm or ectm\n", optarg); bad = 1; }
-            break;
         case 'h': usage(stdout); return 0;
         default: bad = 1;
         }
@@ -212,13 +218,11 @@ int cli_match(int argc, char **argv)
         return 2;
     }
     pe.log_eps = log_eps;
-    if (stages == CORR_STAGES_ECTM && !job.init) {
-        fprintf(stderr, "meshcorr match: --stages ectm needs --init\n");
-        return 2;
-    }
-    if (stages == CORR_STAGES_RHM && (job.init || out_def)) {
-        fprintf(stderr, "meshcorr match: --stages rhm starts from landmarks and has no deformation "
-                "(no --init, no --out-deformed)\n");
+    corr_stages stages = (corr_stages)job.w.stages;
+    int ectm_last = corr_stages_run(stages, !!job.init) & CORR_RUN_ECTM;
+    if (!ectm_last && out_def) {
+        fprintf(stderr, "meshcorr match: --out-deformed needs the ECTM stage (the deformation is "
+                "ECTM's)\n");
         return 2;
     }
     if (pe.model == ECTM_INJECTIVE && out_rev) {
@@ -237,14 +241,18 @@ int cli_match(int argc, char **argv)
     const char *src = argv[optind], *tgt = argv[optind + 1];
     if (!(S = load(src)) || !(T = load(tgt)) || cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
-    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages };
+    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k };
     if (corr_run(&in, &pe, on_progress, &ps, &res, err, sizeof err)) {
         fprintf(stderr, "\nmeshcorr match: %s\n", err);
         goto done;
     }
     char comment[512];
-    if (stages == CORR_STAGES_RHM)
-        snprintf(comment, sizeof comment, "meshcorr match %s -> %s, reversible harmonic map", src, tgt);
+    char chain[64] = "";
+    proto_param_value_name(PROTO_P_stages, (unsigned)stages, chain, sizeof chain);
+    if (!ectm_last)
+        snprintf(comment, sizeof comment, "meshcorr match %s -> %s, stages %s (%s)", src, tgt, chain,
+                 corr_stages_run(stages, !!job.init) & CORR_RUN_RHM ? "reversible harmonic map"
+                                                                    : "DDM-denoised map");
     else
         snprintf(comment, sizeof comment,
                  "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",

@@ -132,8 +132,8 @@ static void json_str(const char *s)
 
 static const char *stage_name(int stage)
 {
-    static const char *const names[] = {"start", "rhm", "ectm", "init"};
-    return stage >= 0 && stage < 4 ? names[stage] : "?";
+    static const char *const names[] = {"start", "rhm", "ectm", "init", "ddm"};
+    return stage >= 0 && stage < 5 ? names[stage] : "?";
 }
 
 /* One line per iteration; every term is the sum of both directions

@@ -96,7 +96,9 @@ void protosample_fill(int type, int v, proto_msg *m)
         u->params = (proto_params){ (uint8_t)(v ? PROTO_MODEL_INJECTIVE : PROTO_MODEL_BIJECTIVE),
                                     (uint8_t)!v, 1e-3, 0.1, 1.0, 1e4, 2, 0.25, 30, 200,
                                     1e-8, 1e-6, v ? 0 : 150, v ? 0 : 12, v ? 0 : 1e-3,
-                                    v ? 0 : 0.5, (uint8_t)!v, v ? "" : "opencl:pocl" };
+                                    v ? 0 : 0.5, (uint8_t)!v, v ? "" : "opencl:pocl",
+                                    (uint8_t)(v ? PROTO_STAGES_ALL : PROTO_STAGES_DDM_RHM_ECTM),
+                                    v ? 0 : 60 };
         u->priority = v ? 0 : -7;
         u->label = s;
         break;

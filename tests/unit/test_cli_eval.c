@@ -154,3 +154,34 @@ TEST(eval_refuses_wrong_ground_truth_and_map_naming_the_file)
     snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s", s381, s390);
     CHECK_INT(run(cmd, out, sizeof out), 2);
 }
+
+/* Published vertex maps (TOSCA gorilla_01 -> man_01) are maps eval reads:
+ * the BCICP map (1-based, holds 5000) with the base told by the rule, the
+ * BIM map (0-based, neither 0 nor 5000) refused until --map-base 0. The
+ * README's sanity figure for BCICP is a Euclidean 0.025 of the bounding
+ * box; the geodesic mean over the 900 points is 0.0474 (test_ddm's). */
+TEST(eval_reads_published_vertex_maps)
+{
+    char s0[512], s1[512], g0[512], g1[512], bim[512], bcicp[512], cmd[4096], out[16384];
+    snprintf(s0, sizeof s0, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/8_gorilla_01.off"));
+    snprintf(s1, sizeof s1, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/8_man_01.off"));
+    snprintf(g0, sizeof g0, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/corres/8_gorilla_01.vts"));
+    snprintf(g1, sizeof g1, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/corres/8_man_01.vts"));
+    snprintf(bim, sizeof bim, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/"
+                                                      "BIM/8_gorilla_01_8_man_01.map"));
+    snprintf(bcicp, sizeof bcicp, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/"
+                                                          "WKSini_direct_BCICP/8_gorilla_01_8_man_01.map"));
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-target %s --gt-format vts-pair "
+             "--json", s0, s1, bcicp, g0, g1);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    const char *geo = strstr(out, "\"geodesic\":");
+    CHECK(geo);
+    CHECK_NEAR(field(geo, "mean"), 0.0474, 5e-5);
+    CHECK_NEAR(field(out, "conformal_median"), 1.392, 5e-4);
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s", s0, s1, bim);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "neither 0 nor 5000");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --map-base 0", s0, s1, bim);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_STR_HAS(out, "conformal distortion: median");
+}

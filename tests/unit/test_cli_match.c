@@ -225,3 +225,66 @@ TEST_T(match_from_landmarks_reports_start_rhm_and_ectm_stages, 120)
     CHECK_INT(run(cmd, out, sizeof out), 2);
     CHECK_STR_HAS(out, "--stages ectm needs --init");
 }
+
+/* A published vertex map as --init (TOSCA gorilla_01 -> man_01): the BIM
+ * map, 0-based but holding neither 0 nor 5000, is refused until
+ * --init-base 0 says its base; then --stages ddm,ectm reports DDM and
+ * every ECTM iteration. A bad line of a vertex map is named; a chain out
+ * of order is refused with the reason; ddm without --init is refused. */
+TEST_T(match_refines_a_vertex_map_with_ddm_then_ectm, 300)
+{
+    char s0[512], s1[512], bim[512], bcicp[512], cmd[4096], out[65536];
+    snprintf(s0, sizeof s0, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/8_gorilla_01.off"));
+    snprintf(s1, sizeof s1, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/8_man_01.off"));
+    snprintf(bim, sizeof bim, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/"
+                                                      "BIM/8_gorilla_01_8_man_01.map"));
+    snprintf(bcicp, sizeof bcicp, "%s", harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/"
+                                                          "WKSini_direct_BCICP/8_gorilla_01_8_man_01.map"));
+    const char *d = harness_tmpdir();
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --stages ddm --out %s/p.map",
+             s0, s1, bim, d);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "8_gorilla_01_8_man_01.map: neither 0 nor 5000 among the indices");
+    CHECK_STR_HAS(out, "--init-base 0 or 1");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --init-base 0 --stages ddm,ectm "
+             "--ddm-k 50 --iterations 2 --inner-iterations 5 --out %s/p.map --out-reverse %s/q.map "
+             "--progress json", s0, s1, bim, d, d);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK_STR_HAS(out, "{\"stage\":\"ddm\",\"done\":0,\"total\":1,\"k\":50,");
+    CHECK_STR_HAS(out, "{\"stage\":\"ddm\",\"done\":1,\"total\":1,\"k\":50,");
+    int ectm = 0;
+    for (char *p = out; (p = strstr(p, "{\"stage\":\"ectm\",\"outer\":")); p++)
+        ectm++;
+    CHECK_INT(ectm, 2);
+    CHECK_STR_HAS(out, "map quality:");
+    /* line 100 of a BCICP map (1-based) pointing past the target */
+    size_t len;
+    char *buf = (char *)testfile_read(bcicp, &len), *w = malloc(len + 64), *o = w;
+    int line = 1;
+    for (char *p = buf; p < buf + len; p++) {
+        if (line == 100 && (p == buf || p[-1] == '\n')) {
+            o += sprintf(o, "5001\n");
+            p = strchr(p, '\n');
+            line++;
+            continue;
+        }
+        *o++ = *p;
+        line += *p == '\n';
+    }
+    const char *bad = testfile_write("bad_vertex.map", w, (size_t)(o - w));
+    free(buf);
+    free(w);
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --stages ddm --out %s/p.map",
+             s0, s1, bad, d);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "bad_vertex.map:100: target vertex 5001 out of range [1, 5000]");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --stages ectm,ddm --out %s/p.map",
+             s0, s1, bcicp, d);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--stages: 'ectm,ddm': ectm before ddm");
+    const char *l = testfile_text("l3.txt", "0 10\n1000 1200\n2000 2100\n");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s --stages ddm,ectm --out %s/p.map",
+             s0, s1, l, d);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--stages ddm,ectm needs --init");
+}

@@ -5,6 +5,7 @@
  * parsed from text round-trips. */
 #include "support/harness.h"
 #include "corr/corr.h"
+#include "lbo/lbo.h"
 #include "meshcorr.h"
 #include "proto.h"
 
@@ -159,6 +160,11 @@ TEST(engine_checks_agree_with_the_validator_at_every_range_end)
 #undef ENGINE_SET
             }
             int got = ectm_params_check(&p, err, sizeof err) != 0 || rhm_params_check(&r, err, sizeof err) != 0;
+            /* the rows the pipeline reads itself (ENGINE NONE): its own rules */
+            if (i == PROTO_P_stages)
+                got = corr_stages_run((corr_stages)v, 1) == 0 || v != floor(v);
+            else if (i == PROTO_P_ddm_k)
+                got = v < 0 || v > LBO_MAX_K;
             if (got != want)
                 FAILF("%s = %g: validator %s, engine %s", f->name, v, want ? "refuses" : "accepts",
                       got ? "refuses" : "accepts");

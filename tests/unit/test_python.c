@@ -105,6 +105,11 @@ TEST_T(bad_mesh_landmarks_and_parameters_are_refused_with_the_message, 120)
     run_case("bad_input_refused");
 }
 
+TEST_T(a_vertex_map_file_refined_by_ddm_then_ectm_streams_the_ddm_stage, 120)
+{
+    run_case("vertex_map_refined_by_ddm_then_ectm");
+}
+
 TEST_T(installed_package_runs_the_readme_example_against_meshcorrd, 240)
 {
     testdaemon_need_worker();

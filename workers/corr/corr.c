@@ -1,7 +1,8 @@
-/* corr.c — the correspondence pipeline (see corr.h): validation, initial
- * maps (start + RHM), ECTM, progress fan-in. Combines modules; computes
- * nothing itself. */
+/* corr.c — the correspondence pipeline (see corr.h): validation, the
+ * chosen stages in their order (DDM, RHM from landmarks or from the maps,
+ * ECTM), progress fan-in. Combines modules; computes nothing itself. */
 #include "corr/corr.h"
+#include "corr/corr__ddm.h"
 #include "mesh/mesh_check.h"
 #include "util/errbuf.h"
 
@@ -24,6 +25,7 @@ const char *corr_stage_name(corr_stage s)
     case CORR_STAGE_ECTM: return "ectm";
     case CORR_STAGE_START: return "start";
     case CORR_STAGE_RHM: return "rhm";
+    case CORR_STAGE_DDM: return "ddm";
     default: return "init";
     }
 }
@@ -62,7 +64,16 @@ static int relay_ectm(void *ctx, const ectm_report *r)
     relay *rl = ctx;
     if (!rl->fn)
         return 0;
-    corr_progress p = { CORR_STAGE_ECTM, r, now() - rl->t0, NULL };
+    corr_progress p = { CORR_STAGE_ECTM, r, now() - rl->t0, NULL, NULL };
+    return rl->fn(rl->ctx, &p);
+}
+
+static int relay_ddm(void *ctx, const corr_ddm_report *r)
+{
+    relay *rl = ctx;
+    if (!rl->fn)
+        return 0;
+    corr_progress p = { CORR_STAGE_DDM, NULL, now() - rl->t0, NULL, r };
     return rl->fn(rl->ctx, &p);
 }
 
@@ -72,7 +83,7 @@ static int relay_rhm(void *ctx, const rhm_report *r)
     if (!rl->fn)
         return 0;
     corr_progress p = { r->iteration ? CORR_STAGE_RHM : CORR_STAGE_START, NULL,
-                        now() - rl->t0, r };
+                        now() - rl->t0, r, NULL };
     return rl->fn(rl->ctx, &p);
 }
 
@@ -104,6 +115,18 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char
     return CORR_OK;
 }
 
+static int from_ectm(int rc)
+{
+    switch (rc) {
+    case ECTM_OK: return CORR_OK;
+    case ECTM_ECANCELED: return CORR_ECANCELED;
+    case ECTM_ENOMEM: return CORR_ENOMEM;
+    case ECTM_EMAP: case ECTM_EPARAM: return CORR_EINPUT;
+    case ECTM_EMESH: return CORR_EMESH;
+    default: return CORR_EFAILED;
+    }
+}
+
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz)
 {
@@ -115,64 +138,71 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
     if ((rc = corr_validate(in->S, in->S_name, err, errsz)) ||
         (rc = corr_validate(in->T, in->T_name, err, errsz)))
         return rc;
-    if (!in->P0 && !in->L)
-        return errbuf_set(err, errsz, CORR_EINPUT, "neither an initial map nor landmarks were given");
-    if (in->Q0 && !in->P0)
-        return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs an initial map");
-    if (in->Q0 && p->model == ECTM_INJECTIVE)
-        return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs the bijective model");
-    if (in->stages == CORR_STAGES_ECTM && !in->P0)
-        return errbuf_set(err, errsz, CORR_EINPUT, "the ECTM stage alone needs an initial map");
-    if (in->stages == CORR_STAGES_RHM && (in->P0 || !in->L))
-        return errbuf_set(err, errsz, CORR_EINPUT, "the RHM stage starts from landmarks, not from a map");
     rhm_params rp;
     if (in->rhm)
         rp = *in->rhm;
     else
         rhm_params_init(&rp);
-    if (!in->P0 && rhm_params_check(&rp, err, errsz))
+    int bij = p->model == ECTM_BIJECTIVE;
+    if ((rc = corr_stages_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
+                                rp.gamma, err, errsz)))
+        return rc;
+    unsigned run = corr_stages_run(in->stages, !!in->P0);
+    if ((run & CORR_RUN_RHM) && rhm_params_check(&rp, err, errsz))
         return CORR_EINPUT;
 
-    rhm_result init = {0};
-    const bmap *P0 = in->P0, *Q0 = in->Q0;
-    if (!P0) {
-        if (progress) {
-            corr_progress cp = { CORR_STAGE_INIT, NULL, now() - rl.t0, NULL };
-            if (progress(ctx, &cp))
-                return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before the initial map");
+    bmap *dP = NULL, *dQ = NULL;               /* DDM's maps */
+    rhm_result init = {0};                     /* RHM's maps */
+    const bmap *P = in->P0, *Q = bij ? in->Q0 : NULL;
+    if (run & CORR_RUN_DDM) {
+        if ((rc = corr__ddm(in, P, Q, relay_ddm, &rl, &dP, &dQ, err, errsz)))
+            goto done;
+        P = dP;
+        Q = dQ;
+        if (!(run & (CORR_RUN_RHM | CORR_RUN_ECTM))) {
+            out->P = dP;
+            out->Q = dQ;
+            dP = dQ = NULL;
+            goto done;
         }
-        if ((rc = rhm_run(in->S, in->T, in->L, &rp, relay_rhm, &rl, &init, err, errsz)))
-            return from_rhm(rc);
+    }
+    if (run & CORR_RUN_RHM) {
+        if (!P && progress) {
+            corr_progress cp = { CORR_STAGE_INIT, NULL, now() - rl.t0, NULL, NULL };
+            if (progress(ctx, &cp)) {
+                rc = errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before the initial map");
+                goto done;
+            }
+        }
+        rc = P ? rhm_run_from_maps(in->S, in->T, in->L, P, Q, &rp, relay_rhm, &rl, &init, err, errsz)
+               : rhm_run(in->S, in->T, in->L, &rp, relay_rhm, &rl, &init, err, errsz);
+        if (rc) {
+            rc = from_rhm(rc);
+            goto done;
+        }
         fold_report rep[2];
-        if ((rc = corr_repair(in, init.P12, init.P21, rep, err, errsz))) {
-            rhm_result_close(&init);
-            return rc;
-        }
-        if (in->stages == CORR_STAGES_RHM) {
+        if ((rc = corr_repair(in, init.P12, init.P21, rep, err, errsz)))
+            goto done;
+        if (!(run & CORR_RUN_ECTM)) {
             out->P = init.P12;
             out->Q = init.P21;
-            return CORR_OK;
+            init.P12 = init.P21 = NULL;
+            goto done;
         }
-        P0 = init.P12;
-        Q0 = p->model == ECTM_BIJECTIVE ? init.P21 : NULL;
+        P = init.P12;
+        Q = bij ? init.P21 : NULL;
     }
-    rc = ectm_run(in->S, in->T, P0, Q0, p, relay_ectm, &rl, out, err, errsz);
-    rhm_result_close(&init);
-    if (rc == ECTM_OK) {
+    rc = from_ectm(ectm_run(in->S, in->T, P, Q, p, relay_ectm, &rl, out, err, errsz));
+    if (rc == CORR_OK) {
         /* ECTM's projection folds where its deformed surface passes a thin
          * part at an angle: the same repair, on the maps it returns */
         fold_report rep[2];
-        if ((rc = corr_repair(in, out->P, out->Q, rep, err, errsz))) {
+        if ((rc = corr_repair(in, out->P, out->Q, rep, err, errsz)))
             ectm_result_close(out);
-            return rc;
-        }
     }
-    switch (rc) {
-    case ECTM_OK: return CORR_OK;
-    case ECTM_ECANCELED: return CORR_ECANCELED;
-    case ECTM_ENOMEM: return CORR_ENOMEM;
-    case ECTM_EMAP: case ECTM_EPARAM: return CORR_EINPUT;
-    case ECTM_EMESH: return CORR_EMESH;
-    default: return CORR_EFAILED;
-    }
+done:
+    bmap_free(dP);
+    bmap_free(dQ);
+    rhm_result_close(&init);
+    return rc;
 }

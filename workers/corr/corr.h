@@ -2,9 +2,12 @@
  * `meshcorr match` runs in-process and `meshcorr-worker` runs for the daemon.
  *
  *   validate both meshes (manifold, one component, finite, no degenerate face)
- *   initial maps: the uploaded P (and Q), or from landmarks: geodesic
- *     start map (rhm.h), then Reversible Harmonic Maps giving P and Q,
- *     whose folds are then repaired (corr_repair, fold.h)
+ *   then the chosen stages, always in this order (corr_stages):
+ *   DDM denoising of the uploaded P (and Q): the map's functional map
+ *     C = Psi1^T M1 P Psi2, deblurred to a precise map (ddm.h, thesis §2.5)
+ *   RHM: from landmarks (a start map, rhm.h) or from the uploaded or
+ *     denoised maps (rhm_run_from_maps), giving P and Q, whose folds are
+ *     then repaired (corr_repair, fold.h)
  *   ECTM refinement, then the same fold repair of the maps it returns
  *     (the rows of bad regions change; out->Y stays ECTM's deformation)
  *
@@ -42,14 +45,56 @@ typedef enum corr_stage {
     CORR_STAGE_INIT = 0,     /* building the initial map starts             */
     CORR_STAGE_ECTM = 1,     /* one report per ECTM outer iteration         */
     CORR_STAGE_START = 2,  /* the start map is built (its RHM energies)  */
-    CORR_STAGE_RHM = 3       /* one report per RHM iteration                */
+    CORR_STAGE_RHM = 3,      /* one report per RHM iteration                */
+    CORR_STAGE_DDM = 4       /* DDM denoising: at its start, per direction  */
 } corr_stage;
-const char *corr_stage_name(corr_stage s);   /* "init", "ectm", "start", "rhm" */
+const char *corr_stage_name(corr_stage s);   /* "init", "ectm", "start", "rhm", "ddm" */
 
-/* Which stages run: all (landmarks -> start -> RHM -> ECTM, or ECTM from
- * an uploaded map), RHM only (from landmarks; its maps are the result), or
- * ECTM only (from an uploaded map). */
-typedef enum corr_stages { CORR_STAGES_ALL = 0, CORR_STAGES_RHM = 1, CORR_STAGES_ECTM = 2 } corr_stages;
+/* Which stages run, the values of the job parameter stages (PROTO_PARAMS,
+ * the names "ddm,ectm" etc.: proto_param_value_name). A chain always runs
+ * in the order DDM, RHM, ECTM: DDM cleans a given map, RHM needs a start,
+ * ECTM only refines (it cannot undo a mirrored or folded start), so it
+ * comes last. all: landmarks -> start -> RHM -> ECTM, or ECTM alone on an
+ * uploaded map (the meaning from before chains); rhm alone: RHM's maps are
+ * the result; ectm alone: ECTM on an uploaded map. */
+typedef enum corr_stages {
+    CORR_STAGES_ALL = 0, CORR_STAGES_RHM = 1, CORR_STAGES_ECTM = 2, CORR_STAGES_DDM = 3,
+    CORR_STAGES_DDM_ECTM = 4, CORR_STAGES_DDM_RHM = 5, CORR_STAGES_DDM_RHM_ECTM = 6,
+    CORR_STAGES_RHM_ECTM = 7
+} corr_stages;
+#define CORR_RUN_DDM  1u
+#define CORR_RUN_RHM  2u
+#define CORR_RUN_ECTM 4u
+/* The CORR_RUN_* bits of s for a job with (have_map) or without an
+ * uploaded map; 0 for a value outside the list. */
+unsigned corr_stages_run(corr_stages s, int have_map);
+/* Whether the chain can run on these inputs: 0, or CORR_EINPUT with the
+ * reason in err (ddm without a map, RHM from landmarks with fewer than
+ * PROTO_MIN_LANDMARKS, ECTM or RHM with neither, a reverse map with the
+ * injective model, a weak landmark term without landmarks). The worker's
+ * SUBMIT check and corr_run use it. */
+int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
+                      int injective, double rhm_landmark_weight, char *err, size_t errsz);
+/* A --stages text as the CLI reads it: a value of the list (*out), or -1
+ * with why not in err: an unknown stage, a stage named twice, or a chain
+ * out of the order ddm, rhm, ectm ("ectm before ddm: ..."). */
+int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errsz);
+
+/* The DDM stage's basis size when ddm_k is 0: min(CORR_DDM_K, vertices - 2).
+ * k = 100 met issue 13's criteria (error within +0.005, median conformal
+ * at most half) on 11 of the 12 published TOSCA BIM and BCICP maps
+ * (tests/bench/bench_refine.c; the BIM map man_02 -> gorilla_01 kept 0.66
+ * of its distortion, 0.61 at k = 150, 1.05 at k = 60); fewer functions
+ * smooth more and cost error (tests/unit/test_ddm.c). */
+#define CORR_DDM_K 100
+
+/* A DDM stage report: directions done of total (1: P only, 2: P and Q),
+ * the basis size, and each done direction's deblurring objective
+ * sum_i M1_ii |(Psi1 C)_i - P_i Psi2|^2 (ddm_stats.cost). */
+typedef struct corr_ddm_report {
+    int done, total, k;
+    double cost[2];
+} corr_ddm_report;
 
 typedef struct corr_input {
     const mesh *S, *T;        /* source and target (required)               */
@@ -58,6 +103,7 @@ typedef struct corr_input {
     const bmap *P0, *Q0;      /* uploaded initial maps, or NULL              */
     const rhm_params *rhm;    /* RHM parameters, NULL: rhm_params_init's     */
     corr_stages stages;
+    int ddm_k;                /* DDM basis size; 0: min(CORR_DDM_K, nv - 2)  */
 } corr_input;
 
 typedef struct corr_progress {
@@ -65,6 +111,7 @@ typedef struct corr_progress {
     const ectm_report *ectm;  /* the outer iteration's report (stage ECTM)  */
     double elapsed;           /* seconds since corr_run started             */
     const rhm_report *rhm;    /* the RHM report (stages START and RHM)      */
+    const corr_ddm_report *ddm; /* the DDM report (stage DDM)               */
 } corr_progress;
 
 typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
@@ -93,9 +140,10 @@ int corr_params_from_job(const proto_params *w, int threads, ectm_params *p, rhm
 void corr_params_to_job(const ectm_params *p, const rhm_params *r, proto_params *w, char *backend,
                         size_t bsz);
 
-/* Runs the pipeline. Needs P0 or at least PROTO_MIN_LANDMARKS landmarks. With
- * stages RHM, out->P and out->Q are RHM's repaired maps and out->Y, out->Yt, out->last
- * stay empty. */
+/* Runs the pipeline: the stages of in->stages (corr_stages_check first).
+ * When the chain ends before ECTM, out->P and out->Q are the last stage's
+ * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
+ * the model is bijective) and out->Y, out->Yt, out->last stay empty. */
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz);
 

@@ -34,9 +34,11 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
     return 0;
 }
 
-/* The inputs' combination: a map or landmarks, q only with p and bijective. */
+/* The inputs' combination: a map or landmarks, q only with p and bijective,
+ * and a chain of stages that can run on them (corr_stages_check). */
 static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 {
+    char why[256];
     if (s->p.n == 0 && s->nlandmarks == 0)
         return errbuf_set(err, errsz, PROTO_EBAD_LANDMARKS,
                           "landmarks: none, and no initial map p: need one or at least %d pairs",
@@ -45,6 +47,11 @@ static int check_inputs(const proto_submit *s, char *err, size_t errsz)
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q without p");
     if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q needs the bijective model");
+    if (corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
+                          (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
+                          s->params.rhm_landmark_weight, why, sizeof why))
+        return errbuf_set(err, errsz, s->p.n ? PROTO_EBAD_PARAMS : PROTO_EBAD_LANDMARKS,
+                          "params.stages: %s", why);
     return 0;
 }
 

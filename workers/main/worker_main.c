@@ -280,7 +280,8 @@ int main(int argc, char **argv)
         wrk_progress_connect(&ctx.pg, progress_tcp, secret_file);
     }
     corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0,
-                      &job.rhm, CORR_STAGES_ALL };
+                      &job.rhm, (corr_stages)sub.u.submit.params.stages,
+                      (int)sub.u.submit.params.ddm_k };
     if (cancel_requested)
         rc = CORR_ECANCELED;
     else

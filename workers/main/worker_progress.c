@@ -97,6 +97,7 @@ void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, doub
     case CORR_STAGE_ECTM: out->stage = PROTO_STAGE_ECTM; break;
     case CORR_STAGE_START: out->stage = PROTO_STAGE_START; break;
     case CORR_STAGE_RHM: out->stage = PROTO_STAGE_RHM; break;
+    case CORR_STAGE_DDM: out->stage = PROTO_STAGE_DDM; break;
     default: out->stage = PROTO_STAGE_INIT; break;
     }
     if (cp->rhm) {  /* RHM's terms in the slots PROTOCOL.md names */
@@ -112,6 +113,14 @@ void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, doub
             out->terms[d][PROTO_TERM_ENERGY] = h->dir[d].dirichlet + h->dir[d].landmark
                                              + h->dir[d].mismatch + h->dir[d].reverse;
         }
+        return;
+    }
+    if (cp->ddm) {  /* directions done of total, each one's deblurring objective */
+        const corr_ddm_report *d = cp->ddm;
+        out->outer = (uint32_t)d->done;
+        out->total = (uint32_t)d->total;
+        for (int k = 0; k < 2; k++)
+            out->terms[k][PROTO_TERM_MISMATCH] = out->terms[k][PROTO_TERM_ENERGY] = d->cost[k];
         return;
     }
     const ectm_report *r = cp->ectm;

@@ -45,10 +45,22 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
     if (res->Q)
         ok->q = (proto_map){ r->q, (uint32_t)res->Q->n };
 
-    mesh deformed = { job->S->nv, job->S->nf, res->Y, job->S->f };
+    /* a chain that ends before ECTM has no deformation: its mesh is the
+     * map's image P X~ of the source (what ECTM's Y approximates) */
+    double *image = NULL;
+    if (!res->Y) {
+        if (!(image = malloc(sizeof(double) * 3 * (size_t)job->S->nv + 1))) {
+            wrk_result_close(r);
+            return errbuf_set(err, errsz, PROTO_ENOMEM, "result mesh: out of memory");
+        }
+        bmap_apply(res->P, job->T->f, job->T->v, 3, image);
+    }
+    mesh deformed = { job->S->nv, job->S->nf, res->Y ? res->Y : image, job->S->f };
     size_t len = 0;
     char detail[512];
-    if (mesh_encode_drc(&deformed, &r->deformed, &len, detail, sizeof detail)) {
+    int erc = mesh_encode_drc(&deformed, &r->deformed, &len, detail, sizeof detail);
+    free(image);
+    if (erc) {
         wrk_result_close(r);
         return errbuf_set(err, errsz, PROTO_EINTERNAL, "deformed mesh: %s", detail);
     }

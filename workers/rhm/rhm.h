@@ -140,4 +140,18 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
             rhm_progress_fn progress, void *ctx, rhm_result *out,
             char *err, size_t errsz);
 
+/* RHM from given maps instead of a start from landmarks (thesis §3.3.2
+ * lists a given map as an RHM input): P12 (S -> T, required) and P21
+ * (T -> S, or NULL: then each vertex v of T goes to the source vertex u
+ * whose image P12(u), in T's embedding, is nearest to v's, as the Voronoi
+ * start's reverse does; brute force, O(n1 n2 m)); X_ij = P_ij X_j, then
+ * the iterations of rhm_run. L may be NULL or hold any number of pairs:
+ * landmarks serve only the weak landmark term, so p->gamma > 0 needs at
+ * least one. p->start is unused. The maps are copied, not kept. Errors as
+ * rhm_run; RHM_EINPUT also for maps sized for other meshes or with a face
+ * out of range. */
+int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap *P12,
+                      const bmap *P21, const rhm_params *p, rhm_progress_fn progress, void *ctx,
+                      rhm_result *out, char *err, size_t errsz);
+
 #endif

@@ -1,7 +1,8 @@
 /* rhm__problem.h — internal (rhm__): the state of one RHM job and its block
- * steps, shared by rhm_problem.c (set-up), rhm_init.c (Voronoi start),
- * rhm_step.c (P-step, X-step, energy) and rhm_run.c (the loop); the tests
- * drive the steps one by one. Not part of the public rhm_ API.
+ * steps, shared by rhm_problem.c (set-up), rhm_init.c (start from
+ * landmarks), rhm_given.c (start from given maps), rhm_step.c (P-step,
+ * X-step, energy) and rhm_run.c (the loop); the tests drive the steps one
+ * by one. Not part of the public rhm_ API.
  *
  * Index convention: side i = 0 is M1 (the source), 1 is M2; direction i is
  * the map from side i to side j = 1 − i (P[0] = P12, P[1] = P21). */
@@ -44,7 +45,18 @@ typedef struct rhm__problem {
  * them). Errors as rhm_run. */
 int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
                      rhm__problem **out, char *err, size_t errsz);
+/* The same for a start from given maps (rhm_given.c): landmarks optional
+ * (L NULL or any number; they serve the weak landmark term only). */
+int rhm__problem_new_maps(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+                          rhm__problem **out, char *err, size_t errsz);
 void rhm__problem_free(rhm__problem *pb);
+
+/* The loop (rhm_run.c) from the current state, maps and X_ij set: reports
+ * iteration 0, iterates, moves the maps into out. t0: rhm__now() at the
+ * start of the run. */
+int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ctx,
+                 rhm_result *out, char *err, size_t errsz);
+double rhm__now(void);   /* monotonic seconds */
 
 /* The distances start describes a vertex by its distances to the
  * landmarks / √area and, for r = 0..nl−1, RHM__ORIENT_WEIGHT times the sine

@@ -121,16 +121,21 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
     return RHM_OK;
 }
 
-int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
-                     rhm__problem **out, char *err, size_t errsz)
+/* min_landmarks: PROTO_MIN_LANDMARKS for a start from landmarks, 0 for
+ * given maps (L may then be NULL). */
+static int problem_new(const mesh *S, const mesh *T, const lmk_set *L, int min_landmarks,
+                       const rhm_params *p, rhm__problem **out, char *err, size_t errsz)
 {
     *out = NULL;
     int rc = rhm_params_check(p, err, errsz);
     if (rc)
         return rc;
-    if (!L || L->n < PROTO_MIN_LANDMARKS)
+    static const lmk_set none = {0, NULL, NULL};
+    if (!L)
+        L = &none;
+    if (L->n < min_landmarks)
         return errbuf_set(err, errsz, RHM_EINPUT, "RHM needs at least %d landmark pairs, got %d",
-                          PROTO_MIN_LANDMARKS, L ? L->n : 0);
+                          min_landmarks, L->n);
     for (int r = 0; r < L->n; r++) {
         if (L->src[r] < 0 || L->src[r] >= S->nv || L->tgt[r] < 0 || L->tgt[r] >= T->nv)
             return errbuf_set(err, errsz, RHM_EINPUT, "landmark %d (%d, %d) out of range",
@@ -147,11 +152,12 @@ int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_p
     pb->cc.print = 0;
     for (int i = 0; i < 2; i++) {
         const int *src = i ? L->tgt : L->src;
-        if (!(pb->side[i].lmk = malloc(sizeof(int) * (size_t)L->n))) {
+        if (!(pb->side[i].lmk = malloc(sizeof(int) * ((size_t)L->n + 1)))) {
             rc = errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
             goto fail;
         }
-        memcpy(pb->side[i].lmk, src, sizeof(int) * (size_t)L->n);
+        if (L->n)
+            memcpy(pb->side[i].lmk, src, sizeof(int) * (size_t)L->n);
         if ((rc = side_build(pb, &pb->side[i], i ? T : S, i ? "target" : "source", err, errsz)))
             goto fail;
     }
@@ -160,4 +166,16 @@ int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_p
 fail:
     rhm__problem_free(pb);
     return rc;
+}
+
+int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+                     rhm__problem **out, char *err, size_t errsz)
+{
+    return problem_new(S, T, L, PROTO_MIN_LANDMARKS, p, out, err, errsz);
+}
+
+int rhm__problem_new_maps(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+                          rhm__problem **out, char *err, size_t errsz)
+{
+    return problem_new(S, T, L, 0, p, out, err, errsz);
 }

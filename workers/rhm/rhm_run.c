@@ -9,66 +9,50 @@
 #include <string.h>
 #include <time.h>
 
-static double now(void)
+double rhm__now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
-            rhm_progress_fn progress, void *ctx, rhm_result *out,
-            char *err, size_t errsz)
+/* The loop from the current state (maps and X_ij set): the start's report
+ * (iteration 0), then iterations until K or the stopping rule. On success
+ * the maps move into out. */
+int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ctx,
+                 rhm_result *out, char *err, size_t errsz)
 {
-    memset(out, 0, sizeof *out);
-    double t0 = now();
-    if (p->threads > 0)
-        omp_set_num_threads(p->threads);
-    rhm__problem *pb = NULL;
-    int rc = rhm__problem_new(S, T, L, p, &pb, err, errsz);
-    if (rc)
-        return rc;
-    if ((rc = rhm__init_start(pb, err, errsz)))
-        goto out;
+    const rhm_params *p = &pb->p;
     rhm_report r;
     memset(&r, 0, sizeof r);
     r.total = p->iterations;
     r.beta = rhm_beta(p, 1);
     r.energy = rhm__energy(pb, r.beta, r.dir);
-    r.t_setup = r.elapsed = now() - t0;
-    if (progress && progress(ctx, &r)) {
-        rc = errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled after the initial map");
-        goto out;
-    }
+    r.t_setup = r.elapsed = rhm__now() - t0;
+    if (progress && progress(ctx, &r))
+        return errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled after the initial map");
     for (int k = 1; k <= p->iterations; k++) {
         double prev = r.energy, beta = rhm_beta(p, k);
+        int rc;
         for (int i = 0; i < 2; i++) {
-            double ta = now();
-            if ((rc = rhm__step_p(pb, i, beta))) {
-                errbuf_set(err, errsz, rc, "RHM iteration %d: projection failed", k);
-                goto out;
-            }
-            double tb = now();
-            if ((rc = rhm__step_x(pb, i, beta))) {
-                errbuf_set(err, errsz, rc, "RHM iteration %d: X-step solve failed "
-                           "(CHOLMOD status %d)", k, pb->cc.status);
-                goto out;
-            }
+            double ta = rhm__now();
+            if ((rc = rhm__step_p(pb, i, beta)))
+                return errbuf_set(err, errsz, rc, "RHM iteration %d: projection failed", k);
+            double tb = rhm__now();
+            if ((rc = rhm__step_x(pb, i, beta)))
+                return errbuf_set(err, errsz, rc, "RHM iteration %d: X-step solve failed "
+                                  "(CHOLMOD status %d)", k, pb->cc.status);
             r.t_project += tb - ta;
-            r.t_solve += now() - tb;
+            r.t_solve += rhm__now() - tb;
         }
         r.iteration = k;
         r.beta = beta;
         r.energy = rhm__energy(pb, beta, r.dir);
-        r.elapsed = now() - t0;
-        if (!isfinite(r.energy)) {
-            rc = errbuf_set(err, errsz, RHM_ENUMERIC, "RHM iteration %d: energy is not finite", k);
-            goto out;
-        }
-        if (progress && progress(ctx, &r)) {
-            rc = errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled at iteration %d", k);
-            goto out;
-        }
+        r.elapsed = rhm__now() - t0;
+        if (!isfinite(r.energy))
+            return errbuf_set(err, errsz, RHM_ENUMERIC, "RHM iteration %d: energy is not finite", k);
+        if (progress && progress(ctx, &r))
+            return errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled at iteration %d", k);
         if (k >= p->min_iterations && fabs(r.energy - prev) < p->stop_change * prev)
             break;
     }
@@ -76,7 +60,23 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
     out->P12 = pb->side[0].P;
     out->P21 = pb->side[1].P;
     pb->side[0].P = pb->side[1].P = NULL;
-out:
+    return RHM_OK;
+}
+
+int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+            rhm_progress_fn progress, void *ctx, rhm_result *out,
+            char *err, size_t errsz)
+{
+    memset(out, 0, sizeof *out);
+    double t0 = rhm__now();
+    if (p->threads > 0)
+        omp_set_num_threads(p->threads);
+    rhm__problem *pb = NULL;
+    int rc = rhm__problem_new(S, T, L, p, &pb, err, errsz);
+    if (rc)
+        return rc;
+    if (!(rc = rhm__init_start(pb, err, errsz)))
+        rc = rhm__iterate(pb, t0, progress, ctx, out, err, errsz);
     rhm__problem_free(pb);
     return rc;
 }

@@ -15,6 +15,7 @@ PARAMS lists the job parameters (the library's one list)."""
 from ._lib import PARAMS
 from .client import Client, Job, Result
 from .errors import MeshcorrError
-from .map import Map, read_map, write_map
+from .map import Map, read_map, read_vertex_map, vertex_map, write_map
 
-__all__ = ["Client", "Job", "Result", "Map", "MeshcorrError", "read_map", "write_map", "PARAMS"]
+__all__ = ["Client", "Job", "Result", "Map", "MeshcorrError", "read_map", "read_vertex_map", "vertex_map",
+           "write_map", "PARAMS"]

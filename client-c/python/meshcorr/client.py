@@ -11,9 +11,9 @@ import numpy as np
 
 from . import _lib
 from ._lib import lib, check, errbuf
-from .map import Map, read_map
+from .map import Map, is_map_file, read_map, read_vertex_map, vertex_map
 
-STAGES = ("start", "rhm", "ectm", "init")
+STAGES = ("start", "rhm", "ectm", "init", "ddm")
 _WANT_P, _WANT_Q, _WANT_DEFORMED, _WANT_METRICS = 1, 2, 4, 8
 _PARAM_NAMES = {p.name: p for p in _lib.PARAMS}
 
@@ -67,10 +67,32 @@ def _vertex_count(blob, n):
     return nv.value
 
 
-def _rows(m):
-    """A Map (or a map file's path) as an array of mc_map_row."""
+def _mesh_of(blob, n):
+    """(vertex count, faces as an (m, 3) array) of Draco bytes."""
+    v, nv = ctypes.POINTER(ctypes.c_double)(), ctypes.c_int()
+    f, nf, err = ctypes.POINTER(ctypes.c_int)(), ctypes.c_int(), errbuf()
+    rc = lib.mc_decode_mesh(ctypes.cast(blob, _lib.c_u8p), n, ctypes.byref(v), ctypes.byref(nv),
+                            ctypes.byref(f), ctypes.byref(nf), err, len(err))
+    F = np.ctypeslib.as_array(f, (nf.value * 3,)).reshape(-1, 3).copy() if rc == 0 else None
+    _lib.free(v)
+    _lib.free(f)
+    check(rc, err.value)
+    return nv.value, F
+
+
+def _rows(m, to=None, n_from=None, base=None):
+    """A Map, a map file's path (meshcorr-map 1, or a vertex map onto the
+    mesh to = (Draco bytes, length) with n_from rows, base as init_base),
+    or 0-based vertex ids as an array of mc_map_row."""
     if not isinstance(m, Map):
-        m = read_map(m)
+        if isinstance(m, (str, bytes, os.PathLike)) and is_map_file(m):
+            m = read_map(m)
+        else:
+            nt, F = _mesh_of(*to)
+            if isinstance(m, (str, bytes, os.PathLike)):
+                m = read_vertex_map(m, F, nt, n_from, base)
+            else:
+                m = vertex_map(m, F, nt)
     rows = (_lib.MapRow * len(m))()
     for i, (f, w) in enumerate(zip(m.faces.tolist(), m.weights.tolist())):
         rows[i].face = f
@@ -142,14 +164,18 @@ class Client:
         self.close()
 
     def submit(self, source, target, landmarks=None, init=None, init_reverse=None, priority=0, label=None,
-               quantization=0, device=None, **params):
+               quantization=0, device=None, init_base=None, **params):
         """Submits a job; returns its Job. source, target: a mesh file's path
         or (V, F) numpy arrays; landmarks: (k, 2) (source, target) vertex
-        ids; init, init_reverse: initial maps P and Q (Map or map file);
+        ids; init, init_reverse: initial maps P and Q (a Map; a map file,
+        meshcorr-map 1 or a vertex map, one target vertex a line, 0- or
+        1-based by the rule of `meshcorr match --init-base` unless
+        init_base says; or an array of 0-based target vertex ids);
         quantization: bits per coordinate (0 lossless); device: an OpenCL
         device name part (backend "opencl:DEVICE"); params: the job
         parameters of `meshcorr params` by name (model="injective",
-        iterations=5, beta0=1e3, partial=True, backend="cpu", ...). A bad
+        iterations=5, beta0=1e3, partial=True, backend="cpu",
+        stages="ddm,ectm", ...). A bad
         value is refused with the server's message."""
         qbits = int(quantization)
         sb, sn = _encode(source, qbits)
@@ -168,11 +194,11 @@ class Client:
             spec.landmarks = lm.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
             spec.nlandmarks = len(lm)
         if init is not None:
-            rows = _rows(init)
+            rows = _rows(init, (tb, tn), _mesh_of(sb, sn)[0], init_base)
             keep.append(rows)
             spec.p, spec.np = rows, len(rows)
         if init_reverse is not None:
-            rows = _rows(init_reverse)
+            rows = _rows(init_reverse, (sb, sn), _mesh_of(tb, tn)[0], init_base)
             keep.append(rows)
             spec.q, spec.nq = rows, len(rows)
         if device is not None:
@@ -268,7 +294,7 @@ class Job:
         """Yields a progress dict per record (replayed from outer iteration
         from_outer, then live) until the job ends; then self.state and
         self.reason tell how it ended. A dict: job, stage (start, rhm, ectm,
-        init), outer, total, beta, gamma, elapsed (s), membrane, bending,
+        init, ddm), outer, total, beta, gamma, elapsed (s), membrane, bending,
         mismatch, reverse, energy (both directions summed), and source,
         target: each direction's terms and inner iterations. It follows the
         job on a connection of its own."""

@@ -2,7 +2,10 @@
 and three weights), its points on that mesh, and the `meshcorr-map 1` text
 format `meshcorr result` and `meshcorr match` write (workers/map/bmap.c):
 the header line, `#` comments, "<source vertices> <target vertices>", then
-"<face> <w0> <w1> <w2>" per source vertex, weights as %.17g."""
+"<face> <w0> <w1> <w2>" per source vertex, weights as %.17g. Also
+vertex-to-vertex maps (one target vertex per source vertex, the layout
+BCICP and BIM write) as Maps, with the base rule of `meshcorr match
+--init-base` (workers/map/vmap.h)."""
 import numpy as np
 
 HEADER = "# meshcorr-map 1"
@@ -75,3 +78,65 @@ def read_map(path):
 def write_map(path, m, comment=None):
     """m.write(path, comment)."""
     m.write(path, comment)
+
+
+def vertex_map(ids, F2, n_target):
+    """A Map from 0-based target vertex ids, one per source vertex: weight 1
+    at the vertex, in the lowest face of F2 (the target's faces) listing it."""
+    ids = np.asarray(ids, dtype=np.int64)
+    F2 = np.asarray(F2, dtype=np.int64)
+    if ids.ndim != 1 or (ids < 0).any() or (ids >= n_target).any():
+        raise ValueError("a vertex map is one target vertex id in [0, %d) per source vertex" % n_target)
+    flat = F2.reshape(-1)
+    none = len(flat)
+    first = np.full(n_target, none, dtype=np.int64)
+    np.minimum.at(first, flat, np.arange(len(flat)))   # the lowest position listing each vertex
+    q = first[ids]
+    if (q == none).any():
+        raise ValueError("target vertex %d lies on no face" % int(ids[np.argmax(q == none)]))
+    weights = np.zeros((len(ids), 3))
+    weights[np.arange(len(ids)), q % 3] = 1
+    return Map((q // 3).astype(np.int32), weights, n_target)
+
+
+def read_vertex_map(path, F2, n_target, n_source=None, base=None):
+    """Reads a vertex-map file (one target vertex index a line; '#' and
+    blank lines skipped) into a Map on the target with faces F2. base 0 or
+    1, or None: a 0 among the indices means 0-based, n_target among them
+    1-based, neither is refused as ambiguous (ValueError naming the file)."""
+    ids, lines = [], []
+    with open(path) as fp:
+        for k, ln in enumerate(fp, 1):
+            t = ln.strip()
+            if not t or t.startswith("#"):
+                continue
+            try:
+                v = float(t)
+                if v != int(v):
+                    raise ValueError
+            except ValueError:
+                raise ValueError("%s:%d: %r is not a target vertex index (one integer a line)" % (path, k, t))
+            ids.append(int(v))
+            lines.append(k)
+    if n_source is not None and len(ids) != n_source:
+        raise ValueError("%s: %d entries, expected %d (one target vertex per source vertex)"
+                         % (path, len(ids), n_source))
+    if base is None:
+        if 0 in ids:
+            base = 0
+        elif n_target in ids:
+            base = 1
+        else:
+            raise ValueError("%s: neither 0 nor %d among the indices: 0- or 1-based cannot be told; "
+                             "give the base (init_base=0 or 1)" % (path, n_target))
+    for v, k in zip(ids, lines):
+        if not base <= v < n_target + base:
+            raise ValueError("%s:%d: target vertex %d out of range [%d, %d] (%d-based)"
+                             % (path, k, v, base, n_target - 1 + base, base))
+    return vertex_map(np.array(ids, dtype=np.int64) - base, F2, n_target)
+
+
+def is_map_file(path):
+    """True when the file starts with the meshcorr-map 1 header."""
+    with open(path) as fp:
+        return fp.readline().rstrip() == HEADER

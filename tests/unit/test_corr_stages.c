@@ -1,0 +1,210 @@
+/* test_corr_stages.c — the pipeline's stage chains (corr.h): reading
+ * "ddm,rhm,ectm" and refusing chains out of order with the reason; which
+ * chains the inputs allow; on TOSCA gorilla_01 -> man_01 from the published
+ * BCICP vertex map: the ddm stage returns exactly ddm_denoise's map, the
+ * ddm,ectm chain reports DDM then every ECTM iteration and keeps the
+ * map's error, and ddm,rhm runs RHM from the denoised map with no
+ * landmarks. */
+#include "support/harness.h"
+#include "support/testddm.h"
+#include "support/testgt.h"
+#include "corr/corr.h"
+#include "ddm/ddm.h"
+#include "geod/geod.h"
+#include "lbo/lbo.h"
+#include "map/vmap.h"
+#include "metric/metric.h"
+
+#include <string.h>
+
+TEST(chains_parse_in_order_and_out_of_order_is_refused_with_the_reason)
+{
+    static const struct { const char *text; int value; } ok[] = {
+        {"all", CORR_STAGES_ALL}, {"rhm", CORR_STAGES_RHM}, {"ectm", CORR_STAGES_ECTM},
+        {"ddm", CORR_STAGES_DDM}, {"ddm,ectm", CORR_STAGES_DDM_ECTM},
+        {"ddm,rhm", CORR_STAGES_DDM_RHM}, {"ddm,rhm,ectm", CORR_STAGES_DDM_RHM_ECTM},
+        {"rhm,ectm", CORR_STAGES_RHM_ECTM}};
+    char err[512], name[64];
+    for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++) {
+        corr_stages s = (corr_stages)-1;
+        if (corr_stages_parse(ok[k].text, &s, err, sizeof err))
+            FAILF("%s: %s", ok[k].text, err);
+        CHECK_INT(s, ok[k].value);
+        /* the same names as the job parameter's values (the wire, --help) */
+        CHECK(proto_param_value_name(PROTO_P_stages, (unsigned)s, name, sizeof name));
+        CHECK(strcmp(name, ok[k].text) == 0);
+    }
+    static const struct { const char *text, *msg; } bad[] = {
+        {"ectm,ddm", "ectm before ddm: stages run in the order ddm, rhm, ectm"},
+        {"rhm,ddm,ectm", "rhm before ddm"},
+        {"ectm,rhm", "ectm before rhm"},
+        {"ddm,ddm", "ddm is named twice"},
+        {"ddm,fmap", "'fmap' is not a stage (ddm, rhm, ectm, or all)"},
+        {"all,ectm", "all stands alone"},
+        {"", "'' is not a stage"},
+        {"ddm,", "'' is not a stage"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        corr_stages s;
+        err[0] = '\0';
+        CHECK_INT(corr_stages_parse(bad[k].text, &s, err, sizeof err), -1);
+        CHECK_STR_HAS(err, bad[k].msg);
+    }
+}
+
+TEST(chains_the_inputs_cannot_run_are_refused)
+{
+    char err[512];
+    /* all: RHM then ECTM from landmarks, ECTM alone on a map */
+    CHECK(corr_stages_run(CORR_STAGES_ALL, 0) == (CORR_RUN_RHM | CORR_RUN_ECTM));
+    CHECK(corr_stages_run(CORR_STAGES_ALL, 1) == CORR_RUN_ECTM);
+    CHECK_INT(corr_stages_check(CORR_STAGES_ALL, 0, 0, 6, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_stages_check(CORR_STAGES_DDM_RHM_ECTM, 1, 1, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_stages_check(CORR_STAGES_RHM, 1, 0, 0, 0, 0, err, sizeof err), 0);
+    static const struct { int s, map, rev, nl, inj; double gamma; const char *msg; } bad[] = {
+        {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, "the DDM stage denoises a given map"},
+        {CORR_STAGES_DDM, 0, 0, 6, 0, 0, "the DDM stage denoises a given map"},
+        {CORR_STAGES_ECTM, 0, 0, 6, 0, 0, "the ECTM stage alone needs an initial map"},
+        {CORR_STAGES_ALL, 0, 0, 0, 0, 0, "neither an initial map nor landmarks"},
+        {CORR_STAGES_RHM_ECTM, 0, 0, 2, 0, 0, "at least 3 landmark pairs, got 2"},
+        {CORR_STAGES_DDM_RHM, 1, 0, 0, 0, 0.5, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks"},
+        {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, "reverse map needs the bijective model"},
+        {CORR_STAGES_RHM, 0, 1, 6, 0, 0, "reverse map needs an initial map"},
+        {8, 1, 0, 0, 0, 0, "stages value 8"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        err[0] = '\0';
+        CHECK_INT(corr_stages_check((corr_stages)bad[k].s, bad[k].map, bad[k].rev, bad[k].nl,
+                                    bad[k].inj, bad[k].gamma, err, sizeof err), CORR_EINPUT);
+        CHECK_STR_HAS(err, bad[k].msg);
+    }
+}
+
+typedef struct stage_log {
+    int n, stage[1024], outer[1024];
+    double ddm_cost;
+} stage_log;
+
+static int record(void *ctx, const corr_progress *p)
+{
+    stage_log *l = ctx;
+    if (l->n < 1024) {
+        l->stage[l->n] = p->stage;
+        l->outer[l->n] = p->ectm ? p->ectm->outer : p->rhm ? p->rhm->iteration
+                       : p->ddm ? p->ddm->done : 0;
+        l->n++;
+    }
+    if (p->ddm && p->ddm->done)
+        l->ddm_cost = p->ddm->cost[p->ddm->done - 1];
+    return 0;
+}
+
+static double mean_error(const testgt *g, const bmap *P)
+{
+    char err[256];
+    geod_solver *s = NULL;
+    if (geod_solver_new(g->T, 0, &s, err, sizeof err))
+        FAILF("%s", err);
+    double e = testddm_mean_error(s, g->T, P, g->src, g->tgt, g->n);
+    geod_solver_free(s);
+    return e;
+}
+
+TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
+{
+    testgt g;
+    testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_man_01", 3);
+    char err[1024] = "";
+    bmap *P0 = NULL;
+    if (vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
+                                    "8_gorilla_01_8_man_01.map"),
+                  VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err))
+        FAILF("%s", err);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 4;
+    p.beta_ramp = 4;
+    p.inner_iterations = 10;
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 3;
+    int k = CORR_DDM_K;             /* ddm_k 0: the default */
+
+    /* ddm alone: the map ddm_denoise makes from the same bases */
+    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_STAGES_DDM, 0};
+    ectm_result r = {0};
+    stage_log l = {0};
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(l.n, 2);                 /* start, then the one direction (no Q given) */
+    CHECK_INT(l.stage[0], CORR_STAGE_DDM);
+    CHECK_INT(l.outer[0], 0);
+    CHECK_INT(l.outer[1], 1);
+    CHECK(r.P && !r.Q && !r.Y);
+    geod_solver *sS = NULL, *sT = NULL;
+    lbo_basis bS, bT;
+    if (geod_solver_new(g.S, 0, &sS, err, sizeof err) || geod_solver_new(g.T, 0, &sT, err, sizeof err) ||
+        lbo_eigenpairs(geod_solver_laplacian(sS), geod_solver_mass(sS), g.S->nv, k, &bS, err, sizeof err) ||
+        lbo_eigenpairs(geod_solver_laplacian(sT), geod_solver_mass(sT), g.T->nv, k, &bT, err, sizeof err))
+        FAILF("%s", err);
+    bmap *D = bmap_new(g.S->nv, g.T->nv);
+    ddm_stats st;
+    if (ddm_denoise(&bS, geod_solver_mass(sS), &bT, g.T, P0, k, k, D, &st, err, sizeof err))
+        FAILF("%s", err);
+    for (int i = 0; i < D->n; i++) {
+        CHECK_INT(r.P->face[i], D->face[i]);
+        for (int c = 0; c < 3; c++)
+            CHECK_NEAR(r.P->w[3 * i + c], D->w[3 * i + c], 1e-12);
+    }
+    CHECK_NEAR(l.ddm_cost, st.cost, 1e-12 * st.cost);
+    double e0 = mean_error(&g, P0), ed = mean_error(&g, r.P);
+    ectm_result_close(&r);
+
+    /* ddm,ectm: DDM's reports, then ECTM's 4 iterations from D */
+    in.stages = CORR_STAGES_DDM_ECTM;
+    memset(&l, 0, sizeof l);
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(l.n, 2 + 4);
+    CHECK_INT(l.stage[1], CORR_STAGE_DDM);
+    for (int i = 2; i < l.n; i++) {
+        CHECK_INT(l.stage[i], CORR_STAGE_ECTM);
+        CHECK_INT(l.outer[i], i - 1);
+    }
+    CHECK(r.P && r.Q && r.Y);
+    double ee = mean_error(&g, r.P);
+    metric_summary m0, m1;
+    CHECK_INT(metric_summarize(g.S, g.T, P0, &m0), 0);
+    CHECK_INT(metric_summarize(g.S, g.T, r.P, &m1), 0);
+    printf("  error: BCICP %.4f, ddm %.4f, ddm,ectm (4 iterations) %.4f; median conformal %.3f -> %.3f\n",
+           e0, ed, ee, m0.median_conformal, m1.median_conformal);
+    CHECK(ed <= e0 + 0.005);
+    CHECK(ee <= e0 + 0.01);
+    CHECK(m1.median_conformal < 0.5 * m0.median_conformal);
+    ectm_result_close(&r);
+
+    /* ddm,rhm: RHM from the denoised map, no landmarks, its 3 iterations */
+    in.stages = CORR_STAGES_DDM_RHM;
+    memset(&l, 0, sizeof l);
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(l.n, 2 + 1 + 3);
+    CHECK_INT(l.stage[2], CORR_STAGE_START);
+    CHECK_INT(l.stage[5], CORR_STAGE_RHM);
+    CHECK_INT(l.outer[5], 3);
+    CHECK(r.P && r.Q && !r.Y);
+    printf("  ddm,rhm (3 iterations): error %.4f\n", mean_error(&g, r.P));
+    ectm_result_close(&r);
+
+    /* a basis larger than the mesh allows names the parameter */
+    in.stages = CORR_STAGES_DDM;
+    in.ddm_k = 4999;
+    CHECK_INT(corr_run(&in, &p, NULL, NULL, &r, err, sizeof err), CORR_EINPUT);
+    CHECK_STR_HAS(err, "params.ddm_k = 4999");
+
+    bmap_free(D);
+    lbo_basis_close(&bS);
+    lbo_basis_close(&bT);
+    geod_solver_free(sS);
+    geod_solver_free(sT);
+    bmap_free(P0);
+    testgt_close(&g);
+}

@@ -1,0 +1,201 @@
+/* test_daemon_refine.c — refining an uploaded map through the real
+ * meshcorrd, meshcorr-worker and libmeshcorr: a job with stages ddm
+ * streams the ddm stage and returns the in-process pipeline's map (the
+ * same Draco-decoded meshes and map); ddm,ectm streams ddm then ECTM and
+ * completes; a chain that cannot run (ddm with no map) is refused before
+ * SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
+ * stretched and bent, the map a vertex map sent as weight-1 rows. */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "support/testmesh.h"
+#include "corr/corr.h"
+#include "map/bmap.h"
+#include "mesh/mesh.h"
+#include "meshcorr.h"
+
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct watch_log {
+    int n;
+    int stage[256];
+    uint32_t outer[256], total[256];
+    double energy[256];
+} watch_log;
+
+static int on_progress(void *ctx, const mc_progress *p)
+{
+    watch_log *w = ctx;
+    if (w->n < 256) {
+        w->stage[w->n] = p->stage;
+        w->outer[w->n] = p->outer;
+        w->total[w->n] = p->total;
+        w->energy[w->n] = p->energy[0];
+        w->n++;
+    }
+    return 0;
+}
+
+typedef struct pair {
+    unsigned char *sb, *tb;
+    size_t sl, tl;
+    mesh *S, *T;              /* as the worker decodes them */
+    bmap *P0;                 /* vertex i -> vertex i, weight 1 */
+    mc_map_row *rows;
+} pair;
+
+static unsigned char *encode(const mesh *m, size_t *len)
+{
+    unsigned char *buf = NULL;
+    char err[512];
+    if (mc_encode_mesh(m->v, m->nv, m->f, m->nf, &buf, len, err, sizeof err))
+        FAILF("mc_encode_mesh: %s", err);
+    return buf;
+}
+
+static void pair_open(pair *p)
+{
+    mesh *S = testmesh_icosphere(2), *T = testmesh_icosphere(2);
+    for (int i = 0; i < T->nv; i++) {
+        double *x = &T->v[3 * i];
+        x[0] *= 1.3;
+        x[2] += 0.15 * x[0] * x[0];
+    }
+    p->sb = encode(S, &p->sl);
+    p->tb = encode(T, &p->tl);
+    mesh_free(S);
+    mesh_free(T);
+    char err[512];
+    if (mesh_read_drc_mem(p->sb, p->sl, 1 << 20, 1 << 21, "source", &p->S, err, sizeof err) ||
+        mesh_read_drc_mem(p->tb, p->tl, 1 << 20, 1 << 21, "target", &p->T, err, sizeof err))
+        FAILF("%s", err);
+    p->P0 = bmap_new(p->S->nv, p->T->nv);
+    p->rows = calloc((size_t)p->S->nv, sizeof *p->rows);
+    int *vf = malloc(sizeof(int) * (size_t)p->T->nv);
+    for (int q = 3 * p->T->nf - 1; q >= 0; q--)
+        vf[p->T->f[q]] = q;
+    for (int i = 0; i < p->S->nv; i++) {
+        p->P0->face[i] = vf[i] / 3;
+        p->P0->w[3 * i + vf[i] % 3] = 1;
+        p->rows[i].face = (uint32_t)(vf[i] / 3);
+        p->rows[i].w[vf[i] % 3] = 1;
+    }
+    free(vf);
+}
+
+static void pair_close(pair *p)
+{
+    free(p->sb);
+    free(p->tb);
+    mesh_free(p->S);
+    mesh_free(p->T);
+    bmap_free(p->P0);
+    free(p->rows);
+}
+
+static void spec_of(const pair *p, int stages, int with_map, mc_job_spec *s)
+{
+    mc_job_spec_init(s);
+    s->source = p->sb;
+    s->source_len = p->sl;
+    s->target = p->tb;
+    s->target_len = p->tl;
+    if (with_map) {
+        s->p = p->rows;
+        s->np = (uint32_t)p->S->nv;
+    }
+    s->stages = stages;
+    s->ddm_k = 30;
+    s->iterations = 3;
+    s->beta_ramp = 3;
+    s->inner_iterations = 10;
+    s->label = "refine";
+}
+
+TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 120)
+{
+    testdaemon_need_worker();
+    pair p;
+    pair_open(&p);
+    testdaemon d;
+    testdaemon_start(&d, "refine", NULL);
+    mc_client *c = testdaemon_client(&d, NULL);
+
+    /* ddm alone */
+    mc_job_spec s;
+    spec_of(&p, MC_STAGES_DDM, 1, &s);
+    uint64_t id = 0;
+    if (mc_submit(c, &s, &id))
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+    watch_log w = {0};
+    int state = -1;
+    char reason[1100];
+    if (mc_watch(c, id, 0, on_progress, &w, &state, reason, sizeof reason))
+        FAILF("WATCH: %s", mc_errmsg(c));
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+    CHECK_INT(w.n, 2);                          /* its start, then P (no Q uploaded) */
+    CHECK_INT(w.stage[0], MC_STAGE_DDM);
+    CHECK_INT(w.stage[1], MC_STAGE_DDM);
+    CHECK_INT(w.outer[1], 1);
+    CHECK_INT(w.total[1], 1);
+    CHECK(w.energy[1] > 0);
+    mc_job_result r;
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q | MC_WANT_DEFORMED, &r), 0);
+    CHECK_INT(r.np, 162);
+    CHECK_INT(r.nq, 0);
+    CHECK(r.deformed_len > 0);                  /* the map's image P X~ */
+    corr_input in = {p.S, p.T, "source", "target", NULL, p.P0, NULL, NULL, CORR_STAGES_DDM, 30};
+    ectm_params ep;
+    ectm_params_init(&ep);
+    ectm_result want = {0};
+    char err[1024];
+    if (corr_run(&in, &ep, NULL, NULL, &want, err, sizeof err))
+        FAILF("in process: %s", err);
+    for (int i = 0; i < want.P->n; i++) {
+        if (r.p[i].face != (uint32_t)want.P->face[i])
+            FAILF("row %d: face %u, in process %d", i, r.p[i].face, want.P->face[i]);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(r.p[i].w[k], want.P->w[3 * i + k], 1e-12);
+    }
+    ectm_result_close(&want);
+    mc_result_free(&r);
+
+    /* ddm,ectm: ddm's reports, then ECTM's 3 iterations */
+    spec_of(&p, MC_STAGES_DDM_ECTM, 1, &s);
+    if (mc_submit(c, &s, &id))
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+    memset(&w, 0, sizeof w);
+    if (mc_watch(c, id, 0, on_progress, &w, &state, reason, sizeof reason))
+        FAILF("WATCH: %s", mc_errmsg(c));
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+    CHECK_INT(w.n, 5);
+    CHECK_INT(w.stage[1], MC_STAGE_DDM);
+    for (int i = 2; i < 5; i++) {
+        CHECK_INT(w.stage[i], MC_STAGE_ECTM);
+        CHECK_INT(w.outer[i], i - 1);
+    }
+    CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q, &r), 0);
+    CHECK_INT(r.np, 162);
+    CHECK_INT(r.nq, 162);
+    mc_result_free(&r);
+
+    /* ddm without a map: refused before SUBMIT_OK, naming the parameter */
+    static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3};
+    spec_of(&p, MC_STAGES_DDM_ECTM, 0, &s);
+    s.landmarks = lm;
+    s.nlandmarks = 4;
+    id = 0;
+    int rc = mc_submit(c, &s, &id);
+    CHECK_INT(rc, PROTO_EBAD_LANDMARKS);   /* the protocol's number */
+    CHECK_STR_HAS(mc_errmsg(c), "params.stages: the DDM stage denoises a given map");
+    CHECK_INT(id, 0);
+    /* the stages value is one of the list: 8 is refused by the validator */
+    spec_of(&p, 8, 1, &s);
+    CHECK(mc_submit(c, &s, &id) != 0);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+    pair_close(&p);
+}

@@ -1,0 +1,97 @@
+/* corr_ddm.c — the pipeline's DDM stage (corr__ddm.h): Laplace–Beltrami
+ * bases of both meshes on the intrinsic Delaunay operators the geodesics
+ * use (lbo.h), then DDM denoising of the given map(s) (ddm.h). */
+#include "corr/corr__ddm.h"
+#include "ddm/ddm.h"
+#include "geod/geod.h"
+#include "lbo/lbo.h"
+#include "util/errbuf.h"
+
+#include <string.h>
+
+_Static_assert(PROTO_DDM_MAX_K <= LBO_MAX_K, "ddm_k's range must fit the eigenpairs'");
+
+typedef struct basis {
+    geod_solver *s;
+    lbo_basis b;
+} basis;
+
+static int basis_open(basis *bs, const mesh *m, const char *name, int k, char *err, size_t errsz)
+{
+    char detail[512] = "";
+    int rc = geod_solver_new(m, 0, &bs->s, detail, sizeof detail);
+    if (rc)
+        return errbuf_set(err, errsz, rc == GEOD_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+                          "DDM: %s: Laplacian: %s", name, detail);
+    rc = lbo_eigenpairs(geod_solver_laplacian(bs->s), geod_solver_mass(bs->s), m->nv, k, &bs->b,
+                        detail, sizeof detail);
+    if (rc)
+        return errbuf_set(err, errsz, rc == LBO_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+                          "DDM: %s: %d eigenpairs: %s", name, k, detail);
+    return CORR_OK;
+}
+
+static void basis_close(basis *bs)
+{
+    lbo_basis_close(&bs->b);
+    geod_solver_free(bs->s);
+}
+
+int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_report_fn report,
+              void *ctx, bmap **P, bmap **Q, char *err, size_t errsz)
+{
+    *P = *Q = NULL;
+    const mesh *S = in->S, *T = in->T;
+    int nmin = S->nv < T->nv ? S->nv : T->nv, k = in->ddm_k;
+    if (k == 0)
+        k = CORR_DDM_K < nmin - 2 ? CORR_DDM_K : nmin - 2;
+    if (k < 1 || k > nmin - 2 || k > LBO_MAX_K)
+        return errbuf_set(err, errsz, CORR_EINPUT,
+                          "params.ddm_k = %d: DDM's basis holds at most vertices - 2 = %d "
+                          "eigenfunctions here (%s: %d vertices, %s: %d), and at most %d",
+                          k, nmin - 2, in->S_name, S->nv, in->T_name, T->nv, LBO_MAX_K);
+    corr_ddm_report r = {0, Q0 ? 2 : 1, k, {0, 0}};
+    if (report && report(ctx, &r))
+        return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before DDM");
+    basis bs[2];
+    memset(bs, 0, sizeof bs);
+    int rc;
+    if ((rc = basis_open(&bs[0], S, in->S_name, k, err, errsz)) ||
+        (rc = basis_open(&bs[1], T, in->T_name, k, err, errsz)))
+        goto out;
+    const bmap *in_map[2] = {P0, Q0};
+    bmap **out_map[2] = {P, Q};
+    for (int d = 0; d < r.total; d++) {
+        const basis *a = &bs[d], *b = &bs[1 - d];
+        const mesh *to = d ? S : T;
+        char detail[512] = "";
+        ddm_stats st;
+        if (!(*out_map[d] = bmap_new(in_map[d]->n, in_map[d]->nt))) {
+            rc = errbuf_set(err, errsz, CORR_ENOMEM, "DDM: out of memory");
+            goto out;
+        }
+        int drc = ddm_denoise(&a->b, geod_solver_mass(a->s), &b->b, to, in_map[d], k, k,
+                              *out_map[d], &st, detail, sizeof detail);
+        if (drc) {
+            rc = errbuf_set(err, errsz, drc == DDM_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+                            "DDM denoising of the %s map: %s", d ? "reverse" : "initial", detail);
+            goto out;
+        }
+        r.done = d + 1;
+        r.cost[d] = st.cost;
+        if (report && report(ctx, &r)) {
+            rc = errbuf_set(err, errsz, CORR_ECANCELED, "cancelled in DDM");
+            goto out;
+        }
+    }
+    rc = CORR_OK;
+out:
+    basis_close(&bs[0]);
+    basis_close(&bs[1]);
+    if (rc) {
+        bmap_free(*P);
+        bmap_free(*Q);
+        *P = *Q = NULL;
+    }
+    return rc;
+}
