@@ -34,11 +34,9 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
     return 0;
 }
 
-/* The inputs' combination: a map or landmarks, q only with p and bijective,
- * and a chain of stages that can run on them (corr_stages_check). */
+/* The inputs' combination: a map or landmarks, q only with p and bijective. */
 static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 {
-    char why[256];
     if (s->p.n == 0 && s->nlandmarks == 0)
         return errbuf_set(err, errsz, PROTO_EBAD_LANDMARKS,
                           "landmarks: none, and no initial map p: need one or at least %d pairs",
@@ -47,6 +45,14 @@ static int check_inputs(const proto_submit *s, char *err, size_t errsz)
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q without p");
     if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
         return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q needs the bijective model");
+    return 0;
+}
+
+/* A chain of stages that can run on the inputs (corr_stages_check); after
+ * the landmarks are read, so that their own rule speaks first. */
+static int check_stages(const proto_submit *s, char *err, size_t errsz)
+{
+    char why[256];
     if (corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
                           (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
                           s->params.rhm_landmark_weight, why, sizeof why))
@@ -122,7 +128,8 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
         (rc = load_mesh(&s->target, "target mesh", lim, &job->T, err, errsz)) ||
         (rc = map_landmarks(s, job->S, job->T, &job->L, err, errsz)) ||
         (rc = map_map(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
-        (rc = map_map(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)))
+        (rc = map_map(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
+        (rc = check_stages(s, err, errsz)))
         wrk_job_close(job);
     return rc;
 }
