@@ -122,7 +122,7 @@ TEST_T(rhm_then_ectm_from_faust_landmarks_against_ground_truth, 300)
  * 0.0316, RHM 0.0226 (16.8 %), RHM + ECTM 0.0215; the distances start
  * 0.0258, 0.0216 (6.1 %), 0.0207. On SHREC'07 (bench_shrec07
  * --rhm-start=fmap) the orientation term took the plier from mirrored
- * (RHM 0.028 with 59 % flipped) to 0.025 with 0.4 % flipped. */
+ * (RHM 0.028 with 59 % flipped) to 0.019 with 0.14 % flipped. */
 TEST_T(fmap_start_gives_rhm_a_usable_start_on_faust, 300)
 {
     double gf[3];
