@@ -193,9 +193,13 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         Q = bij ? init.P21 : NULL;
     }
     rc = from_ectm(ectm_run(in->S, in->T, P, Q, p, relay_ectm, &rl, out, err, errsz));
-    if (rc == CORR_OK) {
+    if (rc == CORR_OK && !in->P0) {
         /* ECTM's projection folds where its deformed surface passes a thin
-         * part at an angle: the same repair, on the maps it returns */
+         * part at an angle: the same repair, on the maps it returns, in
+         * the landmark pipeline where it was measured (bench_shrec07). Not
+         * on a given map's chains: there it re-mapped large regions of
+         * scattered flips and raised the error (the BCICP map gorilla ->
+         * man, ddm,ectm: 0.049 -> 0.083, test_corr_stages) */
         fold_report rep[2];
         if ((rc = corr_repair(in, out->P, out->Q, rep, err, errsz)))
             ectm_result_close(out);

@@ -8,8 +8,9 @@
  *   RHM: from landmarks (a start map, rhm.h) or from the uploaded or
  *     denoised maps (rhm_run_from_maps), giving P and Q, whose folds are
  *     then repaired (corr_repair, fold.h)
- *   ECTM refinement, then the same fold repair of the maps it returns
- *     (the rows of bad regions change; out->Y stays ECTM's deformation)
+ *   ECTM refinement, then (from landmarks, not from a given map) the
+ *     same fold repair of the maps it returns (the rows of bad regions
+ *     change; out->Y stays ECTM's deformation)
  *
  * Stages report progress through one callback; a non-zero return cancels.
  * This module reads no files and knows no sockets: callers load meshes,
