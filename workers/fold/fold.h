@@ -22,7 +22,7 @@
  *           each growing the regions of what is left by two rings more. A
  *           repair never makes a map worse.
  *
- * Landmark source vertices (when given) stay where P sends them. What it
+ * Landmark source vertices (when given) keep their rows. What it
  * cannot undo: a part mirrored as a whole (its boundary is mapped the
  * wrong way round, so the harmonic map inside it is flipped throughout),
  * and regions that are not disks on either side. Reads no files. */

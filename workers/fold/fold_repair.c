@@ -38,6 +38,7 @@ typedef struct ctx {
     const mesh *S, *T;
     geo_edges ES, ET;
     const unsigned char *fixed;   /* S->nv: landmark vertices */
+    int pin_landmarks;            /* remap pins the landmarks too */
     unsigned char *keep;          /* S->nv: the region's vertices that keep
                                      their rows (those of its filled holes) */
     bmap *R;                      /* the map being repaired */
@@ -45,17 +46,18 @@ typedef struct ctx {
     int *tcomp, *tloc, *sloc;     /* T->nf, T->nv (-1), S->nv (-1) */
 } ctx;
 
-/* Whether the region's vertex i is pinned where it is mapped: its boundary,
- * its landmarks, and the holes filled in (their faces were not bad: a
- * limb's end beyond a bad band round it keeps its map, and only the band
- * is re-mapped, so the harmonic map never crowds a long tube's end into a
- * point). Landmarks left free gave fewer bad faces on the ant but moved
- * whole regions away from them (wolf0 -> wolf2: error 0.0165 -> 0.0299 at
- * the repair, fourleg 0.060 -> 0.163), so they stay pinned. */
+/* Whether the region's vertex i is pinned where it is mapped: its boundary
+ * and the holes filled in (their faces were not bad: a limb's end beyond a
+ * bad band round it keeps its map, and only the band is re-mapped, so the
+ * harmonic map never crowds a long tube's end into a point); the landmarks
+ * when c->pin_landmarks. Unpinned landmarks move with the others and get
+ * their rows back afterwards: a pin folds the harmonic map round it when
+ * it is not where that map would put it, so each region is re-mapped both
+ * ways and the accept rule keeps the better. */
 static int pinned(const ctx *c, const fold__patch *pS, int i)
 {
     int v = pS->verts[i];
-    return i < pS->nb || c->keep[v] || c->fixed[v];
+    return i < pS->nb || c->keep[v] || (c->pin_landmarks && c->fixed[v]);
 }
 
 /* The chart: patch pT of T placed in the unit disk (uvT, 2 per vertex),
@@ -64,7 +66,7 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
 {
     const mesh *T = c->T;
     *uvT = NULL;
-    /* the faces the boundary (the kept holes, the landmarks) land in, grown until they
+    /* the faces the boundary (and the kept holes) land in, grown until they
      * are one piece: a band round the boundary's image, whose holes then
      * fill with what lies inside it. Inner vertices' images do not count:
      * those that jumped elsewhere are re-mapped anyway. */
@@ -170,7 +172,7 @@ static int remap(ctx *c, const fold__patch *pS)
         for (int i = 0; i < pT.nv; i++)
             uvT[2 * i + 1] = -uvT[2 * i + 1];
     /* the images in the chart (an inner vertex's outside it starts at 0);
-     * the boundary, the kept holes and the landmarks pinned there */
+     * the boundary and the kept holes pinned there */
     for (int i = 0; i < pS->nv; i++) {
         int v = pS->verts[i], f = c->R->face[v];
         uv[2 * i] = uv[2 * i + 1] = 0;
@@ -211,7 +213,7 @@ static int remap(ctx *c, const fold__patch *pS)
                     break;
             }
         }
-        if (bf < 0)
+        if (bf < 0 || c->fixed[pS->verts[i]])
             continue;
         double sum = 0;
         for (int k = 0; k < 3; k++)
@@ -232,12 +234,13 @@ out:
 }
 
 /* One region taken in a pass: its patch, which of its vertices are kept
- * (c->keep) and the rows it had. */
+ * (c->keep), the rows it had, and the rows of its remap with the
+ * landmarks pinned. */
 typedef struct taken {
     fold__patch p;
     unsigned char *kept;
-    int *face;
-    double *w;
+    int *face, *pface;
+    double *w, *pw;
 } taken;
 
 /* Rows of the region's vertices: from the map into face/w (save) or back. */
@@ -255,9 +258,10 @@ static void rows(bmap *R, const fold__patch *p, int *face, double *w, int save)
     }
 }
 
-/* Remaps every taken region; -1 when out of memory. */
-static int remap_all(ctx *c, taken *tk, int ntaken)
+/* Remaps every taken region (landmarks pinned or not); -1 when out of memory. */
+static int remap_all(ctx *c, taken *tk, int ntaken, int pin_landmarks)
 {
+    c->pin_landmarks = pin_landmarks;
     for (int k = 0; k < ntaken; k++) {
         for (int i = 0; i < tk[k].p.nv; i++)
             c->keep[tk[k].p.verts[i]] = tk[k].kept[i];
@@ -286,10 +290,10 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     int nf = S->nf, nv = S->nv, rc = -1, ntaken = 0;
     unsigned char *in = malloc((size_t)nf + 1), *cin = malloc((size_t)nf + 1);
     unsigned char *mark = malloc((size_t)nv + 1), *claimed = calloc((size_t)nv + 1, 1);
-    unsigned char *kind2 = malloc((size_t)nf + 1);
+    unsigned char *kind2 = malloc((size_t)nf + 1), *kind3 = malloc((size_t)nf + 1);
     int *comp = malloc(sizeof(int) * ((size_t)nf + 1));
     taken *tk = NULL;
-    if (!in || !cin || !mark || !claimed || !kind2 || !comp)
+    if (!in || !cin || !mark || !claimed || !kind2 || !kind3 || !comp)
         goto out;
     for (int t = 0; t < nf; t++)
         in[t] = kind[t] != 0;
@@ -326,9 +330,11 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
         size_t m = (size_t)r->p.nv + 1;
         r->kept = malloc(m);
         r->face = malloc(sizeof(int) * m);
+        r->pface = malloc(sizeof(int) * m);
         r->w = malloc(sizeof(double) * 3 * m);
+        r->pw = malloc(sizeof(double) * 3 * m);
         ntaken++;
-        if (!r->kept || !r->face || !r->w)
+        if (!r->kept || !r->face || !r->pface || !r->w || !r->pw)
             goto out;
         for (int i = 0; i < r->p.nv; i++) {
             r->kept[i] = c->keep[r->p.verts[i]];
@@ -336,13 +342,27 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
         }
         rows(c->R, &r->p, r->face, r->w, 1);
     }
-    /* each region re-mapped (kind2); its new rows kept where they beat the old */
-    if (remap_all(c, tk, ntaken) || metric_fold_faces(S, c->T, c->R, kind2) < 0)
+    /* each region re-mapped with the landmarks pinned (kind2), then without
+     * (kind3); the better of the three rows kept where it beats the old */
+    if (remap_all(c, tk, ntaken, 1) || metric_fold_faces(S, c->T, c->R, kind2) < 0)
+        goto out;
+    for (int k = 0; k < ntaken; k++) {
+        rows(c->R, &tk[k].p, tk[k].pface, tk[k].pw, 1);
+        rows(c->R, &tk[k].p, tk[k].face, tk[k].w, 0);
+    }
+    if (remap_all(c, tk, ntaken, 0) || metric_fold_faces(S, c->T, c->R, kind3) < 0)
         goto out;
     for (int k = 0; k < ntaken; k++) {
         taken *r = tk + k;
-        const unsigned char *won = kind2;
-        if (badness(&r->p, kind2) < badness(&r->p, kind)) {
+        long before = badness(&r->p, kind), pinned_ = badness(&r->p, kind2),
+             free_ = badness(&r->p, kind3);
+        const unsigned char *won = kind3;
+        if (pinned_ < free_) {
+            rows(c->R, &r->p, r->pface, r->pw, 0);
+            won = kind2;
+            free_ = pinned_;
+        }
+        if (free_ < before) {
             rep->regions++;
             rep->region += r->p.nv - r->p.nb;
         } else {
@@ -350,11 +370,11 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
             won = kind;
         }
         for (int q = 0; q < r->p.nf; q++)
-            kind2[r->p.faces[q]] = won[r->p.faces[q]];
+            kind3[r->p.faces[q]] = won[r->p.faces[q]];
     }
     bad = 0;
     for (int t = 0; t < nf; t++)
-        bad += (kind[t] = kind2[t]) != 0;
+        bad += (kind[t] = kind3[t]) != 0;
     rc = bad;
 out:
     if (tk)
@@ -362,7 +382,9 @@ out:
             fold__patch_close(&tk[k].p);
             free(tk[k].kept);
             free(tk[k].face);
+            free(tk[k].pface);
             free(tk[k].w);
+            free(tk[k].pw);
         }
     free(tk);
     free(in);
@@ -370,6 +392,7 @@ out:
     free(mark);
     free(claimed);
     free(kind2);
+    free(kind3);
     free(comp);
     return rc;
 }
