@@ -5,25 +5,13 @@
  * -> refused as ambiguous, an explicit base wins); vmap_read_any telling
  * the two formats apart; every refusal naming file and line. */
 #include "support/harness.h"
+#include "support/testfile.h"
 #include "support/testmesh.h"
 #include "map/bmap.h"
 #include "map/vmap.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-static const char *write_file(const char *name, const char *text)
-{
-    static char path[4][512];
-    static int k;
-    char *p = path[k++ % 4];
-    snprintf(p, 512, "%s/%s", harness_tmpdir(), name);
-    FILE *fp = fopen(p, "w");
-    CHECK(fp);
-    fputs(text, fp);
-    fclose(fp);
-    return p;
-}
 
 static mesh *load(const char *rel)
 {
@@ -114,7 +102,7 @@ TEST(base_rule_zero_means_0_based_nv_means_1_based)
     bmap *P = NULL;
     int used = -1;
     /* a 0 present: 0-based, row 0 on vertex 0 */
-    const char *z = write_file("zero.txt", "0\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n11\n");
+    const char *z = testfile_text("zero.txt", "0\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n11\n");
     CHECK_INT(vmap_read(z, VMAP_BASE_AUTO, m, m, &P, &used, err, sizeof err), 0);
     CHECK_INT(used, 0);
     for (int i = 0; i < 12; i++)
@@ -122,7 +110,7 @@ TEST(base_rule_zero_means_0_based_nv_means_1_based)
     bmap_free(P);
     /* 12 present, no 0: 1-based; '#' lines, blank lines and integral
      * floats are fine */
-    const char *o = write_file("one.txt", "# from MATLAB\n12\n1\n2.0\n3\n\n4\n5\n6\n7\n8\n9\n"
+    const char *o = testfile_text("one.txt", "# from MATLAB\n12\n1\n2.0\n3\n\n4\n5\n6\n7\n8\n9\n"
                                            "1.0e+01\n11\n");
     CHECK_INT(vmap_read(o, VMAP_BASE_AUTO, m, m, &P, &used, err, sizeof err), 0);
     CHECK_INT(used, 1);
@@ -168,7 +156,7 @@ TEST(bad_vertex_maps_are_refused_naming_file_and_line)
         {"empty.txt", "", VMAP_BASE_AUTO, BMAP_ESIZE, "empty.txt:0: 0 entries, expected 12"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        const char *p = write_file(cases[k].name, cases[k].text);
+        const char *p = testfile_text(cases[k].name, cases[k].text);
         int rc = vmap_read(p, cases[k].base, m, m, &P, NULL, err, sizeof err);
         if (rc != cases[k].rc)
             FAILF("%s: rc %d, expected %d (%s)", cases[k].name, rc, cases[k].rc, err);
@@ -191,13 +179,13 @@ TEST(read_any_tells_barycentric_from_vertex_maps)
     int o = snprintf(text, sizeof text, "# meshcorr-map 1\n12 12\n");
     for (int i = 0; i < 12; i++)
         o += snprintf(text + o, sizeof text - (size_t)o, "0 1 0 0\n");
-    CHECK_INT(vmap_read_any(write_file("b.map", text), VMAP_BASE_AUTO, m, m, &P, err, sizeof err), 0);
+    CHECK_INT(vmap_read_any(testfile_text("b.map", text), VMAP_BASE_AUTO, m, m, &P, err, sizeof err), 0);
     CHECK_INT(P->face[5], 0);
     bmap_free(P);
-    CHECK_INT(vmap_read_any(write_file("bad.map", "# meshcorr-map 1\n12 11\n"), VMAP_BASE_AUTO, m, m,
+    CHECK_INT(vmap_read_any(testfile_text("bad.map", "# meshcorr-map 1\n12 11\n"), VMAP_BASE_AUTO, m, m,
                             &P, err, sizeof err), BMAP_ESIZE);
     CHECK_STR_HAS(err, "bad.map:2: map is for 12 -> 11 vertices");
-    CHECK_INT(vmap_read_any(write_file("v.map", "0\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n11\n"),
+    CHECK_INT(vmap_read_any(testfile_text("v.map", "0\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n11\n"),
                             VMAP_BASE_AUTO, m, m, &P, err, sizeof err), 0);
     check_at_vertex(P, 7, m, 7);
     bmap_free(P);

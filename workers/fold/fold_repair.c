@@ -110,21 +110,20 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
         fold__patch_close(pT);
         return -1;
     }
-    /* the loop on the circle by arc length */
-    double len = 0, s = 0;
+    /* the loop on the circle by arc length (uv[2i] holds the length run
+     * up to vertex i until the angles are set) */
+    double len = 0;
     for (int i = 0; i < pT->nb; i++) {
         const double *a = T->v + 3 * pT->verts[i], *b = T->v + 3 * pT->verts[(i + 1) % pT->nb];
+        uv[2 * i] = len;
         len += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                     (a[2] - b[2]) * (a[2] - b[2]));
     }
     for (int i = 0; i < pT->nb; i++) {
-        double th = len > 0 ? 2 * M_PI * s / len : 2 * M_PI * i / pT->nb;
+        double th = len > 0 ? 2 * M_PI * uv[2 * i] / len : 2 * M_PI * i / pT->nb;
         uv[2 * i] = cos(th);
         uv[2 * i + 1] = sin(th);
         pin[i] = 1;
-        const double *a = T->v + 3 * pT->verts[i], *b = T->v + 3 * pT->verts[(i + 1) % pT->nb];
-        s += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                  (a[2] - b[2]) * (a[2] - b[2]));
     }
     rc = fold__harmonic(T, &c->ET, pT, pin, c->tloc, uv);
     free(pin);
