@@ -309,7 +309,7 @@ int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s)
     return -1;
 }
 
-static unsigned char *encode(const mesh *m, size_t *len)
+unsigned char *testdaemon_encode(const mesh *m, size_t *len)
 {
     unsigned char *buf = NULL;
     char err[512];
@@ -331,7 +331,7 @@ uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t p
     mc_job_spec spec;
     mc_job_spec_init(&spec);
     size_t sl, tl;
-    unsigned char *sb = encode(S, &sl), *tb = encode(T, &tl);
+    unsigned char *sb = testdaemon_encode(S, &sl), *tb = testdaemon_encode(T, &tl);
     static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5};
     spec.source = sb;
     spec.source_len = sl;

@@ -45,15 +45,6 @@ typedef struct pair {
     mc_map_row *rows;
 } pair;
 
-static unsigned char *encode(const mesh *m, size_t *len)
-{
-    unsigned char *buf = NULL;
-    char err[512];
-    if (mc_encode_mesh(m->v, m->nv, m->f, m->nf, &buf, len, err, sizeof err))
-        FAILF("mc_encode_mesh: %s", err);
-    return buf;
-}
-
 static void pair_open(pair *p)
 {
     mesh *S = testmesh_icosphere(2), *T = testmesh_icosphere(2);
@@ -62,8 +53,8 @@ static void pair_open(pair *p)
         x[0] *= 1.3;
         x[2] += 0.15 * x[0] * x[0];
     }
-    p->sb = encode(S, &p->sl);
-    p->tb = encode(T, &p->tl);
+    p->sb = testdaemon_encode(S, &p->sl);
+    p->tb = testdaemon_encode(T, &p->tl);
     mesh_free(S);
     mesh_free(T);
     char err[512];
