@@ -25,7 +25,7 @@
  * curvature ratio <= 0.75 in at least 8, median error <= 0.035; wolf:
  * error <= 0.01 and flipped <= 1 %.
  *
- * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm
+ * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm|repair
  * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for
  * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
  * the default, for comparing), --rhm-start=NAME (a start map of
@@ -222,6 +222,8 @@ static void run_pair(const void *arg, void *out)
     printf("  %s: repair %d -> %d bad faces (%d vertices relaxed), reverse %d -> %d\n", ps->label,
            rep[0].bad_before, rep[0].bad_after, rep[0].region, rep[1].bad_before, rep[1].bad_after);
     maps[fig->nmaps++] = rr.P12;
+    if (job->last == REPAIR)
+        goto score;
 
     corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0 };
     t0 = now();
@@ -365,9 +367,10 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     int start = o_start ? (int)w.rhm_start : -1;
     int iters = o_it ? atoi(o_it) : 0, last = ECTM;
     if (o_stop)
-        last = !strcmp(o_stop, "start") ? START : !strcmp(o_stop, "rhm") ? RHM : -1;
+        last = !strcmp(o_stop, "start") ? START : !strcmp(o_stop, "rhm") ? RHM
+                                       : !strcmp(o_stop, "repair") ? REPAIR : -1;
     if (last < 0)
-        FAILF("--stop takes start or rhm");
+        FAILF("--stop takes start, rhm or repair");
     if (o_it && iters < 1)
         FAILF("--ectm-iterations takes a positive integer");
     ectm_params ep;

@@ -1,7 +1,8 @@
 /* test_fold.c — fold repair (fold.h): a fold planted in the identity map
  * of a mesh onto itself is found (metric_fold_faces) and relaxed away,
- * landmarks stay put, and a map mirrored as a whole is left as it was
- * (the repair never makes a map worse). */
+ * landmarks stay put, a crowded cap and a cap whose images jumped are
+ * re-mapped, and a map mirrored as a whole is left as it was (the repair
+ * never makes a map worse). */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "fold/fold.h"
@@ -124,6 +125,50 @@ TEST(refuses_bad_arguments)
     P = bmap_new(m->nv, m->nv);
     fp.passes = 0;
     CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
+    bmap_free(P);
+    mesh_free(m);
+}
+
+/* The identity of a sphere onto itself with a polar cap (z > 0.75)
+ * shrunk toward the pole by 1e-3: no face is flipped and none has an
+ * image below the metric's 1e-12 of its area, but the cap's faces are
+ * crowded (area ratio ~1e-6), as a harmonic map crowds a long part. The
+ * repair counts them as bad and spreads the cap back over the cap. */
+TEST(crowded_cap_counts_as_bad_and_is_spread_back)
+{
+    mesh *m = testmesh_icosphere(4);
+    int nv = m->nv;
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, m->v, sizeof(double) * 3 * (size_t)nv);
+    for (int v = 0; v < nv; v++)
+        if (m->v[3 * v + 2] > 0.75) {
+            img[3 * v] *= 1e-3;
+            img[3 * v + 1] *= 1e-3;
+            img[3 * v + 2] = 1;
+        }
+    bmap *P = map_of_points(m, img, nv);
+    CHECK_INT(count_bad(m, m, P, METRIC_FACE_FLIPPED) + count_bad(m, m, P, METRIC_FACE_COLLAPSED), 0);
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_OK);
+    printf("  crowded faces %d -> %d, %d vertices re-mapped\n", rep.bad_before, rep.bad_after,
+           rep.region);
+    CHECK(rep.bad_before > 50);
+    CHECK(rep.accepted);
+    CHECK_INT(rep.bad_after, 0);
+    double *y = malloc(sizeof(double) * 3 * (size_t)nv), worst = 0;
+    bmap_apply(P, m->f, m->v, 3, y);
+    for (int v = 0; v < nv; v++) {
+        double d = 0;
+        for (int k = 0; k < 3; k++)
+            d += (y[3 * v + k] - m->v[3 * v + k]) * (y[3 * v + k] - m->v[3 * v + k]);
+        worst = fmax(worst, sqrt(d));
+    }
+    printf("  farthest vertex from its place: %.3f (the cap's radius is about 0.66)\n", worst);
+    CHECK(worst < 0.2);
+    free(y);
+    free(img);
     bmap_free(P);
     mesh_free(m);
 }

@@ -6,9 +6,12 @@
  *
  *   region  the bad faces grown by `rings` rings, split into components,
  *           each with its holes filled (a ring of bad faces round a limb
- *           takes the limb's end with it), kept when it is a disk;
- *   chart   the target faces P sends the region's vertices into, grown by
- *           two rings and hole-filled, a disk too, placed in the unit disk
+ *           takes the limb's end with it), kept when it is a disk of at
+ *           most a quarter of the faces;
+ *   chart   the target faces P sends the region's boundary and filled
+ *           holes into (not its landmarks: a limb's tip may lie far
+ *           inside), grown by two to six rings until one piece and
+ *           hole-filled, a disk too, placed in the unit disk
  *           by its harmonic map (boundary on the circle by arc length);
  *   remap   the region's boundary, its landmarks and its filled holes
  *           (faces that were not bad) stay where P sends them (their
@@ -18,9 +21,21 @@
  *           untwisted this way: its boundary ring is only rotated, and the
  *           harmonic map inside a rotated ring does not fold;
  *   accept  a region's new rows are kept only when its faces then have
- *           no more collapsed ones and fewer bad ones; `passes` passes,
- *           each growing the regions of what is left by two rings more. A
- *           repair never makes a map worse.
+ *           no more collapsed ones and fewer bad ones (flipped, collapsed,
+ *           or crowded: an image below 1e-4 of its face's area, both
+ *           meshes at unit area, as a harmonic map crowds a long part),
+ *           and when no vertex whose faces were all good moved farther
+ *           than the diameter of the boundary's image (the map was right
+ *           there; a foot's ring round a long leg would spread the foot up
+ *           the leg); `passes` passes, each growing the regions of what
+ *           is left by two rings more. A repair never makes a map worse.
+ *
+ * Each region is re-mapped with its landmarks pinned and with them free
+ * (their rows restored afterwards: a pin folds the harmonic map round it
+ * when it is not where that map would put it); the free one counts only
+ * when it puts every landmark within 0.25 of the chart's radius of its
+ * image, and a tie goes to the pinned one. A pinned landmark outside the
+ * chart leaves the region to the free remap.
  *
  * Landmark source vertices (when given) keep their rows. What it
  * cannot undo: a part mirrored as a whole (its boundary is mapped the
@@ -53,7 +68,7 @@ typedef struct fold_params {
 void fold_params_init(fold_params *p);
 
 typedef struct fold_report {
-    int bad_before, bad_after;   /* flipped + collapsed faces             */
+    int bad_before, bad_after;   /* flipped + collapsed + crowded faces   */
     int region;                  /* source vertices re-mapped (accepted)   */
     int regions;                 /* regions accepted, over all passes      */
     int accepted;                /* 1: P was changed                        */

@@ -3,19 +3,36 @@
  * accept-if-better rule per region. */
 #include "fold/fold.h"
 #include "fold/fold__patch.h"
+#include "geo/geo_area.h"
 #include "metric/metric.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* A region (hole-filled) may take at most this share of the source's
  * faces, and its chart this share of the target's: beyond that the map is
- * wrong on a whole part, which a local repair cannot decide. */
+ * wrong on a whole part (a limb), which a local repair cannot decide. */
 #define FOLD__MAX_REGION 0.25
 #define FOLD__MAX_CHART 0.5
 #define FOLD__CHART_RINGS 2       /* rings round the boundary image, at least */
 #define FOLD__CHART_MAX_RINGS 6   /* ... and at most */
+/* A remap with the landmarks free counts only when it puts each of them
+ * at most this far (in the chart's unit disk) from its image: farther, it
+ * contradicts the landmark, and restoring the landmark's row leaves its
+ * neighbourhood mapped elsewhere. */
+#define FOLD__MAX_SHIFT 0.25
+/* A face whose image (both meshes at unit area) has less than this share
+ * of its own area counts as collapsed for the repair: a harmonic map
+ * crowds a long part toward a point, exponentially, without reaching the
+ * metric's 1e-12. */
+#define FOLD__CROWDED 1e-4
+/* A remap may move a vertex whose faces were all good at most this
+ * multiple of the diameter of the region boundary's image: the map was
+ * right there, and a remap that carries it farther spreads the region over
+ * a larger part the boundary encloses (a foot's ring round a long leg). */
+#define FOLD__MAX_MOVE 1.0
 
 const char *fold_strerror(int code)
 {
@@ -39,12 +56,42 @@ typedef struct ctx {
     geo_edges ES, ET;
     const unsigned char *fixed;   /* S->nv: landmark vertices */
     int pin_landmarks;            /* remap pins the landmarks too */
+    double shift;                 /* remap's farthest free landmark from its
+                                     image, in the chart's unit disk */
+    unsigned char *badv;          /* S->nv: vertices of bad faces (pass) */
     unsigned char *keep;          /* S->nv: the region's vertices that keep
                                      their rows (those of its filled holes) */
     bmap *R;                      /* the map being repaired */
     unsigned char *tin, *tmark;   /* T->nf, T->nv scratch */
     int *tcomp, *tloc, *sloc;     /* T->nf, T->nv (-1), S->nv (-1) */
 } ctx;
+
+enum { FOLD__FACE_CROWDED = 3 };   /* beside metric.h's METRIC_FACE_* */
+
+/* metric_fold_faces' kinds of P's faces, and FOLD__FACE_CROWDED for an
+ * OK one whose image is crowded (FOLD__CROWDED); the number not OK, or -1
+ * when out of memory. */
+static int kinds(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind)
+{
+    int bad = metric_fold_faces(S, T, P, kind);
+    double *img = malloc(sizeof(double) * (3 * (size_t)S->nv + 1));
+    double *lr = malloc(sizeof(double) * ((size_t)S->nf + 1));
+    if (bad < 0 || !img || !lr) {
+        free(img);
+        free(lr);
+        return -1;
+    }
+    bmap_apply(P, T->f, T->v, 3, img);
+    metric_area_distortion(S, img, geo_total_area(S), geo_total_area(T), lr);
+    for (int t = 0; t < S->nf; t++)
+        if (kind[t] == METRIC_FACE_OK && !(lr[t] >= log(FOLD__CROWDED))) {
+            kind[t] = FOLD__FACE_CROWDED;
+            bad++;
+        }
+    free(img);
+    free(lr);
+    return bad;
+}
 
 /* Whether the region's vertex i is pinned where it is mapped: its boundary
  * and the holes filled in (their faces were not bad: a limb's end beyond a
@@ -60,6 +107,14 @@ static int pinned(const ctx *c, const fold__patch *pS, int i)
     return i < pS->nb || c->keep[v] || (c->pin_landmarks && c->fixed[v]);
 }
 
+/* Whether the region's vertex i places the chart: its boundary and kept
+ * holes; not its landmarks, whose images may lie far inside the part the
+ * boundary encloses (a limb's tip). */
+static int anchored(const ctx *c, const fold__patch *pS, int i)
+{
+    return i < pS->nb || c->keep[pS->verts[i]];
+}
+
 /* The chart: patch pT of T placed in the unit disk (uvT, 2 per vertex),
  * oriented as T. Returns 0, 1 when it is no disk or too large, -1 (memory). */
 static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
@@ -72,7 +127,7 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
      * those that jumped elsewhere are re-mapped anyway. */
     memset(c->tin, 0, (size_t)T->nf);
     for (int i = 0; i < pS->nv; i++)
-        if (pinned(c, pS, i))
+        if (anchored(c, pS, i))
             c->tin[c->R->face[pS->verts[i]]] = 1;
     int n = 0, best = 0;
     for (int r = 0; r < FOLD__CHART_MAX_RINGS; r++) {
@@ -84,7 +139,7 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
         best = c->tcomp[c->R->face[pS->verts[0]]];
         int one = 1;
         for (int i = 0; i < pS->nv && one; i++)
-            if (pinned(c, pS, i))
+            if (anchored(c, pS, i))
                 one = c->tcomp[c->R->face[pS->verts[i]]] == best;
         if (one)
             break;
@@ -176,8 +231,15 @@ static int remap(ctx *c, const fold__patch *pS)
         int v = pS->verts[i], f = c->R->face[v];
         uv[2 * i] = uv[2 * i + 1] = 0;
         pin[i] = pinned(c, pS, i);
-        if (c->tloc[T->f[3 * f]] < 0)
+        if (c->tloc[T->f[3 * f]] < 0) {
+            if (pin[i]) {          /* a pinned landmark outside the chart */
+                rc = 1;
+                for (int j = 0; j < pT.nv; j++)
+                    c->tloc[pT.verts[j]] = -1;
+                goto out;
+            }
             continue;
+        }
         for (int k = 0; k < 3; k++) {
             int j = c->tloc[T->f[3 * f + k]];
             uv[2 * i] += c->R->w[3 * v + k] * uvT[2 * j];
@@ -186,8 +248,19 @@ static int remap(ctx *c, const fold__patch *pS)
     }
     for (int i = 0; i < pT.nv; i++)
         c->tloc[pT.verts[i]] = -1;
-    if (fold__harmonic(c->S, &c->ES, pS, pin, c->sloc, uv))
+    double *lm = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
+    if (!lm)
         goto out;
+    memcpy(lm, uv, sizeof(double) * 2 * (size_t)pS->nv);
+    if (fold__harmonic(c->S, &c->ES, pS, pin, c->sloc, uv)) {
+        free(lm);
+        goto out;
+    }
+    c->shift = 0;
+    for (int i = 0; i < pS->nv; i++)
+        if (!pin[i] && c->fixed[pS->verts[i]])
+            c->shift = fmax(c->shift, hypot(uv[2 * i] - lm[2 * i], uv[2 * i + 1] - lm[2 * i + 1]));
+    free(lm);
     /* read the inner vertices back through the chart: the chart face whose
      * smallest barycentric coordinate is largest (inside when >= 0) */
     for (int i = 0; i < pS->nv; i++) {
@@ -237,6 +310,8 @@ out:
  * landmarks pinned. */
 typedef struct taken {
     fold__patch p;
+    double shift;                 /* c->shift of its remap with free landmarks */
+    int pfar;                     /* moved_far of the remap with landmarks pinned */
     unsigned char *kept;
     int *face, *pface;
     double *w, *pw;
@@ -264,21 +339,60 @@ static int remap_all(ctx *c, taken *tk, int ntaken, int pin_landmarks)
     for (int k = 0; k < ntaken; k++) {
         for (int i = 0; i < tk[k].p.nv; i++)
             c->keep[tk[k].p.verts[i]] = tk[k].kept[i];
+        c->shift = 0;
         if (remap(c, &tk[k].p) < 0)
             return -1;
+        tk[k].shift = c->shift;
     }
     return 0;
 }
 
-/* The region's bad faces, a collapsed one counted as more than all the
- * faces it has: a remap that trades flips for collapse (a harmonic map
- * crowding a long part into a point) never counts as better. */
+/* The region's bad faces (flipped, crowded or collapsed), a collapsed one
+ * counted as more than all the faces it has: a remap that trades flips for
+ * collapse never counts as better; one that crowds a part (a harmonic map
+ * of a long part) counts each crowded face as bad. */
 static long badness(const fold__patch *p, const unsigned char *kind)
 {
     long n = 0;
     for (int q = 0; q < p->nf; q++)
         n += kind[p->faces[q]] == METRIC_FACE_COLLAPSED ? p->nf + 1 : kind[p->faces[q]] != 0;
     return n;
+}
+
+/* A point of T: row v of the map (face, w). */
+static void point(const mesh *T, int face, const double *w, double *x)
+{
+    const int *tf = T->f + 3 * face;
+    for (int d = 0; d < 3; d++)
+        x[d] = w[0] * T->v[3 * tf[0] + d] + w[1] * T->v[3 * tf[1] + d] + w[2] * T->v[3 * tf[2] + d];
+}
+
+/* Whether the region's remap (its rows in c->R against its old rows)
+ * moved a vertex with good faces farther than FOLD__MAX_MOVE times the
+ * diameter of the boundary's image (a box's diagonal). */
+static int moved_far(const ctx *c, const taken *r)
+{
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    double far = 0, x[3], y[3];
+    for (int i = 0; i < r->p.nb; i++) {
+        point(c->T, r->face[i], r->w + 3 * i, x);
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fmin(lo[d], x[d]);
+            hi[d] = fmax(hi[d], x[d]);
+        }
+    }
+    for (int i = r->p.nb; i < r->p.nv; i++) {
+        int v = r->p.verts[i];
+        if (c->badv[v])
+            continue;
+        point(c->T, r->face[i], r->w + 3 * i, x);
+        point(c->T, c->R->face[v], c->R->w + 3 * v, y);
+        far = fmax(far, (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
+                            (x[2] - y[2]) * (x[2] - y[2]));
+    }
+    double diam2 = (hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                   (hi[2] - lo[2]) * (hi[2] - lo[2]);
+    return far > FOLD__MAX_MOVE * FOLD__MAX_MOVE * diam2;
 }
 
 /* One pass with regions grown by `rings`: returns the new number of bad
@@ -294,8 +408,12 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     taken *tk = NULL;
     if (!in || !cin || !mark || !claimed || !kind2 || !kind3 || !comp)
         goto out;
-    for (int t = 0; t < nf; t++)
+    memset(c->badv, 0, (size_t)nv);
+    for (int t = 0; t < nf; t++) {
         in[t] = kind[t] != 0;
+        for (int j = 0; j < 3 && in[t]; j++)
+            c->badv[S->f[3 * t + j]] = 1;
+    }
     fold__grow(S, in, rings, mark);
     int n = fold__components(&c->ES, in, comp);
     if (n < 0 || !(tk = calloc((size_t)n + 1, sizeof(taken))))
@@ -343,20 +461,25 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     }
     /* each region re-mapped with the landmarks pinned (kind2), then without
      * (kind3); the better of the three rows kept where it beats the old */
-    if (remap_all(c, tk, ntaken, 1) || metric_fold_faces(S, c->T, c->R, kind2) < 0)
+    if (remap_all(c, tk, ntaken, 1) || kinds(S, c->T, c->R, kind2) < 0)
         goto out;
     for (int k = 0; k < ntaken; k++) {
+        tk[k].pfar = moved_far(c, tk + k);
         rows(c->R, &tk[k].p, tk[k].pface, tk[k].pw, 1);
         rows(c->R, &tk[k].p, tk[k].face, tk[k].w, 0);
     }
-    if (remap_all(c, tk, ntaken, 0) || metric_fold_faces(S, c->T, c->R, kind3) < 0)
+    if (remap_all(c, tk, ntaken, 0) || kinds(S, c->T, c->R, kind3) < 0)
         goto out;
     for (int k = 0; k < ntaken; k++) {
         taken *r = tk + k;
         long before = badness(&r->p, kind), pinned_ = badness(&r->p, kind2),
              free_ = badness(&r->p, kind3);
+        if (r->pfar)               /* a remap that moved good parts far never wins */
+            pinned_ = LONG_MAX;
+        if (moved_far(c, r))
+            free_ = LONG_MAX;
         const unsigned char *won = kind3;
-        if (pinned_ < free_) {
+        if (pinned_ <= free_ || r->shift > FOLD__MAX_SHIFT) {
             rows(c->R, &r->p, r->pface, r->pw, 0);
             won = kind2;
             free_ = pinned_;
@@ -416,7 +539,8 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     c.tloc = malloc(sizeof(int) * ((size_t)T->nv + 1));
     c.sloc = malloc(sizeof(int) * ((size_t)S->nv + 1));
     c.R = bmap_new(P->n, P->nt);
-    if (!kind || !fx || !c.keep || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
+    c.badv = malloc((size_t)S->nv + 1);
+    if (!c.badv || !kind || !fx || !c.keep || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
         goto out;
     for (int v = 0; v < T->nv; v++)
         c.tloc[v] = -1;
@@ -428,7 +552,7 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     c.fixed = fx;
     memcpy(c.R->face, P->face, sizeof(int) * (size_t)P->n);
     memcpy(c.R->w, P->w, sizeof(double) * 3 * (size_t)P->n);
-    int bad = metric_fold_faces(S, T, P, kind);
+    int bad = kinds(S, T, P, kind);
     if (bad < 0)
         goto out;
     rep->bad_before = rep->bad_after = bad;
@@ -455,6 +579,7 @@ out:
     geo_edges_close(&c.ES);
     geo_edges_close(&c.ET);
     bmap_free(c.R);
+    free(c.badv);
     free(kind);
     free(fx);
     free(c.keep);
