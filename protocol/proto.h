@@ -122,10 +122,10 @@ enum proto_slot_state {
     PROTO_SLOT_LAST = 3
 };
 
-/* values of the ENUM parameters model, rhm_start and stages (their names: proto_params.h) */
+/* values of the ENUM parameters model, start and stages (their names: proto_params.h) */
 enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1 };
 /* RHM's start map from the landmarks (workers/rhm/rhm.h) */
-enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1, PROTO_RHM_START_FMAP = 2 };
+enum proto_start { PROTO_START_DISTANCES = 0, PROTO_START_VORONOI = 1, PROTO_START_FMAP = 2 };
 /* the stages a job runs (workers/corr/corr.h) */
 enum proto_stages {
     PROTO_STAGES_ALL = 0, PROTO_STAGES_RHM = 1, PROTO_STAGES_ECTM = 2, PROTO_STAGES_DDM = 3,

@@ -135,10 +135,10 @@ TEST(match_refuses_bad_option_value)
              s381, s390, p0);
     CHECK_INT(run(cmd, out, sizeof out), 2);
     CHECK_STR_HAS(out, "gamma");
-    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --rhm-start cells",
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --start cells",
              s381, s390, p0);
     CHECK_INT(run(cmd, out, sizeof out), 2);
-    CHECK_STR_HAS(out, "--rhm-start: 'cells' is not distances, voronoi or fmap");
+    CHECK_STR_HAS(out, "--start: 'cells' is not distances, voronoi or fmap");
 }
 
 TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)

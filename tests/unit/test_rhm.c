@@ -63,7 +63,7 @@ static void faust_pipeline(int start, double ge[3], metric_summary ms[3])
         FAILF("%s", err);
     char name[32];
     printf("  start %s; RHM: %d iterations, %.1f ms per iteration\n",
-           proto_param_value_name(PROTO_P_rhm_start, (unsigned)start, name, sizeof name),
+           proto_param_value_name(PROTO_P_start, (unsigned)start, name, sizeof name),
            res.last.iteration, 1e3 * (res.last.elapsed - res.last.t_setup) / res.last.iteration);
     ectm_params ep;
     ectm_params_init(&ep);
@@ -121,7 +121,7 @@ TEST_T(rhm_then_ectm_from_faust_landmarks_against_ground_truth, 300)
  * 0.0195 (8.3 %), RHM + ECTM 0.0180; without the orientation term start
  * 0.0316, RHM 0.0226 (16.8 %), RHM + ECTM 0.0215; the distances start
  * 0.0258, 0.0216 (6.1 %), 0.0207. On SHREC'07 (bench_shrec07
- * --rhm-start=fmap) the orientation term took the plier from mirrored
+ * --start=fmap) the orientation term took the plier from mirrored
  * (RHM 0.028 with 59 % flipped) to 0.019 with 0.14 % flipped. */
 TEST_T(fmap_start_gives_rhm_a_usable_start_on_faust, 300)
 {

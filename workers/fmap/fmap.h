@@ -109,7 +109,7 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
 /* Orientation weight and the descriptors it uses: per block of
  * fmap_landmark_descriptors' columns (the WKS, each landmark's WKM) the
  * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. mu_o = 3
- * was the best of 1, 3, 10 on bench_shrec07 --rhm-start=fmap --stop=rhm
+ * was the best of 1, 3, 10 on bench_shrec07 --start=fmap --stop=rhm
  * over plier, glasses, airplane, hand, fish, ant (after RHM: mean flipped
  * 7.8 / 6.3 / 6.9 %, mean held-out error without the hand 0.0266 / 0.0257
  * / 0.0273; without the term 21.5 % and 0.0259) and the smallest of them

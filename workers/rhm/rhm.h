@@ -77,12 +77,12 @@ typedef enum rhm_start {
     RHM_START_VORONOI = 1,     /* the thesis' geodesic Voronoi map          */
     RHM_START_FMAP = 2         /* functional map (Δ + D_N) deblurred by DDM */
 } rhm_start;
-/* Their names are the values of rhm_start in PROTO_PARAMS (proto_params.h):
+/* Their names are the values of start in PROTO_PARAMS (proto_params.h):
  * proto_param_value_name, proto_param_parse. */
 
 /* start, alpha, gamma, dim and iterations are job parameters: their
  * defaults and ranges are PROTO_PARAMS' (protocol/proto_params.h, ENGINE
- * column RHM: rhm_start, rhm_alpha, rhm_landmark_weight, rhm_dim,
+ * column RHM: start, rhm_alpha, rhm_landmark_weight, rhm_dim,
  * rhm_iterations). */
 typedef struct rhm_params {
     int start;             /* RHM_START_*                                   */

@@ -24,8 +24,8 @@ const char *rhm_strerror(int code)
 #define RHM_ROW_ECTM(x)
 #define RHM_ROW_NONE(x)
 _Static_assert(EMBED_MAX_DIM == PROTO_RHM_MAX_DIM, "rhm_dim's max in PROTO_PARAMS is EMBED_MAX_DIM");
-_Static_assert((int)RHM_START_VORONOI == (int)PROTO_RHM_START_VORONOI &&
-                   (int)RHM_START_FMAP == (int)PROTO_RHM_START_FMAP, "rhm_start values");
+_Static_assert((int)RHM_START_VORONOI == (int)PROTO_START_VORONOI &&
+                   (int)RHM_START_FMAP == (int)PROTO_START_FMAP, "start values");
 
 void rhm_params_init(rhm_params *p)
 {
