@@ -178,6 +178,31 @@ int fmap_deformation_operator(const mesh *m, const double *V, const lbo_basis *b
 int fmap_normal_operator(const mesh *m, const lbo_basis *b, int k, double *D, char *err,
                          size_t errsz);
 
+/* ZoomOut (Melzi et al. 2019, "ZoomOut: spectral upsampling for efficient
+ * shape correspondence"): from C0 (k0 by k0), rounds of
+ *   (a) the vertex map Pi: vertex i of M1 -> the vertex j of M2 whose
+ *       first k coordinates (Psi2) are nearest to row i of Psi1 C
+ *       (fmap_vertex_map's rule, the thesis' row-wise form of the
+ *       spectral nearest neighbour), and
+ *   (b) C <- Psi1^T M1 Pi Psi2 on k + step functions each (Psi1^+ =
+ *       Psi1^T M1),
+ * until k = kmax, then (a) once more. C: kmax by kmax, the last round's
+ * functional map; map: n1 vertices of M2, the vertex map of C (the NN
+ * map; DDM deblurring of C gives a precise one). The nearest neighbours
+ * are exhaustive (exact), each row's search bounded from the start by its
+ * previous round's match (n1 n2 k work at worst per round; the spectral
+ * coordinates of 20 to 100 dimensions leave a k-d tree little to prune).
+ * m1: M1's lumped mass. stats (may be NULL): rounds of (b). FMAP_EINVAL
+ * for k0 < 1, kmax < k0, kmax above a basis, step < 1, no mass;
+ * FMAP_ENOMEM. */
+#define FMAP_ZOOMOUT_STEP 1   /* the paper's: one function per round */
+typedef struct fmap_zoomout_stats {
+    int rounds;
+} fmap_zoomout_stats;
+int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const double *C0,
+                 int k0, int kmax, int step, double *C, int *map, fmap_zoomout_stats *stats,
+                 char *err, size_t errsz);
+
 /* map: n1 vertices of M2. */
 int fmap_vertex_map(const lbo_basis *b1, const lbo_basis *b2, const double *C, int k1, int k2,
                     int *map, char *err, size_t errsz);
