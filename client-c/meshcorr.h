@@ -92,7 +92,8 @@ typedef struct mc_job_spec {
      * rhm_alpha, rhm_landmark_weight, start (MC_START_*), backend
      * (NULL or "" = the server's default; "cpu", "opencl", "auto",
      * optionally ":DEVICE", a platform or device name part), stages
-     * (MC_STAGES_*), ddm_k. */
+     * (MC_STAGES_*), ddm_k, ddm_mode (MC_DDM_PLAIN, MC_DDM_BIJECTIVE),
+     * zoomout. */
 #define MC_PARAM_CTYPE_ENUM int
 #define MC_PARAM_CTYPE_BOOL int
 #define MC_PARAM_CTYPE_U32  uint32_t
@@ -137,6 +138,8 @@ enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 
 enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM = 3,
        MC_STAGES_DDM_ECTM = 4, MC_STAGES_DDM_RHM = 5, MC_STAGES_DDM_RHM_ECTM = 6,
        MC_STAGES_RHM_ECTM = 7 };
+/* Values of ddm_mode: each given map denoised alone, or p and q together. */
+enum { MC_DDM_PLAIN = 0, MC_DDM_BIJECTIVE = 1 };
 
 /* For stages start and rhm the five terms are RHM's (PROTOCOL.md,
  * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */

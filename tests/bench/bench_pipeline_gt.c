@@ -226,7 +226,7 @@ static void run_pair(const void *arg, void *out)
     fig->nmaps = 1;
 
     watch w = { ps->label, {0} };
-    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0 };
+    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0, CORR_DDM_PLAIN };
     double t0 = now();
     if (corr_run(&in, &ep, on_progress, &w, &rr, err, sizeof err))
         goto score;
@@ -236,7 +236,7 @@ static void run_pair(const void *arg, void *out)
     printf("  %s: rhm %d iterations, %.0f s\n", ps->label, w.rhm.iteration, fig->secs[RHM]);
     fflush(stdout);
 
-    corr_input in2 = { g.S, g.T, S_name, T_name, NULL, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0 };
+    corr_input in2 = { g.S, g.T, S_name, T_name, NULL, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
     if (corr_run(&in2, &ep, on_progress, &w, &er, err, sizeof err))
         goto score;
     fig->secs[ECTM] = er.last.elapsed;

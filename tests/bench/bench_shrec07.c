@@ -200,7 +200,7 @@ static void run_pair(const void *arg, void *out)
         goto score;
 
     /* the pipeline's calls one by one (corr_run): RHM, the fold repair, ECTM */
-    corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0 };
+    corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
     t0 = now();
     if (rhm_run(S, T, L, &rp, NULL, NULL, &rr, err, sizeof err))
         goto score;
@@ -223,7 +223,7 @@ static void run_pair(const void *arg, void *out)
            rep[0].bad_before, rep[0].bad_after, rep[0].region, rep[1].bad_before, rep[1].bad_after);
     maps[fig->nmaps++] = rr.P12;
 
-    corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0 };
+    corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
     t0 = now();
     if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
         goto score;

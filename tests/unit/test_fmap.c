@@ -204,7 +204,8 @@ TEST_T(zoomout_recovers_the_identity_from_a_perturbed_small_map, 30)
         for (int c = 0; c < 40; c++)
             dev = fmax(dev, fabs(C[a * 40 + c] - (a == c)));
     printf("  perturbed 10 x 10: %d of %d vertices elsewhere; after ZoomOut to 40 (%d rounds): "
-           "%d, max |C - I| %.2g\n", wrong0, m->nv, st.rounds, wrong, dev);
+           "%d, max |C - I| %.2g; searches %.3f s, %.1f %% of brute force's coordinates\n",
+           wrong0, m->nv, st.rounds, wrong, dev, st.nn_seconds, 100 * st.nn_work);
     CHECK(wrong0 > m->nv / 10);
     CHECK_INT(wrong, 0);
     CHECK_INT(st.rounds, 30);

@@ -165,6 +165,9 @@ TEST(engine_checks_agree_with_the_validator_at_every_range_end)
                 got = corr_stages_run((corr_stages)v, 1) == 0 || v != floor(v);
             else if (i == PROTO_P_ddm_k)
                 got = v < 0 || v > LBO_MAX_K;
+            else if (i == PROTO_P_ddm_mode)
+                got = v != floor(v) || corr_stages_check(CORR_STAGES_DDM, 1, 1, 0, 0, 0,
+                                                         (corr_ddm_mode)v, err, sizeof err) != 0;
             if (got != want)
                 FAILF("%s = %g: validator %s, engine %s", f->name, v, want ? "refuses" : "accepts",
                       got ? "refuses" : "accepts");

@@ -192,12 +192,16 @@ int fmap_normal_operator(const mesh *m, const lbo_basis *b, int k, double *D, ch
  * are exhaustive (exact), each row's search bounded from the start by its
  * previous round's match (n1 n2 k work at worst per round; the spectral
  * coordinates of 20 to 100 dimensions leave a k-d tree little to prune).
- * m1: M1's lumped mass. stats (may be NULL): rounds of (b). FMAP_EINVAL
+ * m1: M1's lumped mass. stats (may be NULL): rounds of (b), seconds in
+ * the searches (a), and the coordinates they compared as a fraction of
+ * brute force's n1 n2 k per search. FMAP_EINVAL
  * for k0 < 1, kmax < k0, kmax above a basis, step < 1, no mass;
  * FMAP_ENOMEM. */
 #define FMAP_ZOOMOUT_STEP 1   /* the paper's: one function per round */
 typedef struct fmap_zoomout_stats {
-    int rounds;
+    int rounds;          /* functional maps recomputed (one per size step) */
+    double nn_seconds;   /* wall seconds in the nearest-neighbour searches */
+    double nn_work;      /* coordinates compared / (n1 n2 k) summed over searches */
 } fmap_zoomout_stats;
 int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const double *C0,
                  int k0, int kmax, int step, double *C, int *map, fmap_zoomout_stats *stats,

@@ -8,15 +8,17 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* map[i] = the vertex j of M2 whose first k coordinates (Psi2) are nearest
  * to row i of Psi1 C (C: k by k). Exhaustive and exact (on a tie the
  * first found); the previous map[i] (when in range) gives the first bound,
  * so most candidates stop after a few coordinates. */
 static void nearest_vertices(const lbo_basis *b1, const double *E, int n2, const double *C, int k,
-                             int *map, int *fail)
+                             int *map, int *fail, long long *coords)
 {
-#pragma omp parallel
+    long long visited = 0;
+#pragma omp parallel reduction(+ : visited)
     {
         double *q = malloc((size_t)k * sizeof *q);
         if (!q) {
@@ -40,8 +42,10 @@ static void nearest_vertices(const lbo_basis *b1, const double *E, int n2, const
             for (int j = 0; j < n2; j++) {
                 const double *e = E + (size_t)j * k;
                 double d = 0;
-                for (int c = 0; c < k && d < best; c++)
+                int c = 0;
+                for (; c < k && d < best; c++)
                     d += (q[c] - e[c]) * (q[c] - e[c]);
+                visited += c;
                 if (d < best) {
                     best = d;
                     arg = j;
@@ -51,6 +55,14 @@ static void nearest_vertices(const lbo_basis *b1, const double *E, int n2, const
         }
         free(q);
     }
+    *coords += visited;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const double *C0,
@@ -63,6 +75,8 @@ int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, con
                           "bases' %d, %d; step >= 1)%s", k0, kmax, step, b1->k, b2->k,
                           m1 ? "" : "; no source mass");
     int n1 = b1->nv, n2 = b2->nv, fail = 0, rounds = 0;
+    long long coords = 0, full = 0;
+    double t_nn = 0;
     double *E = malloc((size_t)n2 * kmax * sizeof *E), *Ck = malloc((size_t)kmax * kmax * sizeof *Ck);
     if (!E || !Ck) {
         free(E);
@@ -77,7 +91,10 @@ int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, con
     for (;;) {
         for (int j = 0; j < n2; j++)   /* Psi2's first k columns, packed */
             memcpy(E + (size_t)j * k, b2->phi + (size_t)j * b2->k, (size_t)k * sizeof *E);
-        nearest_vertices(b1, E, n2, Ck, k, map, &fail);
+        double t0 = now();
+        nearest_vertices(b1, E, n2, Ck, k, map, &fail, &coords);
+        t_nn += now() - t0;
+        full += (long long)n1 * n2 * k;
         if (fail)
             break;
         if (k == kmax)
@@ -97,8 +114,11 @@ int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, con
     }
     if (!fail)
         memcpy(C, Ck, (size_t)kmax * kmax * sizeof *C);
-    if (stats)
+    if (stats) {
         stats->rounds = rounds;
+        stats->nn_seconds = t_nn;
+        stats->nn_work = full ? (double)coords / (double)full : 0;
+    }
     free(E);
     free(Ck);
     return fail ? errbuf_set(err, errsz, FMAP_ENOMEM, "ZoomOut: out of memory for a row's work")
