@@ -89,10 +89,11 @@ typedef struct mc_job_spec {
      * params` prints it), in its order: model (MC_BIJECTIVE, MC_INJECTIVE),
      * partial, alpha, eta, beta0, beta1, beta_ramp, gamma, iterations,
      * inner_iterations, tolerance, stop_change, rhm_iterations, rhm_dim,
-     * rhm_alpha, rhm_landmark_weight, rhm_start (MC_RHM_START_*), backend
+     * rhm_alpha, rhm_landmark_weight, start (MC_START_*), backend
      * (NULL or "" = the server's default; "cpu", "opencl", "auto",
      * optionally ":DEVICE", a platform or device name part), stages
-     * (MC_STAGES_*), ddm_k. */
+     * (MC_STAGES_*), ddm_k, ddm_mode (MC_DDM_PLAIN, MC_DDM_BIJECTIVE),
+     * zoomout. */
 #define MC_PARAM_CTYPE_ENUM int
 #define MC_PARAM_CTYPE_BOOL int
 #define MC_PARAM_CTYPE_U32  uint32_t
@@ -131,12 +132,14 @@ size_t mc_job_spec_size(void);
  * that does not parse: MC_EARG, detail in err. */
 int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
 
-enum { MC_RHM_START_DISTANCES = 0, MC_RHM_START_VORONOI = 1, MC_RHM_START_FMAP = 2 };
+enum { MC_START_DISTANCES = 0, MC_START_VORONOI = 1, MC_START_FMAP = 2 };
 enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3, MC_STAGE_DDM = 4 };
 /* Values of the stages parameter (PROTO_PARAMS; `meshcorr submit --stages`). */
 enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM = 3,
        MC_STAGES_DDM_ECTM = 4, MC_STAGES_DDM_RHM = 5, MC_STAGES_DDM_RHM_ECTM = 6,
        MC_STAGES_RHM_ECTM = 7 };
+/* Values of ddm_mode: each given map denoised alone, or p and q together. */
+enum { MC_DDM_PLAIN = 0, MC_DDM_BIJECTIVE = 1 };
 
 /* For stages start and rhm the five terms are RHM's (PROTOCOL.md,
  * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */

@@ -27,7 +27,7 @@
 
 /* ---- framing ------------------------------------------------------------ */
 #define PROTO_MAGIC      0x5052434Du  /* bytes "MCRP" on the wire */
-#define PROTO_VERSION    2
+#define PROTO_VERSION    3
 #define PROTO_HDR_SIZE   20
 
 /* ---- limits (PROTOCOL.md repeats each one) ------------------------------ */
@@ -122,16 +122,18 @@ enum proto_slot_state {
     PROTO_SLOT_LAST = 3
 };
 
-/* values of the ENUM parameters model, rhm_start and stages (their names: proto_params.h) */
+/* values of the ENUM parameters model, start, stages and ddm_mode (their names: proto_params.h) */
 enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1 };
 /* RHM's start map from the landmarks (workers/rhm/rhm.h) */
-enum proto_rhm_start { PROTO_RHM_START_DISTANCES = 0, PROTO_RHM_START_VORONOI = 1, PROTO_RHM_START_FMAP = 2 };
+enum proto_start { PROTO_START_DISTANCES = 0, PROTO_START_VORONOI = 1, PROTO_START_FMAP = 2 };
 /* the stages a job runs (workers/corr/corr.h) */
 enum proto_stages {
     PROTO_STAGES_ALL = 0, PROTO_STAGES_RHM = 1, PROTO_STAGES_ECTM = 2, PROTO_STAGES_DDM = 3,
     PROTO_STAGES_DDM_ECTM = 4, PROTO_STAGES_DDM_RHM = 5, PROTO_STAGES_DDM_RHM_ECTM = 6,
     PROTO_STAGES_RHM_ECTM = 7
 };
+/* DDM denoising of the given maps (workers/ddm/ddm.h) */
+enum proto_ddm_mode { PROTO_DDM_PLAIN = 0, PROTO_DDM_BIJECTIVE = 1 };
 
 /* Energy terms reported per direction in PROGRESS (index into terms[d][]). */
 enum proto_term {

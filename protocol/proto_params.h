@@ -38,6 +38,7 @@
 #define PROTO_MAX_DEVICE    127      /* bytes of ":DEVICE" in backend, the colon excluded */
 #define PROTO_RHM_MAX_DIM   64       /* rhm_dim's max: the embedding's (EMBED_MAX_DIM) */
 #define PROTO_DDM_MAX_K     300      /* ddm_k's max: the eigenpairs' (LBO_MAX_K) */
+#define PROTO_ZOOMOUT_MAX   300      /* zoomout's max: the eigenpairs' (LBO_MAX_K) */
 
 #define PROTO_PARAM_OPEN_MIN     1u
 #define PROTO_PARAM_OPEN_MAX     2u
@@ -77,9 +78,9 @@
       "RHM harmonic vs reversibility weight")                                                    \
     X(rhm_landmark_weight, "rhm-landmark-weight", F64, 0, 0, INFINITY, 0, RHM, gamma, "",        \
       "RHM weak landmark term weight (0: off)")                                                  \
-    X(rhm_start, "rhm-start", ENUM, 0, 0, 2, 0, RHM, start, "distances|voronoi|fmap",            \
-      "RHM start map: distances to the landmarks, the thesis' geodesic Voronoi cells, or a "     \
-      "functional map from landmark descriptors made precise by DDM")                            \
+    X(start, "start", ENUM, 0, 0, 2, 0, RHM, start, "distances|voronoi|fmap",                    \
+      "start map from landmarks (before RHM): distances to the landmarks, the thesis' geodesic " \
+      "Voronoi cells, or a functional map from landmark descriptors made precise by DDM")        \
     X(backend, "backend", STR, 0, 0, 0, 0, NONE, backend, "cpu|opencl|auto",                     \
       "elastic energy on the CPU, an OpenCL device, or auto (a GPU, else the CPU); "             \
       "\"\" = the server's default (cpu); on the wire optionally :DEVICE")                     \
@@ -89,6 +90,12 @@
       "ECTM alone on a given map; ddm (denoising through the map's functional map) needs a "     \
       "given map; rhm starts from landmarks or from the given (or denoised) map")                \
     X(ddm_k, "ddm-k", U32, 0, 0, PROTO_DDM_MAX_K, 0, NONE, ddm_k, "",                            \
-      "DDM basis size: eigenfunctions per mesh (0: min(100, vertices - 2); at most vertices - 2)")
+      "DDM basis size: eigenfunctions per mesh (0: min(100, vertices - 2); at most vertices - 2)") \
+    X(ddm_mode, "ddm-mode", ENUM, 0, 0, 1, 0, NONE, ddm_mode, "plain|bijective",                 \
+      "DDM denoising: plain (each given map alone) or bijective (the map p and its reverse q "   \
+      "denoised together, each made consistent with the other's functional map; needs q)")   \
+    X(zoomout, "zoomout", U32, 0, 0, PROTO_ZOOMOUT_MAX, 0, RHM, zoomout, "",                      \
+      "start fmap: ZoomOut from the start's 50 basis functions to this many per mesh before "    \
+      "DDM deblurring (0: off; else more than 50 and at most vertices - 2)")
 
 #endif

@@ -14,7 +14,7 @@ void cli_job_usage(FILE *fp)
         "  inputs:  --landmarks PAIRS | --source-landmarks A --target-landmarks B [--one-based]\n"
         "           | --init P.map [--init-reverse Q.map] [--init-base 0|1|auto] [landmarks]\n"
         "           (landmarks: at least %d pairs; without --init the initial maps come from\n"
-        "           them: a start map (--rhm-start), then Reversible Harmonic Maps)\n"
+        "           them: a start map (--start), then Reversible Harmonic Maps)\n"
         "           --init files: meshcorr-map 1, or a vertex map (one target vertex per\n"
         "           source vertex a line, as BCICP and BIM write them); its base: --init-base,\n"
         "           else auto: a 0 among the indices -> 0-based, else the target's vertex\n"

@@ -241,7 +241,8 @@ int cli_match(int argc, char **argv)
     const char *src = argv[optind], *tgt = argv[optind + 1];
     if (!(S = load(src)) || !(T = load(tgt)) || cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
-    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k };
+    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k,
+                      (corr_ddm_mode)job.w.ddm_mode };
     if (corr_run(&in, &pe, on_progress, &ps, &res, err, sizeof err)) {
         fprintf(stderr, "\nmeshcorr match: %s\n", err);
         goto done;

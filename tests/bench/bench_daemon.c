@@ -231,7 +231,7 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
     p.iterations = 3;
     p.threads = 1;
     ectm_result want = {0};
-    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_STAGES_ALL, 0 };
+    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
     double t0 = now();
     if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
         FAILF("corr_run: %s", err);

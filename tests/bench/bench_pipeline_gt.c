@@ -6,7 +6,7 @@
  * scale-invariant), and the cartoon pairs homerA->homerB and headA->headB.
  *
  * Stages: the start map RHM begins with (rhm.h: by default from the
- * geodesic distances to the landmarks; --rhm-start=voronoi for the thesis'
+ * geodesic distances to the landmarks; --start=voronoi for the thesis'
  * Voronoi cells), RHM with rhm_params_init's values, then ECTM with
  * ectm_params_init's values from RHM's two maps: meshcorr match's
  * defaults. RHM and ECTM run through corr_run (stages rhm, then stages ectm
@@ -31,7 +31,7 @@
  * them). ECTM lowers mean |log a| on every pair and leaves almost no
  * collapsed triangle, raises the flipped ones on every pair, and lowers
  * the median conformal distortion only on FAUST 000->001. With
- * --rhm-start=voronoi RHM's FAUST errors were 0.0377 / 0.0605 / 0.0320 /
+ * --start=voronoi RHM's FAUST errors were 0.0377 / 0.0605 / 0.0320 /
  * 0.0353, cat 0.0419, Homer 0.0609, head 0.0166.
  * Scale: with --scale=0.01, 4, 100 or 1.0000001 the start and RHM rows
  * are the same to 4 decimals; --scale=4 (exact in floating point) repeats
@@ -45,7 +45,7 @@
  *   --pairs=A,B,...       only these pairs (labels as in the table)
  *   --scale=S             multiply both meshes' coordinates by S first
  *                         (a check of scale invariance)
- *   --rhm-start=NAME      distances (the default), voronoi or fmap
+ *   --start=NAME          distances (the default), voronoi or fmap
  * Each pair runs in its own process (support/testapart.h): a crash or an
  * error becomes that pair's row, and the other pairs still run. The rhm
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
@@ -87,7 +87,7 @@ static const pair_spec pairs[] = {
 
 enum { VORONOI, RHM, ECTM, NSTAGES };
 static const char *const stage_name[NSTAGES] = { "start", "rhm", "rhm+ectm" };
-static int start_kind = RHM_START_DISTANCES;   /* --rhm-start */
+static int start_kind = RHM_START_DISTANCES;   /* --start */
 
 /* One pair's figures: plain data, sent from the pair's process through a pipe. */
 typedef struct pair_fig {
@@ -226,7 +226,7 @@ static void run_pair(const void *arg, void *out)
     fig->nmaps = 1;
 
     watch w = { ps->label, {0} };
-    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0 };
+    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0, CORR_DDM_PLAIN };
     double t0 = now();
     if (corr_run(&in, &ep, on_progress, &w, &rr, err, sizeof err))
         goto score;
@@ -236,7 +236,7 @@ static void run_pair(const void *arg, void *out)
     printf("  %s: rhm %d iterations, %.0f s\n", ps->label, w.rhm.iteration, fig->secs[RHM]);
     fflush(stdout);
 
-    corr_input in2 = { g.S, g.T, S_name, T_name, NULL, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0 };
+    corr_input in2 = { g.S, g.T, S_name, T_name, NULL, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
     if (corr_run(&in2, &ep, on_progress, &w, &er, err, sizeof err))
         goto score;
     fig->secs[ECTM] = er.last.elapsed;
@@ -315,13 +315,13 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     if (!harness_data_dir())
         SKIP("../shared/data is absent");
     const char *o_it = harness_option("ectm-iterations"), *o_pairs = harness_option("pairs");
-    const char *o_scale = harness_option("scale"), *o_start = harness_option("rhm-start");
+    const char *o_scale = harness_option("scale"), *o_start = harness_option("start");
     proto_params w;                      /* the start's names are the list's */
     char perr[256], start_name[32];
     proto_params_init(&w);
-    if (o_start && proto_param_parse(&w, PROTO_P_rhm_start, o_start, perr, sizeof perr))
-        FAILF("--rhm-start: %s", perr);
-    start_kind = w.rhm_start;
+    if (o_start && proto_param_parse(&w, PROTO_P_start, o_start, perr, sizeof perr))
+        FAILF("--start: %s", perr);
+    start_kind = w.start;
     int iters = o_it ? atoi(o_it) : 0;
     double scale = o_scale ? atof(o_scale) : 1;
     if ((o_it && iters < 1) || !(scale > 0))
@@ -329,7 +329,7 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     ectm_params ep;
     ectm_params_init(&ep);
     printf("start (%s) -> RHM -> ECTM from %d farthest-point landmarks; RHM defaults; ECTM defaults "
-           "with %d outer iterations%s; scale x%g; %s\n", proto_param_value_name(PROTO_P_rhm_start, (unsigned)start_kind, start_name, sizeof start_name), NL,
+           "with %d outer iterations%s; scale x%g; %s\n", proto_param_value_name(PROTO_P_start, (unsigned)start_kind, start_name, sizeof start_name), NL,
            iters ? iters : ep.iterations,
            iters && iters != ep.iterations ? " (not the default)" : " (the default)", scale,
            harness_data_dir() ? harness_data_dir() : "no data folder");

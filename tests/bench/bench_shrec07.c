@@ -28,8 +28,8 @@
  * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm|repair
  * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for
  * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
- * the default, for comparing), --rhm-start=NAME (a start map of
- * proto_params.h's rhm_start list instead of the default). Each pair runs in
+ * the default, for comparing), --start=NAME (a start map of
+ * proto_params.h's start list instead of the default). Each pair runs in
  * its own process (support/testapart.h). Prints figures, never fails on
  * quality. */
 #include "support/harness.h"
@@ -72,7 +72,7 @@ typedef struct pair_job {
     int last;               /* the last stage to run (--stop) */
     const char *out_dir;    /* --out-dir: each stage's map is written there */
     double eta;             /* --eta: ECTM's bending weight, 0: the default */
-    int start;              /* --rhm-start: RHM_START_*, -1: the default */
+    int start;              /* --start: RHM_START_*, -1: the default */
 } pair_job;
 
 static double now(void)
@@ -200,7 +200,7 @@ static void run_pair(const void *arg, void *out)
         goto score;
 
     /* the pipeline's calls one by one (corr_run): RHM, the fold repair, ECTM */
-    corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0 };
+    corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
     t0 = now();
     if (rhm_run(S, T, L, &rp, NULL, NULL, &rr, err, sizeof err))
         goto score;
@@ -225,7 +225,7 @@ static void run_pair(const void *arg, void *out)
     if (job->last == REPAIR)
         goto score;
 
-    corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0 };
+    corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
     t0 = now();
     if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
         goto score;
@@ -358,13 +358,13 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     const char *o_it = harness_option("ectm-iterations"), *o_pairs = harness_option("pairs");
     const char *o_stop = harness_option("stop"), *o_out = harness_option("out-dir");
     double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
-    const char *o_start = harness_option("rhm-start");
+    const char *o_start = harness_option("start");
     proto_params w;                      /* the start's names are the list's */
     char perr[256];
     proto_params_init(&w);
-    if (o_start && proto_param_parse(&w, PROTO_P_rhm_start, o_start, perr, sizeof perr))
-        FAILF("--rhm-start: %s", perr);
-    int start = o_start ? (int)w.rhm_start : -1;
+    if (o_start && proto_param_parse(&w, PROTO_P_start, o_start, perr, sizeof perr))
+        FAILF("--start: %s", perr);
+    int start = o_start ? (int)w.start : -1;
     int iters = o_it ? atoi(o_it) : 0, last = ECTM;
     if (o_stop)
         last = !strcmp(o_stop, "start") ? START : !strcmp(o_stop, "rhm") ? RHM

@@ -135,10 +135,22 @@ TEST(match_refuses_bad_option_value)
              s381, s390, p0);
     CHECK_INT(run(cmd, out, sizeof out), 2);
     CHECK_STR_HAS(out, "gamma");
-    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --rhm-start cells",
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --start cells",
              s381, s390, p0);
     CHECK_INT(run(cmd, out, sizeof out), 2);
-    CHECK_STR_HAS(out, "--rhm-start: 'cells' is not distances, voronoi or fmap");
+    CHECK_STR_HAS(out, "--start: 'cells' is not distances, voronoi or fmap");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --stages ddm "
+             "--ddm-mode bijective", s381, s390, p0);
+    CHECK(run(cmd, out, sizeof out) != 0);
+    CHECK_STR_HAS(out, "bijective DDM (ddm_mode bijective) denoises a map and its reverse");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --ddm-mode both",
+             s381, s390, p0);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "--ddm-mode: 'both' is not plain or bijective");
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out x.map --zoomout 301",
+             s381, s390, p0);
+    CHECK_INT(run(cmd, out, sizeof out), 2);
+    CHECK_STR_HAS(out, "zoomout");
 }
 
 TEST_T(match_short_run_writes_maps_meshes_and_json_progress, 300)

@@ -57,23 +57,29 @@ TEST(chains_the_inputs_cannot_run_are_refused)
     /* all: RHM then ECTM from landmarks, ECTM alone on a map */
     CHECK(corr_stages_run(CORR_STAGES_ALL, 0) == (CORR_RUN_RHM | CORR_RUN_ECTM));
     CHECK(corr_stages_run(CORR_STAGES_ALL, 1) == CORR_RUN_ECTM);
-    CHECK_INT(corr_stages_check(CORR_STAGES_ALL, 0, 0, 6, 0, 0, err, sizeof err), 0);
-    CHECK_INT(corr_stages_check(CORR_STAGES_DDM_RHM_ECTM, 1, 1, 0, 0, 0, err, sizeof err), 0);
-    CHECK_INT(corr_stages_check(CORR_STAGES_RHM, 1, 0, 0, 0, 0, err, sizeof err), 0);
-    static const struct { int s, map, rev, nl, inj; double gamma; const char *msg; } bad[] = {
-        {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, "the DDM stage denoises a given map"},
-        {CORR_STAGES_DDM, 0, 0, 6, 0, 0, "the DDM stage denoises a given map"},
-        {CORR_STAGES_ECTM, 0, 0, 6, 0, 0, "the ECTM stage alone needs an initial map"},
-        {CORR_STAGES_ALL, 0, 0, 0, 0, 0, "neither an initial map nor landmarks"},
-        {CORR_STAGES_RHM_ECTM, 0, 0, 2, 0, 0, "at least 3 landmark pairs, got 2"},
-        {CORR_STAGES_DDM_RHM, 1, 0, 0, 0, 0.5, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks"},
-        {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, "reverse map needs the bijective model"},
-        {CORR_STAGES_RHM, 0, 1, 6, 0, 0, "reverse map needs an initial map"},
-        {8, 1, 0, 0, 0, 0, "stages value 8"}};
+    CHECK_INT(corr_stages_check(CORR_STAGES_ALL, 0, 0, 6, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_stages_check(CORR_STAGES_DDM_RHM_ECTM, 1, 1, 0, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_stages_check(CORR_STAGES_RHM, 1, 0, 0, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_stages_check(CORR_STAGES_DDM, 1, 1, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err), 0);
+    CHECK_INT(corr_stages_check(CORR_STAGES_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err),
+              0);                                  /* no DDM stage: the mode is not used */
+    static const struct { int s, map, rev, nl, inj; double gamma; int mode; const char *msg; } bad[] = {
+        {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map"},
+        {CORR_STAGES_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map"},
+        {CORR_STAGES_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map"},
+        {CORR_STAGES_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks"},
+        {CORR_STAGES_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2"},
+        {CORR_STAGES_DDM_RHM, 1, 0, 0, 0, 0.5, 0, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks"},
+        {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model"},
+        {CORR_STAGES_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map"},
+        {CORR_STAGES_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too"},
+        {CORR_STAGES_DDM, 1, 1, 0, 0, 0, 2, "ddm_mode value 2"},
+        {8, 1, 0, 0, 0, 0, 0, "stages value 8"}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         err[0] = '\0';
         CHECK_INT(corr_stages_check((corr_stages)bad[k].s, bad[k].map, bad[k].rev, bad[k].nl,
-                                    bad[k].inj, bad[k].gamma, err, sizeof err), CORR_EINPUT);
+                                    bad[k].inj, bad[k].gamma, (corr_ddm_mode)bad[k].mode, err,
+                                    sizeof err), CORR_EINPUT);
         CHECK_STR_HAS(err, bad[k].msg);
     }
 }
@@ -129,7 +135,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     int k = CORR_DDM_K;             /* ddm_k 0: the default */
 
     /* ddm alone: the map ddm_denoise makes from the same bases */
-    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_STAGES_DDM, 0};
+    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_STAGES_DDM, 0, CORR_DDM_PLAIN};
     ectm_result r = {0};
     stage_log l = {0};
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))

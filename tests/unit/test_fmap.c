@@ -167,6 +167,64 @@ TEST_T(self_map_is_identity, 30)
     mesh_free(m);
 }
 
+/* ZoomOut on a mesh onto itself (the asymmetric ellipsoid above, 642
+ * vertices): from the identity's 10 by 10 block perturbed by noise of 0.15
+ * per entry, whose vertex map sends many vertices elsewhere, ZoomOut to 40
+ * functions recovers the identity on every vertex; refusals. */
+TEST_T(zoomout_recovers_the_identity_from_a_perturbed_small_map, 30)
+{
+    mesh *m = testmesh_icosphere(3);
+    for (int i = 0; i < m->nv; i++) {
+        m->v[3 * i] *= 1.3;
+        m->v[3 * i + 1] *= 1.1;
+        m->v[3 * i + 2] *= 0.8 + 0.1 * m->v[3 * i + 2];
+    }
+    shape A;
+    shape_open(&A, m, 40);
+    const double *ma = geod_solver_mass(A.s);
+    double C0[10 * 10], C[40 * 40];
+    unsigned seed = 7;
+    for (int a = 0; a < 10; a++)
+        for (int c = 0; c < 10; c++) {
+            seed = seed * 1103515245u + 12345u;
+            C0[a * 10 + c] = (a == c) + 0.15 * (2.0 * ((seed >> 8) & 0xffff) / 65535.0 - 1);
+        }
+    int map0[642], map[642], wrong0 = 0, wrong = 0;
+    char err[256] = "";
+    fmap_zoomout_stats st;
+    CHECK_INT(fmap_vertex_map(&A.b, &A.b, C0, 10, 10, map0, err, sizeof err), FMAP_OK);
+    CHECK_INT(fmap_zoomout(&A.b, ma, &A.b, C0, 10, 40, FMAP_ZOOMOUT_STEP, C, map, &st, err,
+                           sizeof err), FMAP_OK);
+    for (int i = 0; i < m->nv; i++) {
+        wrong0 += map0[i] != i;
+        wrong += map[i] != i;
+    }
+    double dev = 0;
+    for (int a = 0; a < 40; a++)
+        for (int c = 0; c < 40; c++)
+            dev = fmax(dev, fabs(C[a * 40 + c] - (a == c)));
+    printf("  perturbed 10 x 10: %d of %d vertices elsewhere; after ZoomOut to 40 (%d rounds): "
+           "%d, max |C - I| %.2g; searches %.3f s, %.1f %% of brute force's coordinates\n",
+           wrong0, m->nv, st.rounds, wrong, dev, st.nn_seconds, 100 * st.nn_work);
+    CHECK(wrong0 > m->nv / 10);
+    CHECK_INT(wrong, 0);
+    CHECK_INT(st.rounds, 30);
+    CHECK(dev < 1e-8);
+    CHECK_INT(fmap_zoomout(&A.b, ma, &A.b, C0, 10, 41, 1, C, map, NULL, err, sizeof err),
+              FMAP_EINVAL);
+    CHECK_STR_HAS(err, "sizes 10 -> 41");
+    CHECK_INT(fmap_zoomout(&A.b, ma, &A.b, C0, 10, 9, 1, C, map, NULL, err, sizeof err),
+              FMAP_EINVAL);
+    CHECK_INT(fmap_zoomout(&A.b, ma, &A.b, C0, 10, 40, 0, C, map, NULL, err, sizeof err),
+              FMAP_EINVAL);
+    CHECK_STR_HAS(err, "in steps of 0");
+    CHECK_INT(fmap_zoomout(&A.b, NULL, &A.b, C0, 10, 40, 1, C, map, NULL, err, sizeof err),
+              FMAP_EINVAL);
+    CHECK_STR_HAS(err, "no source mass");
+    shape_close(&A);
+    mesh_free(m);
+}
+
 /* With mu_n = 0 the D_N solver returns the row-wise solution bit for bit;
  * with mu_n > 0 its solution minimises the objective: no random
  * perturbation lowers ||C A2 - A1||^2 + mu sum D_ab C_ab^2 / ||D||_F +

@@ -165,6 +165,9 @@ TEST(engine_checks_agree_with_the_validator_at_every_range_end)
                 got = corr_stages_run((corr_stages)v, 1) == 0 || v != floor(v);
             else if (i == PROTO_P_ddm_k)
                 got = v < 0 || v > LBO_MAX_K;
+            else if (i == PROTO_P_ddm_mode)
+                got = v != floor(v) || corr_stages_check(CORR_STAGES_DDM, 1, 1, 0, 0, 0,
+                                                         (corr_ddm_mode)v, err, sizeof err) != 0;
             if (got != want)
                 FAILF("%s = %g: validator %s, engine %s", f->name, v, want ? "refuses" : "accepts",
                       got ? "refuses" : "accepts");
@@ -179,8 +182,8 @@ TEST(values_parse_from_text_by_type)
     proto_params_init(&w);
     CHECK_INT(proto_param_parse(&w, PROTO_P_model, "injective", err, sizeof err), 0);
     CHECK_INT(w.model, PROTO_MODEL_INJECTIVE);
-    CHECK_INT(proto_param_parse(&w, PROTO_P_rhm_start, "voronoi", err, sizeof err), 0);
-    CHECK_INT(w.rhm_start, PROTO_RHM_START_VORONOI);
+    CHECK_INT(proto_param_parse(&w, PROTO_P_start, "voronoi", err, sizeof err), 0);
+    CHECK_INT(w.start, PROTO_START_VORONOI);
     CHECK_INT(proto_param_parse(&w, PROTO_P_inner_iterations, "77", err, sizeof err), 0);
     CHECK_INT(w.inner_iterations, 77);
     CHECK_INT(proto_param_parse(&w, PROTO_P_alpha, "2.5e1", err, sizeof err), 0);
@@ -188,11 +191,11 @@ TEST(values_parse_from_text_by_type)
     CHECK_INT(proto_param_parse(&w, PROTO_P_alpha, "abc", err, sizeof err), PROTO_EBAD_PARAMS);
     CHECK_STR(err, "'abc' is not a number");
     CHECK_INT(proto_param_parse(&w, PROTO_P_iterations, "1.5", err, sizeof err), PROTO_EBAD_PARAMS);
-    CHECK_INT(proto_param_parse(&w, PROTO_P_rhm_start, "cells", err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_INT(proto_param_parse(&w, PROTO_P_start, "cells", err, sizeof err), PROTO_EBAD_PARAMS);
     CHECK_STR(err, "'cells' is not distances, voronoi or fmap");
     char line[1024];
     proto_params_format(&w, line, sizeof line);
     CHECK_STR_HAS(line, "model=injective partial=0 alpha=25 ");
     CHECK_STR_HAS(line, " inner_iterations=77 ");
-    CHECK_STR_HAS(line, " rhm_start=voronoi backend=");
+    CHECK_STR_HAS(line, " start=voronoi backend=");
 }

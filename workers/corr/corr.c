@@ -145,7 +145,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         rhm_params_init(&rp);
     int bij = p->model == ECTM_BIJECTIVE;
     if ((rc = corr_stages_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
-                                rp.gamma, err, errsz)))
+                                rp.gamma, in->ddm_mode, err, errsz)))
         return rc;
     unsigned run = corr_stages_run(in->stages, !!in->P0);
     if ((run & CORR_RUN_RHM) && rhm_params_check(&rp, err, errsz))

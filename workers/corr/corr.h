@@ -69,13 +69,20 @@ typedef enum corr_stages {
 /* The CORR_RUN_* bits of s for a job with (have_map) or without an
  * uploaded map; 0 for a value outside the list. */
 unsigned corr_stages_run(corr_stages s, int have_map);
+/* How the DDM stage denoises (job parameter ddm_mode): each given map on
+ * its own (ddm_denoise), or P and its reverse Q together, made consistent
+ * (ddm_denoise_bijective, DDM_BIJ_ALPHA_DEFAULT, DDM_BIJ_ITERATIONS_DEFAULT). */
+typedef enum corr_ddm_mode { CORR_DDM_PLAIN = 0, CORR_DDM_BIJECTIVE = 1 } corr_ddm_mode;
+
 /* Whether the chain can run on these inputs: 0, or CORR_EINPUT with the
  * reason in err (ddm without a map, RHM from landmarks with fewer than
  * PROTO_MIN_LANDMARKS, ECTM or RHM with neither, a reverse map with the
- * injective model, a weak landmark term without landmarks). The worker's
+ * injective model, a weak landmark term without landmarks, bijective DDM
+ * without a reverse map or a ddm_mode outside the list). The worker's
  * SUBMIT check and corr_run use it. */
 int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
-                      int injective, double rhm_landmark_weight, char *err, size_t errsz);
+                      int injective, double rhm_landmark_weight, corr_ddm_mode ddm_mode,
+                      char *err, size_t errsz);
 /* A --stages text as the CLI reads it: a value of the list (*out), or -1
  * with why not in err: an unknown stage, a stage named twice, or a chain
  * out of the order ddm, rhm, ectm ("ectm before ddm: ..."). */
@@ -105,6 +112,7 @@ typedef struct corr_input {
     const rhm_params *rhm;    /* RHM parameters, NULL: rhm_params_init's     */
     corr_stages stages;
     int ddm_k;                /* DDM basis size; 0: min(CORR_DDM_K, nv - 2)  */
+    corr_ddm_mode ddm_mode;   /* plain, or bijective (needs Q0)              */
 } corr_input;
 
 typedef struct corr_progress {

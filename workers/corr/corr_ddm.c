@@ -59,6 +59,33 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
     if ((rc = basis_open(&bs[0], S, in->S_name, k, err, errsz)) ||
         (rc = basis_open(&bs[1], T, in->T_name, k, err, errsz)))
         goto out;
+    if (in->ddm_mode == CORR_DDM_BIJECTIVE) {   /* P and Q together: one report at the end */
+        char detail[512] = "";
+        double energy[DDM_BIJ_ITERATIONS_DEFAULT + 1];
+        if (!Q0) {
+            rc = errbuf_set(err, errsz, CORR_EINPUT,
+                            "bijective DDM (ddm_mode bijective) needs an initial reverse map");
+            goto out;
+        }
+        if (!(*P = bmap_new(P0->n, P0->nt)) || !(*Q = bmap_new(Q0->n, Q0->nt))) {
+            rc = errbuf_set(err, errsz, CORR_ENOMEM, "DDM: out of memory");
+            goto out;
+        }
+        int drc = ddm_denoise_bijective(&bs[0].b, geod_solver_mass(bs[0].s), S, &bs[1].b,
+                                        geod_solver_mass(bs[1].s), T, P0, Q0, k,
+                                        DDM_BIJ_ALPHA_DEFAULT, DDM_BIJ_ITERATIONS_DEFAULT, *P, *Q,
+                                        energy, detail, sizeof detail);
+        if (drc) {
+            rc = errbuf_set(err, errsz, drc == DDM_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+                            "bijective DDM denoising of the initial maps: %s", detail);
+            goto out;
+        }
+        r.done = 2;
+        r.cost[0] = r.cost[1] = energy[DDM_BIJ_ITERATIONS_DEFAULT] / 2;
+        rc = report && report(ctx, &r)
+                 ? errbuf_set(err, errsz, CORR_ECANCELED, "cancelled in DDM") : CORR_OK;
+        goto out;
+    }
     const bmap *in_map[2] = {P0, Q0};
     bmap **out_map[2] = {P, Q};
     for (int d = 0; d < r.total; d++) {

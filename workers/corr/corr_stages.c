@@ -24,11 +24,15 @@ unsigned corr_stages_run(corr_stages s, int have_map)
 }
 
 int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
-                      int injective, double rhm_landmark_weight, char *err, size_t errsz)
+                      int injective, double rhm_landmark_weight, corr_ddm_mode ddm_mode,
+                      char *err, size_t errsz)
 {
     unsigned run = corr_stages_run(s, have_map);
     if (!run)
         return errbuf_set(err, errsz, CORR_EINPUT, "stages value %d is not one of the list", (int)s);
+    if (ddm_mode != CORR_DDM_PLAIN && ddm_mode != CORR_DDM_BIJECTIVE)
+        return errbuf_set(err, errsz, CORR_EINPUT, "ddm_mode value %d is not one of the list",
+                          (int)ddm_mode);
     if (have_reverse && !have_map)
         return errbuf_set(err, errsz, CORR_EINPUT, "an initial reverse map needs an initial map");
     if (have_reverse && injective)
@@ -36,6 +40,10 @@ int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandma
     if ((run & CORR_RUN_DDM) && !have_map)
         return errbuf_set(err, errsz, CORR_EINPUT,
                           "the DDM stage denoises a given map: it needs an initial map");
+    if ((run & CORR_RUN_DDM) && ddm_mode == CORR_DDM_BIJECTIVE && !have_reverse)
+        return errbuf_set(err, errsz, CORR_EINPUT,
+                          "bijective DDM (ddm_mode bijective) denoises a map and its reverse "
+                          "together: it needs an initial reverse map too");
     if (!have_map) {
         if (!(run & CORR_RUN_RHM))
             return errbuf_set(err, errsz, CORR_EINPUT, "the ECTM stage alone needs an initial map");

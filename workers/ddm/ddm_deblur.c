@@ -1,10 +1,12 @@
 /* ddm_deblur.c — DDM's precise map from a functional map: per vertex of
- * M1, the exact nearest point of M2 embedded in R^k2, with App. A.2's
- * candidate-face bound; see ddm.h. */
+ * M1, the exact nearest point of M2 embedded in R^k2 (or, for
+ * ddm_nearest_points, in any R^d), with App. A.2's candidate-face bound;
+ * see ddm.h. */
 #include "ddm/ddm.h"
 #include "util/errbuf.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -71,48 +73,42 @@ static double triangle_min(const face_pre *f, double D, double E, double F, doub
     return best;
 }
 
-int ddm_deblur(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const mesh *T,
-               const double *C, int k1, int k2, bmap *P, ddm_stats *stats, char *err,
-               size_t errsz)
+int ddm_nearest_points(const double *A, int d, const mesh *T, const double *B, int n1,
+                       const double *m1, bmap *P, ddm_stats *stats, char *err, size_t errsz)
 {
-    if (k1 < 1 || k1 > b1->k || k2 < 1 || k2 > b2->k)
+    if (d < 1 || n1 < 1 || P->n != n1 || P->nt != T->nv)
         return errbuf_set(err, errsz, DDM_EINVAL,
-                          "deblurring: basis sizes %d, %d (the bases hold %d, %d)", k1, k2,
-                          b1->k, b2->k);
-    if (T->nv != b2->nv || P->n != b1->nv || P->nt != T->nv)
-        return errbuf_set(err, errsz, DDM_EINVAL,
-                          "deblurring: target of %d vertices for a basis of %d; map %d by %d "
-                          "for %d by %d", T->nv, b2->nv, P->n, P->nt, b1->nv, T->nv);
+                          "nearest points: dimension %d, %d points; map %d by %d for %d by %d", d,
+                          n1, P->n, P->nt, n1, T->nv);
     int n2 = T->nv, nf = T->nf, rc = DDM_ENOMEM;
     if (nf < 1)
-        return errbuf_set(err, errsz, DDM_EINVAL, "deblurring: the target has no faces");
+        return errbuf_set(err, errsz, DDM_EINVAL, "nearest points: the target has no faces");
     for (int q = 0; q < 3 * nf; q++)
         if (T->f[q] < 0 || T->f[q] >= n2)
-            return errbuf_set(err, errsz, DDM_EINVAL, "deblurring: face %d has vertex %d of %d",
+            return errbuf_set(err, errsz, DDM_EINVAL, "nearest points: face %d has vertex %d of %d",
                               q / 3, T->f[q], n2);
-    double *A = malloc((size_t)n2 * k2 * sizeof *A), *norm2 = malloc((size_t)n2 * sizeof *norm2);
+    double *norm2 = malloc((size_t)n2 * sizeof *norm2);
     face_pre *fp = malloc((size_t)nf * sizeof *fp);
     int *vface = malloc((size_t)n2 * sizeof *vface);
     long long solved = 0;
     double cost = 0;
     int fail = 0;
-    if (!A || !norm2 || !fp || !vface) {
-        errbuf_set(err, errsz, DDM_ENOMEM, "deblurring: out of memory (%d vertices)", n2);
+    if (!norm2 || !fp || !vface) {
+        errbuf_set(err, errsz, DDM_ENOMEM, "nearest points: out of memory (%d vertices)", n2);
         goto out;
     }
     for (int j = 0; j < n2; j++) {
-        memcpy(A + (size_t)j * k2, b2->phi + (size_t)j * b2->k, (size_t)k2 * sizeof *A);
-        norm2[j] = dot(A + (size_t)j * k2, A + (size_t)j * k2, k2);
+        norm2[j] = dot(A + (size_t)j * d, A + (size_t)j * d, d);
         vface[j] = -1;
     }
     for (int f = nf - 1; f >= 0; f--)            /* lowest face with corner j, and which corner */
         for (int q = 0; q < 3; q++)
             vface[T->f[3 * f + q]] = 3 * f + q;
     for (int f = 0; f < nf; f++) {
-        const double *a0 = A + (size_t)T->f[3 * f] * k2, *a1 = A + (size_t)T->f[3 * f + 1] * k2;
-        const double *a2 = A + (size_t)T->f[3 * f + 2] * k2;
+        const double *a0 = A + (size_t)T->f[3 * f] * d, *a1 = A + (size_t)T->f[3 * f + 1] * d;
+        const double *a2 = A + (size_t)T->f[3 * f + 2] * d;
         double a = 0, h = 0, c = 0, p1 = 0, p2 = 0;
-        for (int j = 0; j < k2; j++) {
+        for (int j = 0; j < d; j++) {
             double e1 = a1[j] - a0[j], e2 = a2[j] - a0[j];
             a += e1 * e1;
             h += e1 * e2;
@@ -126,25 +122,19 @@ int ddm_deblur(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const
 #pragma omp parallel reduction(+ : solved, cost)
     {
         double *g = malloc((size_t)n2 * sizeof *g), *d2 = malloc((size_t)n2 * sizeof *d2);
-        double *b = malloc((size_t)k2 * sizeof *b);
-        if (!g || !d2 || !b) {
+        if (!g || !d2) {
 #pragma omp atomic write
             fail = 1;
         }
 #pragma omp for schedule(dynamic, 16)
-        for (int i = 0; i < b1->nv; i++) {
-            if (!g || !d2 || !b)
+        for (int i = 0; i < n1; i++) {
+            if (!g || !d2)
                 continue;
-            const double *p = b1->phi + (size_t)i * b1->k;
-            for (int c = 0; c < k2; c++)
-                b[c] = 0;
-            for (int a = 0; a < k1; a++)
-                for (int c = 0; c < k2; c++)
-                    b[c] += p[a] * C[(size_t)a * k2 + c];
-            double bb = dot(b, b, k2), best = INFINITY;
+            const double *b = B + (size_t)i * d;
+            double bb = dot(b, b, d), best = INFINITY;
             int vbest = 0;
             for (int j = 0; j < n2; j++) {
-                g[j] = dot(A + (size_t)j * k2, b, k2);
+                g[j] = dot(A + (size_t)j * d, b, d);
                 d2[j] = fmax(norm2[j] - 2 * g[j] + bb, 0);
                 if (d2[j] < best && vface[j] >= 0) {
                     best = d2[j];
@@ -183,22 +173,62 @@ int ddm_deblur(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const
         }
         free(g);
         free(d2);
-        free(b);
     }
     if (fail) {
-        errbuf_set(err, errsz, DDM_ENOMEM, "deblurring: out of memory for a row's work");
+        errbuf_set(err, errsz, DDM_ENOMEM, "nearest points: out of memory for a row's work");
         goto out;
     }
     if (stats) {
         stats->faces_solved = solved;
-        stats->faces_total = (long long)b1->nv * nf;
+        stats->faces_total = (long long)n1 * nf;
         stats->cost = cost;
     }
     rc = DDM_OK;
 out:
-    free(A);
     free(norm2);
     free(fp);
     free(vface);
+    return rc;
+}
+
+int ddm_deblur(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const mesh *T,
+               const double *C, int k1, int k2, bmap *P, ddm_stats *stats, char *err,
+               size_t errsz)
+{
+    if (k1 < 1 || k1 > b1->k || k2 < 1 || k2 > b2->k)
+        return errbuf_set(err, errsz, DDM_EINVAL,
+                          "deblurring: basis sizes %d, %d (the bases hold %d, %d)", k1, k2,
+                          b1->k, b2->k);
+    if (T->nv != b2->nv || P->n != b1->nv || P->nt != T->nv)
+        return errbuf_set(err, errsz, DDM_EINVAL,
+                          "deblurring: target of %d vertices for a basis of %d; map %d by %d "
+                          "for %d by %d", T->nv, b2->nv, P->n, P->nt, b1->nv, T->nv);
+    int n1 = b1->nv, n2 = T->nv;
+    double *A = malloc((size_t)n2 * k2 * sizeof *A), *B = malloc((size_t)n1 * k2 * sizeof *B);
+    if (!A || !B) {
+        free(A);
+        free(B);
+        return errbuf_set(err, errsz, DDM_ENOMEM, "deblurring: out of memory (%d, %d vertices)",
+                          n1, n2);
+    }
+    for (int j = 0; j < n2; j++)
+        memcpy(A + (size_t)j * k2, b2->phi + (size_t)j * b2->k, (size_t)k2 * sizeof *A);
+    for (int i = 0; i < n1; i++) {                /* B = rows of Psi1 C */
+        const double *p = b1->phi + (size_t)i * b1->k;
+        double *b = B + (size_t)i * k2;
+        for (int c = 0; c < k2; c++)
+            b[c] = 0;
+        for (int a = 0; a < k1; a++)
+            for (int c = 0; c < k2; c++)
+                b[c] += p[a] * C[(size_t)a * k2 + c];
+    }
+    int rc = ddm_nearest_points(A, k2, T, B, n1, m1, P, stats, err, errsz);
+    if (rc == DDM_EINVAL && err && errsz) {
+        char detail[512];
+        snprintf(detail, sizeof detail, "%s", err);
+        errbuf_set(err, errsz, rc, "deblurring: %s", detail);
+    }
+    free(A);
+    free(B);
     return rc;
 }

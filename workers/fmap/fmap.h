@@ -109,7 +109,7 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
 /* Orientation weight and the descriptors it uses: per block of
  * fmap_landmark_descriptors' columns (the WKS, each landmark's WKM) the
  * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. mu_o = 3
- * was the best of 1, 3, 10 on bench_shrec07 --rhm-start=fmap --stop=rhm
+ * was the best of 1, 3, 10 on bench_shrec07 --start=fmap --stop=rhm
  * over plier, glasses, airplane, hand, fish, ant (after RHM: mean flipped
  * 7.8 / 6.3 / 6.9 %, mean held-out error without the hand 0.0266 / 0.0257
  * / 0.0273; without the term 21.5 % and 0.0259) and the smallest of them
@@ -177,6 +177,35 @@ int fmap_deformation_operator(const mesh *m, const double *V, const lbo_basis *b
 /* fmap_deformation_operator of the area-weighted unit vertex normals. */
 int fmap_normal_operator(const mesh *m, const lbo_basis *b, int k, double *D, char *err,
                          size_t errsz);
+
+/* ZoomOut (Melzi et al. 2019, "ZoomOut: spectral upsampling for efficient
+ * shape correspondence"): from C0 (k0 by k0), rounds of
+ *   (a) the vertex map Pi: vertex i of M1 -> the vertex j of M2 whose
+ *       first k coordinates (Psi2) are nearest to row i of Psi1 C
+ *       (fmap_vertex_map's rule, the thesis' row-wise form of the
+ *       spectral nearest neighbour), and
+ *   (b) C <- Psi1^T M1 Pi Psi2 on k + step functions each (Psi1^+ =
+ *       Psi1^T M1),
+ * until k = kmax, then (a) once more. C: kmax by kmax, the last round's
+ * functional map; map: n1 vertices of M2, the vertex map of C (the NN
+ * map; DDM deblurring of C gives a precise one). The nearest neighbours
+ * are exhaustive (exact), each row's search bounded from the start by its
+ * previous round's match (n1 n2 k work at worst per round; the spectral
+ * coordinates of 20 to 100 dimensions leave a k-d tree little to prune).
+ * m1: M1's lumped mass. stats (may be NULL): rounds of (b), seconds in
+ * the searches (a), and the coordinates they compared as a fraction of
+ * brute force's n1 n2 k per search. FMAP_EINVAL
+ * for k0 < 1, kmax < k0, kmax above a basis, step < 1, no mass;
+ * FMAP_ENOMEM. */
+#define FMAP_ZOOMOUT_STEP 1   /* the paper's: one function per round */
+typedef struct fmap_zoomout_stats {
+    int rounds;          /* functional maps recomputed (one per size step) */
+    double nn_seconds;   /* wall seconds in the nearest-neighbour searches */
+    double nn_work;      /* coordinates compared / (n1 n2 k) summed over searches */
+} fmap_zoomout_stats;
+int fmap_zoomout(const lbo_basis *b1, const double *m1, const lbo_basis *b2, const double *C0,
+                 int k0, int kmax, int step, double *C, int *map, fmap_zoomout_stats *stats,
+                 char *err, size_t errsz);
 
 /* map: n1 vertices of M2. */
 int fmap_vertex_map(const lbo_basis *b1, const lbo_basis *b2, const double *C, int k1, int k2,

@@ -70,5 +70,10 @@ typedef struct lbo_basis {
 int lbo_eigenpairs(const geo_csr *L, const double *mass, int nv, int k, lbo_basis *out,
                    char *err, size_t errsz);
 void lbo_basis_close(lbo_basis *b);
+/* *out: a copy of b's first k eigenpairs (its own arrays, freed by
+ * lbo_basis_close), for what must see only them (descriptors built from
+ * the whole basis). LBO_EINVAL for k < 1 or k > b->k (out zeroed),
+ * LBO_ENOMEM. */
+int lbo_basis_first(const lbo_basis *b, int k, lbo_basis *out);
 
 #endif

@@ -29,6 +29,27 @@ void lbo_basis_close(lbo_basis *b)
     memset(b, 0, sizeof *b);
 }
 
+int lbo_basis_first(const lbo_basis *b, int k, lbo_basis *out)
+{
+    memset(out, 0, sizeof *out);
+    if (k < 1 || k > b->k)
+        return LBO_EINVAL;
+    out->lambda = malloc((size_t)k * sizeof *out->lambda);
+    out->phi = malloc((size_t)b->nv * k * sizeof *out->phi);
+    if (!out->lambda || !out->phi) {
+        lbo_basis_close(out);
+        return LBO_ENOMEM;
+    }
+    out->nv = b->nv;
+    out->k = k;
+    memcpy(out->lambda, b->lambda, (size_t)k * sizeof *out->lambda);
+    for (int i = 0; i < b->nv; i++)
+        memcpy(out->phi + (size_t)i * k, b->phi + (size_t)i * b->k, (size_t)k * sizeof *out->phi);
+    out->restarts = b->restarts;
+    out->op_solves = b->op_solves;
+    return LBO_OK;
+}
+
 /* The upper triangle of L - sigma M as a CHOLMOD symmetric (stype 1)
  * matrix; a row whose diagonal comes out 0 (a vertex without area or
  * edges) gets 1: it is decoupled and the matrix stays definite. */

@@ -55,7 +55,8 @@ static int check_stages(const proto_submit *s, char *err, size_t errsz)
     char why[256];
     if (corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
                           (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
-                          s->params.rhm_landmark_weight, why, sizeof why))
+                          s->params.rhm_landmark_weight, (corr_ddm_mode)s->params.ddm_mode, why,
+                          sizeof why))
         return errbuf_set(err, errsz, s->p.n ? PROTO_EBAD_PARAMS : PROTO_EBAD_LANDMARKS,
                           "params.stages: %s", why);
     return 0;

@@ -281,7 +281,8 @@ int main(int argc, char **argv)
     }
     corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0,
                       &job.rhm, (corr_stages)sub.u.submit.params.stages,
-                      (int)sub.u.submit.params.ddm_k };
+                      (int)sub.u.submit.params.ddm_k,
+                      (corr_ddm_mode)sub.u.submit.params.ddm_mode };
     if (cancel_requested)
         rc = CORR_ECANCELED;
     else

@@ -72,17 +72,22 @@ enum rhm_error {
 };
 const char *rhm_strerror(int code);
 
+/* Basis size of the functional-map start (the k of fmap's tests and
+ * figures), capped by what a small mesh has; ZoomOut (rhm_params.zoomout)
+ * grows it from there. */
+#define RHM_FMAP_K 50
+
 typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
     RHM_START_VORONOI = 1,     /* the thesis' geodesic Voronoi map          */
     RHM_START_FMAP = 2         /* functional map (Δ + D_N) deblurred by DDM */
 } rhm_start;
-/* Their names are the values of rhm_start in PROTO_PARAMS (proto_params.h):
+/* Their names are the values of start in PROTO_PARAMS (proto_params.h):
  * proto_param_value_name, proto_param_parse. */
 
 /* start, alpha, gamma, dim and iterations are job parameters: their
  * defaults and ranges are PROTO_PARAMS' (protocol/proto_params.h, ENGINE
- * column RHM: rhm_start, rhm_alpha, rhm_landmark_weight, rhm_dim,
+ * column RHM: start, rhm_alpha, rhm_landmark_weight, rhm_dim,
  * rhm_iterations). */
 typedef struct rhm_params {
     int start;             /* RHM_START_*                                   */
@@ -95,13 +100,15 @@ typedef struct rhm_params {
     int min_iterations;    /* no early stop before this iteration  (>= 1)   */
     double stop_change;    /* relative energy change to stop; 0 = never     */
     int threads;           /* OpenMP threads; 0: all cores                  */
+    int zoomout;           /* start fmap: ZoomOut's final basis size; 0 off */
 } rhm_params;
 
 /* The authors' release: α = 5e-4, β = 5e-3·min(k, 100), γ = 0, m = 8,
  * K = 200, stop when the relative change is below 1e-9 after iteration 110;
  * start: distances (ours, see above). */
 void rhm_params_init(rhm_params *p);
-/* 0 or RHM_EPARAM with the offending field named in err. */
+/* 0 or RHM_EPARAM with the offending field named in err (zoomout from 1 to
+ * RHM_FMAP_K: ZoomOut only grows the start's basis). */
 int rhm_params_check(const rhm_params *p, char *err, size_t errsz);
 double rhm_beta(const rhm_params *p, int k);
 
