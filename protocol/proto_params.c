@@ -85,6 +85,8 @@ int proto_param_check(int i, double v, char *err, size_t errsz)
                            f->name, v);
     if ((f->type == PROTO_PARAM_U32 || f->type == PROTO_PARAM_BOOL) && v != floor(v))
         return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g: not an integer", f->name, v);
+    if (v == 0 && (f->flags & PROTO_PARAM_ZERO_OFF))
+        return PROTO_OK;
     if (v < f->min || (v == f->min && (f->flags & PROTO_PARAM_OPEN_MIN)))
         return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g %s %g", f->name, v,
                            v < f->min ? "<" : "<=", f->min);
@@ -227,7 +229,9 @@ const char *proto_param_range(int i, char *buf, size_t sz)
         snprintf(buf, sz, "%s%s, %s%s%s", (f->flags & PROTO_PARAM_OPEN_MIN) ? "(" : "[",
                  num(f->min, lo, sizeof lo), isinf(f->max) ? "inf" : num(f->max, hi, sizeof hi),
                  (f->flags & PROTO_PARAM_OPEN_MAX) || isinf(f->max) ? ")" : "]",
-                 (f->flags & PROTO_PARAM_ZERO_DEFAULT) ? "; 0 = the default" : "");
+                 (f->flags & PROTO_PARAM_ZERO_DEFAULT) ? "; 0 = the default"
+                 : (f->flags & PROTO_PARAM_ZERO_OFF)   ? "; or 0 = off"
+                                                       : "");
     }
     return buf;
 }

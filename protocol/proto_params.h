@@ -23,7 +23,9 @@
  *            PROTO_PARAM_OPEN_MAX; F64 values must also be finite
  *   flags    PROTO_PARAM_* bits; PROTO_PARAM_ZERO_DEFAULT: 0 on the wire
  *            means the default (kept from protocol version 1's first
- *            clients, which sent 0 for "the release's RHM value")
+ *            clients, which sent 0 for "the release's RHM value");
+ *            PROTO_PARAM_ZERO_OFF: 0 is a value besides [min, max] (the
+ *            feature off)
  *   ENGINE   ECTM (field of ectm_params), RHM (of rhm_params) or NONE
  *   values   ENUM: the value names "a|b" (0, 1, ...); STR: the accepted words
  *   help     one line for --help and PROTOCOL.md */
@@ -38,11 +40,13 @@
 #define PROTO_MAX_DEVICE    127      /* bytes of ":DEVICE" in backend, the colon excluded */
 #define PROTO_RHM_MAX_DIM   64       /* rhm_dim's max: the embedding's (EMBED_MAX_DIM) */
 #define PROTO_DDM_MAX_K     300      /* ddm_k's max: the eigenpairs' (LBO_MAX_K) */
+#define PROTO_ZOOMOUT_MIN   51       /* zoomout's min besides 0 (off): RHM_FMAP_K + 1 */
 #define PROTO_ZOOMOUT_MAX   300      /* zoomout's max: the eigenpairs' (LBO_MAX_K) */
 
 #define PROTO_PARAM_OPEN_MIN     1u
 #define PROTO_PARAM_OPEN_MAX     2u
 #define PROTO_PARAM_ZERO_DEFAULT 4u
+#define PROTO_PARAM_ZERO_OFF 8u
 
 #define PROTO_PARAMS(X)                                                                          \
     X(model, "model", ENUM, 0, 0, 1, 0, ECTM, model, "bijective|injective",                      \
@@ -94,7 +98,8 @@
     X(ddm_mode, "ddm-mode", ENUM, 0, 0, 1, 0, NONE, ddm_mode, "plain|bijective",                 \
       "DDM denoising: plain (each given map alone) or bijective (the map p and its reverse q "   \
       "denoised together, each made consistent with the other's functional map; needs q)")   \
-    X(zoomout, "zoomout", U32, 0, 0, PROTO_ZOOMOUT_MAX, 0, RHM, zoomout, "",                      \
+    X(zoomout, "zoomout", U32, 0, PROTO_ZOOMOUT_MIN, PROTO_ZOOMOUT_MAX, PROTO_PARAM_ZERO_OFF,    \
+      RHM, zoomout, "",                                                                          \
       "start fmap: ZoomOut from the start's 50 basis functions to this many per mesh before "    \
       "DDM deblurring (0: off; else more than 50 and at most vertices - 2)")
 

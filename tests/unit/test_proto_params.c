@@ -199,3 +199,23 @@ TEST(values_parse_from_text_by_type)
     CHECK_STR_HAS(line, " inner_iterations=77 ");
     CHECK_STR_HAS(line, " start=voronoi backend=");
 }
+
+/* zoomout: 0 (off) or 51..300; 1..50 refused where a job is parsed (the
+ * client and the daemon), not only when the worker starts it. */
+TEST(zoomout_is_off_or_larger_than_the_fmap_start_basis)
+{
+    char err[256];
+    CHECK_INT(proto_param_check(PROTO_P_zoomout, 0, err, sizeof err), PROTO_OK);
+    CHECK_INT(proto_param_check(PROTO_P_zoomout, 51, err, sizeof err), PROTO_OK);
+    CHECK_INT(proto_param_check(PROTO_P_zoomout, 300, err, sizeof err), PROTO_OK);
+    CHECK(proto_param_check(PROTO_P_zoomout, 20, err, sizeof err) != PROTO_OK);
+    printf("  %s\n", err);
+    CHECK(strstr(err, "zoomout") && strstr(err, "51"));
+    CHECK(proto_param_check(PROTO_P_zoomout, 301, err, sizeof err) != PROTO_OK);
+    proto_params w;
+    proto_params_init(&w);
+    CHECK_INT(proto_param_parse(&w, PROTO_P_zoomout, "50", err, sizeof err), PROTO_OK);
+    CHECK(proto_params_check(&w, err, sizeof err) != PROTO_OK);
+    w.zoomout = 0;
+    CHECK_INT(proto_params_check(&w, err, sizeof err), PROTO_OK);
+}

@@ -25,6 +25,7 @@ const char *rhm_strerror(int code)
 #define RHM_ROW_ECTM(x)
 #define RHM_ROW_NONE(x)
 _Static_assert(PROTO_ZOOMOUT_MAX <= LBO_MAX_K, "zoomout's range must fit the eigenpairs'");
+_Static_assert(PROTO_ZOOMOUT_MIN == RHM_FMAP_K + 1, "ZoomOut grows the fmap start's basis");
 _Static_assert(EMBED_MAX_DIM == PROTO_RHM_MAX_DIM, "rhm_dim's max in PROTO_PARAMS is EMBED_MAX_DIM");
 _Static_assert((int)RHM_START_VORONOI == (int)PROTO_START_VORONOI &&
                    (int)RHM_START_FMAP == (int)PROTO_START_FMAP, "start values");
@@ -57,11 +58,6 @@ int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
     NEED(p->min_iterations >= 1, "min-iterations", "an integer >= 1");
     NEED(isfinite(p->stop_change) && p->stop_change >= 0, "stop-change", "a finite number >= 0");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");
-    if (p->zoomout > 0 && p->zoomout <= RHM_FMAP_K)
-        return errbuf_set(err, errsz, RHM_EPARAM,
-                          "params.zoomout = %d: ZoomOut grows the functional-map start's basis of "
-                          "%d functions, so it must be 0 (off) or more than %d", p->zoomout,
-                          RHM_FMAP_K, RHM_FMAP_K);
 #undef NEED
     return RHM_OK;
 }
