@@ -23,15 +23,15 @@
  * iterations and wall time of RHM and ECTM. The RHM paper reports a mean
  * geodesic error of about 0.033 on remeshed FAUST/SCAPE.
  *
- * Measured (default 300 ECTM iterations, the distances start, about 6
- * min on 2 cores): FAUST geodesic error RHM 0.0235 / 0.0389 / 0.0386 /
- * 0.0270 (000->001, 002->007, 000->020, 010->020; mean 0.032, the paper's
- * ~0.033), RHM + ECTM 0.0196 / 0.0314 / 0.0300 / 0.0205; cat 0.0314 ->
- * 0.0293; Homer 0.0176 -> 0.0228 and head 0.0213 -> 0.0235 (ECTM raises
- * them). ECTM lowers mean |log a| on every pair and leaves almost no
- * collapsed triangle, raises the flipped ones on every pair, and lowers
- * the median conformal distortion only on FAUST 000->001. With
- * --start=voronoi RHM's FAUST errors were 0.0377 / 0.0605 / 0.0320 /
+ * Measured at 2d9c8da (default 300 ECTM iterations, the distances start,
+ * fold repair after RHM and after ECTM; about 20 min on 2 loaded cores):
+ * FAUST geodesic error RHM 0.0212 / 0.0363 / 0.0361 / 0.0275 (000->001,
+ * 002->007, 000->020, 010->020), RHM + ECTM 0.0189 / 0.0396 / 0.0251 /
+ * 0.0195; cat 0.0239 -> 0.0235; Homer 0.0117 -> 0.0204 and head 0.0159 ->
+ * 0.0226 (ECTM raises them). The repair of ECTM's maps leaves 0.9-3.3 %
+ * flipped (6.7 % collapsed on 002->007) but raises mean |log a| 2-5x on
+ * FAUST: its harmonic remaps are far from area-preserving. Earlier, with
+ * --start=voronoi, RHM's FAUST errors were 0.0377 / 0.0605 / 0.0320 /
  * 0.0353, cat 0.0419, Homer 0.0609, head 0.0166.
  * Scale: with --scale=0.01, 4, 100 or 1.0000001 the start and RHM rows
  * are the same to 4 decimals; --scale=4 (exact in floating point) repeats
