@@ -1,10 +1,20 @@
 /* testmesh.c — generated test meshes; see testmesh.h. Consistently oriented
  * (outward normals for the closed ones, +z for the disk). */
 #include "support/testmesh.h"
+#include "support/harness.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+mesh *testmesh_read(const char *rel)
+{
+    char err[512];
+    mesh *m = NULL;
+    if (mesh_read(harness_data_path(rel), &m, err, sizeof err) != 0)
+        FAILF("%s", err);
+    return m;
+}
 
 double testmesh_rand(unsigned long long *s)
 {

@@ -1,7 +1,8 @@
 /* testmesh.h — meshes the tests generate, with known closed forms:
  * an icosphere (radius 1, closed, genus 0), a torus (radii R, r, closed,
- * genus 1) and a flat open disk (radius 1, one boundary loop). Test code
- * only: never linked into the engine. Caller frees with mesh_free. */
+ * genus 1) and a flat open disk (radius 1, one boundary loop); and a real
+ * mesh of ../shared/data read for a test. Test code only: never linked
+ * into the engine. Caller frees with mesh_free. */
 #ifndef TESTMESH_H
 #define TESTMESH_H
 #include "mesh/mesh.h"
@@ -16,6 +17,9 @@ mesh *testmesh_disk(int rings);
  * order reversed, so that the normals stay outward (a proper mesh, not an
  * inside-out one); vertex i is vertex i of m reflected. */
 mesh *testmesh_mirrored(const mesh *m);
+/* The mesh at rel under the data folder (harness_data_path); the test
+ * fails with mesh_read's message when it cannot be read. */
+mesh *testmesh_read(const char *rel);
 /* Deterministic pseudo-random numbers in [0, 1) for tests (xorshift). */
 double testmesh_rand(unsigned long long *state);
 

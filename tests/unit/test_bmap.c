@@ -17,15 +17,6 @@ static const char *write_file(const char *name, const char *text)
     return path;
 }
 
-static mesh *load(const char *rel)
-{
-    char err[512];
-    mesh *m = NULL;
-    if (mesh_read(harness_data_path(rel), &m, err, sizeof err) != 0)
-        FAILF("%s", err);
-    return m;
-}
-
 static void check_valid(const bmap *P, const mesh *tg)
 {
     for (int i = 0; i < P->n; i++) {
@@ -38,7 +29,7 @@ static void check_valid(const bmap *P, const mesh *tg)
 
 TEST(read_real_maps_381_390_both_directions)
 {
-    mesh *a = load("shrec07_bim/Meshes/381.off"), *b = load("shrec07_bim/Meshes/390.off");
+    mesh *a = testmesh_read("shrec07_bim/Meshes/381.off"), *b = testmesh_read("shrec07_bim/Meshes/390.off");
     char err[512];
     bmap *P = NULL, *Q = NULL;
     int rc = bmap_read(harness_data_path("ectm_demo_381_390/init_381_to_390.map"), a, b, &P,
@@ -72,7 +63,7 @@ TEST(read_real_maps_381_390_both_directions)
 
 TEST(write_then_read_is_bit_identical)
 {
-    mesh *a = load("shrec07_bim/Meshes/381.off"), *b = load("shrec07_bim/Meshes/390.off");
+    mesh *a = testmesh_read("shrec07_bim/Meshes/381.off"), *b = testmesh_read("shrec07_bim/Meshes/390.off");
     char err[512], out[512];
     bmap *P = NULL, *P2 = NULL;
     CHECK_INT(bmap_read(harness_data_path("ectm_demo_381_390/init_381_to_390.map"), a, b, &P,

@@ -278,10 +278,7 @@ TEST(triangle_degenerate_collinear_and_coincident)
 
 static mesh *load_unit_area(const char *rel)
 {
-    char err[512];
-    mesh *m = NULL;
-    if (mesh_read(harness_data_path(rel), &m, err, sizeof err) != 0)
-        FAILF("%s", err);
+    mesh *m = testmesh_read(rel);
     double area = 0;
     for (int t = 0; t < m->nf; t++) {
         const double *a = m->v + 3 * m->f[3 * t], *b = m->v + 3 * m->f[3 * t + 1],

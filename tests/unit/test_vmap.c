@@ -13,15 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static mesh *load(const char *rel)
-{
-    char err[512];
-    mesh *m = NULL;
-    if (mesh_read(harness_data_path(rel), &m, err, sizeof err) != 0)
-        FAILF("%s", err);
-    return m;
-}
-
 /* The point P puts source vertex i on, against target vertex v. */
 static void check_at_vertex(const bmap *P, int i, const mesh *T, int v)
 {
@@ -49,8 +40,8 @@ static int *raw_ids(const char *path, int n)
 
 TEST(published_bim_and_bcicp_maps_put_each_vertex_on_its_target_vertex)
 {
-    mesh *S = load("tosca_r_nonisometric/vtx_5k/8_gorilla_01.off");
-    mesh *T = load("tosca_r_nonisometric/vtx_5k/8_man_01.off");
+    mesh *S = testmesh_read("tosca_r_nonisometric/vtx_5k/8_gorilla_01.off");
+    mesh *T = testmesh_read("tosca_r_nonisometric/vtx_5k/8_man_01.off");
     static const char *const rel[2] = {
         "tosca_r_nonisometric/vtx_5k/maps_baseline/BIM/8_gorilla_01_8_man_01.map",
         "tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/8_gorilla_01_8_man_01.map"};

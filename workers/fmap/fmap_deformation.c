@@ -25,17 +25,8 @@ int fmap_deformation_operator(const mesh *m, const double *V, const lbo_basis *b
         if (geo__face_cross(m, t, cr))
             continue;
         const int *f = m->f + 3 * (size_t)t;
-        const double *p[3];
-        geo__corners(m, t, p);
-        double a2 = sqrt(geo__dot(cr, cr)), n[3] = {cr[0] / a2, cr[1] / a2, cr[2] / a2};
-        double g[3][3];   /* hat gradients: grad phi_k = n x (p_{k+2} - p_{k+1}) / (2 area) */
-        for (int c = 0; c < 3; c++) {
-            double e[3];
-            geo__sub(p[(c + 2) % 3], p[(c + 1) % 3], e);
-            geo__cross(n, e, g[c]);
-            for (int q = 0; q < 3; q++)
-                g[c][q] /= a2;
-        }
+        double n[3], g[3][3];   /* hat gradients */
+        double a2 = geo__hat_gradients(m, t, cr, n, g);
         /* dV = sum_c V_c grad phi_c^T (3 by 3); S = dV + dV^T */
         double S[3][3];
         for (int r = 0; r < 3; r++)

@@ -41,20 +41,13 @@ int fmap_orientation_operators(const mesh *m, const lbo_basis *b, const double *
                 if (geo__face_cross(m, t, cr))
                     continue;
                 const int *f = m->f + 3 * (size_t)t;
-                const double *p[3];
-                geo__corners(m, t, p);
-                double a2 = sqrt(geo__dot(cr, cr)), n[3] = {cr[0] / a2, cr[1] / a2, cr[2] / a2};
-                double g[3][3], gf[3] = {0, 0, 0};
-                /* hat gradients grad phi_c = n x (p_{c+2} - p_{c+1}) / (2 area), grad f */
+                double n[3], g[3][3], gf[3] = {0, 0, 0};
+                /* the hat gradients, and grad f */
+                double a2 = geo__hat_gradients(m, t, cr, n, g);
                 for (int c = 0; c < 3; c++) {
-                    double e[3];
-                    geo__sub(p[(c + 2) % 3], p[(c + 1) % 3], e);
-                    geo__cross(n, e, g[c]);
                     double fc = F[(size_t)f[c] * nd + cols[d]];
-                    for (int q = 0; q < 3; q++) {
-                        g[c][q] /= a2;
+                    for (int q = 0; q < 3; q++)
                         gf[q] += fc * g[c][q];
-                    }
                 }
                 /* s_c = area <n, grad f x grad phi_c>: F_f of the hat function of corner c */
                 double s[3];

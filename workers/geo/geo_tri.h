@@ -54,4 +54,26 @@ static inline int geo__face_cross(const mesh *m, int t, double *c)
     return !(n > GEO__DEGENERATE_REL * (geo__dot(e1, e1) + geo__dot(e2, e2)));
 }
 
+/* The gradients of face t's three hat functions, grad phi_c =
+ * n x (p_{c+2} - p_{c+1}) / (2 area), from its cross product cr
+ * (geo__face_cross, not degenerate); n gets the unit normal. Returns |cr|,
+ * twice the area. */
+static inline double geo__hat_gradients(const mesh *m, int t, const double *cr, double *n,
+                                        double g[3][3])
+{
+    const double *p[3];
+    geo__corners(m, t, p);
+    double a2 = sqrt(geo__dot(cr, cr));
+    for (int q = 0; q < 3; q++)
+        n[q] = cr[q] / a2;
+    for (int c = 0; c < 3; c++) {
+        double e[3];
+        geo__sub(p[(c + 2) % 3], p[(c + 1) % 3], e);
+        geo__cross(n, e, g[c]);
+        for (int q = 0; q < 3; q++)
+            g[c][q] /= a2;
+    }
+    return a2;
+}
+
 #endif
