@@ -104,6 +104,41 @@ mesh *testmesh_torus(double R, double r, int nu, int nv)
     return m;
 }
 
+mesh *testmesh_spheroid(double length, int rings, int around)
+{
+    int nv = rings * around + 2, nf = 2 * around * rings;
+    mesh *m = mesh_new(nv, nf);
+    for (int k = 0; k < rings; k++)
+        for (int j = 0; j < around; j++) {
+            double t = M_PI * (k + 1) / (rings + 1), u = 2 * M_PI * j / around;
+            double *p = m->v + 3 * (k * around + j);
+            p[0] = sin(t) * cos(u);
+            p[1] = sin(t) * sin(u);
+            p[2] = length * (k + 1) / (rings + 1);
+        }
+    int s = rings * around, n = s + 1;   /* the poles: z = 0 and z = length */
+    m->v[3 * s] = m->v[3 * s + 1] = m->v[3 * s + 2] = 0;
+    m->v[3 * n] = m->v[3 * n + 1] = 0;
+    m->v[3 * n + 2] = length;
+    int t = 0;
+    for (int j = 0; j < around; j++) {
+        int j1 = (j + 1) % around;
+        int q[3] = { s, j1, j };
+        memcpy(m->f + 3 * t++, q, sizeof q);
+        int r[3] = { n, (rings - 1) * around + j, (rings - 1) * around + j1 };
+        memcpy(m->f + 3 * t++, r, sizeof r);
+    }
+    for (int k = 0; k + 1 < rings; k++)
+        for (int j = 0; j < around; j++) {
+            int a = k * around + j, b = k * around + (j + 1) % around;
+            int c = (k + 1) * around + (j + 1) % around, d = (k + 1) * around + j;
+            int q[6] = { a, b, c, a, c, d };
+            memcpy(m->f + 3 * t, q, sizeof q);
+            t += 2;
+        }
+    return m;
+}
+
 mesh *testmesh_disk(int rings)
 {
     /* ring k (1..rings) has 6k vertices; centre vertex 0 */

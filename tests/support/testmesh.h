@@ -1,5 +1,5 @@
 /* testmesh.h — meshes the tests generate, with known closed forms:
- * an icosphere (radius 1, closed, genus 0), a torus (radii R, r, closed,
+ * an icosphere (radius 1, closed, genus 0), a stretched sphere, a torus (radii R, r, closed,
  * genus 1) and a flat open disk (radius 1, one boundary loop); and a real
  * mesh of ../shared/data read for a test. Test code only: never linked
  * into the engine. Caller frees with mesh_free. */
@@ -11,6 +11,11 @@
 mesh *testmesh_icosphere(int level);
 /* Torus around the z axis, nu segments around the axis, nv around the tube. */
 mesh *testmesh_torus(double R, double r, int nu, int nv);
+/* A closed tube along z of the given length: rings of `around` vertices
+ * at z = length·k/(rings+1), k = 1..rings, of radius sin(π k/(rings+1)),
+ * and a pole at each end (the meridian of a sphere, stretched along z).
+ * Two with the same rings and around have the same connectivity. */
+mesh *testmesh_spheroid(double length, int rings, int around);
 /* Flat disk in the z = 0 plane, rings concentric rings around the centre. */
 mesh *testmesh_disk(int rings);
 /* The mirror image of m through the plane x = 0 with every face's corner

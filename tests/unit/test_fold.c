@@ -1,8 +1,9 @@
 /* test_fold.c — fold repair (fold.h): a fold planted in the identity map
  * of a mesh onto itself is found (metric_fold_faces) and relaxed away,
- * landmarks stay put, a crowded cap and a cap whose images jumped are
- * re-mapped, and a map mirrored as a whole is left as it was (the repair
- * never makes a map worse). */
+ * landmarks stay put, a crowded cap, a cap whose images jumped and a long
+ * part's end collapsed onto a short part's are re-mapped, and a map
+ * mirrored as a whole is left as it was (the repair never makes a map
+ * worse). */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "fold/fold.h"
@@ -222,4 +223,46 @@ TEST(cap_whose_images_jumped_is_re_mapped_inside_its_boundary)
     free(img);
     bmap_free(P);
     mesh_free(m);
+}
+
+/* A long part onto a short one: the source is a tube 6.4 times as long as
+ * it is wide, the target one of the same connectivity 1.6 times (the
+ * sphere's meridian stretched along z), the map the identity of their
+ * vertices with the last 12 rings and the pole all sent to the target's
+ * pole (collapsed). The harmonic map of the long end inside its ring
+ * crowds it into the short end's tip (48 faces below 1e-4 of their area
+ * are left without the reweighting); the repair's reweighting opens it
+ * up: no bad face is left, and every re-mapped vertex lands within a
+ * tenth of the tube's length of its own ring (the two ends' area does not
+ * run along them alike, so not at it). */
+TEST(long_part_onto_short_part_is_re_mapped_without_crowding)
+{
+    int rings = 60, around = 24;
+    mesh *S = testmesh_spheroid(12.8, rings, around), *T = testmesh_spheroid(3.2, rings, around);
+    int nv = S->nv, first = (rings - 12) * around;
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, T->v, sizeof(double) * 3 * (size_t)nv);
+    for (int v = first; v < nv; v++)     /* the end's rings and its pole: onto the pole */
+        if (v < rings * around || v == nv - 1)
+            memcpy(img + 3 * v, T->v + 3 * (nv - 1), 3 * sizeof(double));
+    bmap *P = map_of_points(T, img, nv);
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(S, T, NULL, 0, &fp, P, &rep), FOLD_OK);
+    printf("  bad faces %d -> %d, %d vertices re-mapped in %d regions\n", rep.bad_before,
+           rep.bad_after, rep.region, rep.regions);
+    CHECK(rep.accepted);
+    CHECK_INT(rep.bad_after, 0);
+    bmap_apply(P, T->f, T->v, 3, img);
+    double worst = 0;
+    for (int v = first; v < nv; v++)
+        worst = fmax(worst, fabs(img[3 * v + 2] - T->v[3 * v + 2]));
+    printf("  farthest along the tube from its own ring: %.3f (ring spacing %.3f)\n", worst,
+           3.2 / (rings + 1));
+    CHECK(worst < 0.32);
+    free(img);
+    bmap_free(P);
+    mesh_free(S);
+    mesh_free(T);
 }

@@ -13,13 +13,19 @@
  *           inside), grown by two to six rings until one piece and
  *           hole-filled, a disk too, placed in the unit disk
  *           by its harmonic map (boundary on the circle by arc length);
- *   remap   the region's boundary, its landmarks and its filled holes
- *           (faces that were not bad) stay where P sends them (their
+ *   remap   the region's boundary and its filled holes (faces that
+ *           were not bad) stay where P sends them (their
  *           points in the chart); its other vertices are placed by its own
  *           harmonic map inside that boundary and read back through the
  *           chart as points of T. A limb end turned about its axis is
  *           untwisted this way: its boundary ring is only rotated, and the
  *           harmonic map inside a rotated ring does not fold;
+ *   balance the harmonic map then reweighted toward the target's area, a
+ *           few rounds (each face's weights scaled by a power of its
+ *           image's area ratio; any positive weights keep Tutte's
+ *           guarantee): a harmonic map crowds a long part toward a point,
+ *           and a limb end longer than the target's would crowd into the
+ *           target's tip; the round with the fewest bad images is kept;
  *   accept  a region's new rows are kept only when its faces then have
  *           no more collapsed ones and fewer bad ones (flipped, collapsed,
  *           or crowded: an image below 1e-4 of its face's area, both
@@ -30,12 +36,16 @@
  *           the leg); `passes` passes, each growing the regions of what
  *           is left by two rings more. A repair never makes a map worse.
  *
- * Each region is re-mapped with its landmarks pinned and with them free
- * (their rows restored afterwards: a pin folds the harmonic map round it
- * when it is not where that map would put it); the free one counts only
- * when it puts every landmark within 0.25 of the chart's radius of its
- * image, and a tie goes to the pinned one. A pinned landmark outside the
- * chart leaves the region to the free remap.
+ * Each region is re-mapped twice: with its landmarks free, and with the
+ * placement then dragged so that each landmark lands at its image (small
+ * steps of a smooth displacement about it that stops short of the pinned
+ * vertices and the other landmarks, each a diffeomorphism; a landmark
+ * pinned inside a harmonic map would fold it round the pin when it is not
+ * where that map puts it). Landmarks get their rows back either way. The
+ * free one counts only when it puts every landmark within 0.25 of the
+ * chart's radius of its image, and a tie goes to the dragged one. A
+ * landmark whose image is outside the chart leaves the region to the free
+ * remap.
  *
  * Landmark source vertices (when given) keep their rows. What it
  * cannot undo: a part mirrored as a whole (its boundary is mapped the

@@ -42,10 +42,13 @@ int fold__disk(const mesh *m, const geo_edges *E, const unsigned char *in, int *
  * (pin: p->nv bytes; the boundary loop must be pinned) and solved for the
  * others, each the weighted mean of its neighbours with the cotangent
  * weights of m's geometry clamped positive (Tutte's theorem: a fold-free
- * placement when the boundary is convex and nothing inside is pinned).
- * Preconditioned conjugate gradients. loc as for fold__disk. Returns 0, -1
- * when out of memory. */
+ * placement when the boundary is convex and nothing inside is pinned),
+ * each edge's weight times the mean of scale[] over its faces in the
+ * patch when scale (p->nf values, > 0) is not NULL: any positive weights
+ * keep Tutte's guarantee. Preconditioned conjugate gradients, from uv's
+ * values as the first guess. loc as for fold__disk. Returns 0, -1 when out
+ * of memory. */
 int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
-                   const unsigned char *pin, int *loc, double *uv);
+                   const unsigned char *pin, const double *scale, int *loc, double *uv);
 
 #endif

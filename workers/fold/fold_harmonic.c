@@ -14,6 +14,8 @@
 typedef struct ew {
     int e;
     double w;
+    double s;      /* sum of its faces' scales */
+    int nfaces;
 } ew;
 
 static int cmp_ew(const void *a, const void *b)
@@ -85,7 +87,7 @@ static void solve(int n, const int *start, const int *col, const double *w, cons
 }
 
 int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
-                   const unsigned char *pin, int *loc, double *uv)
+                   const unsigned char *pin, const double *scale, int *loc, double *uv)
 {
     int nv = p->nv, ne = 0, rc = -1;
     ew *list = malloc(sizeof(ew) * ((size_t)p->nf * 3 + 1));
@@ -103,15 +105,19 @@ int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
         const int *f = m->f + 3 * t;
         for (int k = 0; k < 3; k++) {
             list[3 * q + k].e = E->fe[3 * t + k];
+            list[3 * q + k].s = scale ? scale[q] : 1;
+            list[3 * q + k].nfaces = 1;
             list[3 * q + k].w = 0.5 * cot_at(m->v + 3 * f[k], m->v + 3 * f[(k + 1) % 3],
                                              m->v + 3 * f[(k + 2) % 3]);
         }
     }
     qsort(list, (size_t)p->nf * 3, sizeof(ew), cmp_ew);
     for (int i = 0; i < 3 * p->nf; i++) {       /* merge the two sides of an edge */
-        if (ne && list[ne - 1].e == list[i].e)
+        if (ne && list[ne - 1].e == list[i].e) {
             list[ne - 1].w += list[i].w;
-        else
+            list[ne - 1].s += list[i].s;
+            list[ne - 1].nfaces++;
+        } else
             list[ne++] = list[i];
     }
     /* the free vertices' rows: neighbours that are free (col) or pinned (rhs) */
@@ -126,6 +132,7 @@ int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
         ea[2 * k + 1] = loc[E->ev[2 * e + 1]];
         if (list[k].w < FOLD__MIN_WEIGHT)
             list[k].w = FOLD__MIN_WEIGHT;
+        list[k].w *= list[k].s / list[k].nfaces;
         for (int s = 0; s < 2; s++)
             if (id[ea[2 * k + s]] >= 0)
                 start[id[ea[2 * k + s]] + 1]++;

@@ -4,6 +4,7 @@
 #include "fold/fold.h"
 #include "fold/fold__patch.h"
 #include "geo/geo_area.h"
+#include "geo/geo_tri.h"
 #include "metric/metric.h"
 
 #include <limits.h>
@@ -33,6 +34,11 @@
  * right there, and a remap that carries it farther spreads the region over
  * a larger part the boundary encloses (a foot's ring round a long leg). */
 #define FOLD__MAX_MOVE 1.0
+/* The reweighting of a region's harmonic map toward its target's area
+ * (balance): rounds, and the power of the area ratio each applies. */
+#define FOLD__BALANCE_ROUNDS 8
+#define FOLD__BALANCE_STEP 0.5
+#define FOLD__DRAG_STEPS 200      /* steps of a landmark's drag, at most */
 
 const char *fold_strerror(int code)
 {
@@ -53,9 +59,10 @@ void fold_params_init(fold_params *p)
 /* What one repair call works with. */
 typedef struct ctx {
     const mesh *S, *T;
+    double area_S, area_T;        /* total areas */
     geo_edges ES, ET;
     const unsigned char *fixed;   /* S->nv: landmark vertices */
-    int pin_landmarks;            /* remap pins the landmarks too */
+    int drag_landmarks;           /* remap drags the landmarks to their images */
     double shift;                 /* remap's farthest free landmark from its
                                      image, in the chart's unit disk */
     unsigned char *badv;          /* S->nv: vertices of bad faces (pass) */
@@ -96,15 +103,15 @@ static int kinds(const mesh *S, const mesh *T, const bmap *P, unsigned char *kin
 /* Whether the region's vertex i is pinned where it is mapped: its boundary
  * and the holes filled in (their faces were not bad: a limb's end beyond a
  * bad band round it keeps its map, and only the band is re-mapped, so the
- * harmonic map never crowds a long tube's end into a point); the landmarks
- * when c->pin_landmarks. Unpinned landmarks move with the others and get
- * their rows back afterwards: a pin folds the harmonic map round it when
- * it is not where that map would put it, so each region is re-mapped both
- * ways and the accept rule keeps the better. */
+ * harmonic map never crowds a long tube's end into a point). Landmarks are
+ * not pinned: a pin folds the harmonic map round it when it is not where
+ * that map would put it. They move with the others and get their rows back
+ * afterwards; with c->drag_landmarks the placement is then dragged so that
+ * each lands at its image (drag). Each region is re-mapped both ways and
+ * the accept rule keeps the better. */
 static int pinned(const ctx *c, const fold__patch *pS, int i)
 {
-    int v = pS->verts[i];
-    return i < pS->nb || c->keep[v] || (c->pin_landmarks && c->fixed[v]);
+    return i < pS->nb || c->keep[pS->verts[i]];
 }
 
 /* Whether the region's vertex i places the chart: its boundary and kept
@@ -180,7 +187,7 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
         uv[2 * i + 1] = sin(th);
         pin[i] = 1;
     }
-    rc = fold__harmonic(T, &c->ET, pT, pin, c->tloc, uv);
+    rc = fold__harmonic(T, &c->ET, pT, pin, NULL, c->tloc, uv);
     free(pin);
     if (rc) {
         free(uv);
@@ -197,6 +204,185 @@ static double area2(const double *a, const double *b, const double *c)
     return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
+/* A point of T: row v of the map (face, w). */
+static void point(const mesh *T, int face, const double *w, double *x)
+{
+    const int *tf = T->f + 3 * face;
+    for (int d = 0; d < 3; d++)
+        x[d] = w[0] * T->v[3 * tf[0] + d] + w[1] * T->v[3 * tf[1] + d] + w[2] * T->v[3 * tf[2] + d];
+}
+
+/* The chart face holding plane point x: the one whose smallest barycentric
+ * coordinate is largest (inside when >= 0), its coordinates clamped to the
+ * face in bw. Returns the chart face, -1 when none has area. */
+static int locate(const fold__patch *pT, const int *corner, const double *uvT, const double *x,
+                  double bw[3])
+{
+    int bf = -1;
+    double bmin = -INFINITY;
+    for (int q = 0; q < pT->nf; q++) {
+        const double *a = uvT + 2 * corner[3 * q], *b = uvT + 2 * corner[3 * q + 1],
+                     *d = uvT + 2 * corner[3 * q + 2];
+        double A = area2(a, b, d);
+        if (!(fabs(A) > 0))
+            continue;
+        double w[3] = { area2(x, b, d) / A, area2(a, x, d) / A, area2(a, b, x) / A };
+        double m = fmin(w[0], fmin(w[1], w[2]));
+        if (m > bmin) {
+            bmin = m;
+            bf = q;
+            memcpy(bw, w, 3 * sizeof(double));
+            if (m >= 0)
+                break;
+        }
+    }
+    if (bf >= 0) {
+        double sum = 0;
+        for (int k = 0; k < 3; k++)
+            sum += bw[k] = fmax(bw[k], 0);
+        for (int k = 0; k < 3; k++)
+            bw[k] /= sum;
+    }
+    return bf;
+}
+
+/* n = (b - a) x (c - a): twice the area, along the normal. */
+static void tri_cross(const double *a, const double *b, const double *c, double *n)
+{
+    double u[3], v[3];
+    geo__sub(b, a, u);
+    geo__sub(c, a, v);
+    geo__cross(u, v, n);
+}
+
+/* Reweights the region's placement toward its target's area: each face's
+ * edge weights scaled by (its image's area ratio over the region's mean)
+ * to the power FOLD__BALANCE_STEP (a crowded face's weights fall, so it
+ * opens up), up to FOLD__BALANCE_ROUNDS times, each a harmonic map again
+ * (any positive weights keep Tutte's guarantee: Yoshizawa, Belyaev and
+ * Seidel's stretch-minimising iteration). A harmonic map crowds a long
+ * part toward a point, exponentially in its length over its girth: when
+ * the source's part is longer so than the target's, its vertices all land
+ * in the few chart faces round the target's tip. The placement kept is
+ * the round's whose images have the fewest bad faces (flipped against the
+ * target faces they land in, or crowded): pinned vertices inside void the
+ * guarantee, and a round can fold round them. */
+static int balance(ctx *c, const fold__patch *pS, const unsigned char *pin, const fold__patch *pT,
+                   const int *corner, const double *uvT, double *uv)
+{
+    const mesh *S = c->S, *T = c->T;
+    size_t nv = (size_t)pS->nv + 1;
+    double *scale = malloc(sizeof(double) * ((size_t)pS->nf + 1));
+    double *img = malloc(sizeof(double) * 3 * nv), *nrm = malloc(sizeof(double) * 3 * nv);
+    double *lr = malloc(sizeof(double) * ((size_t)pS->nf + 1));
+    double *best = malloc(sizeof(double) * 2 * nv);
+    int rc = -1, fewest = INT_MAX;
+    if (!scale || !img || !nrm || !lr || !best)
+        goto out;
+    rc = 0;
+    for (int q = 0; q < pS->nf; q++)
+        scale[q] = 1;
+    for (int round = 0;; round++) {
+        for (int i = 0; i < pS->nv; i++) {
+            double bw[3];
+            int q = locate(pT, corner, uvT, uv + 2 * i, bw);
+            if (q < 0)
+                goto out;
+            point(T, pT->faces[q], bw, img + 3 * i);
+            geo__face_cross(T, pT->faces[q], nrm + 3 * i);
+        }
+        for (int i = 0; i < pS->nv; i++)
+            c->sloc[pS->verts[i]] = i;
+        double mean = 0, wsum = 0;
+        int bad = 0;
+        for (int q = 0; q < pS->nf; q++) {
+            const int *f = S->f + 3 * pS->faces[q];
+            int i0 = c->sloc[f[0]], i1 = c->sloc[f[1]], i2 = c->sloc[f[2]];
+            double n[3], m[3], dot = 0;
+            geo__face_cross(S, pS->faces[q], m);
+            tri_cross(img + 3 * i0, img + 3 * i1, img + 3 * i2, n);
+            double a = sqrt(geo__dot(m, m)), b = sqrt(geo__dot(n, n));
+            for (int d = 0; d < 3; d++)
+                dot += n[d] * (nrm[3 * i0 + d] + nrm[3 * i1 + d] + nrm[3 * i2 + d]);
+            lr[q] = log(fmax(b, 1e-300) / fmax(a, 1e-300));
+            bad += dot < 0 || !(b / c->area_T >= FOLD__CROWDED * a / c->area_S);
+            mean += a * lr[q];
+            wsum += a;
+        }
+        for (int i = 0; i < pS->nv; i++)
+            c->sloc[pS->verts[i]] = -1;
+        if (bad < fewest) {
+            fewest = bad;
+            memcpy(best, uv, sizeof(double) * 2 * (size_t)pS->nv);
+        }
+        if (round == FOLD__BALANCE_ROUNDS || bad == 0)
+            break;
+        mean = wsum > 0 ? mean / wsum : 0;
+        for (int q = 0; q < pS->nf; q++) {
+            double g = exp(FOLD__BALANCE_STEP * fmax(-20, fmin(20, lr[q] - mean)));
+            scale[q] = fmin(1e4, fmax(1e-4, scale[q] * g));
+        }
+        if (fold__harmonic(S, &c->ES, pS, pin, scale, c->sloc, uv)) {
+            rc = -1;
+            goto out;
+        }
+    }
+out:
+    if (fewest < INT_MAX)
+        memcpy(uv, best, sizeof(double) * 2 * (size_t)pS->nv);
+    free(scale);
+    free(img);
+    free(nrm);
+    free(lr);
+    free(best);
+    return rc;
+}
+
+/* Moves each landmark of the region from its place in uv to its image's
+ * in the chart (lm), carrying its neighbourhood along: small steps of the
+ * displacement x -> x + (1 - s^2)^2 d, s = |x - a| / R, about the
+ * landmark's place a, R short of the nearest pinned vertex and of the
+ * other landmarks, |d| below R / 3 so that each step is a diffeomorphism
+ * (its Jacobian's determinant 1 + d·grad stays above 1/2). A landmark
+ * pinned inside a harmonic map folds it round the pin when the map would
+ * put it elsewhere; this leaves the placement fold-free but for the
+ * triangles' coarseness. */
+static void drag(ctx *c, const fold__patch *pS, const unsigned char *pin, const double *lm, double *uv)
+{
+    for (int l = 0; l < pS->nv; l++) {
+        if (pin[l] || !c->fixed[pS->verts[l]])
+            continue;
+        for (int step = 0; step < FOLD__DRAG_STEPS; step++) {
+            double a[2] = { uv[2 * l], uv[2 * l + 1] };
+            double d[2] = { lm[2 * l] - a[0], lm[2 * l + 1] - a[1] };
+            double len = hypot(d[0], d[1]);
+            if (!(len > 1e-12))
+                break;
+            double R = INFINITY;
+            for (int i = 0; i < pS->nv; i++)
+                if (i != l && (pin[i] || c->fixed[pS->verts[i]]))
+                    R = fmin(R, hypot(uv[2 * i] - a[0], uv[2 * i + 1] - a[1]));
+            R *= 0.9;
+            if (!(R > 0) || !isfinite(R))
+                break;
+            double f = fmin(1, R / 3 / len);
+            d[0] *= f;
+            d[1] *= f;
+            for (int i = 0; i < pS->nv; i++) {
+                if (pin[i])
+                    continue;
+                double s2 = ((uv[2 * i] - a[0]) * (uv[2 * i] - a[0]) +
+                             (uv[2 * i + 1] - a[1]) * (uv[2 * i + 1] - a[1])) / (R * R);
+                if (s2 >= 1)
+                    continue;
+                double phi = (1 - s2) * (1 - s2);
+                uv[2 * i] += phi * d[0];
+                uv[2 * i + 1] += phi * d[1];
+            }
+        }
+    }
+}
+
 /* Re-maps the inner vertices of region pS (see fold.h) in c->R. Returns 0,
  * 1 when it cannot (no chart), -1 when out of memory. */
 static int remap(ctx *c, const fold__patch *pS)
@@ -209,9 +395,10 @@ static int remap(ctx *c, const fold__patch *pS)
         return rc;
     rc = -1;
     double *uv = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
+    double *lm = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
     unsigned char *pin = malloc((size_t)pS->nv + 1);
     int *corner = malloc(sizeof(int) * 3 * ((size_t)pT.nf + 1));
-    if (!uv || !pin || !corner)
+    if (!uv || !lm || !pin || !corner)
         goto out;
     for (int i = 0; i < pT.nv; i++)
         c->tloc[pT.verts[i]] = i;
@@ -232,7 +419,7 @@ static int remap(ctx *c, const fold__patch *pS)
         uv[2 * i] = uv[2 * i + 1] = 0;
         pin[i] = pinned(c, pS, i);
         if (c->tloc[T->f[3 * f]] < 0) {
-            if (pin[i]) {          /* a pinned landmark outside the chart */
+            if (pin[i] || (c->drag_landmarks && c->fixed[v])) {   /* outside the chart */
                 rc = 1;
                 for (int j = 0; j < pT.nv; j++)
                     c->tloc[pT.verts[j]] = -1;
@@ -248,56 +435,32 @@ static int remap(ctx *c, const fold__patch *pS)
     }
     for (int i = 0; i < pT.nv; i++)
         c->tloc[pT.verts[i]] = -1;
-    double *lm = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
-    if (!lm)
-        goto out;
     memcpy(lm, uv, sizeof(double) * 2 * (size_t)pS->nv);
-    if (fold__harmonic(c->S, &c->ES, pS, pin, c->sloc, uv)) {
-        free(lm);
+    if (fold__harmonic(c->S, &c->ES, pS, pin, NULL, c->sloc, uv) ||
+        balance(c, pS, pin, &pT, corner, uvT, uv))
         goto out;
-    }
+    if (c->drag_landmarks)
+        drag(c, pS, pin, lm, uv);
     c->shift = 0;
     for (int i = 0; i < pS->nv; i++)
         if (!pin[i] && c->fixed[pS->verts[i]])
             c->shift = fmax(c->shift, hypot(uv[2 * i] - lm[2 * i], uv[2 * i + 1] - lm[2 * i + 1]));
-    free(lm);
-    /* read the inner vertices back through the chart: the chart face whose
-     * smallest barycentric coordinate is largest (inside when >= 0) */
+    /* read the inner vertices back through the chart */
     for (int i = 0; i < pS->nv; i++) {
-        if (pin[i])
-            continue;
-        const double *x = uv + 2 * i;
-        int bf = -1;
-        double bw[3] = {1, 0, 0}, bmin = -INFINITY;
-        for (int q = 0; q < pT.nf; q++) {
-            const double *a = uvT + 2 * corner[3 * q], *b = uvT + 2 * corner[3 * q + 1],
-                         *d = uvT + 2 * corner[3 * q + 2];
-            double A = area2(a, b, d);
-            if (!(fabs(A) > 0))
-                continue;
-            double w[3] = { area2(x, b, d) / A, area2(a, x, d) / A, area2(a, b, x) / A };
-            double m = fmin(w[0], fmin(w[1], w[2]));
-            if (m > bmin) {
-                bmin = m;
-                bf = q;
-                memcpy(bw, w, sizeof bw);
-                if (m >= 0)
-                    break;
-            }
-        }
-        if (bf < 0 || c->fixed[pS->verts[i]])
-            continue;
-        double sum = 0;
-        for (int k = 0; k < 3; k++)
-            sum += bw[k] = fmax(bw[k], 0);
         int v = pS->verts[i];
+        if (pin[i] || c->fixed[v])
+            continue;
+        double bw[3];
+        int bf = locate(&pT, corner, uvT, uv + 2 * i, bw);
+        if (bf < 0)
+            continue;
         c->R->face[v] = pT.faces[bf];
-        for (int k = 0; k < 3; k++)
-            c->R->w[3 * v + k] = bw[k] / sum;
+        memcpy(c->R->w + 3 * v, bw, sizeof bw);
     }
     rc = 0;
 out:
     free(uv);
+    free(lm);
     free(pin);
     free(corner);
     free(uvT);
@@ -307,11 +470,11 @@ out:
 
 /* One region taken in a pass: its patch, which of its vertices are kept
  * (c->keep), the rows it had, and the rows of its remap with the
- * landmarks pinned. */
+ * landmarks dragged to their images. */
 typedef struct taken {
     fold__patch p;
     double shift;                 /* c->shift of its remap with free landmarks */
-    int pfar;                     /* moved_far of the remap with landmarks pinned */
+    int pfar;                     /* moved_far of the remap with landmarks dragged */
     unsigned char *kept;
     int *face, *pface;
     double *w, *pw;
@@ -332,10 +495,10 @@ static void rows(bmap *R, const fold__patch *p, int *face, double *w, int save)
     }
 }
 
-/* Remaps every taken region (landmarks pinned or not); -1 when out of memory. */
-static int remap_all(ctx *c, taken *tk, int ntaken, int pin_landmarks)
+/* Remaps every taken region (landmarks dragged or free); -1 when out of memory. */
+static int remap_all(ctx *c, taken *tk, int ntaken, int drag_landmarks)
 {
-    c->pin_landmarks = pin_landmarks;
+    c->drag_landmarks = drag_landmarks;
     for (int k = 0; k < ntaken; k++) {
         for (int i = 0; i < tk[k].p.nv; i++)
             c->keep[tk[k].p.verts[i]] = tk[k].kept[i];
@@ -357,14 +520,6 @@ static long badness(const fold__patch *p, const unsigned char *kind)
     for (int q = 0; q < p->nf; q++)
         n += kind[p->faces[q]] == METRIC_FACE_COLLAPSED ? p->nf + 1 : kind[p->faces[q]] != 0;
     return n;
-}
-
-/* A point of T: row v of the map (face, w). */
-static void point(const mesh *T, int face, const double *w, double *x)
-{
-    const int *tf = T->f + 3 * face;
-    for (int d = 0; d < 3; d++)
-        x[d] = w[0] * T->v[3 * tf[0] + d] + w[1] * T->v[3 * tf[1] + d] + w[2] * T->v[3 * tf[2] + d];
 }
 
 /* Whether the region's remap (its rows in c->R against its old rows)
@@ -459,7 +614,7 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
         }
         rows(c->R, &r->p, r->face, r->w, 1);
     }
-    /* each region re-mapped with the landmarks pinned (kind2), then without
+    /* each region re-mapped with the landmarks dragged (kind2), then free
      * (kind3); the better of the three rows kept where it beats the old */
     if (remap_all(c, tk, ntaken, 1) || kinds(S, c->T, c->R, kind2) < 0)
         goto out;
@@ -529,7 +684,7 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     for (int v = 0; v < P->n; v++)
         if (P->face[v] < 0 || P->face[v] >= T->nf)
             return FOLD_EINVAL;
-    ctx c = { .S = S, .T = T };
+    ctx c = { .S = S, .T = T, .area_S = geo_total_area(S), .area_T = geo_total_area(T) };
     int rc = FOLD_ENOMEM;
     unsigned char *kind = malloc((size_t)S->nf + 1), *fx = calloc((size_t)S->nv + 1, 1);
     c.keep = malloc((size_t)S->nv + 1);
