@@ -82,9 +82,11 @@
       "RHM harmonic vs reversibility weight")                                                    \
     X(rhm_landmark_weight, "rhm-landmark-weight", F64, 0, 0, INFINITY, 0, RHM, gamma, "",        \
       "RHM weak landmark term weight (0: off)")                                                  \
-    X(start, "start", ENUM, 0, 0, 2, 0, RHM, start, "distances|voronoi|fmap",                    \
+    X(start, "start", ENUM, 3, 0, 3, 0, RHM, start, "distances|voronoi|fmap|auto",               \
       "start map from landmarks (before RHM): distances to the landmarks, the thesis' geodesic " \
-      "Voronoi cells, or a functional map from landmark descriptors made precise by DDM")        \
+      "Voronoi cells, a functional map from landmark descriptors made precise by DDM, or auto: " \
+      "distances, and when RHM's maps from it are folded (over 5 % of the triangles flipped or " \
+      "collapsed) the functional map too, the less folded kept")                                \
     X(backend, "backend", STR, 0, 0, 0, 0, NONE, backend, "cpu|opencl|auto",                     \
       "elastic energy on the CPU, an OpenCL device, or auto (a GPU, else the CPU); "             \
       "\"\" = the server's default (cpu); on the wire optionally :DEVICE")                     \

@@ -88,7 +88,7 @@ static const pair_spec pairs[] = {
 
 enum { VORONOI, RHM, ECTM, NSTAGES };
 static const char *const stage_name[NSTAGES] = { "start", "rhm", "rhm+ectm" };
-static int start_kind = RHM_START_DISTANCES;   /* --start */
+static int start_kind = RHM_START_AUTO;        /* --start */
 
 /* One pair's figures: plain data, sent from the pair's process through a pipe. */
 typedef struct pair_fig {

@@ -6,10 +6,13 @@
  * tosca_hires/Corrs/wolf.pid given; dense identity ground truth scored).
  *
  * Stages as meshcorr match runs them with its defaults: the start map
- * (rebuilt by the RHM internals rhm_run begins with), RHM (rhm_run), the
- * fold repair of its maps (corr_repair), ECTM from the repaired maps
- * (corr_run with stages ectm) and the repair of its maps: the calls
- * corr_run makes for stages all.
+ * (rebuilt by the RHM internals rhm_run begins with: with start auto the
+ * distances start), RHM and the fold repair of its maps (corr_rhm, with
+ * start auto's second run from the functional map when the repaired maps
+ * stay folded; the line after it names the start kept; the rhm row is
+ * the kept map before its repair, the time of both in that row), ECTM
+ * from the repaired maps (corr_run with stages ectm) and the repair of
+ * its maps: the calls corr_run makes for stages all.
  *
  * Per pair and stage, both meshes at unit area: held-out error (mean
  * geodesic distance on the target from each held-out source landmark's
@@ -201,26 +204,24 @@ static void run_pair(const void *arg, void *out)
 
     /* the pipeline's calls one by one (corr_run): RHM, the fold repair, ECTM */
     corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+    /* RHM and its repair (with start auto's second run when the first
+     * stays folded): corr_rhm, timed as one; the RHM row is its kept
+     * forward map before the repair */
     t0 = now();
-    if (rhm_run(S, T, L, &rp, NULL, NULL, &rr, err, sizeof err))
+    fold_report rep[2];
+    if (corr_rhm(&in, &rp, NULL, NULL, &rr, &rhm_P, rep, err, sizeof err))
         goto score;
     fig->secs[RHM] = now() - t0;
-    if (!(rhm_P = bmap_new(rr.P12->n, rr.P12->nt)))
-        FAILF("out of memory");
-    memcpy(rhm_P->face, rr.P12->face, sizeof(int) * (size_t)rr.P12->n);
-    memcpy(rhm_P->w, rr.P12->w, sizeof(double) * 3 * (size_t)rr.P12->n);
+    fig->secs[REPAIR] = 0;
     maps[fig->nmaps++] = rhm_P;
-    printf("  %s: rhm %.0f s\n", ps->label, fig->secs[RHM]);
+    char kept[32];
+    proto_param_value_name(PROTO_P_start, (unsigned)rr.start, kept, sizeof kept);
+    printf("  %s: rhm and repair %.0f s, from the %s start; repair %d -> %d bad faces (%d "
+           "vertices relaxed), reverse %d -> %d\n", ps->label, fig->secs[RHM], kept,
+           rep[0].bad_before, rep[0].bad_after, rep[0].region, rep[1].bad_before, rep[1].bad_after);
     fflush(stdout);
     if (job->last == RHM)
         goto score;
-    t0 = now();
-    fold_report rep[2];
-    if (corr_repair(&in, rr.P12, rr.P21, rep, err, sizeof err))
-        goto score;
-    fig->secs[REPAIR] = now() - t0;
-    printf("  %s: repair %d -> %d bad faces (%d vertices relaxed), reverse %d -> %d\n", ps->label,
-           rep[0].bad_before, rep[0].bad_after, rep[0].region, rep[1].bad_before, rep[1].bad_after);
     maps[fig->nmaps++] = rr.P12;
     if (job->last == REPAIR)
         goto score;

@@ -2,8 +2,8 @@
  * meshcorrd, meshcorr-worker and libmeshcorr: a job with stages ddm
  * streams the ddm stage and returns the in-process pipeline's map (the
  * same Draco-decoded meshes and map); ddm,ectm streams ddm then ECTM and
- * completes; a chain that cannot run (ddm with no map) is refused before
- * SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
+ * completes; a chain that cannot run (ddm with no map) and a basis larger
+ * than the meshes allow are refused before SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
  * stretched and bent, the map a vertex map sent as weight-1 rows. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
@@ -182,6 +182,23 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     int rc = mc_submit(c, &s, &id);
     CHECK_INT(rc, PROTO_EBAD_LANDMARKS);   /* the protocol's number */
     CHECK_STR_HAS(mc_errmsg(c), "params.stages: the DDM stage denoises a given map");
+    CHECK_INT(id, 0);
+    /* a basis larger than the decoded meshes allow (162 vertices: at most
+     * 160): refused before SUBMIT_OK, naming the parameter and the limit */
+    spec_of(&p, MC_STAGES_DDM, 1, &s);
+    s.ddm_k = 161;
+    id = 0;
+    CHECK_INT(mc_submit(c, &s, &id), PROTO_EBAD_PARAMS);
+    CHECK_STR_HAS(mc_errmsg(c), "params.ddm_k = 161: DDM's basis holds at most vertices - 2 = 160");
+    CHECK_INT(id, 0);
+    /* and ZoomOut's, from landmarks with the functional-map start */
+    spec_of(&p, MC_STAGES_ALL, 0, &s);
+    s.landmarks = lm;
+    s.nlandmarks = 4;
+    s.start = MC_START_FMAP;
+    s.zoomout = 200;
+    CHECK_INT(mc_submit(c, &s, &id), PROTO_EBAD_PARAMS);
+    CHECK_STR_HAS(mc_errmsg(c), "params.zoomout = 200: a basis holds at most vertices - 2 = 160");
     CHECK_INT(id, 0);
     /* the stages value is one of the list: 8 is refused by the validator */
     spec_of(&p, 8, 1, &s);

@@ -192,7 +192,7 @@ TEST(values_parse_from_text_by_type)
     CHECK_STR(err, "'abc' is not a number");
     CHECK_INT(proto_param_parse(&w, PROTO_P_iterations, "1.5", err, sizeof err), PROTO_EBAD_PARAMS);
     CHECK_INT(proto_param_parse(&w, PROTO_P_start, "cells", err, sizeof err), PROTO_EBAD_PARAMS);
-    CHECK_STR(err, "'cells' is not distances, voronoi or fmap");
+    CHECK_STR(err, "'cells' is not distances, voronoi, fmap or auto");
     char line[1024];
     proto_params_format(&w, line, sizeof line);
     CHECK_STR_HAS(line, "model=injective partial=0 alpha=25 ");

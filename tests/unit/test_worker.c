@@ -339,19 +339,26 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     CHECK_INT(wait_exit(pid), 0);
     proto_progress pr[16];
     int np = progress_frames(pbuf, plen, pr, 16);
-    /* init, the start map, 3 RHM iterations, 2 ECTM iterations */
-    CHECK_INT(np, 7);
+    /* init; the start map and 3 RHM iterations, twice: after 3 iterations
+     * from 8 landmarks the distances start's maps are still folded (over
+     * 5 % of the triangles), so start auto (the default) runs RHM again
+     * from the functional-map start and keeps the less folded; then 2 ECTM
+     * iterations */
+    CHECK_INT(np, 11);
     CHECK_INT(pr[0].stage, PROTO_STAGE_INIT);
-    CHECK_INT(pr[1].stage, PROTO_STAGE_START);
-    CHECK_INT(pr[1].outer, 0);
-    for (int k = 2; k <= 4; k++) {
-        CHECK_INT(pr[k].stage, PROTO_STAGE_RHM);
-        CHECK_INT(pr[k].outer, k - 1);
-        CHECK_INT(pr[k].total, 3);
-        CHECK(isfinite(pr[k].terms[0][PROTO_TERM_ENERGY]) && pr[k].terms[0][PROTO_TERM_ENERGY] > 0);
+    for (int run = 0; run < 2; run++) {
+        const proto_progress *q = pr + 1 + 4 * run;
+        CHECK_INT(q[0].stage, PROTO_STAGE_START);
+        CHECK_INT(q[0].outer, 0);
+        for (int k = 1; k <= 3; k++) {
+            CHECK_INT(q[k].stage, PROTO_STAGE_RHM);
+            CHECK_INT(q[k].outer, k);
+            CHECK_INT(q[k].total, 3);
+            CHECK(isfinite(q[k].terms[0][PROTO_TERM_ENERGY]) && q[k].terms[0][PROTO_TERM_ENERGY] > 0);
+        }
     }
-    CHECK_INT(pr[5].stage, PROTO_STAGE_ECTM);
-    CHECK_INT(pr[6].outer, 2);
+    CHECK_INT(pr[9].stage, PROTO_STAGE_ECTM);
+    CHECK_INT(pr[10].outer, 2);
     free(pbuf);
     proto_msg m;
     unsigned char *file;

@@ -4,6 +4,7 @@
 #include "corr/corr.h"
 #include "corr/corr__ddm.h"
 #include "mesh/mesh_check.h"
+#include "metric/metric.h"
 #include "util/errbuf.h"
 
 #include <string.h>
@@ -115,6 +116,76 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char
     return CORR_OK;
 }
 
+/* The share of bad triangles (flipped plus collapsed) of the more folded
+ * of the two maps; 2 (worse than any) when it cannot be measured. */
+static double folded(const corr_input *in, const rhm_result *r)
+{
+    metric_summary m1, m2;
+    if (metric_summarize(in->S, in->T, r->P12, &m1) || metric_summarize(in->T, in->S, r->P21, &m2))
+        return 2;
+    double f1 = m1.flipped_fraction + m1.collapsed_fraction;
+    double f2 = m2.flipped_fraction + m2.collapsed_fraction;
+    return f1 > f2 ? f1 : f2;
+}
+
+/* One RHM run from q and its repair; raw: a copy of P12 before it. */
+static int rhm_repaired(const corr_input *in, const rhm_params *q, rhm_progress_fn progress,
+                        void *ctx, rhm_result *out, bmap **raw, fold_report rep[2], char *err,
+                        size_t errsz)
+{
+    int rc = rhm_run(in->S, in->T, in->L, q, progress, ctx, out, err, errsz);
+    if (rc)
+        return from_rhm(rc);
+    if (raw) {
+        if (!(*raw = bmap_new(out->P12->n, out->P12->nt)))
+            return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory");
+        memcpy((*raw)->face, out->P12->face, sizeof(int) * (size_t)out->P12->n);
+        memcpy((*raw)->w, out->P12->w, sizeof(double) * 3 * (size_t)out->P12->n);
+    }
+    return corr_repair(in, out->P12, out->P21, rep, err, errsz);
+}
+
+int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
+             rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz)
+{
+    memset(out, 0, sizeof *out);
+    if (raw)
+        *raw = NULL;
+    rhm_params q = *rp;
+    int autos = q.start == RHM_START_AUTO;
+    if (autos)
+        q.start = RHM_START_DISTANCES;
+    int rc = rhm_repaired(in, &q, progress, ctx, out, raw, rep, err, errsz);
+    double bad = rc ? 2 : folded(in, out);
+    if (rc || !autos || metric_verdict(bad, 0) == METRIC_VERDICT_OK)
+        return rc;
+    q.start = RHM_START_FMAP;
+    rhm_result alt;
+    bmap *raw2 = NULL;
+    fold_report rep2[2];
+    char why[1024];
+    rc = rhm_repaired(in, &q, progress, ctx, &alt, raw ? &raw2 : NULL, rep2, why, sizeof why);
+    if (rc == CORR_ECANCELED || rc == CORR_ENOMEM) {
+        rhm_result_close(&alt);
+        bmap_free(raw2);
+        return errbuf_set(err, errsz, rc, "%s", why);
+    }
+    if (rc == CORR_OK && folded(in, &alt) < bad) {     /* keep the functional map's */
+        rhm_result t = *out;
+        *out = alt;
+        alt = t;
+        if (raw) {
+            bmap *b = *raw;
+            *raw = raw2;
+            raw2 = b;
+        }
+        memcpy(rep, rep2, sizeof rep2);
+    }
+    rhm_result_close(&alt);
+    bmap_free(raw2);
+    return CORR_OK;
+}
+
 static int from_ectm(int rc)
 {
     switch (rc) {
@@ -125,6 +196,25 @@ static int from_ectm(int rc)
     case ECTM_EMESH: return CORR_EMESH;
     default: return CORR_EFAILED;
     }
+}
+
+int corr_check_sizes(const corr_input *in, char *err, size_t errsz)
+{
+    const mesh *S = in->S, *T = in->T;
+    int most = (S->nv < T->nv ? S->nv : T->nv) - 2;
+    unsigned run = corr_stages_run(in->stages, !!in->P0);
+    if ((run & CORR_RUN_DDM) && in->ddm_k > most)
+        return errbuf_set(err, errsz, CORR_EINPUT,
+                          "params.ddm_k = %d: DDM's basis holds at most vertices - 2 = %d "
+                          "eigenfunctions here (%s: %d vertices, %s: %d)",
+                          in->ddm_k, most, in->S_name, S->nv, in->T_name, T->nv);
+    const rhm_params *rp = in->rhm;
+    if ((run & CORR_RUN_RHM) && !in->P0 && rp && rp->start == RHM_START_FMAP && rp->zoomout > most)
+        return errbuf_set(err, errsz, CORR_EINPUT,
+                          "params.zoomout = %d: a basis holds at most vertices - 2 = %d "
+                          "eigenfunctions here (%s: %d vertices, %s: %d)",
+                          rp->zoomout, most, in->S_name, S->nv, in->T_name, T->nv);
+    return CORR_OK;
 }
 
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
@@ -145,7 +235,8 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         rhm_params_init(&rp);
     int bij = p->model == ECTM_BIJECTIVE;
     if ((rc = corr_stages_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
-                                rp.gamma, in->ddm_mode, err, errsz)))
+                                rp.gamma, in->ddm_mode, err, errsz)) ||
+        (rc = corr_check_sizes(in, err, errsz)))
         return rc;
     unsigned run = corr_stages_run(in->stages, !!in->P0);
     if ((run & CORR_RUN_RHM) && rhm_params_check(&rp, err, errsz))
@@ -174,14 +265,13 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
                 goto done;
             }
         }
-        rc = P ? rhm_run_from_maps(in->S, in->T, in->L, P, Q, &rp, relay_rhm, &rl, &init, err, errsz)
-               : rhm_run(in->S, in->T, in->L, &rp, relay_rhm, &rl, &init, err, errsz);
-        if (rc) {
-            rc = from_rhm(rc);
-            goto done;
-        }
         fold_report rep[2];
-        if ((rc = corr_repair(in, init.P12, init.P21, rep, err, errsz)))
+        if (P) {
+            if ((rc = from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, &rp, relay_rhm, &rl,
+                                                 &init, err, errsz))) ||
+                (rc = corr_repair(in, init.P12, init.P21, rep, err, errsz)))
+                goto done;
+        } else if ((rc = corr_rhm(in, &rp, relay_rhm, &rl, &init, NULL, rep, err, errsz)))
             goto done;
         if (!(run & CORR_RUN_ECTM)) {
             out->P = init.P12;

@@ -129,6 +129,31 @@ typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
+/* The sizes a job's meshes bound: DDM's basis (in->ddm_k, when the chain
+ * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM starts from the
+ * functional map) hold at most vertices - 2 eigenfunctions of either mesh.
+ * CORR_OK, or CORR_EINPUT with the parameter and both meshes named.
+ * corr_run checks it first; the check of a job where it is built (the
+ * daemon's of a SUBMIT) calls it too, so such a job is refused before it
+ * is queued. */
+int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
+
+/* RHM from the landmarks as the pipeline runs it: rhm_run from rp, then
+ * the fold repair of its maps (corr_repair, rep). Start auto (the
+ * default): from the distances start, and when the repaired maps are still
+ * folded (metric_verdict: over 5 % of either map's triangles flipped or
+ * collapsed), RHM and the repair again from the functional-map start, the
+ * maps with the fewer bad triangles kept (out->start says which).
+ * Landmarks alone can leave the distances start mirrored on a part of a
+ * shape, and a wrong map folds: SHREC'07 plier 203 -> 214, held-out error
+ * 0.54 and 19 % flipped after the repair from distances, 0.026 and 0 %
+ * from fmap (tests/bench/bench_shrec07.c). A failure of the second run
+ * leaves the first maps; a cancel cancels. raw (may be NULL): a copy of
+ * the kept forward map before its repair (for benchmarks). progress:
+ * rhm_run's, the second run's reports from iteration 0 again. */
+int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
+             rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz);
+
 /* The fold repair the pipeline applies to RHM's maps and to ECTM's: fold_repair of P
  * (S -> T) and, when Q is not NULL, of Q (T -> S), the landmarks fixed
  * (in->L may be NULL), with fold_params_init's values. rep[0], rep[1]:

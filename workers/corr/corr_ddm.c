@@ -42,14 +42,9 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
 {
     *P = *Q = NULL;
     const mesh *S = in->S, *T = in->T;
-    int nmin = S->nv < T->nv ? S->nv : T->nv, k = in->ddm_k;
+    int nmin = S->nv < T->nv ? S->nv : T->nv, k = in->ddm_k;   /* in range: corr_check_sizes */
     if (k == 0)
         k = CORR_DDM_K < nmin - 2 ? CORR_DDM_K : nmin - 2;
-    if (k < 1 || k > nmin - 2 || k > LBO_MAX_K)
-        return errbuf_set(err, errsz, CORR_EINPUT,
-                          "params.ddm_k = %d: DDM's basis holds at most vertices - 2 = %d "
-                          "eigenfunctions here (%s: %d vertices, %s: %d), and at most %d",
-                          k, nmin - 2, in->S_name, S->nv, in->T_name, T->nv, LBO_MAX_K);
     corr_ddm_report r = {0, Q0 ? 2 : 1, k, {0, 0}};
     if (report && report(ctx, &r))
         return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before DDM");

@@ -26,6 +26,9 @@ typedef struct wrk_job {
     bmap *P0, *Q0;                 /* NULL when absent */
     ectm_params params;
     rhm_params rhm;                /* for landmark jobs */
+    corr_stages stages;            /* the chain, DDM's basis and mode as sent */
+    int ddm_k;
+    corr_ddm_mode ddm_mode;
 } wrk_job;
 
 /* worker_job.c — the one mapping from a SUBMIT to a job: decodes both Draco
@@ -35,10 +38,14 @@ typedef struct wrk_job {
  * proto_params_check: BAD_PARAMS naming the field), checks that there are
  * landmarks or a map (and q only with p, bijective), builds the landmark set
  * (lmk_from_arrays: BAD_LANDMARKS) and the initial maps (bmap_check_row:
- * BAD_PARAMS). On error job is left closed. */
+ * BAD_PARAMS), and the sizes the meshes bound (corr_check_sizes: DDM's and
+ * ZoomOut's bases, BAD_PARAMS). On error job is left closed. */
 int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
                         char *err, size_t errsz);
 void wrk_job_close(wrk_job *job);
+/* The job as corr_run's input (pointers into job; the meshes named
+ * "source mesh" and "target mesh", as in every message of a job). */
+void wrk_job_input(const wrk_job *job, corr_input *in);
 
 /* worker_io.c — the spool files. wrk_frame_read reads path whole and decodes
  * one frame filling it exactly (*buf holds the payload m borrows from; free

@@ -62,6 +62,21 @@ static int check_stages(const proto_submit *s, char *err, size_t errsz)
     return 0;
 }
 
+void wrk_job_input(const wrk_job *job, corr_input *in)
+{
+    *in = (corr_input){ job->S, job->T, "source mesh", "target mesh", job->L, job->P0, job->Q0,
+                        &job->rhm, job->stages, job->ddm_k, job->ddm_mode };
+}
+
+/* The sizes the decoded meshes bound (corr_check_sizes), as the run would
+ * find them at its start. */
+static int check_sizes(const wrk_job *job, char *err, size_t errsz)
+{
+    corr_input in;
+    wrk_job_input(job, &in);
+    return corr_check_sizes(&in, err, errsz) ? PROTO_EBAD_PARAMS : 0;
+}
+
 static int map_landmarks(const proto_submit *s, const mesh *S, const mesh *T, lmk_set **out,
                          char *err, size_t errsz)
 {
@@ -124,13 +139,17 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
         wrk_job_close(job);
         return rc == CORR_ENOMEM ? PROTO_ENOMEM : PROTO_EBAD_PARAMS;
     }
+    job->stages = (corr_stages)s->params.stages;
+    job->ddm_k = (int)s->params.ddm_k;
+    job->ddm_mode = (corr_ddm_mode)s->params.ddm_mode;
     if ((rc = check_inputs(s, err, errsz)) ||
         (rc = load_mesh(&s->source, "source mesh", lim, &job->S, err, errsz)) ||
         (rc = load_mesh(&s->target, "target mesh", lim, &job->T, err, errsz)) ||
         (rc = map_landmarks(s, job->S, job->T, &job->L, err, errsz)) ||
         (rc = map_map(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
         (rc = map_map(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
-        (rc = check_stages(s, err, errsz)))
+        (rc = check_stages(s, err, errsz)) ||
+        (rc = check_sizes(job, err, errsz)))
         wrk_job_close(job);
     return rc;
 }

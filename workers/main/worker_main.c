@@ -279,10 +279,8 @@ int main(int argc, char **argv)
         snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, SPOOL_PROGRESS_FILE);
         wrk_progress_connect(&ctx.pg, progress_tcp, secret_file);
     }
-    corr_input in = { job.S, job.T, "source mesh", "target mesh", job.L, job.P0, job.Q0,
-                      &job.rhm, (corr_stages)sub.u.submit.params.stages,
-                      (int)sub.u.submit.params.ddm_k,
-                      (corr_ddm_mode)sub.u.submit.params.ddm_mode };
+    corr_input in;
+    wrk_job_input(&job, &in);
     if (cancel_requested)
         rc = CORR_ECANCELED;
     else

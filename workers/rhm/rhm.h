@@ -15,8 +15,9 @@
  * mass; s_i: total area. All in the meshes' own units (the energy is
  * scale-invariant as written).
  *
- * Start from the landmarks (p_r on M1, q_r on M2, r = 1..nl), two kinds:
- *  - distances (the default): every vertex described by its geodesic
+ * Start from the landmarks (p_r on M1, q_r on M2, r = 1..nl), three kinds
+ * and a rule among them:
+ *  - distances: every vertex described by its geodesic
  *    distances to the landmarks of its side, divided by √(area); P12 row v
  *    = the closest point to v's description on M2 with M2's descriptions as
  *    vertex coordinates (an exact projection in R^nl, proj.h), P21 the same
@@ -32,6 +33,10 @@
  *    landmark is nearest to v in M2's embedding (the nearest neighbour of v
  *    among the images T12(V1), which are exactly the target landmarks; ties
  *    to the lower landmark index); X_ij = P_ij X_j.
+ *  - fmap: a functional map from the landmarks' descriptors (Δ + D_N
+ *    commutativity, fmap.h), made precise by DDM's deblurring.
+ *  - auto (the default): a rule of the pipeline, which repairs RHM's
+ *    maps (corr_rhm, corr.h); rhm_run runs the distances start for it.
  *
  * Iteration k = 1..K (Algorithm 3.1), β_k = beta_step·min(k, beta_ramp):
  * for i = 1, 2: P_ij <- projection, X_ij <- sparse linear solve. Each block
@@ -80,7 +85,9 @@ const char *rhm_strerror(int code);
 typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
     RHM_START_VORONOI = 1,     /* the thesis' geodesic Voronoi map          */
-    RHM_START_FMAP = 2         /* functional map (Δ + D_N) deblurred by DDM */
+    RHM_START_FMAP = 2,        /* functional map (Δ + D_N) deblurred by DDM */
+    RHM_START_AUTO = 3         /* the pipeline's rule (corr_rhm); rhm_run
+                                  runs distances for it                    */
 } rhm_start;
 /* Their names are the values of start in PROTO_PARAMS (proto_params.h):
  * proto_param_value_name, proto_param_parse. */
@@ -105,7 +112,7 @@ typedef struct rhm_params {
 
 /* The authors' release: α = 5e-4, β = 5e-3·min(k, 100), γ = 0, m = 8,
  * K = 200, stop when the relative change is below 1e-9 after iteration 110;
- * start: distances (ours, see above). */
+ * start: auto (ours, see above). */
 void rhm_params_init(rhm_params *p);
 /* 0 or RHM_EPARAM with the offending field named in err (zoomout from 1 to
  * RHM_FMAP_K: ZoomOut only grows the start's basis). */
@@ -136,11 +143,15 @@ typedef struct rhm_result {
     bmap *P12;             /* M1 -> M2 (ECTM's P0)                          */
     bmap *P21;             /* M2 -> M1 (ECTM's Q0)                          */
     rhm_report last;
+    int start;             /* the start the maps came from (rhm_run: auto
+                              is distances; corr_rhm: the one kept); -1
+                              from given maps                             */
 } rhm_result;
 void rhm_result_close(rhm_result *r);
 
 /* Runs RHM from the landmark pairs L (L->src on S = M1, L->tgt on T = M2,
- * at least PROTO_MIN_LANDMARKS). The meshes must be validated (manifold,
+ * at least PROTO_MIN_LANDMARKS), from p->start (auto: distances). The
+ * meshes must be validated (manifold,
  * connected, no degenerate face). Errors: RHM_EPARAM, RHM_EINPUT,
  * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC; detail in err. */
 int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,

@@ -68,6 +68,7 @@ int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap
                       rhm_result *out, char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
+    out->start = -1;
     double t0 = rhm__now();
     int rc;
     if (!P12)

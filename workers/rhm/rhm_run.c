@@ -77,6 +77,8 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
         return rc;
     if (!(rc = rhm__init_start(pb, err, errsz)))
         rc = rhm__iterate(pb, t0, progress, ctx, out, err, errsz);
+    if (!rc)
+        out->start = p->start == RHM_START_AUTO ? RHM_START_DISTANCES : p->start;
     rhm__problem_free(pb);
     return rc;
 }
