@@ -356,6 +356,7 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
     terms->mismatch = st.mismatch;
     terms->reverse = st.reverse;
     terms->inner_iterations = os.iterations;
+    terms->evaluations = os.evaluations;
     terms->admissible_edges = st.admissible;
     terms->energy = f;
     return ECTM_OK;

@@ -82,6 +82,7 @@ typedef struct ectm_terms {
                               that depends on this direction's deformation  */
     double energy;         /* α·w_mem + η·w_bnd + mismatch + reverse        */
     int inner_iterations;  /* L-BFGS iterations of this direction's Y-step  */
+    int evaluations;       /* energy + gradient evaluations of that Y-step  */
     int admissible_edges;
 } ectm_terms;
 
