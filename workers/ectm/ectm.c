@@ -114,6 +114,13 @@ typedef struct side {
     double *resid;        /* scratch: per row of the other map, residual (3) */
     double *Zq;           /* scratch: projection embedding / queries         */
     double *Zt;
+    /* The Y-step's L-BFGS pairs, kept from one outer iteration to the next
+     * (β and the maps change little between them), and the β they are
+     * exact for: the β term's Hessian is 2β·M, so a new β moves every y by
+     * 2Δβ·M·s (opt_memory_add_diagonal with mass3 = M per coordinate). */
+    opt_memory *mem;
+    double mem_beta;
+    double *mass3;
 } side;
 
 static void side_close(side *s)
@@ -133,6 +140,8 @@ static void side_close(side *s)
     free(s->resid);
     free(s->Zq);
     free(s->Zt);
+    opt_memory_free(s->mem);
+    free(s->mass3);
 }
 
 static double now(void)
@@ -172,9 +181,15 @@ static int side_open(side *s, const mesh *in, int partial, const ener_def_params
     s->PY = malloc(sizeof(double) * (n3 + 1));
     s->tr_start = malloc(sizeof(int) * ((size_t)s->X->nv + 2));
     s->Zq = malloc(sizeof(double) * ((size_t)s->X->nv * 6 + 1));
-    if (!s->mass || !s->Y || !s->PX || !s->PY || !s->tr_start || !s->Zq)
+    s->mass3 = malloc(sizeof(double) * (n3 + 1));
+    opt_params op;
+    opt_params_init(&op);
+    s->mem = opt_memory_new((int)n3, op.memory);
+    if (!s->mass || !s->Y || !s->PX || !s->PY || !s->tr_start || !s->Zq || !s->mass3 || !s->mem)
         return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory for the %s mesh", which);
     geo_vertex_areas(s->X, s->mass);
+    for (size_t i = 0; i < n3; i++)
+        s->mass3[i] = s->mass[i / 3];
     return ECTM_OK;
 }
 
@@ -276,7 +291,8 @@ static double ystep_eval(void *ctx, const double *Y, double *g, int n3)
 }
 
 /* After each accepted L-BFGS iteration: refresh the admissible edge set (the
- * paper's rule); the energy changed, so the solver's memory restarts. */
+ * paper's rule); when it changed, so did the energy: the solver evaluates
+ * it again at Y. */
 static int ystep_iter(void *ctx, const double *Y, double fx, double gnorm, int iter)
 {
     (void)fx; (void)gnorm; (void)iter;
@@ -284,7 +300,7 @@ static int ystep_iter(void *ctx, const double *Y, double fx, double gnorm, int i
     int count = ener_backend_update_admissible(st->a->def, Y);
     if (count != st->admissible) {
         st->admissible = count;
-        return OPT_ITER_RESTART;
+        return OPT_ITER_CHANGED;
     }
     return OPT_ITER_GO;
 }
@@ -341,7 +357,10 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
     op.gtol = pr->p.tolerance;
     opt_stats os;
     int n3 = a->X->nv * 3;
-    int rc = opt_minimize(n3, a->Y, ystep_eval, ystep_iter, &st, &op, &os);
+    if (beta != a->mem_beta)
+        opt_memory_add_diagonal(a->mem, a->mass3, 2 * (beta - a->mem_beta));
+    a->mem_beta = beta;
+    int rc = opt_minimize(n3, a->Y, ystep_eval, ystep_iter, &st, &op, a->mem, &os);
     if (rc == OPT_ENOMEM)
         return ECTM_ENOMEM;
     if (rc == OPT_ENONFINITE)
