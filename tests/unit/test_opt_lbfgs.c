@@ -163,6 +163,24 @@ TEST(lbfgs_warm_memory_saves_evaluations_for_the_same_minimiser)
     opt_memory_free(m);
 }
 
+TEST(lbfgs_stops_when_an_iteration_gains_little_of_the_total)
+{
+    double x[4] = {-1.2, 1, -1.2, 1}, y[4] = {-1.2, 1, -1.2, 1}, g[4];
+    double f0 = rosen(NULL, x, g, 4);
+    opt_params p;
+    opt_params_init(&p);
+    p.max_iter = 500;
+    opt_stats full, part;
+    CHECK_INT(opt_minimize(4, x, rosen, NULL, NULL, &p, NULL, &full), OPT_OK);
+    p.rel_decrease = 0.01;
+    CHECK_INT(opt_minimize(4, y, rosen, NULL, NULL, &p, NULL, &part), OPT_OK);
+    CHECK(part.stalled && !full.stalled);
+    CHECK(part.iterations < full.iterations);
+    CHECK(part.f < f0);
+    p.rel_decrease = 1;
+    CHECK_INT(opt_minimize(4, y, rosen, NULL, NULL, &p, NULL, &part), OPT_EPARAM);
+}
+
 TEST(lbfgs_memory_of_another_size_is_refused)
 {
     double x[4] = {0};

@@ -328,6 +328,16 @@ static void pstep(side *a, const side *b, double beta, double gamma, int bijecti
     bmap_apply(a->P, b->X->f, b->X->v, 3, a->PX);
 }
 
+/* A Y-step stops when one L-BFGS iteration lowers its energy by less than
+ * this fraction of what the step has gained so far (or after
+ * inner_iterations). With pairs kept across outer iterations, the later
+ * iterations of a Y-step gain little that the next outer iteration would
+ * not: on the authors' demo (381 -> 390, 300 iterations) 0.05 takes 22.5
+ * evaluations per outer iteration instead of 107 with all 50 iterations, at
+ * final energy 23.57 (23.43 with 50) and uv distance to the authors' result
+ * 0.0039 (0.0023); 0.1 drifts to 0.0052, 0.03 gives 0.0029 with 28.4. */
+#define ECTM_INNER_REL_DECREASE 0.05
+
 typedef struct pair {
     side s[2];
     ectm_params p;
@@ -355,6 +365,7 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
     opt_params_init(&op);
     op.max_iter = pr->p.inner_iterations;
     op.gtol = pr->p.tolerance;
+    op.rel_decrease = ECTM_INNER_REL_DECREASE;
     opt_stats os;
     int n3 = a->X->nv * 3;
     if (beta != a->mem_beta)

@@ -29,6 +29,7 @@ void opt_params_init(opt_params *p)
     p->max_iter = 50;
     p->gtol = 1e-8;
     p->memory = 6;
+    p->rel_decrease = 0;
     p->max_restarts = 2;
 }
 
@@ -198,6 +199,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
                  const opt_params *p, opt_memory *mem, opt_stats *st)
 {
     if (n <= 0 || p->max_iter < 1 || !(p->gtol > 0) || p->memory < 1 || p->max_restarts < 0 ||
+        !(p->rel_decrease >= 0 && p->rel_decrease < 1) ||
         (mem && mem->n != n))
         return OPT_EPARAM;
     memset(st, 0, sizeof *st);
@@ -211,6 +213,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
         rc = OPT_ENONFINITE;
         goto done;
     }
+    double f0 = f;
     while (st->iterations < p->max_iter) {
         double gnorm = sqrt(dot(g, g, n)), xnorm = sqrt(dot(x, x, n));
         if (gnorm < p->gtol * (xnorm > 1 ? xnorm : 1)) {
@@ -245,6 +248,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
             continue;
         }
         steepest = 0;
+        int stall = f - ft < p->rel_decrease * (f0 - ft);
         remember(mem, x, g);
         memcpy(x, xt, sizeof(double) * (size_t)n);
         memcpy(g, gt, sizeof(double) * (size_t)n);
@@ -263,7 +267,12 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
                     rc = OPT_ENONFINITE;
                     break;
                 }
+                f0 += f - ft;   /* the decrease so far is the solver's, not the change's */
             }
+        }
+        if (stall) {
+            st->stalled = 1;
+            break;
         }
     }
     if (!st->converged && rc == OPT_OK) {

@@ -43,6 +43,9 @@ typedef struct opt_params {
     double gtol;        /* stop when |g| < gtol·max(1, |x|) (default 1e-8, > 0) */
     int memory;         /* correction pairs of a solve without opt_memory
                            (default 6, >= 1)                               */
+    double rel_decrease; /* stop when an iteration lowers f by less than this
+                           fraction of the decrease since the solve began
+                           (default 0: never, >= 0, < 1)                   */
     int max_restarts;   /* retries along −g after a failed line search
                            before giving up (default 2, >= 0)              */
 } opt_params;
@@ -56,6 +59,7 @@ typedef struct opt_stats {
                            (a failed line search, an uphill direction)     */
     int changes;        /* OPT_ITER_CHANGED answers of the callback */
     int converged;      /* gradient tolerance reached */
+    int stalled;        /* stopped by rel_decrease */
     double f;           /* energy at the returned x */
 } opt_stats;
 
