@@ -140,27 +140,61 @@ static void direction(opt_memory *m, const double *g, double gnorm, int steepest
             d[i] = -c * g[i];
         return;
     }
-    for (int i = 0; i < n; i++)
+    /* Each pass applies one pair's update and takes the dot product the
+     * next pair needs: count + 1 passes over d per loop instead of 2·count. */
+    int j = slot(m, 0);
+    double a = 0;
+    for (int i = 0; i < n; i++) {
         d[i] = -g[i];
-    for (int k = 0; k < m->count; k++) {
-        int j = slot(m, k);
-        const double *s = m->s + (size_t)j * n, *y = m->y + (size_t)j * n;
-        double a = m->rho[j] * dot(s, d, n);
-        m->alpha[j] = a;
-        for (int i = 0; i < n; i++)
-            d[i] -= a * y[i];
+        a += m->s[(size_t)j * n + i] * d[i];
     }
-    const double *y0 = m->y + (size_t)slot(m, 0) * n;
-    double h0 = 1.0 / (m->rho[slot(m, 0)] * dot(y0, y0, n));   /* sᵀy / yᵀy */
-    for (int i = 0; i < n; i++)
+    for (int k = 0; k < m->count; k++) {
+        j = slot(m, k);
+        a *= m->rho[j];
+        m->alpha[j] = a;
+        const double *y = m->y + (size_t)j * n;
+        const double *s1 = k + 1 < m->count ? m->s + (size_t)slot(m, k + 1) * n : NULL;
+        double next = 0;
+        if (s1) {
+#pragma omp simd reduction(+ : next)
+            for (int i = 0; i < n; i++) {
+                d[i] -= a * y[i];
+                next += s1[i] * d[i];
+            }
+        } else {
+            for (int i = 0; i < n; i++)
+                d[i] -= a * y[i];
+        }
+        a = next;
+    }
+    j = slot(m, 0);
+    const double *y0 = m->y + (size_t)j * n;
+    double h0 = 1.0 / (m->rho[j] * dot(y0, y0, n));   /* sᵀy / yᵀy */
+    j = slot(m, m->count - 1);
+    const double *yo = m->y + (size_t)j * n;
+    double b = 0;
+#pragma omp simd reduction(+ : b)
+    for (int i = 0; i < n; i++) {
         d[i] *= h0;
+        b += yo[i] * d[i];
+    }
     for (int k = m->count - 1; k >= 0; k--) {
-        int j = slot(m, k);
-        const double *s = m->s + (size_t)j * n, *y = m->y + (size_t)j * n;
-        double b = m->rho[j] * dot(y, d, n);
-        double c = m->alpha[j] - b;
-        for (int i = 0; i < n; i++)
-            d[i] += c * s[i];
+        j = slot(m, k);
+        double c = m->alpha[j] - m->rho[j] * b;
+        const double *sv = m->s + (size_t)j * n;
+        const double *y1 = k > 0 ? m->y + (size_t)slot(m, k - 1) * n : NULL;
+        double next = 0;
+        if (y1) {
+#pragma omp simd reduction(+ : next)
+            for (int i = 0; i < n; i++) {
+                d[i] += c * sv[i];
+                next += y1[i] * d[i];
+            }
+        } else {
+            for (int i = 0; i < n; i++)
+                d[i] += c * sv[i];
+        }
+        b = next;
     }
 }
 
