@@ -17,11 +17,13 @@
  *     8.60 s, 2 threads 8.36 s (1.03x).
  *   issue 16 (own L-BFGS, pairs kept across outer iterations, a Y-step stops
  *   at an iteration that gains < 5 % of the step's total): 300 iterations
- *   17.7 s lightly loaded (projections 5.0 s, L-BFGS 12.3 s), 34.1 s with
- *   three other benchmarks running (projections 16.6 s, L-BFGS 17.0 s);
- *   22.0 evaluations and 18.2 L-BFGS iterations per outer iteration, final
- *   energy 23.3596379, uv distance 0.00324; 30 iterations 1 thread 4.05 s,
- *   2 threads 3.60 s (1.12x, loaded). */
+ *   20.5 s with one other job running (projections 7.3 s, L-BFGS 12.8 s),
+ *   34.1 s with three (projections 16.6 s, L-BFGS 17.0 s); 22.0 evaluations
+ *   and 18.2 L-BFGS iterations per outer iteration, final energy
+ *   23.3596379, uv distance 0.00324; 30 iterations 1 thread 4.05 s,
+ *   2 threads 3.60 s (1.12x, loaded). The same before the two-loop's fused
+ *   passes (rounding only): 17.7 s (projections 5.0 s, L-BFGS 12.3 s), 22.5
+ *   evaluations, energy 23.56948296, uv distance 0.00392. */
 #include "support/harness.h"
 #include "support/testdemo.h"
 #include "ectm/ectm.h"
