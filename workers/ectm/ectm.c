@@ -337,8 +337,10 @@ static void pstep(side *a, const side *b, double beta, double gamma, int bijecti
  * distance to the authors' result 0.0033): all 50 iterations with kept pairs
  * 106.9, 23.428, 0.0023; 0.02: 23.745, 0.0027; 0.03: 28.4, 23.278, 0.0029;
  * 0.05: 22.5, 23.569, 0.0039 (22.0, 23.360, 0.0032 after a change of
- * rounding only: the final energy moves by ~1 % with rounding); 0.1: 15.8,
- * 23.866, 0.0052 (too far). */
+ * rounding only: the final energy moves by ~1 % with rounding; 20.7,
+ * 23.507, 0.0037 once opt_memory_add_diagonal kept the pairs' order);
+ * 0.1: 15.8, 23.866, 0.0052 (too far). The 0.02-0.1 figures are from a
+ * build whose opt_memory_add_diagonal reordered the pairs. */
 #define ECTM_INNER_REL_DECREASE 0.05
 
 typedef struct pair {

@@ -108,24 +108,24 @@ static int slot(const opt_memory *m, int k)
 
 void opt_memory_add_diagonal(opt_memory *m, const double *d, double c)
 {
-    int kept = 0;
-    for (int k = m->count - 1; k >= 0; k--) {   /* oldest first: kept in order */
-        int from = slot(m, k);
-        double *s = m->s + (size_t)from * m->n, *y = m->y + (size_t)from * m->n;
-        for (int i = 0; i < m->n; i++)
+    /* Newest first; a pair that is no curvature pair any more ends the
+     * memory there (it and the older ones are dropped, the ring order
+     * stays). With c·d >= 0, as for a growing weight, none is dropped. */
+    for (int k = 0; k < m->count; k++) {
+        int j = slot(m, k);
+        const double *s = m->s + (size_t)j * m->n;
+        double *y = m->y + (size_t)j * m->n;
+        double ys = 0;
+        for (int i = 0; i < m->n; i++) {
             y[i] += c * d[i] * s[i];
-        double ys = dot(y, s, m->n);
-        if (!(ys > 0) || !isfinite(ys))
-            continue;                           /* no longer a curvature pair */
-        int to = kept++ % m->m;
-        if (to != from) {
-            memcpy(m->s + (size_t)to * m->n, s, sizeof(double) * (size_t)m->n);
-            memcpy(m->y + (size_t)to * m->n, y, sizeof(double) * (size_t)m->n);
+            ys += y[i] * s[i];
         }
-        m->rho[to] = 1.0 / ys;
+        if (!(ys > 0) || !isfinite(ys)) {
+            m->count = k;
+            break;
+        }
+        m->rho[j] = 1.0 / ys;
     }
-    m->count = kept;
-    m->head = kept % m->m;
 }
 
 /* d = −H·g by the two-loop recursion over the pairs held; −g/|g| (a unit
@@ -198,19 +198,22 @@ static void direction(opt_memory *m, const double *g, double gnorm, int steepest
     }
 }
 
-/* Stores s = xt − x, y = gt − g when sᵀy > 0. */
+/* Stores s = xt − x, y = gt − g when sᵀy > 0 (over the oldest pair when
+ * the memory is full; a pair that fails the test writes nothing). */
 static void remember(opt_memory *m, const double *x, const double *g)
 {
     const int n = m->n;
-    double *s = m->s + (size_t)m->head * n, *y = m->y + (size_t)m->head * n;
     double ys = 0;
+#pragma omp simd reduction(+ : ys)
+    for (int i = 0; i < n; i++)
+        ys += (m->xt[i] - x[i]) * (m->gt[i] - g[i]);
+    if (!(ys > 0) || !isfinite(ys))
+        return;
+    double *s = m->s + (size_t)m->head * n, *y = m->y + (size_t)m->head * n;
     for (int i = 0; i < n; i++) {
         s[i] = m->xt[i] - x[i];
         y[i] = m->gt[i] - g[i];
-        ys += s[i] * y[i];
     }
-    if (!(ys > 0) || !isfinite(ys))
-        return;
     m->rho[m->head] = 1.0 / ys;
     m->head = (m->head + 1) % m->m;
     if (m->count < m->m)
