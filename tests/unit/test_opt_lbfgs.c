@@ -181,6 +181,40 @@ TEST(lbfgs_stops_when_an_iteration_gains_little_of_the_total)
     CHECK_INT(opt_minimize(4, y, rosen, NULL, NULL, &p, NULL, &part), OPT_EPARAM);
 }
 
+/* A wrapped ring of pairs (more iterations than pairs), shifted by a zero
+ * diagonal: the next solve must take the very same steps as from the
+ * untouched copy (the pairs keep their order and values). */
+TEST(lbfgs_zero_diagonal_shift_leaves_a_wrapped_memory_as_it_was)
+{
+    enum { N = 30 };
+    double a[N] = {0}, b[N] = {0}, zero[N] = {0}, ones[N];
+    for (int i = 0; i < N; i++)
+        ones[i] = 1;
+    opt_params p;
+    opt_params_init(&p);
+    p.max_iter = 9;                       /* 9 pairs into a ring of 4 */
+    opt_memory *ma = opt_memory_new(N, 4), *mb = opt_memory_new(N, 4);
+    CHECK(ma && mb);
+    ramp r = {5.0, 0.3};
+    opt_stats st;
+    CHECK_INT(opt_minimize(N, a, ramped, NULL, &r, &p, ma, &st), OPT_OK);
+    CHECK_INT(opt_minimize(N, b, ramped, NULL, &r, &p, mb, &st), OPT_OK);
+    CHECK_INT(opt_memory_pairs(ma), 4);
+    opt_memory_add_diagonal(mb, zero, 0.0);
+    opt_memory_add_diagonal(mb, ones, 0.0);
+    CHECK_INT(opt_memory_pairs(mb), 4);
+    r.w = 6.0;
+    p.max_iter = 20;
+    CHECK_INT(opt_minimize(N, a, ramped, NULL, &r, &p, ma, &st), OPT_OK);
+    int ea = st.evaluations;
+    CHECK_INT(opt_minimize(N, b, ramped, NULL, &r, &p, mb, &st), OPT_OK);
+    CHECK_INT(st.evaluations, ea);
+    for (int i = 0; i < N; i++)
+        CHECK(a[i] == b[i]);
+    opt_memory_free(ma);
+    opt_memory_free(mb);
+}
+
 TEST(lbfgs_memory_of_another_size_is_refused)
 {
     double x[4] = {0};
