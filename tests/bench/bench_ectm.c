@@ -16,11 +16,12 @@
  *     energy 23.60194198, uv distance 0.00329; 30 iterations 1 thread
  *     8.60 s, 2 threads 8.36 s (1.03x).
  *   issue 16 (own L-BFGS, pairs kept across outer iterations, a Y-step stops
- *   at an iteration that gains < 5 % of the step's total), at a297172 + the
- *   fix of opt_memory_add_diagonal: 39.3 s with three other jobs running
- *   (projections 18.9 s, L-BFGS 19.4 s), 20.7 evaluations and 17.1 L-BFGS
- *   iterations per outer iteration, final energy 23.50718625, uv distance
- *   0.00366. Before that fix (pairs reordered, one corrected twice):
+ *   at an iteration that gains < 5 % of the step's total), at 7c2dcc1:
+ *   19.3 s under a load average of 6.6 (projections 7.6 s, L-BFGS 11.2 s;
+ *   39.3 s at another moment of that load), 20.7 evaluations and 17.1
+ *   L-BFGS iterations per outer iteration, final energy 23.50718625, uv
+ *   distance 0.00366; 30 iterations 1 thread 3.26 s, 2 threads 3.17 s
+ *   (1.03x). Before that fix (pairs reordered, one corrected twice):
  *   20.5 s with one other job running (projections 7.3 s, L-BFGS 12.8 s),
  *   34.1 s with three (projections 16.6 s, L-BFGS 17.0 s); 22.0 evaluations
  *   and 18.2 L-BFGS iterations per outer iteration, final energy
