@@ -246,6 +246,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
     double *g = mem->g, *d = mem->d, *xt = mem->xt, *gt = mem->gt;
     int rc = OPT_OK, failures = 0, steepest = 0;
     double f = evaluate(eval, ctx, x, g, n, st);
+    int at_x = 1;               /* the last evaluation was at x */
     if (!isfinite(f)) {
         rc = OPT_ENONFINITE;
         goto done;
@@ -270,6 +271,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
             for (int i = 0; i < n; i++)
                 xt[i] = x[i] + step * d[i];
             ft = evaluate(eval, ctx, xt, gt, n, st);
+            at_x = 0;
             /* strict decrease too: near the minimum the Armijo bound
              * rounds to f and would accept steps that change nothing */
             accepted = ft <= f + OPT_FTOL * step * gd && ft < f;   /* false for +inf */
@@ -290,6 +292,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
         memcpy(x, xt, sizeof(double) * (size_t)n);
         memcpy(g, gt, sizeof(double) * (size_t)n);
         f = ft;
+        at_x = 1;
         st->iterations++;
         if (iter) {
             int v = iter(ctx, x, f, sqrt(dot(g, g, n)), st->iterations);
@@ -300,6 +303,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
             if (v == OPT_ITER_CHANGED) {
                 st->changes++;
                 f = evaluate(eval, ctx, x, g, n, st);
+                at_x = 1;
                 if (!isfinite(f)) {
                     rc = OPT_ENONFINITE;
                     break;
@@ -317,6 +321,7 @@ int opt_minimize(int n, double *x, opt_eval_fn eval, opt_iter_fn iter, void *ctx
         st->converged = gnorm < p->gtol * (xnorm > 1 ? xnorm : 1);
     }
     st->f = f;
+    st->last_at_x = at_x;
 done:
     opt_memory_free(own);
     return rc;

@@ -60,6 +60,9 @@ typedef struct opt_stats {
     int changes;        /* OPT_ITER_CHANGED answers of the callback */
     int converged;      /* gradient tolerance reached */
     int stalled;        /* stopped by rel_decrease */
+    int last_at_x;      /* the last evaluation was at the returned x (not a
+                           rejected trial), so what eval left in its ctx
+                           describes x */
     double f;           /* energy at the returned x */
 } opt_stats;
 
