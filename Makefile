@@ -13,7 +13,7 @@ BUILD   ?= build
 
 CC      ?= cc
 CXX     ?= c++
-PKGS     = draco liblbfgs
+PKGS     = draco
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
 CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(BUILD)/gen

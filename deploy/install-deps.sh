@@ -8,7 +8,6 @@ PACKAGES="
 build-essential pkg-config g++
 libembree-dev
 libdraco-dev draco
-liblbfgs-dev
 libsuitesparse-dev liblapack-dev libarpack2-dev
 libcgal-demo
 ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd

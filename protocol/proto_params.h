@@ -68,7 +68,7 @@
     X(iterations, "iterations", U32, 300, 1, 1000000, 0, ECTM, iterations, "",                   \
       "outer iterations K")                                                                      \
     X(inner_iterations, "inner-iterations", U32, 50, 1, 100000, 0, ECTM, inner_iterations, "",  \
-      "L-BFGS iterations per Y-step")                                                            \
+      "L-BFGS iterations per Y-step at most")                                                    \
     X(tolerance, "tolerance", F64, 1e-8, 0, INFINITY, PROTO_PARAM_OPEN_MIN, ECTM, tolerance, "", \
       "L-BFGS gradient tolerance")                                                               \
     X(stop_change, "stop-change", F64, 0, 0, INFINITY, 0, ECTM, stop_change, "",                 \

@@ -5,6 +5,7 @@
  * no numerics. */
 #include "cli/cli.h"
 #include "cli/cli_job.h"
+#include "util/ompenv.h"
 #include "corr/corr.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
@@ -12,6 +13,7 @@
 #include "mesh/mesh.h"
 
 #include <getopt.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -241,6 +243,9 @@ int cli_match(int argc, char **argv)
     const char *src = argv[optind], *tgt = argv[optind + 1];
     if (!(S = load(src)) || !(T = load(tgt)) || cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
+    /* --threads, else as many as the pair's size pays for (as the worker) */
+    pe.threads = rp.threads = ompenv_threads_for(S->nv + T->nv, threads);
+    omp_set_num_threads(pe.threads);
     corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k,
                       (corr_ddm_mode)job.w.ddm_mode };
     if (corr_run(&in, &pe, on_progress, &ps, &res, err, sizeof err)) {

@@ -7,6 +7,10 @@
  * Locally injective model: E_inj = W_def(X,Y) + β‖PX̃ − Y‖²_X (no Q, Ỹ).
  * Each outer iteration k = 1..K: β_k from the schedule, then
  *   P ← projection, Y ← L-BFGS, (bijective:) Q ← projection, Ỹ ← L-BFGS.
+ * Each side's L-BFGS correction pairs are kept from one outer iteration to
+ * the next (corrected for the change of β), and a Y-step ends at
+ * inner_iterations or at the first iteration that gains less than 5 % of
+ * what the step has gained (ectm.c, ECTM_INNER_REL_DECREASE).
  * Both meshes are scaled to unit area first (not with `partial`, which
  * instead divides α by the source area s and β by s·s̃) and the outputs are
  * returned in the input frames.
@@ -49,7 +53,7 @@ typedef struct ectm_params {
     int beta_ramp;         /* iterations of the linear ramp                  */
     double gamma;          /* reversibility weight, bijective only           */
     int iterations;        /* outer iterations K                             */
-    int inner_iterations;  /* L-BFGS iterations per Y-step                   */
+    int inner_iterations;  /* L-BFGS iterations per Y-step at most          */
     double tolerance;      /* L-BFGS gradient tolerance                      */
     double stop_change;    /* stop when |ΔE|/E < this at fixed β; 0: never   */
     double log_eps;        /* −log extension threshold on det G       (> 0)  */
@@ -82,6 +86,7 @@ typedef struct ectm_terms {
                               that depends on this direction's deformation  */
     double energy;         /* α·w_mem + η·w_bnd + mismatch + reverse        */
     int inner_iterations;  /* L-BFGS iterations of this direction's Y-step  */
+    int evaluations;       /* energy + gradient evaluations of that Y-step  */
     int admissible_edges;
 } ectm_terms;
 

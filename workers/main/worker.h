@@ -16,7 +16,8 @@
 
 typedef struct wrk_limits {
     int max_vertices, max_faces;   /* per mesh, checked while decoding */
-    int threads;                   /* ectm_params.threads (0: all cores) */
+    int threads;                   /* ectm_params.threads (0: by the job's size,
+                                      ompenv_threads_for) */
 } wrk_limits;
 
 /* A job ready for corr_run; everything owned (wrk_job_close). */

@@ -3,8 +3,10 @@
  * Reads no files and runs no optimisation. */
 #include "main/worker.h"
 #include "util/errbuf.h"
+#include "util/ompenv.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -149,7 +151,15 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
         (rc = map_map(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
         (rc = map_map(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
         (rc = check_stages(s, err, errsz)) ||
-        (rc = check_sizes(job, err, errsz)))
+        (rc = check_sizes(job, err, errsz))) {
         wrk_job_close(job);
-    return rc;
+        return rc;
+    }
+    /* The job's size decides the threads unless the worker was given a
+     * count: before any parallel region, so a small job never starts a
+     * second one. */
+    int threads = ompenv_threads_for(job->S->nv + job->T->nv, lim->threads);
+    job->params.threads = job->rhm.threads = threads;
+    omp_set_num_threads(threads);
+    return 0;
 }

@@ -15,4 +15,15 @@
 
 void ompenv_ensure_passive(char **argv);
 
+/* Threads for a job whose two meshes have `vertices` vertices together:
+ * requested when > 0 (the user's choice, kept), else one thread per
+ * OMPENV_VERTICES_PER_THREAD vertices, at least 1 and at most the cores.
+ * A small job's passes over its elements take microseconds, less than
+ * waking a second thread at each of their barriers costs (issue 16: a
+ * 162-vertex pair, 2 iterations, 0.76 s with 2 threads against 0.26 s with
+ * 1). ompenv_threads.c; the caller passes the result to omp_set_num_threads
+ * and to the engines' thread parameters before the first parallel region. */
+#define OMPENV_VERTICES_PER_THREAD 2000
+int ompenv_threads_for(int vertices, int requested);
+
 #endif
