@@ -260,7 +260,7 @@ TEST_T(job_whose_worker_is_killed_twice_fails_as_crashed_twice_and_daemon_keeps_
     testdaemon d;
     testdaemon_start(&d, "crash", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = testdaemon_submit_ok(c, 1000, 1, 0);
+    uint64_t id = testdaemon_submit_ok(c, 100000, 1, 0);
     uint64_t next = testdaemon_submit_ok(c, 3, 0, 0);
     testdaemon_wait_state(c, id, MC_RUNNING, 10);
     pid_t w = testdaemon_worker_pid(&d, id);
@@ -288,8 +288,8 @@ TEST_T(cancel_ends_running_and_pending_jobs_cancelled, 60)
     testdaemon d;
     testdaemon_start(&d, "cancel", NULL);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t run = testdaemon_submit_ok(c, 1000, 1, 0);
-    uint64_t wait = testdaemon_submit_ok(c, 1000, 1, 0);
+    uint64_t run = testdaemon_submit_ok(c, 100000, 1, 0);
+    uint64_t wait = testdaemon_submit_ok(c, 100000, 1, 0);
     testdaemon_wait_state(c, run, MC_RUNNING, 10);
     CHECK_INT(mc_cancel(c, wait), 0);          /* pending: at once */
     mc_job_status s;

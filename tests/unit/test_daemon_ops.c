@@ -36,7 +36,7 @@ TEST_T(job_over_the_wall_time_limit_ends_timeout_with_a_reason, 60)
     const char *args[] = {"--job-timeout", "2", NULL};
     testdaemon_start(&d, "timeout", args);
     mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
-    uint64_t id = testdaemon_submit_ok(c, 1000, 1, 0);
+    uint64_t id = testdaemon_submit_ok(c, 100000, 1, 0);
     CHECK_INT(testdaemon_wait_state(c, id, -1, 20), MC_TIMEOUT);
     mc_job_status s;
     CHECK_INT(mc_status(c, id, &s), 0);
@@ -106,7 +106,7 @@ TEST_T(config_file_options_take_effect_and_an_unknown_key_names_file_and_line, 3
     CHECK_INT((int)st.workers, 1);
     mc_stats_free(&st);
     /* max-queue 1: with one job queued behind a running one, the next is refused */
-    uint64_t first = testdaemon_submit_ok(c, 1000, 1, 0);
+    uint64_t first = testdaemon_submit_ok(c, 100000, 1, 0);
     testdaemon_wait_state(c, first, MC_RUNNING, 10);
     testdaemon_submit_ok(c, 2, 0, 0);
     int rc;
