@@ -5,9 +5,11 @@
  * TOSCA_r isometric cat0->cat1 (about 100 units across: the engine is
  * scale-invariant), and the cartoon pairs homerA->homerB and headA->headB.
  *
- * Stages: the start map RHM begins with (rhm.h: by default from the
- * geodesic distances to the landmarks; --start=voronoi for the thesis'
- * Voronoi cells), RHM with rhm_params_init's values, then ECTM with
+ * Stages: the start map RHM begins with (rhm.h: by default start auto,
+ * whose first start is the geodesic distances to the landmarks, rebuilt
+ * here; --start=voronoi for the thesis' Voronoi cells), RHM with
+ * rhm_params_init's values (start auto: from the functional-map start too
+ * when the repaired maps from distances stay folded), then ECTM with
  * ectm_params_init's values from RHM's two maps: meshcorr match's
  * defaults. RHM and ECTM run through corr_run (stages rhm, then stages ectm
  * from RHM's P and Q: the same calls as stages all); the start map is
@@ -23,16 +25,19 @@
  * iterations and wall time of RHM and ECTM. The RHM paper reports a mean
  * geodesic error of about 0.033 on remeshed FAUST/SCAPE.
  *
- * Measured at 2d9c8da (default 300 ECTM iterations, the distances start,
- * fold repair after RHM and after ECTM; about 20 min on 2 loaded cores):
- * FAUST geodesic error RHM 0.0212 / 0.0363 / 0.0361 / 0.0275 (000->001,
- * 002->007, 000->020, 010->020), RHM + ECTM 0.0189 / 0.0396 / 0.0251 /
- * 0.0195; cat 0.0239 -> 0.0235; Homer 0.0117 -> 0.0204 and head 0.0159 ->
- * 0.0226 (ECTM raises them). The repair of ECTM's maps leaves 0.9-3.3 %
- * flipped (6.7 % collapsed on 002->007) but raises mean |log a| 2-5x on
- * FAUST: its harmonic remaps are far from area-preserving. Earlier, with
- * --start=voronoi, RHM's FAUST errors were 0.0377 / 0.0605 / 0.0320 /
- * 0.0353, cat 0.0419, Homer 0.0609, head 0.0166.
+ * Measured at 5202800 (default 300 ECTM iterations, start auto, fold
+ * repair after RHM and after ECTM; about 9 min on 2 loaded cores): FAUST
+ * geodesic error RHM 0.0209 / 0.0352 / 0.0349 / 0.0262 (000->001,
+ * 002->007, 000->020, 010->020), RHM + ECTM 0.0151 / 0.0300 / 0.0191 /
+ * 0.0128; cat 0.0233 -> 0.0197; Homer 0.0113 -> 0.0194 and head 0.0159 ->
+ * 0.0223 (ECTM raises them). After ECTM 0.1-0.2 % flipped (002->007:
+ * 5.2 % flipped, 0.6 % collapsed) and mean |log a| below RHM's on every
+ * pair. At 2d9c8da (liblbfgs, the harmonic repair without its reweighting,
+ * the distances start) RHM + ECTM was 0.0189 / 0.0396 / 0.0251 / 0.0195,
+ * cat 0.0235, Homer 0.0204, head 0.0226, and the repair of ECTM's maps
+ * raised mean |log a| 2-5x on FAUST. Earlier, with --start=voronoi, RHM's
+ * FAUST errors were 0.0377 / 0.0605 / 0.0320 / 0.0353, cat 0.0419, Homer
+ * 0.0609, head 0.0166.
  * Scale: with --scale=0.01, 4, 100 or 1.0000001 the start and RHM rows
  * are the same to 4 decimals; --scale=4 (exact in floating point) repeats
  * ECTM's row bit for bit, the others move it by up to 0.0005 in geodesic
@@ -45,7 +50,7 @@
  *   --pairs=A,B,...       only these pairs (labels as in the table)
  *   --scale=S             multiply both meshes' coordinates by S first
  *                         (a check of scale invariance)
- *   --start=NAME          distances (the default), voronoi or fmap
+ *   --start=NAME          auto (the default), distances, voronoi or fmap
  * Each pair runs in its own process (support/testapart.h): a crash or an
  * error becomes that pair's row, and the other pairs still run. The rhm
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
