@@ -132,7 +132,7 @@ size_t mc_job_spec_size(void);
  * that does not parse: MC_EARG, detail in err. */
 int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
 
-enum { MC_START_DISTANCES = 0, MC_START_VORONOI = 1, MC_START_FMAP = 2 };
+enum { MC_START_DISTANCES = 0, MC_START_VORONOI = 1, MC_START_FMAP = 2, MC_START_AUTO = 3 };
 enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3, MC_STAGE_DDM = 4 };
 /* Values of the stages parameter (PROTO_PARAMS; `meshcorr submit --stages`). */
 enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM = 3,

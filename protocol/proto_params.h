@@ -102,7 +102,7 @@
       "denoised together, each made consistent with the other's functional map; needs q)")   \
     X(zoomout, "zoomout", U32, 0, PROTO_ZOOMOUT_MIN, PROTO_ZOOMOUT_MAX, PROTO_PARAM_ZERO_OFF,    \
       RHM, zoomout, "",                                                                          \
-      "start fmap: ZoomOut from the start's 50 basis functions to this many per mesh before "    \
-      "DDM deblurring (0: off; else more than 50 and at most vertices - 2)")
+      "start fmap (and auto's second run): ZoomOut from the start's 50 basis functions to this " \
+      "many per mesh before DDM deblurring (0: off; else more than 50 and at most vertices - 2)")
 
 #endif

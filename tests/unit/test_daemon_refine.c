@@ -200,6 +200,10 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     CHECK_INT(mc_submit(c, &s, &id), PROTO_EBAD_PARAMS);
     CHECK_STR_HAS(mc_errmsg(c), "params.zoomout = 200: a basis holds at most vertices - 2 = 160");
     CHECK_INT(id, 0);
+    s.start = MC_START_AUTO;                   /* its second run starts from the functional map */
+    CHECK_INT(mc_submit(c, &s, &id), PROTO_EBAD_PARAMS);
+    CHECK_STR_HAS(mc_errmsg(c), "params.zoomout = 200");
+    CHECK_INT(id, 0);
     /* the stages value is one of the list: 8 is refused by the validator */
     spec_of(&p, 8, 1, &s);
     CHECK(mc_submit(c, &s, &id) != 0);

@@ -209,7 +209,8 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz)
                           "eigenfunctions here (%s: %d vertices, %s: %d)",
                           in->ddm_k, most, in->S_name, S->nv, in->T_name, T->nv);
     const rhm_params *rp = in->rhm;
-    if ((run & CORR_RUN_RHM) && !in->P0 && rp && rp->start == RHM_START_FMAP && rp->zoomout > most)
+    int fmap = rp && (rp->start == RHM_START_FMAP || rp->start == RHM_START_AUTO);
+    if ((run & CORR_RUN_RHM) && !in->P0 && fmap && rp->zoomout > most)
         return errbuf_set(err, errsz, CORR_EINPUT,
                           "params.zoomout = %d: a basis holds at most vertices - 2 = %d "
                           "eigenfunctions here (%s: %d vertices, %s: %d)",

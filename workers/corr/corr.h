@@ -130,8 +130,9 @@ typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
 /* The sizes a job's meshes bound: DDM's basis (in->ddm_k, when the chain
- * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM starts from the
- * functional map) hold at most vertices - 2 eigenfunctions of either mesh.
+ * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM may start from the
+ * functional map: start fmap, or auto's second run) hold at most
+ * vertices - 2 eigenfunctions of either mesh.
  * CORR_OK, or CORR_EINPUT with the parameter and both meshes named.
  * corr_run checks it first; the check of a job where it is built (the
  * daemon's of a SUBMIT) calls it too, so such a job is refused before it
