@@ -1,10 +1,12 @@
 /* bench_daemon.c — what the daemon costs a client: SUBMIT of a 10K-vertex
  * pair (Draco encoding and the round trip to SUBMIT_OK, timed apart), PING
  * round trips while large SUBMITs are stored, PROGRESS fan-out to 20 watchers of one job, and one small job through the
- * daemon against the same job run in process (corr_run). Prints figures,
+ * daemon against the same job run in process (corr_run), for the demo pair
+ * and for a 162-vertex pair (the per-job overhead). Prints figures,
  * never fails on time. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testmesh.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -264,4 +266,97 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
     testdaemon_demo_close(&dm);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
+}
+
+/* Issue 16's small job: the 162-vertex icosphere pair of testdaemon_submit
+ * (6 landmarks, 3 RHM and 2 ECTM iterations), NSMALL times one after the
+ * other through the daemon (submit to END, then RESULT), against the same
+ * job's corr_run in process (one thread, as the worker picks for this
+ * size). The overhead is the daemon's wall time less the in-process run:
+ * spawning the worker, its decode, its threads, the result's write and
+ * the round trips. The worker's own elapsed_s (from its start, decode
+ * included) splits it in two. */
+#define NSMALL 10
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+TEST_T(small_job_overhead_through_the_daemon, 600)
+{
+    testdaemon_need_worker();
+    char err[1024];
+    mesh *S = testmesh_icosphere(2), *T = testmesh_icosphere(2);
+    CHECK(S && T);
+    for (int i = 0; i < T->nv; i++) {           /* testdaemon_submit's target */
+        double *x = &T->v[3 * i];
+        x[0] *= 1.3;
+        x[2] += 0.15 * x[0] * x[0];
+    }
+    long lm[6] = {0, 1, 2, 3, 4, 5};
+    lmk_set *L = NULL;
+    if (lmk_from_arrays(lm, lm, 6, 0, "S", "T", S, T, &L, err, sizeof err))
+        FAILF("%s", err);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 2;
+    p.inner_iterations = 10;
+    p.beta_ramp = 2;
+    p.stop_change = 0;
+    p.threads = 1;
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 3;
+    rp.threads = 1;
+    double local[NSMALL];
+    for (int k = 0; k < NSMALL; k++) {
+        ectm_result r = {0};
+        corr_input in = { S, T, "S", "T", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+        double t0 = now();
+        if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err))
+            FAILF("corr_run: %s", err);
+        local[k] = now() - t0;
+        ectm_result_close(&r);
+    }
+
+    testdaemon d;
+    testdaemon_start(&d, "bench-small", NULL);
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    double wall[NSMALL], worker[NSMALL], fetch[NSMALL];
+    for (int k = 0; k < NSMALL; k++) {
+        double t0 = now();
+        uint64_t id = testdaemon_submit_ok(c, 2, 0, 0);
+        int state = -1;
+        char reason[1100];
+        CHECK_INT(mc_watch(c, id, 0, NULL, NULL, &state, reason, sizeof reason), 0);
+        if (state != MC_COMPLETED)
+            FAILF("job ended %s: %s", mc_state_name(state), reason);
+        mc_job_result r;
+        double t1 = now();
+        CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q | MC_WANT_METRICS, &r), 0);
+        fetch[k] = now() - t1;
+        wall[k] = now() - t0;
+        worker[k] = NAN;
+        for (uint32_t i = 0; i < r.nmetrics; i++)
+            if (!strcmp(r.metric_keys[i], "elapsed_s"))
+                worker[k] = r.metric_values[i];
+        mc_result_free(&r);
+    }
+    qsort(local, NSMALL, sizeof(double), cmp_double);
+    qsort(wall, NSMALL, sizeof(double), cmp_double);
+    qsort(worker, NSMALL, sizeof(double), cmp_double);
+    qsort(fetch, NSMALL, sizeof(double), cmp_double);
+    int h = NSMALL / 2;
+    printf("162-vertex pair, 3 RHM + 2 ECTM iterations, %d jobs one after the other (medians): "
+           "in process %.1f ms; through the daemon, submit to RESULT %.1f ms, of which the worker's "
+           "elapsed_s %.1f ms and the RESULT fetch %.1f ms; overhead %.1f ms (target <= 50 ms), "
+           "ratio %.2f\n", NSMALL, 1e3 * local[h], 1e3 * wall[h], 1e3 * worker[h], 1e3 * fetch[h],
+           1e3 * (wall[h] - local[h]), wall[h] / local[h]);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+    lmk_free(L);
+    mesh_free(S);
+    mesh_free(T);
 }

@@ -51,6 +51,7 @@
  *   --scale=S             multiply both meshes' coordinates by S first
  *                         (a check of scale invariance)
  *   --start=NAME          auto (the default), distances, voronoi or fmap
+ *   --eta=E               ECTM's bending weight instead of the default
  * Each pair runs in its own process (support/testapart.h): a crash or an
  * error becomes that pair's row, and the other pairs still run. The rhm
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
@@ -175,6 +176,7 @@ typedef struct pair_job {
     const pair_spec *ps;
     int ectm_iterations;
     double scale;
+    double eta;             /* --eta: ECTM's bending weight, 0: the default */
 } pair_job;
 
 static void run_pair(const void *arg, void *out)
@@ -223,6 +225,8 @@ static void run_pair(const void *arg, void *out)
     ectm_params_init(&ep);
     if (ectm_iterations > 0)
         ep.iterations = ectm_iterations;
+    if (job->eta > 0)
+        ep.eta = job->eta;
 
     /* the start map, and T's geodesic solver for scoring */
     if (rhm__problem_new(g.S, g.T, L, &rp, &pb, err, sizeof err) ||
@@ -335,6 +339,7 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     start_kind = w.start;
     int iters = o_it ? atoi(o_it) : 0;
     double scale = o_scale ? atof(o_scale) : 1;
+    double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
     if ((o_it && iters < 1) || !(scale > 0))
         FAILF("--ectm-iterations takes a positive integer, --scale a positive number");
     ectm_params ep;
@@ -349,7 +354,7 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     for (int i = 0; i < NPAIRS; i++) {
         if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
-        pair_job job = { &pairs[i], iters, scale };
+        pair_job job = { &pairs[i], iters, scale, eta };
         char why[256];
         if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
             snprintf(figs[i].err, sizeof figs[i].err, "%s", why);

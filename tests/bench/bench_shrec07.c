@@ -32,7 +32,12 @@
  * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for
  * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
  * the default, for comparing), --start=NAME (a start map of
- * proto_params.h's start list instead of the default). Each pair runs in
+ * proto_params.h's start list instead of the default),
+ * --rhm-landmark-weight=G (RHM's weak landmark term, default off). Last,
+ * the job time (start + RHM and repair + ECTM and repair) per pair, its
+ * median, and the exponent of a least-squares fit of log time against
+ * log(source + target vertices) per stage, over the pairs run: issue 16's
+ * cost against size. Each pair runs in
  * its own process (support/testapart.h). Prints figures, never fails on
  * quality. */
 #include "support/harness.h"
@@ -41,6 +46,7 @@
 #include "metric/metric.h"
 #include "rhm/rhm__problem.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -76,6 +82,7 @@ typedef struct pair_job {
     const char *out_dir;    /* --out-dir: each stage's map is written there */
     double eta;             /* --eta: ECTM's bending weight, 0: the default */
     int start;              /* --start: RHM_START_*, -1: the default */
+    double rhm_gamma;       /* --rhm-landmark-weight, < 0: the default */
 } pair_job;
 
 static double now(void)
@@ -185,6 +192,8 @@ static void run_pair(const void *arg, void *out)
     rhm_params_init(&rp);
     if (job->start >= 0)
         rp.start = job->start;
+    if (job->rhm_gamma >= 0)
+        rp.gamma = job->rhm_gamma;
     ectm_params ep;
     ectm_params_init(&ep);
     if (job->ectm_iterations > 0)
@@ -352,6 +361,45 @@ static void print_targets(const int *ran, const pair_fig *figs)
     }
 }
 
+/* Job times and their growth with the pair's size (issue 16). */
+static void print_cost(const int *ran, const pair_fig *figs)
+{
+    double t[NPAIRS], x[NPAIRS], y[NSTAGES][NPAIRS];
+    int n = 0;
+    for (int i = 0; i < NPAIRS; i++) {
+        const pair_fig *f = &figs[i];
+        if (!ran[i] || f->nmaps < NSTAGES)
+            continue;
+        x[n] = log((double)(f->nS + f->nT));
+        t[n] = f->secs[START] + f->secs[RHM] + f->secs[ECTM];
+        for (int a = 0; a < NSTAGES; a++)   /* REPAIR's slot: the whole job (the
+                                               repair is timed with RHM) */
+            y[a][n] = log(fmax(a == REPAIR ? t[n] : f->secs[a], 1e-3));
+        n++;
+    }
+    if (n < 2)
+        return;
+    double xm = 0;
+    for (int k = 0; k < n; k++)
+        xm += x[k] / n;
+    printf("\ncost against size over %d pairs, time ~ (source + target vertices)^e:", n);
+    static const char *const what[NSTAGES] = { "start", "rhm+repair", "job", "ectm+repair" };
+    for (int a = 0; a < NSTAGES; a++) {
+        double ym = 0, sxy = 0, sxx = 0;
+        for (int k = 0; k < n; k++)
+            ym += y[a][k] / n;
+        for (int k = 0; k < n; k++) {
+            sxy += (x[k] - xm) * (y[a][k] - ym);
+            sxx += (x[k] - xm) * (x[k] - xm);
+        }
+        printf(" %s e = %.2f%s", what[a], sxx > 0 ? sxy / sxx : NAN, a + 1 < NSTAGES ? ";" : "");
+    }
+    qsort(t, (size_t)n, sizeof *t, cmp_double);
+    printf("\njob time (start + rhm + ectm stages): median %.1f s, from %.1f to %.1f s "
+           "(issue 16's target: median <= 20 s)\n", n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]),
+           t[0], t[n - 1]);
+}
+
 TEST_T(shrec07_classes_from_landmarks, 86400)
 {
     if (!harness_data_dir())
@@ -360,6 +408,8 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     const char *o_stop = harness_option("stop"), *o_out = harness_option("out-dir");
     double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
     const char *o_start = harness_option("start");
+    const char *o_rg = harness_option("rhm-landmark-weight");
+    double rhm_gamma = o_rg ? atof(o_rg) : -1;
     proto_params w;                      /* the start's names are the list's */
     char perr[256];
     proto_params_init(&w);
@@ -384,7 +434,7 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     for (int i = 0; i < NPAIRS; i++) {
         if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
-        pair_job job = { &pairs[i], iters, last, o_out, eta, start };
+        pair_job job = { &pairs[i], iters, last, o_out, eta, start, rhm_gamma };
         char why[256];
         if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
             snprintf(figs[i].why, sizeof figs[i].why, "%s", why);
@@ -401,4 +451,5 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
         if (ran[i])
             print_rows(&pairs[i], &figs[i]);
     print_targets(ran, figs);
+    print_cost(ran, figs);
 }
