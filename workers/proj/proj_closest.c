@@ -54,24 +54,30 @@ static float query_radius(const proj__row *r)
     return (float)(sqrt(r->best) / r->s * (1 + 1e-6) + r->pad);
 }
 
-/* Squared R^d distance from the query to face t's bounding box: a lower
- * bound of its cost that is tighter than the tree's three coordinates. */
-static double box_cost(const proj__row *r, int t)
+/* Whether the squared R^d distance from the query to face t's bounding
+ * box, a lower bound of its cost tighter than the tree's three
+ * coordinates, is below the best cost so far. The partial sums only grow,
+ * so the answer is known once one reaches the best: the same answer as
+ * the whole sum's, sooner where the leading coordinates carry the
+ * distance (the callers' embeddings come in principal axes). */
+static bool box_may_win(const proj__row *r, int t)
 {
     const double *lo = r->box + 2 * (size_t)r->d * t, *hi = lo + r->d;
     double c = 0;
     for (int k = 0; k < r->d; k++) {
         double e = r->q[k] < lo[k] ? lo[k] - r->q[k] : r->q[k] > hi[k] ? r->q[k] - hi[k] : 0;
         c += e * e;
+        if (!(c < r->best))
+            return false;
     }
-    return c;
+    return true;
 }
 
 static bool visit_face(struct RTCPointQueryFunctionArguments *args)
 {
     proj__row *r = args->userPtr;
     double bary[3];
-    if (r->box && !(box_cost(r, (int)args->primID) < r->best))
+    if (r->box && !box_may_win(r, (int)args->primID))
         return false;
     double c = face_cost(r, (int)args->primID, bary);
     if (!(c < r->best))
