@@ -6,7 +6,6 @@
  * never fails on time. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
-#include "support/testmesh.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -288,13 +287,8 @@ TEST_T(small_job_overhead_through_the_daemon, 600)
 {
     testdaemon_need_worker();
     char err[1024];
-    mesh *S = testmesh_icosphere(2), *T = testmesh_icosphere(2);
-    CHECK(S && T);
-    for (int i = 0; i < T->nv; i++) {           /* testdaemon_submit's target */
-        double *x = &T->v[3 * i];
-        x[0] *= 1.3;
-        x[2] += 0.15 * x[0] * x[0];
-    }
+    mesh *S, *T;
+    testdaemon_pair(0, &S, &T);                 /* testdaemon_submit's pair */
     long lm[6] = {0, 1, 2, 3, 4, 5};
     lmk_set *L = NULL;
     if (lmk_from_arrays(lm, lm, 6, 0, "S", "T", S, T, &L, err, sizeof err))

@@ -318,16 +318,23 @@ unsigned char *testdaemon_encode(const mesh *m, size_t *len)
     return buf;
 }
 
-uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc)
+void testdaemon_pair(int long_job, mesh **S, mesh **T)
 {
-    mesh *S = testmesh_icosphere(long_job ? 3 : 2), *T = testmesh_icosphere(long_job ? 3 : 2);
-    if (!S || !T)
+    *S = testmesh_icosphere(long_job ? 3 : 2);
+    *T = testmesh_icosphere(long_job ? 3 : 2);
+    if (!*S || !*T)
         FAILF("testmesh_icosphere failed");
-    for (int i = 0; i < T->nv; i++) {           /* an ellipsoid, a little bent */
-        double *x = &T->v[3 * i];
+    for (int i = 0; i < (*T)->nv; i++) {        /* an ellipsoid, a little bent */
+        double *x = &(*T)->v[3 * i];
         x[0] *= 1.3;
         x[2] += 0.15 * x[0] * x[0];
     }
+}
+
+uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc)
+{
+    mesh *S, *T;
+    testdaemon_pair(long_job, &S, &T);
     mc_job_spec spec;
     mc_job_spec_init(&spec);
     size_t sl, tl;
