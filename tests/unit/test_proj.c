@@ -450,6 +450,31 @@ TEST(closest_matches_brute_381_390_d16_rhm_like)
         f[i] = -1;
     CHECK_INT(proj_closest(tree, d, Z, s, n, Q, f, w, c), 0);
     check_same(tg, d, Z, n, Q, fb, cb, f, w, c);
+    /* seeded with any face: the seed only bounds the search */
+    unsigned long long st = 11;
+    for (int i = 0; i < n; i++)
+        f[i] = (int)(testmesh_rand(&st) * tg->nf);
+    CHECK_INT(proj_closest(tree, d, Z, s, n, Q, f, w, c), 0);
+    check_same(tg, d, Z, n, Q, fb, cb, f, w, c);
+    /* from PROJ_HD_MIN_DIM on the search runs in R^d: the first three
+     * columns need not be s·X̃ (here a rotation of all sixteen, the
+     * distances unchanged, so the brute force's costs still hold) */
+    double *Zr = malloc(sizeof(double) * d * tg->nv), *Qr = malloc(sizeof(double) * d * n);
+    for (int pass = 0; pass < 2; pass++) {
+        const double *in = pass ? Q : Z;
+        double *out = pass ? Qr : Zr;
+        for (int i = 0; i < (pass ? n : tg->nv); i++)
+            for (int k = 0; k < d; k += 2) {   /* 45 degrees in each plane (k, k + 1) */
+                double x = in[d * i + k], y = in[d * i + k + 1];
+                out[d * i + k] = (x - y) / sqrt(2.0);
+                out[d * i + k + 1] = (x + y) / sqrt(2.0);
+            }
+    }
+    for (int i = 0; i < n; i++)
+        f[i] = -1;
+    CHECK_INT(proj_closest(tree, d, Zr, s, n, Qr, f, w, c), 0);
+    check_same(tg, d, Zr, n, Qr, fb, cb, f, w, c);
+    free(Zr), free(Qr);
     free(Z), free(Q), free(fb), free(f), free(wb), free(w), free(cb), free(c);
     proj_tree_free(tree);
     mesh_free(src);
@@ -494,10 +519,11 @@ TEST(tree_refuses_bad_target_naming_it)
     mesh_free(m);
 }
 
-TEST(closest_handles_degenerate_target_faces)
+/* A 3-D-degenerate face (collinear in X̃) that is the unique winner
+ * because its extra coordinates lift it towards the query; in d = 4 (the
+ * 3-D tree) and d = 8 (the R^d hierarchy), the columns past the 4th 0. */
+static void degenerate_case(int d)
 {
-    /* A 3-D-degenerate face (collinear in X̃) that is the unique winner
-     * because its extra coordinates lift it towards the query. */
     mesh *m = mesh_new(5, 2);
     double v[15] = { 0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 1 };
     int fc[6] = { 0, 1, 2, 0, 3, 4 };
@@ -506,13 +532,11 @@ TEST(closest_handles_degenerate_target_faces)
     char err[256];
     proj_tree *tree = proj_tree_new(m, err, sizeof err);
     CHECK(tree);
-    const int d = 4;
-    double Z[20] = { 0 };
+    double Z[5 * 8] = { 0 }, Q[8] = { 1, 0.3, 0, 5 };
     for (int j = 0; j < 5; j++)
         for (int k = 0; k < 3; k++)
             Z[d * j + k] = v[3 * j + k];
     Z[d * 1 + 3] = 5;                 /* lifts vertex 1 in the 4th column */
-    double Q[4] = { 1, 0.3, 0, 5 };
     int f = -1, fb;
     double w[3], wb[3], c, cb;
     CHECK_INT(proj_closest(tree, d, Z, 1, 1, Q, &f, w, &c), 0);
@@ -524,4 +548,10 @@ TEST(closest_handles_degenerate_target_faces)
     CHECK_NEAR(c, cb, 1e-15);
     proj_tree_free(tree);
     mesh_free(m);
+}
+
+TEST(closest_handles_degenerate_target_faces)
+{
+    degenerate_case(4);
+    degenerate_case(PROJ_HD_MIN_DIM);
 }

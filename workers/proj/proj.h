@@ -8,7 +8,10 @@
  * the embedded target. Because |q − p|² ≥ |q[0:3] − p[0:3]|² =
  * s²·dist₃(q[0:3]/s, triangle)², an Embree point query around q[0:3]/s whose
  * radius shrinks to √(best cost)/s visits every triangle that can win; the
- * previous assignment (face[i] >= 0 on entry) seeds the bound.
+ * previous assignment (face[i] >= 0 on entry) seeds the bound. From
+ * d = PROJ_HD_MIN_DIM on, the search runs over a box hierarchy of Z in R^d
+ * instead (built per call), the tree's 3-D BVH is not used and Z's first
+ * columns need not be s·X̃ (the tree still gives the connectivity).
  *
  * Result: face[i], bary[3i..3i+2] (weights of the face's vertices in their
  * listed order) and cost[i] (squared R^d distance; cost may be NULL). Exact:
@@ -39,6 +42,8 @@ enum proj_error {
 };
 const char *proj_strerror(int code);
 
+#define PROJ_HD_MIN_DIM 8
+
 typedef struct proj_tree proj_tree;
 
 proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz);
@@ -46,7 +51,7 @@ void proj_tree_free(proj_tree *t);
 
 /* Returns 0, PROJ_EINVAL if d < 3, s <= 0 or n < 0, or PROJ_EFACE if an
  * entry face[i] >= target->nf (negative entries mean "no previous
- * assignment"). Nothing is written on error. */
+ * assignment"), PROJ_ENOMEM. Nothing is written on error. */
 int proj_closest(const proj_tree *t, int d, const double *Z, double s,
                  int n, const double *Q, int *face, double *bary, double *cost);
 

@@ -4,6 +4,7 @@
 #ifndef PROJ__TREE_H
 #define PROJ__TREE_H
 #include <embree3/rtcore.h>
+#include "proj/proj__hd.h"
 
 struct proj_tree {
     RTCDevice device;
@@ -12,6 +13,7 @@ struct proj_tree {
     int *f;         /* nf by 3 copy of the target's faces */
     double scale;   /* bounding-box diagonal plus largest |coordinate| of X̃:
                        the size that float rounding in the BVH is relative to */
+    proj__hd *hd;   /* the patches of X̃ for queries in R^d, d >= PROJ_HD_MIN_DIM */
 };
 
 #endif

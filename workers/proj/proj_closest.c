@@ -9,22 +9,24 @@
  * is padded (relative 1e-5 of the scene's size and 1e-6 of the query's
  * distance from the origin) to keep rounding from excluding the winner.
  *
- * In high dimension the three tree coordinates see little of the distance
- * and the tree hands over many faces; each is then first checked against
- * its bounding box in R^d (a second exact lower bound, 2d numbers per face
- * made per call) before the triangle itself. Measured (one run each way):
- * RHM on FAUST 5K, d = 16, 200 iterations: P-steps 8.4 s -> 6.7 s; ECTM
- * 381 -> 390, d = 6, seeded, 1 thread: 15.7 -> 10.7 ms at beta 500 but
- * 4.2 -> 5.5 ms at beta 1e5 (making the boxes costs more than they save),
- * hence only from PROJ_BOX_MIN_DIM on. */
+ * In R^d from PROJ_HD_MIN_DIM on the three tree coordinates see little of
+ * the distance: the 3-D ball of radius √best holds a number of faces that
+ * grows with the mesh's resolution. There each call fits the tree's box
+ * hierarchy (proj_hd.c: patches of X̃, boxes in R^d) to Z and searches it;
+ * the Embree tree is not used. Measured (quiet machine, two runs each):
+ * RHM on FAUST 5K, d = 16, 200 iterations: P-steps 6.6-7.0 s with the 3-D
+ * tree and an R^d box test per face it handed over, 5.2-5.5 s with the
+ * hierarchy (boxes as floats: 5.9 s, the conversions cost more than the
+ * memory saved); TOSCA cat 28K: the 400 P-steps 41 s. Below that dimension
+ * (ECTM, d = 6) the leading coordinates, s·X̃, carry most of the distance
+ * and the Embree tree stays. */
 #include "proj/proj.h"
+#include "proj/proj__hd.h"
 #include "proj/proj__tree.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
-
-#define PROJ_BOX_MIN_DIM 8
 
 typedef struct proj__row {
     int d;
@@ -32,7 +34,6 @@ typedef struct proj__row {
     const int *f;
     const double *q;
     double s;
-    const double *box; /* nf by 2d: per face, the low corner then the high one; or NULL */
     double pad;        /* absolute padding of the query radius */
     double best;       /* best cost so far (+inf: none) */
     int face;          /* its face, or -1 */
@@ -54,31 +55,10 @@ static float query_radius(const proj__row *r)
     return (float)(sqrt(r->best) / r->s * (1 + 1e-6) + r->pad);
 }
 
-/* Whether the squared R^d distance from the query to face t's bounding
- * box, a lower bound of its cost tighter than the tree's three
- * coordinates, is below the best cost so far. The partial sums only grow,
- * so the answer is known once one reaches the best: the same answer as
- * the whole sum's, sooner where the leading coordinates carry the
- * distance (the callers' embeddings come in principal axes). */
-static bool box_may_win(const proj__row *r, int t)
-{
-    const double *lo = r->box + 2 * (size_t)r->d * t, *hi = lo + r->d;
-    double c = 0;
-    for (int k = 0; k < r->d; k++) {
-        double e = r->q[k] < lo[k] ? lo[k] - r->q[k] : r->q[k] > hi[k] ? r->q[k] - hi[k] : 0;
-        c += e * e;
-        if (!(c < r->best))
-            return false;
-    }
-    return true;
-}
-
 static bool visit_face(struct RTCPointQueryFunctionArguments *args)
 {
     proj__row *r = args->userPtr;
     double bary[3];
-    if (r->box && !box_may_win(r, (int)args->primID))
-        return false;
     double c = face_cost(r, (int)args->primID, bary);
     if (!(c < r->best))
         return false;
@@ -98,23 +78,36 @@ int proj_closest(const proj_tree *t, int d, const double *Z, double s,
         if (face[i] >= t->nf)
             return PROJ_EFACE;
 
-    double *box = d >= PROJ_BOX_MIN_DIM ? malloc(2 * (size_t)d * t->nf * sizeof *box) : NULL;
-    if (box) {
-        #pragma omp parallel for schedule(static)
-        for (int f = 0; f < t->nf; f++) {
-            const int *v = t->f + 3 * (size_t)f;
-            double *lo = box + 2 * (size_t)d * f, *hi = lo + d;
-            for (int k = 0; k < d; k++) {
-                double a = Z[(size_t)d * v[0] + k], b = Z[(size_t)d * v[1] + k], c = Z[(size_t)d * v[2] + k];
-                lo[k] = fmin(a, fmin(b, c));
-                hi[k] = fmax(a, fmax(b, c));
+    if (d >= PROJ_HD_MIN_DIM) {
+        double *box = malloc(sizeof(double) * proj__hd_box_size(t->hd, d));
+        if (!box)
+            return PROJ_ENOMEM;
+        proj__hd_fit(t->hd, d, Z, box);
+        #pragma omp parallel for schedule(dynamic, 256)
+        for (int i = 0; i < n; i++) {
+            const double *q = Q + (size_t)d * i;
+            int fi = face[i];
+            double best = INFINITY, b[3] = { 1, 0, 0 };
+            if (fi >= 0) {
+                const int *v = t->f + 3 * (size_t)fi;
+                best = proj_point_triangle(d, q, Z + (size_t)d * v[0], Z + (size_t)d * v[1],
+                                           Z + (size_t)d * v[2], b);
             }
+            proj__hd_closest(t->hd, d, Z, box, q, &fi, &best, b);
+            face[i] = fi;
+            bary[3 * (size_t)i] = b[0];
+            bary[3 * (size_t)i + 1] = b[1];
+            bary[3 * (size_t)i + 2] = b[2];
+            if (cost)
+                cost[i] = best;
         }
+        free(box);
+        return 0;
     }
     #pragma omp parallel for schedule(dynamic, 256)
     for (int i = 0; i < n; i++) {
         const double *q = Q + (size_t)d * i;
-        proj__row r = { .d = d, .Z = Z, .f = t->f, .q = q, .s = s, .box = box,
+        proj__row r = { .d = d, .Z = Z, .f = t->f, .q = q, .s = s,
                         .best = INFINITY, .face = -1 };
         double qmax = fmax(fabs(q[0]), fmax(fabs(q[1]), fabs(q[2]))) / s;
         r.pad = 1e-5 * t->scale + 1e-6 * qmax + FLT_MIN;
@@ -135,7 +128,6 @@ int proj_closest(const proj_tree *t, int d, const double *Z, double s,
         if (cost)
             cost[i] = r.best;
     }
-    free(box);
     return 0;
 }
 

@@ -1,5 +1,5 @@
 /* proj_tree.c — building and freeing the Embree 3 BVH over the target's 3-D
- * triangles. No queries here (proj_closest.c), and no pointer kept to the
+ * triangles, and the patches of the R^d hierarchy (proj_hd.c). No queries here (proj_closest.c), and no pointer kept to the
  * caller's mesh: vertices and faces are copied into Embree's own buffers. */
 #include "proj/proj.h"
 #include "proj/proj__tree.h"
@@ -60,6 +60,10 @@ proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz)
         goto fail;
     }
     memcpy(t->f, target->f, sizeof(int) * 3 * (size_t)target->nf);
+    if (!(t->hd = proj__hd_new(target->v, t->f, t->nf))) {
+        errbuf_set(err, errsz, PROJ_ENOMEM, "out of memory for %d faces", target->nf);
+        goto fail;
+    }
 
     /* One build thread: Embree's parallel BVH build is not deterministic,
      * and the tree's shape decides which of two faces at equal cost a
@@ -113,6 +117,7 @@ void proj_tree_free(proj_tree *t)
         rtcReleaseScene(t->scene);
     if (t->device)
         rtcReleaseDevice(t->device);
+    proj__hd_free(t->hd);
     free(t->f);
     free(t);
 }

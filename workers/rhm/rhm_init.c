@@ -84,13 +84,15 @@ static double *landmark_description(rhm__side *a, int nl, int dd, int *rc)
 /* Moves both sides' descriptions (n[i] rows of dd) into the principal axes
  * of their union: D ← (D − mean)·V, V the eigenvectors of the covariance,
  * by decreasing variance. A rigid motion of R^dd, so every distance, and
- * with it every closest point, stays the same; but the projection's tree
- * holds the first three coordinates, and its bound is only as tight as
- * the share of the distance they carry. The distances to the landmarks
- * are strongly correlated (a surface in R^dd): along the first three
- * landmarks' distances the bound let the search visit most faces (TOSCA
- * cat0 -> cat1, 28K vertices, 21 landmarks, dd = 42: 57 s for the start's
- * two projections). */
+ * with it every closest point, stays the same; but the projection's
+ * bounds end their sums over the coordinates once they pass the best
+ * cost, sooner where the leading coordinates carry the distance, and with
+ * fewer than four landmarks (dd < PROJ_HD_MIN_DIM) its 3-D tree holds the
+ * first three. The distances to the landmarks are strongly correlated (a
+ * surface in R^dd): along the first three landmarks' distances the 3-D
+ * bound let the search visit most faces (TOSCA cat0 -> cat1, 28K vertices,
+ * 21 landmarks, dd = 42: 57 s for the start's two projections, 20 s in
+ * these axes). */
 static int principal_frame(double *D[2], const int n[2], int dd)
 {
     double *C = calloc((size_t)dd * dd, sizeof *C), *mu = calloc((size_t)dd, sizeof *mu);
@@ -140,8 +142,8 @@ out:
 }
 
 /* P_ij row v: the closest point, in R^dd, of v's description (above) on
- * side j embedded with its own; exact (proj.h), the bound from the first
- * three principal axes of both descriptions (principal_frame). Seeding
+ * side j embedded with its own; exact (proj.h), in the principal axes of
+ * both descriptions (principal_frame). Seeding
  * each search with a neighbour's face (waves over the edges) left the cat's
  * 20 s unchanged: the radius is set by the closest distance itself. */
 static int start_distances(rhm__problem *pb, char *err, size_t errsz)

@@ -17,14 +17,15 @@
  * β/(s_i s_j) |x_ij,l − p X_j|²], the common M_i(l) drops out, and the
  * minimiser is the closest point of [√(β/(s_i s_j)) x_ij,l | √(1−α)/s_i x_i,l]
  * on M_j embedded with vertices [√(β/(s_i s_j)) X_j | √(1−α)/s_i X_ji].
- * The projection's lower bound comes from the first three coordinates of
- * the block listed first; early on (small β) the reversibility block
- * weighs more, and a bound from X_j alone would prune almost nothing
- * (measured: the first 20 iterations on FAUST 5K cost 19 s that way), so
- * that block goes first, on a tree rebuilt over the current X_ji. Turning
- * both point sets onto the principal axes of the embedded target instead
- * was tried: 0.98x at iterations 5, 60 and 150 (no gain; the embedding's
- * coordinates are principal axes already). */
+ * From m = 4 on (d = 2m >= PROJ_HD_MIN_DIM) the projection searches a box
+ * hierarchy in R^d over Z itself, on b's own tree (its patches; proj.h):
+ * no tree is rebuilt, and the heavier block first only ends the boxes'
+ * partial sums sooner. Below that the lower bound
+ * comes from the first three coordinates of the block listed first; early
+ * on (small β) the reversibility block weighs more, and a bound from X_j
+ * alone would prune almost nothing (measured: the first 20 iterations on
+ * FAUST 5K cost 19 s that way), so that block goes first, on a tree
+ * rebuilt over the current X_ji. */
 #include "rhm/rhm__problem.h"
 
 #include <math.h>
@@ -70,7 +71,7 @@ int rhm__step_p(rhm__problem *pb, int i, double beta)
         goto out;
     double s;
     const proj_tree *tree = b->tree;
-    if (rhm__projection_setup(pb, i, beta, Z, Q, &s)) {
+    if (rhm__projection_setup(pb, i, beta, Z, Q, &s) && d < PROJ_HD_MIN_DIM) {
         /* a tree over the current X_ji: rebuilt, as X_ji moves */
         if (!(emb = mesh_new(b->n, b->m->nf)))
             goto out;
