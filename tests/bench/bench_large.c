@@ -1,20 +1,34 @@
-/* bench_large.c — issue 16's large pair: TOSCA cat0 -> cat1 of
- * ../shared/data/tosca_hires (27894 vertices each, the same connectivity,
- * dense identity ground truth), the 21 landmarks of Corrs/cat.pid given,
- * through corr_run's stages all with meshcorr match's defaults (start auto,
- * RHM and its repair, ECTM and its repair). Prints the wall time of each
- * stage (from the progress reports: the start map until RHM's iteration 0,
- * RHM until ECTM's first outer iteration, ECTM to the end, which includes
- * the last repair), the job's peak resident memory (getrusage), the
- * flipped and collapsed triangles and the mean Euclidean distance from
- * each vertex's image to its ground truth over sqrt(target area), a lower
- * bound of the geodesic error, the threads used. Targets: the job <= 120 s,
- * <= 2 GB. Options: --ectm-iterations=K. Prints figures, never fails on
- * time. */
+/* bench_large.c — issue 16's large pairs, through corr_run's stages all
+ * with meshcorr match's defaults (start auto, RHM and its repair, ECTM and
+ * its repair) and the threads the machine has:
+ *
+ * - tosca_cat_28k_pipeline_from_21_landmarks: TOSCA cat0 -> cat1 of
+ *   ../shared/data/tosca_hires (27894 vertices each, the same
+ *   connectivity, dense identity ground truth), the 21 landmarks of
+ *   Corrs/cat.pid given. Targets: the job <= 120 s, <= 2 GB.
+ * - cost_against_size_wolf_4k_17k_69k: TOSCA wolf0 -> wolf2 (4344
+ *   vertices, the same connectivity, Corrs/wolf.pid's 21 landmarks) as
+ *   shipped and split 1-to-4 at the edge midpoints once and twice
+ *   (testmesh_subdivided: the same surfaces, 17K and 69K vertices, the
+ *   identity still the ground truth, the landmarks the same vertices);
+ *   each size in its own process. Then the exponent of the fit of each
+ *   stage's time against the vertices (target: <= 1.2).
+ *
+ * Per run: the wall time of each stage (from the progress reports: the
+ * start map until RHM's iteration 0, RHM and its repair until ECTM's
+ * first outer iteration, ECTM and its repair to the end), the peak
+ * resident memory at each of those three points (getrusage: the peak so
+ * far, so the last is the job's), flipped and collapsed triangles and
+ * the mean Euclidean distance from each vertex's image to its ground
+ * truth over sqrt(target area), a lower bound of the geodesic error.
+ * Options: --ectm-iterations=K, --levels=L (the scaling test's most
+ * subdivisions, default 2). Prints figures, never fails on time. */
 #include "support/harness.h"
+#include "support/testapart.h"
+#include "support/testfit.h"
+#include "support/testgt.h"
 #include "support/testmesh.h"
 #include "corr/corr.h"
-#include "geo/geo_area.h"
 #include "metric/metric.h"
 
 #include <math.h>
@@ -31,36 +45,55 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static double peak_mb(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024.0;
+}
+
+enum { START, RHM, ECTM, NSTAGES };
+static const char *const stage_name[NSTAGES] = { "start", "rhm+repair", "ectm+repair" };
+
+/* One run's figures (plain data: it comes back from a child process). */
+typedef struct run_fig {
+    int nv, nf, threads, ectm_iterations;
+    double secs[NSTAGES], mb[NSTAGES];   /* per stage; mb: the peak at its end */
+    double flipped, collapsed, err;      /* % , %, identity error */
+} run_fig;
+
 typedef struct marks {
-    double t0, rhm0, ectm1;   /* the job's start, RHM's iteration 0, ECTM's iteration 1 */
+    double t0, at[NSTAGES];   /* the job's start; each stage's end */
+    double mb[NSTAGES];
 } marks;
 
 static int on_progress(void *ctx, const corr_progress *p)
 {
     marks *m = ctx;
-    if (p->stage == CORR_STAGE_RHM && p->rhm && m->rhm0 == 0)
-        m->rhm0 = now();
-    if (p->stage == CORR_STAGE_ECTM && m->ectm1 == 0)
-        m->ectm1 = now();
+    if (p->stage == CORR_STAGE_RHM && p->rhm && m->at[START] == 0) {
+        m->at[START] = now();
+        m->mb[START] = peak_mb();
+    }
+    if (p->stage == CORR_STAGE_ECTM && m->at[RHM] == 0) {
+        m->at[RHM] = now();
+        m->mb[RHM] = peak_mb();
+    }
     return 0;
 }
 
-TEST_T(tosca_cat_28k_pipeline_from_21_landmarks, 3600)
+/* The pipeline on S -> T (the same vertex count) from the landmark
+ * vertices listed in pid_rel (given on both sides), into f. */
+static void run_pipeline(const mesh *S, const mesh *T, const char *pid_rel, run_fig *f)
 {
-    if (!harness_data_dir())
-        SKIP("../shared/data is absent");
-    mesh *S = testmesh_read("tosca_hires/Meshes/cat0.off");
-    mesh *T = testmesh_read("tosca_hires/Meshes/cat1.off");
     char err[1024];
     int *ids, n;
-    if (lmk_read_ids(harness_data_path("tosca_hires/Corrs/cat.pid"), 0, S->nv, 1000, &ids, &n, err,
-                     sizeof err))
+    if (lmk_read_ids(harness_data_path(pid_rel), 0, S->nv, 1000, &ids, &n, err, sizeof err))
         FAILF("%s", err);
     long ls[1000];
     for (int r = 0; r < n; r++)
         ls[r] = ids[r];
     lmk_set *L = NULL;
-    if (lmk_from_arrays(ls, ls, n, 0, "cat0.off", "cat1.off", S, T, &L, err, sizeof err))
+    if (lmk_from_arrays(ls, ls, n, 0, "source", "target", S, T, &L, err, sizeof err))
         FAILF("%s", err);
     ectm_params p;
     ectm_params_init(&p);
@@ -71,40 +104,111 @@ TEST_T(tosca_cat_28k_pipeline_from_21_landmarks, 3600)
     rhm_params rp;
     rhm_params_init(&rp);
     rp.threads = p.threads;
-    corr_input in = { S, T, "cat0.off", "cat1.off", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
+    corr_input in = { S, T, "source", "target", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
                       CORR_DDM_PLAIN };
     ectm_result r = {0};
-    marks m = { now(), 0, 0 };
+    marks m = { now(), {0}, {0} };
     if (corr_run(&in, &p, on_progress, &m, &r, err, sizeof err))
         FAILF("corr_run: %s", err);
-    double t1 = now();
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
+    m.at[ECTM] = now();
+    m.mb[ECTM] = peak_mb();
     metric_summary ms;
     CHECK_INT(metric_summarize(S, T, r.P, &ms), 0);
-    double e = 0;
-    for (int v = 0; v < S->nv; v++) {
-        const int *f = T->f + 3 * r.P->face[v];
-        double d2 = 0;
-        for (int k = 0; k < 3; k++) {
-            double x = 0;
-            for (int c = 0; c < 3; c++)
-                x += r.P->w[3 * v + c] * T->v[3 * f[c] + k];
-            d2 += (x - T->v[3 * v + k]) * (x - T->v[3 * v + k]);
-        }
-        e += sqrt(d2);
+    *f = (run_fig){ .nv = S->nv, .nf = S->nf, .threads = p.threads,
+                    .ectm_iterations = p.iterations, .flipped = 100 * ms.flipped_fraction,
+                    .collapsed = 100 * ms.collapsed_fraction,
+                    .err = testgt_identity_error(S, T, r.P) };
+    for (int s = 0; s < NSTAGES; s++) {
+        f->secs[s] = m.at[s] - (s ? m.at[s - 1] : m.t0);
+        f->mb[s] = m.mb[s];
     }
-    e /= S->nv * sqrt(geo_total_area(T));
-    printf("cat0 -> cat1, %d -> %d vertices, %d landmarks, %d threads, ECTM %d iterations: "
-           "start %.1f s, RHM and repair %.1f s, ECTM and repair %.1f s, job %.1f s (target <= 120 s); "
-           "peak resident %.0f MB (target <= 2048); flipped %.2f %%, collapsed %.2f %%; mean "
-           "Euclidean error to the identity / sqrt(area) %.4f\n",
-           S->nv, T->nv, n, p.threads, p.iterations, m.rhm0 - m.t0, m.ectm1 - m.rhm0, t1 - m.ectm1,
-           t1 - m.t0, ru.ru_maxrss / 1024.0, 100 * ms.flipped_fraction,
-           100 * ms.collapsed_fraction, e);
     ectm_result_close(&r);
     lmk_free(L);
     free(ids);
+}
+
+static void print_run(const char *what, const run_fig *f)
+{
+    printf("%s, %d vertices, %d faces, %d threads, ECTM %d iterations:", what, f->nv, f->nf,
+           f->threads, f->ectm_iterations);
+    for (int s = 0; s < NSTAGES; s++)
+        printf(" %s %.1f s (peak %.0f MB)%s", stage_name[s], f->secs[s], f->mb[s],
+               s + 1 < NSTAGES ? "," : ";");
+    printf(" job %.1f s; flipped %.2f %%, collapsed %.2f %%; mean Euclidean error to the "
+           "identity / sqrt(area) %.4f\n", f->secs[START] + f->secs[RHM] + f->secs[ECTM],
+           f->flipped, f->collapsed, f->err);
+    fflush(stdout);
+}
+
+TEST_T(tosca_cat_28k_pipeline_from_21_landmarks, 3600)
+{
+    if (!harness_data_dir())
+        SKIP("../shared/data is absent");
+    mesh *S = testmesh_read("tosca_hires/Meshes/cat0.off");
+    mesh *T = testmesh_read("tosca_hires/Meshes/cat1.off");
+    run_fig f;
+    run_pipeline(S, T, "tosca_hires/Corrs/cat.pid", &f);
+    print_run("cat0 -> cat1", &f);
+    printf("targets: job <= 120 s, peak resident <= 2048 MB\n");
     mesh_free(S);
     mesh_free(T);
+}
+
+typedef struct scale_arg {
+    int level;
+} scale_arg;
+
+static void run_level(const void *arg, void *out)
+{
+    int level = ((const scale_arg *)arg)->level;
+    mesh *S = testmesh_read("tosca_hires/Meshes/wolf0.off");
+    mesh *T = testmesh_read("tosca_hires/Meshes/wolf2.off");
+    for (int l = 0; l < level; l++) {
+        mesh *s = testmesh_subdivided(S), *t = testmesh_subdivided(T);
+        if (!s || !t)
+            FAILF("subdivision: out of memory");
+        mesh_free(S);
+        mesh_free(T);
+        S = s;
+        T = t;
+    }
+    run_pipeline(S, T, "tosca_hires/Corrs/wolf.pid", out);
+    mesh_free(S);
+    mesh_free(T);
+}
+
+TEST_T(cost_against_size_wolf_4k_17k_69k, 14400)
+{
+    if (!harness_data_dir())
+        SKIP("../shared/data is absent");
+    const char *o_lv = harness_option("levels");
+    int levels = o_lv ? atoi(o_lv) : 2;
+    if (levels < 1 || levels > 3)
+        FAILF("--levels=%s: expected 1, 2 or 3", o_lv);
+    run_fig f[4];
+    double x[4], y[NSTAGES + 1][4];
+    int n = 0;
+    for (int l = 0; l <= levels; l++) {
+        char why[256], what[64];
+        scale_arg a = { l };
+        if (testapart_run(run_level, &a, &f[n], sizeof f[n], why, sizeof why)) {
+            printf("wolf0 -> wolf2 subdivided %d times: %s\n", l, why);
+            continue;
+        }
+        snprintf(what, sizeof what, "wolf0 -> wolf2 subdivided %d times", l);
+        print_run(what, &f[n]);
+        x[n] = f[n].nv;
+        for (int s = 0; s < NSTAGES; s++)
+            y[s][n] = f[n].secs[s];
+        y[NSTAGES][n] = f[n].secs[START] + f[n].secs[RHM] + f[n].secs[ECTM];
+        n++;
+    }
+    printf("cost against size over %d sizes, time ~ vertices^e (target e <= 1.2):", n);
+    for (int s = 0; s <= NSTAGES; s++)
+        printf(" %s e = %.2f%s", s < NSTAGES ? stage_name[s] : "job",
+               testfit_exponent(x, y[s], n), s < NSTAGES ? ";" : "\n");
+    double mb[4];
+    for (int k = 0; k < n; k++)
+        mb[k] = f[k].mb[ECTM];
+    printf("peak resident ~ vertices^e: e = %.2f\n", testfit_exponent(x, mb, n));
 }

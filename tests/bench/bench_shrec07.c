@@ -42,6 +42,7 @@
  * quality. */
 #include "support/harness.h"
 #include "support/testapart.h"
+#include "support/testfit.h"
 #include "corr/corr.h"
 #include "metric/metric.h"
 #include "rhm/rhm__problem.h"
@@ -375,27 +376,16 @@ static void print_cost(const int *ran, const pair_fig *figs)
             continue;
         const double secs[NSERIES] = { f->secs[START], f->secs[RHM], f->secs[ECTM],
                                        f->secs[START] + f->secs[RHM] + f->secs[ECTM] };
-        x[n] = log((double)(f->nS + f->nT));
+        x[n] = (double)(f->nS + f->nT);
         for (int a = 0; a < NSERIES; a++)
-            y[a][n] = log(fmax(secs[a], 1e-3));
+            y[a][n] = secs[a];
         job[n++] = secs[NSERIES - 1];
     }
     if (n < 2)
         return;
-    double xm = 0;
-    for (int k = 0; k < n; k++)
-        xm += x[k] / n;
     printf("\ncost against size over %d pairs, time ~ (source + target vertices)^e:", n);
-    for (int a = 0; a < NSERIES; a++) {
-        double ym = 0, sxy = 0, sxx = 0;
-        for (int k = 0; k < n; k++)
-            ym += y[a][k] / n;
-        for (int k = 0; k < n; k++) {
-            sxy += (x[k] - xm) * (y[a][k] - ym);
-            sxx += (x[k] - xm) * (x[k] - xm);
-        }
-        printf(" %s e = %.2f%s", what[a], sxx > 0 ? sxy / sxx : NAN, a + 1 < NSERIES ? ";" : "");
-    }
+    for (int a = 0; a < NSERIES; a++)
+        printf(" %s e = %.2f%s", what[a], testfit_exponent(x, y[a], n), a + 1 < NSERIES ? ";" : "");
     qsort(job, (size_t)n, sizeof *job, cmp_double);
     printf("\njob time (start + rhm + ectm stages): median %.1f s, from %.1f to %.1f s "
            "(issue 16's target: median <= 20 s)\n",

@@ -1,6 +1,7 @@
 /* testgt.c — see testgt.h. */
 #include "support/testgt.h"
 #include "support/harness.h"
+#include "geo/geo_area.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -110,4 +111,21 @@ void testgt_close(testgt *g)
     free(g->tgt_sym);
     free(g->L.src);
     free(g->L.tgt);
+}
+
+double testgt_identity_error(const mesh *S, const mesh *T, const bmap *P)
+{
+    double e = 0;
+    for (int v = 0; v < S->nv; v++) {
+        const int *f = T->f + 3 * P->face[v];
+        double d2 = 0;
+        for (int k = 0; k < 3; k++) {
+            double x = 0;
+            for (int c = 0; c < 3; c++)
+                x += P->w[3 * v + c] * T->v[3 * f[c] + k];
+            d2 += (x - T->v[3 * v + k]) * (x - T->v[3 * v + k]);
+        }
+        e += sqrt(d2);
+    }
+    return e / (S->nv * sqrt(geo_total_area(T)));
 }

@@ -19,6 +19,7 @@
 #define TESTGT_H
 #include <stddef.h>
 #include "lmk/lmk.h"
+#include "map/bmap.h"
 #include "mesh/mesh.h"
 
 #define TESTGT_MAX_LINES 10000000
@@ -41,5 +42,10 @@ void testgt_vertex_list(testgt *g, const char *S_rel, const char *T_rel, const c
 /* FAUST remeshed tr_reg_000 -> tr_reg_001 (testgt_vts on faust_r/vtx_5k). */
 void testgt_faust(testgt *g, int nl);
 void testgt_close(testgt *g);
+/* The error of P against the identity ground truth of two meshes with the
+ * same vertices (TOSCA hi-res pairs): the mean Euclidean distance from each
+ * source vertex's image to the target vertex of the same index, over
+ * sqrt(target area): a lower bound of the geodesic error. */
+double testgt_identity_error(const mesh *S, const mesh *T, const bmap *P);
 
 #endif

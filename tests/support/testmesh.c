@@ -181,6 +181,55 @@ mesh *testmesh_disk(int rings)
     return m;
 }
 
+/* Open addressing over edges (lo, hi): slot -> the midpoint's vertex. */
+static int edge_midpoint(long long *key, int *val, size_t cap, mesh *out, int *nv, const mesh *m,
+                         int a, int b)
+{
+    long long lo = a < b ? a : b, hi = a < b ? b : a, k = lo * (long long)m->nv + hi;
+    size_t h = (size_t)(k * 0x9E3779B97F4A7C15ULL) & (cap - 1);
+    while (key[h] >= 0 && key[h] != k)
+        h = (h + 1) & (cap - 1);
+    if (key[h] == k)
+        return val[h];
+    key[h] = k;
+    val[h] = (*nv)++;
+    for (int c = 0; c < 3; c++)
+        out->v[3 * val[h] + c] = 0.5 * (m->v[3 * a + c] + m->v[3 * b + c]);
+    return val[h];
+}
+
+mesh *testmesh_subdivided(const mesh *m)
+{
+    size_t cap = 1;
+    while (cap < 4 * (size_t)m->nf)   /* at most 3 nf edges: load below 3/4 */
+        cap <<= 1;
+    long long *key = malloc(sizeof *key * cap);
+    int *val = malloc(sizeof *val * cap);
+    mesh *out = mesh_new(m->nv + 3 * m->nf, 4 * m->nf);  /* nv shrunk below */
+    if (!key || !val || !out) {
+        free(key);
+        free(val);
+        mesh_free(out);
+        return NULL;
+    }
+    for (size_t h = 0; h < cap; h++)
+        key[h] = -1;
+    memcpy(out->v, m->v, sizeof(double) * 3 * (size_t)m->nv);
+    int nv = m->nv;
+    for (int t = 0; t < m->nf; t++) {
+        int a = m->f[3 * t], b = m->f[3 * t + 1], c = m->f[3 * t + 2];
+        int ab = edge_midpoint(key, val, cap, out, &nv, m, a, b);
+        int bc = edge_midpoint(key, val, cap, out, &nv, m, b, c);
+        int ca = edge_midpoint(key, val, cap, out, &nv, m, c, a);
+        int q[12] = { a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca };
+        memcpy(out->f + 12 * (size_t)t, q, sizeof q);
+    }
+    out->nv = nv;
+    free(key);
+    free(val);
+    return out;
+}
+
 mesh *testmesh_mirrored(const mesh *m)
 {
     mesh *r = mesh_new(m->nv, m->nf);

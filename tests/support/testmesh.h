@@ -22,6 +22,12 @@ mesh *testmesh_disk(int rings);
  * order reversed, so that the normals stay outward (a proper mesh, not an
  * inside-out one); vertex i is vertex i of m reflected. */
 mesh *testmesh_mirrored(const mesh *m);
+/* m with every triangle split into four at its edge midpoints (the
+ * geometry is unchanged): vertices 0..nv-1 are m's, then one per edge in
+ * the order the faces first meet them, so two meshes with the same
+ * connectivity give two with the same connectivity (an identity ground
+ * truth stays one). Faces keep m's orientation. NULL when out of memory. */
+mesh *testmesh_subdivided(const mesh *m);
 /* The mesh at rel under the data folder (harness_data_path); the test
  * fails with mesh_read's message when it cannot be read. */
 mesh *testmesh_read(const char *rel);
