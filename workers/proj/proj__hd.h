@@ -34,8 +34,7 @@ void proj__hd_free(proj__hd *h);
 /* Doubles proj__hd_fit writes for dimension d. */
 size_t proj__hd_box_size(const proj__hd *h, int d);
 /* The boxes in R^d of every face and node for vertex coordinates Z (row
- * v: d values) into box (proj__hd_box_size floats, rounded outwards).
- * Parallel (OpenMP). */
+ * v: d values) into box (proj__hd_box_size doubles). Parallel (OpenMP). */
 void proj__hd_fit(const proj__hd *h, int d, const double *Z, double *box);
 
 /* The closest point of q (d values) on the faces embedded by Z, with the

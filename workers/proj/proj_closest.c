@@ -89,9 +89,8 @@ int proj_closest(const proj_tree *t, int d, const double *Z, double s,
             int fi = face[i];
             double best = INFINITY, b[3] = { 1, 0, 0 };
             if (fi >= 0) {
-                const int *v = t->f + 3 * (size_t)fi;
-                best = proj_point_triangle(d, q, Z + (size_t)d * v[0], Z + (size_t)d * v[1],
-                                           Z + (size_t)d * v[2], b);
+                const proj__row r = { .d = d, .Z = Z, .f = t->f, .q = q };
+                best = face_cost(&r, fi, b);
             }
             proj__hd_closest(t->hd, d, Z, box, q, &fi, &best, b);
             face[i] = fi;
