@@ -46,6 +46,9 @@ const char *proj_strerror(int code);
 
 typedef struct proj_tree proj_tree;
 
+/* NULL on failure, with the reason in err and errno ENOMEM when memory ran
+ * out (malloc's or Embree's: a worker under its memory limit), else EINVAL
+ * (a bad target, another Embree error). */
 proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz);
 void proj_tree_free(proj_tree *t);
 

@@ -5,6 +5,7 @@
 #include "proj/proj__tree.h"
 #include "util/errbuf.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -42,15 +43,30 @@ static double scene_scale(const mesh *m)
     return diag + amax;
 }
 
+/* An Embree failure into err, its out-of-memory read as such; returns
+ * whether it was. */
+static int embree_failed(enum RTCError e, const char *what, char *err, size_t errsz)
+{
+    if (e == RTC_ERROR_OUT_OF_MEMORY)
+        errbuf_set(err, errsz, PROJ_ENOMEM, "out of memory (%s)", what);
+    else
+        errbuf_set(err, errsz, PROJ_EEMBREE, "%s (error %d)", what, (int)e);
+    return e == RTC_ERROR_OUT_OF_MEMORY;
+}
+
 proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz)
 {
-    if (check_target(target, err, errsz) < 0)
+    if (check_target(target, err, errsz) < 0) {
+        errno = EINVAL;
         return NULL;
+    }
     proj_tree *t = calloc(1, sizeof *t);
     if (!t) {
         errbuf_set(err, errsz, PROJ_ENOMEM, "out of memory");
+        errno = ENOMEM;
         return NULL;
     }
+    int nomem = 1;
     t->nv = target->nv;
     t->nf = target->nf;
     t->scale = scene_scale(target);
@@ -73,8 +89,7 @@ proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz)
      * The build is a small part of a job: one tree per mesh. */
     t->device = rtcNewDevice("threads=1");
     if (!t->device) {
-        errbuf_set(err, errsz, PROJ_EEMBREE, "rtcNewDevice failed (error %d)",
-                   (int)rtcGetDeviceError(NULL));
+        nomem = embree_failed(rtcGetDeviceError(NULL), "rtcNewDevice failed", err, errsz);
         goto fail;
     }
     t->scene = rtcNewScene(t->device);
@@ -86,8 +101,8 @@ proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz)
     if (!t->scene || !vb || !ib) {
         if (g)
             rtcReleaseGeometry(g);
-        errbuf_set(err, errsz, PROJ_EEMBREE, "Embree could not allocate the scene (error %d)",
-                   (int)rtcGetDeviceError(t->device));
+        nomem = embree_failed(rtcGetDeviceError(t->device), "Embree could not allocate the scene",
+                              err, errsz);
         goto fail;
     }
     for (int i = 0; i < 3 * target->nv; i++)
@@ -100,12 +115,13 @@ proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz)
     rtcCommitScene(t->scene);
     enum RTCError e = rtcGetDeviceError(t->device);
     if (e != RTC_ERROR_NONE) {
-        errbuf_set(err, errsz, PROJ_EEMBREE, "Embree failed to build the BVH (error %d)", (int)e);
+        nomem = embree_failed(e, "Embree failed to build the BVH", err, errsz);
         goto fail;
     }
     return t;
 fail:
     proj_tree_free(t);
+    errno = nomem ? ENOMEM : EINVAL;
     return NULL;
 }
 

@@ -13,6 +13,7 @@
 #include "lbo/lbo.h"
 #include "util/errbuf.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -166,7 +167,9 @@ static int start_distances(rhm__problem *pb, char *err, size_t errsz)
             for (int v = 0; v < b->n; v++)
                 memcpy(emb->v + 3 * v, D[1 - i] + (size_t)v * dd, 3 * sizeof(double));
             memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
-            rc = (t = proj_tree_new(emb, NULL, 0)) ? RHM_OK : RHM_ENUMERIC;
+            rc = (t = proj_tree_new(emb, NULL, 0)) ? RHM_OK
+                 : errno == ENOMEM                   ? RHM_ENOMEM
+                                                     : RHM_ENUMERIC;
         }
         for (int v = 0; rc == RHM_OK && v < a->n; v++)
             a->P->face[v] = -1;

@@ -10,6 +10,7 @@
 #include "geo/geo_edges.h"
 #include "util/errbuf.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -109,9 +110,11 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
         memcpy(emb->v + 3 * v, sd->X + (size_t)v * pb->dim, 3 * sizeof(double));
     memcpy(emb->f, m->f, sizeof(int) * 3 * (size_t)m->nf);
     sd->tree = proj_tree_new(emb, detail, sizeof detail);
+    int nomem = errno == ENOMEM;
     mesh_free(emb);
     if (!sd->tree)
-        return errbuf_set(err, errsz, RHM_ENUMERIC, "%s: projection tree: %s", name, detail);
+        return errbuf_set(err, errsz, nomem ? RHM_ENOMEM : RHM_ENUMERIC,
+                          "%s: projection tree: %s", name, detail);
     if (!(sd->A = pattern(sd, &pb->cc)))
         return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
     sd->F = cholmod_analyze(sd->A, &pb->cc);

@@ -28,6 +28,7 @@
  * rebuilt over the current X_ji. */
 #include "rhm/rhm__problem.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -79,9 +80,10 @@ int rhm__step_p(rhm__problem *pb, int i, double beta)
             for (int c = 0; c < 3; c++)
                 emb->v[3 * v + c] = Z[(size_t)v * d + c] / s;
         memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
-        rc = RHM_ENUMERIC;
-        if (!(tmp = proj_tree_new(emb, NULL, 0)))
+        if (!(tmp = proj_tree_new(emb, NULL, 0))) {
+            rc = errno == ENOMEM ? RHM_ENOMEM : RHM_ENUMERIC;
             goto out;
+        }
         tree = tmp;
     }
     rc = proj_closest(tree, d, Z, s, a->n, Q, a->P->face, a->P->w, NULL) ? RHM_ENUMERIC : RHM_OK;
