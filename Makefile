@@ -23,7 +23,7 @@ CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(B
 PIC      = -fPIC -fno-semantic-interposition
 CFLAGS   += -std=c11 $(OPT) $(WARN) $(PIC) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) $(PIC) -pthread $(shell pkg-config --cflags draco)
-LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lcholmod -larpack -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
+LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lOpenMeshTools -lOpenMeshCore -lcholmod -larpack -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
 
 # The engine library: everything under workers/ except the worker main.
 ENGINE_C   := $(filter-out workers/main/%,$(wildcard workers/*/*.c))

@@ -9,6 +9,7 @@ build-essential pkg-config g++
 libembree-dev
 libdraco-dev draco
 libsuitesparse-dev liblapack-dev libarpack2-dev
+libopenmesh-dev
 libcgal-demo
 ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd
 libuv1-dev

@@ -56,8 +56,11 @@
  * error becomes that pair's row, and the other pairs still run. The rhm
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
  * repair (corr_repair); the rhm+ectm row is ECTM's maps after the same
- * repair, as corr_run's stages all returns them. Prints figures, never fails
- * on quality. */
+ * repair, as corr_run's stages all returns them (a pair over
+ * CORR_COARSE_ABOVE, headA -> headB: the start on the decimated pair
+ * carried to the input meshes, the rhm row as stages rhm returns it, the
+ * rhm+ectm row stages all from the landmarks, its time the whole job's).
+ * Prints figures, never fails on quality. */
 #include "support/harness.h"
 #include "support/testapart.h"
 #include "support/testgt.h"
@@ -208,6 +211,9 @@ static void run_pair(const void *arg, void *out)
     lmk_set *L = NULL;
     rhm__problem *pb = NULL;
     ectm_result rr = {0}, er = {0};
+    corr_coarse cc = {0};
+    bmap *start = NULL;            /* coarse to fine: the start carried */
+    geod_solver *geodT = NULL;
     double *e = NULL;
     /* the landmark rule of meshcorr match's files */
     long ls[NL], lt[NL];
@@ -228,15 +234,28 @@ static void run_pair(const void *arg, void *out)
     if (job->eta > 0)
         ep.eta = job->eta;
 
-    /* the start map, and T's geodesic solver for scoring */
-    if (rhm__problem_new(g.S, g.T, L, &rp, &pb, err, sizeof err) ||
+    /* the start map (a pair over CORR_COARSE_ABOVE: on the decimated
+     * pair, as corr_run makes it, carried to the input meshes), and T's
+     * geodesic solver for scoring */
+    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0, CORR_DDM_PLAIN };
+    int coarse = corr_coarse_wanted(&in);
+    if (coarse && corr_coarse_open(&in, &cc, err, sizeof err))
+        goto out;
+    const corr_input *ri = coarse ? &cc.in : &in;
+    if (rhm__problem_new(ri->S, ri->T, ri->L, &rp, &pb, err, sizeof err) ||
         rhm__init_start(pb, err, sizeof err))
         goto out;
-    const bmap *maps[NSTAGES] = { pb->side[0].P, NULL, NULL };
+    if (coarse) {
+        printf("  %s: coarse to fine, stages on %d -> %d vertices\n", ps->label, ri->S->nv,
+               ri->T->nv);
+        if (corr_coarse_carry(&in, &cc, pb->side[0].P, NULL, 0, &start, NULL, err, sizeof err) ||
+            geod_solver_new(g.T, 0, &geodT, err, sizeof err))
+            goto out;
+    }
+    const bmap *maps[NSTAGES] = { coarse ? start : pb->side[0].P, NULL, NULL };
     fig->nmaps = 1;
 
     watch w = { ps->label, {0} };
-    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0, CORR_DDM_PLAIN };
     double t0 = now();
     if (corr_run(&in, &ep, on_progress, &w, &rr, err, sizeof err))
         goto score;
@@ -247,14 +266,19 @@ static void run_pair(const void *arg, void *out)
     fflush(stdout);
 
     corr_input in2 = { g.S, g.T, S_name, T_name, NULL, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
-    if (corr_run(&in2, &ep, on_progress, &w, &er, err, sizeof err))
+    in.stages = CORR_STAGES_ALL;
+    t0 = now();
+    /* coarse to fine: the ECTM after the carried RHM maps is not the
+     * pipeline's (ECTM runs on the decimated pair first), so stages all
+     * from the landmarks again */
+    if (corr_run(coarse ? &in : &in2, &ep, on_progress, &w, &er, err, sizeof err))
         goto score;
     /* from landmarks, corr_run repairs ECTM's maps too (a run from given
      * maps, as in2 is, does not): the same call */
     fold_report rep[2];
-    if (corr_repair(&in, er.P, er.Q, rep, err, sizeof err))
+    if (!coarse && corr_repair(&in, er.P, er.Q, rep, err, sizeof err))
         FAILF("%s", err);
-    fig->secs[ECTM] = er.last.elapsed;
+    fig->secs[ECTM] = now() - t0;
     fig->iters[ECTM] = er.last.outer;
     maps[fig->nmaps++] = er.P;
 
@@ -262,8 +286,9 @@ score:
     e = malloc(sizeof(double) * (size_t)fig->nmaps * (size_t)g.n * 2);
     if (!e)
         FAILF("out of memory");
-    if (metric_geodesic_errors(pb->side[1].geod, g.T, maps, fig->nmaps, g.src, g.tgt, g.n, e) ||
-        (g.tgt_sym && metric_geodesic_errors(pb->side[1].geod, g.T, maps, fig->nmaps, g.src,
+    const geod_solver *gT = coarse ? geodT : pb->side[1].geod;
+    if (metric_geodesic_errors(gT, g.T, maps, fig->nmaps, g.src, g.tgt, g.n, e) ||
+        (g.tgt_sym && metric_geodesic_errors(gT, g.T, maps, fig->nmaps, g.src,
                                              g.tgt_sym, g.n, e + (size_t)fig->nmaps * g.n)))
         FAILF("%s: geodesic errors failed", ps->label);
     for (int a = 0; a < fig->nmaps; a++) {
@@ -281,6 +306,9 @@ score:
     }
 out:
     snprintf(fig->err, sizeof fig->err, "%s", err);
+    bmap_free(start);
+    geod_solver_free(geodT);
+    corr_coarse_close(&cc);
     free(e);
     ectm_result_close(&er);
     ectm_result_close(&rr);

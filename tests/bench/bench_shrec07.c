@@ -12,7 +12,12 @@
  * stay folded; the line after it names the start kept; the rhm row is
  * the kept map before its repair, the time of both in that row), ECTM
  * from the repaired maps (corr_run with stages ectm) and the repair of
- * its maps: the calls corr_run makes for stages all.
+ * its maps: the calls corr_run makes for stages all. A pair with a mesh
+ * over CORR_COARSE_ABOVE vertices runs these on its decimated copies
+ * (corr_coarse_open), each stage's map carried to the input meshes to be
+ * scored; its ectm row is the pipeline's: the coarse ECTM's maps carried
+ * and repaired, ECTM on the input meshes from them and its repair (the
+ * time: both ECTM runs).
  *
  * Per pair and stage, both meshes at unit area: held-out error (mean
  * geodesic distance on the target from each held-out source landmark's
@@ -184,7 +189,9 @@ static void run_pair(const void *arg, void *out)
     rhm__problem *pb = NULL;
     rhm_result rr = {0};
     ectm_result er = {0};
-    bmap *rhm_P = NULL;
+    bmap *rhm_P = NULL, *fine[NSTAGES] = {0};    /* fine: the maps carried (coarse to fine) */
+    corr_coarse cc = {0};
+    geod_solver *geodT = NULL;
     double *e = NULL;
     if (lmk_from_arrays(gs, gt, fig->given, 0, S_name, T_name, S, T, &L, err, sizeof err) ||
         corr_validate(S, S_name, err, sizeof err) || corr_validate(T, T_name, err, sizeof err))
@@ -202,8 +209,21 @@ static void run_pair(const void *arg, void *out)
     if (job->eta > 0)
         ep.eta = job->eta;
 
+    /* a pair over CORR_COARSE_ABOVE: the stages run on the decimated
+     * copies as corr_run's, each stage's map carried to the input meshes
+     * to be scored (the last one repaired there too, as corr_run does) */
+    corr_input in0 = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
     double t0 = now();
-    if (rhm__problem_new(S, T, L, &rp, &pb, err, sizeof err) ||
+    int coarse = corr_coarse_wanted(&in0);
+    if (coarse && corr_coarse_open(&in0, &cc, err, sizeof err))
+        goto out;
+    const corr_input *ri = coarse ? &cc.in : &in0;     /* the pair the stages run on */
+    if (coarse) {
+        printf("  %s: coarse to fine, stages on %d -> %d vertices\n", ps->label, ri->S->nv,
+               ri->T->nv);
+        fflush(stdout);
+    }
+    if (rhm__problem_new(ri->S, ri->T, ri->L, &rp, &pb, err, sizeof err) ||
         rhm__init_start(pb, err, sizeof err))
         goto out;
     fig->secs[START] = now() - t0;
@@ -213,7 +233,7 @@ static void run_pair(const void *arg, void *out)
         goto score;
 
     /* the pipeline's calls one by one (corr_run): RHM, the fold repair, ECTM */
-    corr_input in = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+    corr_input in = *ri;
     /* RHM and its repair (with start auto's second run when the first
      * stays folded): corr_rhm, timed as one; the RHM row is its kept
      * forward map before the repair */
@@ -236,7 +256,8 @@ static void run_pair(const void *arg, void *out)
     if (job->last == REPAIR)
         goto score;
 
-    corr_input in2 = { S, T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
+    corr_input in2 = { ri->S, ri->T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0,
+                       CORR_DDM_PLAIN };
     t0 = now();
     if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
         goto score;
@@ -244,10 +265,35 @@ static void run_pair(const void *arg, void *out)
      * maps, as in2 is, does not): the same call */
     if (corr_repair(&in, er.P, er.Q, rep, err, sizeof err))
         FAILF("%s", err);
-    fig->secs[ECTM] = now() - t0;
     maps[fig->nmaps++] = er.P;
+    if (coarse) {   /* carried, repaired, finished by ECTM on the input pair, repaired */
+        bmap *cP, *cQ;
+        ectm_result fr = {0};
+        if (corr_coarse_carry(&in0, &cc, er.P, er.Q, 1, &cP, &cQ, err, sizeof err))
+            FAILF("%s", err);
+        corr_input in3 = { S, T, S_name, T_name, NULL, cP, cQ, &rp, CORR_STAGES_ECTM, 0,
+                           CORR_DDM_PLAIN };
+        if (corr_run(&in3, &ep, on_progress, NULL, &fr, err, sizeof err))
+            FAILF("%s", err);
+        if (corr_repair(&in0, fr.P, fr.Q, rep, err, sizeof err))
+            FAILF("%s", err);
+        fine[fig->nmaps - 1] = fr.P;
+        fr.P = NULL;
+        ectm_result_close(&fr);
+        bmap_free(cP);
+        bmap_free(cQ);
+    }
+    fig->secs[ECTM] = now() - t0;
 
 score:
+    for (int a = 0; coarse && a < fig->nmaps; a++) {
+        if (!fine[a] && corr_coarse_carry(&in0, &cc, maps[a], NULL, 0, &fine[a], NULL, err,
+                                          sizeof err))
+            FAILF("%s", err);
+        maps[a] = fine[a];
+    }
+    if (coarse && geod_solver_new(T, 0, &geodT, err, sizeof err))
+        FAILF("%s", err);
     for (int a = 0; a < fig->nmaps && job->out_dir; a++) {
         snprintf(p, sizeof p, "%s/%s.%s.map", job->out_dir, ps->label, stage_name[a]);
         if (bmap_write(p, maps[a], stage_name[a], err, sizeof err))
@@ -256,7 +302,7 @@ score:
     e = malloc(sizeof(double) * (size_t)fig->nmaps * (size_t)hs_n);
     if (!e)
         FAILF("out of memory");
-    if (metric_geodesic_errors(pb->side[1].geod, T, maps, fig->nmaps, hs, ht, hs_n, e))
+    if (metric_geodesic_errors(coarse ? geodT : pb->side[1].geod, T, maps, fig->nmaps, hs, ht, hs_n, e))
         FAILF("%s: geodesic errors failed", ps->label);
     for (int a = 0; a < fig->nmaps; a++) {
         double s = 0;
@@ -269,6 +315,10 @@ score:
     }
 out:
     snprintf(fig->why, sizeof fig->why, "%s", err);
+    for (int a = 0; a < NSTAGES; a++)
+        bmap_free(fine[a]);
+    geod_solver_free(geodT);
+    corr_coarse_close(&cc);
     free(e);
     bmap_free(rhm_P);
     ectm_result_close(&er);

@@ -8,6 +8,7 @@
 #include "support/harness.h"
 #include "support/testddm.h"
 #include "support/testgt.h"
+#include "support/testmesh.h"
 #include "corr/corr.h"
 #include "ddm/ddm.h"
 #include "geod/geod.h"
@@ -213,4 +214,88 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     geod_solver_free(sT);
     bmap_free(P0);
     testgt_close(&g);
+}
+
+/* A pair over CORR_COARSE_ABOVE from landmarks: TOSCA wolf0 -> wolf2
+ * (tosca_hires, 4344 vertices, the 21 landmarks of Corrs/wolf.pid) split
+ * 1-to-4 (17370 vertices; the shipped vertices keep their indices, so the
+ * identity is their ground truth — not the midpoints', as the two meshes'
+ * face lists differ in 240 faces). The chain runs on the decimated pair
+ * (RHM, then ECTM: each ECTM iteration reported once there and once on
+ * the input pair), the maps come back on the input meshes with ECTM's
+ * deformation of them, near the identity and unfolded; stages rhm stops
+ * after the coarse RHM's maps are carried back. */
+TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
+{
+    if (!harness_data_dir())
+        SKIP("../shared/data is absent");
+    mesh *S0 = testmesh_read("tosca_hires/Meshes/wolf0.off");
+    mesh *T0 = testmesh_read("tosca_hires/Meshes/wolf2.off");
+    mesh *S = testmesh_subdivided(S0), *T = testmesh_subdivided(T0);
+    CHECK(S && T && S->nv > CORR_COARSE_ABOVE);
+    char err[1024];
+    int *ids, n;
+    if (lmk_read_ids(harness_data_path("tosca_hires/Corrs/wolf.pid"), 0, S0->nv, 1000, &ids, &n,
+                     err, sizeof err))
+        FAILF("%s", err);
+    long ls[1000];
+    for (int r = 0; r < n; r++)
+        ls[r] = ids[r];
+    lmk_set *L = NULL;
+    if (lmk_from_arrays(ls, ls, n, 0, "wolf0", "wolf2", S, T, &L, err, sizeof err))
+        FAILF("%s", err);
+    ectm_params p;
+    ectm_params_init(&p);
+    rhm_params rp;
+    rhm_params_init(&rp);
+    corr_input in = { S, T, "wolf0", "wolf2", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
+                      CORR_DDM_PLAIN };
+    CHECK(corr_coarse_wanted(&in));
+    ectm_result r = {0};
+    stage_log l = {0};
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    int ectm = 0, rhm = 0;
+    for (int i = 0; i < l.n; i++) {
+        ectm += l.stage[i] == CORR_STAGE_ECTM;
+        rhm += l.stage[i] == CORR_STAGE_RHM;
+    }
+    CHECK_INT(ectm, 2 * p.iterations);
+    CHECK(rhm >= rp.min_iterations);
+    CHECK(r.P && r.Q && r.Y);
+    CHECK_INT(r.P->n, S->nv);
+    CHECK_INT(r.Q->n, T->nv);
+    bmap shipped = *r.P;        /* the rows of the shipped vertices */
+    shipped.n = S0->nv;
+    metric_summary m;
+    CHECK_INT(metric_summarize(S, T, r.P, &m), 0);
+    double e = testgt_identity_error(S, T, &shipped);
+    printf("  all: error %.4f, flipped %.2f %%, collapsed %.2f %%\n", e, 100 * m.flipped_fraction,
+           100 * m.collapsed_fraction);
+    CHECK(e < 0.015);   /* 0.006-0.011 as rounding moves it; the direct run on
+                           these meshes: 0.017 (issue 16's note) */
+    CHECK(m.flipped_fraction < 0.01);
+    CHECK(m.collapsed_fraction < 0.005);
+    ectm_result_close(&r);
+
+    in.stages = CORR_STAGES_RHM;
+    memset(&l, 0, sizeof l);
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    for (int i = 0; i < l.n; i++)
+        CHECK(l.stage[i] != CORR_STAGE_ECTM);
+    CHECK(r.P && r.Q && !r.Y);
+    CHECK_INT(r.P->n, S->nv);
+    shipped = *r.P;
+    shipped.n = S0->nv;
+    e = testgt_identity_error(S, T, &shipped);
+    printf("  rhm: error %.4f\n", e);
+    CHECK(e < 0.03);
+    ectm_result_close(&r);
+    lmk_free(L);
+    free(ids);
+    mesh_free(S);
+    mesh_free(T);
+    mesh_free(S0);
+    mesh_free(T0);
 }

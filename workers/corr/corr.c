@@ -218,6 +218,40 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz)
     return CORR_OK;
 }
 
+/* RHM from the given (or denoised) maps P, Q and the repair of its maps. */
+static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
+                         const rhm_params *rp, relay *rl, rhm_result *out, char *err,
+                         size_t errsz)
+{
+    fold_report rep[2];
+    int rc = from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err,
+                                        errsz));
+    return rc ? rc : corr_repair(in, out->P12, out->P21, rep, err, errsz);
+}
+
+/* The chain of in (from landmarks) on the decimated pair, its last maps
+ * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL).
+ * *ran = 0 (and nothing done) when the decimation left a mesh over
+ * CORR_COARSE_ABOVE: collapses refused everywhere (its normals or its
+ * faces' shapes), the job then runs on in's meshes. */
+static int run_coarse(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
+                      void *ctx, bmap **P, bmap **Q, int *ran, char *err, size_t errsz)
+{
+    corr_coarse c;
+    ectm_result cr = {0};
+    int rc = corr_coarse_open(in, &c, err, errsz);
+    *ran = !rc && !corr_coarse_wanted(&c.in);
+    if (rc || !*ran) {
+        corr_coarse_close(&c);
+        return rc;
+    }
+    if (!(rc = corr_run(&c.in, p, progress, ctx, &cr, err, errsz)))
+        rc = corr_coarse_carry(in, &c, cr.P, cr.Q, 1, P, Q, err, errsz);
+    ectm_result_close(&cr);
+    corr_coarse_close(&c);
+    return rc;
+}
+
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz)
 {
@@ -244,7 +278,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         return CORR_EINPUT;
 
     bmap *dP = NULL, *dQ = NULL;               /* DDM's maps */
-    rhm_result init = {0};                     /* RHM's maps */
+    rhm_result init = {0};                     /* RHM's maps (or the coarse chain's) */
     const bmap *P = in->P0, *Q = bij ? in->Q0 : NULL;
     if (run & CORR_RUN_DDM) {
         if ((rc = corr__ddm(in, P, Q, relay_ddm, &rl, &dP, &dQ, err, errsz)))
@@ -266,13 +300,17 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
                 goto done;
             }
         }
+        int coarse = 0;
+        if (corr_coarse_wanted(in))
+            /* the chain on the decimated pair; ECTM below finishes its
+             * maps on in's meshes */
+            rc = run_coarse(in, p, progress, ctx, &init.P12, &init.P21, &coarse, err, errsz);
         fold_report rep[2];
-        if (P) {
-            if ((rc = from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, &rp, relay_rhm, &rl,
-                                                 &init, err, errsz))) ||
-                (rc = corr_repair(in, init.P12, init.P21, rep, err, errsz)))
-                goto done;
-        } else if ((rc = corr_rhm(in, &rp, relay_rhm, &rl, &init, NULL, rep, err, errsz)))
+        if (!rc && !coarse && P)
+            rc = rhm_from_maps(in, P, Q, &rp, &rl, &init, err, errsz);
+        else if (!rc && !coarse)
+            rc = corr_rhm(in, &rp, relay_rhm, &rl, &init, NULL, rep, err, errsz);
+        if (rc)
             goto done;
         if (!(run & CORR_RUN_ECTM)) {
             out->P = init.P12;

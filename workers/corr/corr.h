@@ -175,6 +175,35 @@ int corr_params_from_job(const proto_params *w, int threads, ectm_params *p, rhm
 void corr_params_to_job(const ectm_params *p, const rhm_params *r, proto_params *w, char *backend,
                         size_t bsz);
 
+/* Coarse to fine (corr_coarse.c). A chain from landmarks (no P0, RHM
+ * runs) on a pair with a mesh over CORR_COARSE_ABOVE vertices runs on
+ * copies of the meshes decimated to CORR_COARSE_VERTICES (ctf_decimate,
+ * the landmark vertices kept; a mesh that small already is used as it
+ * is); its maps are carried back to the input meshes (ctf_prolong) and
+ * repaired there (corr_repair). corr_run does this by itself; the
+ * benchmarks call the steps to score each stage. */
+#define CORR_COARSE_ABOVE 12000
+#define CORR_COARSE_VERTICES 6000
+
+typedef struct corr_coarse {
+    mesh *S, *T;          /* the decimated copies; NULL: the input mesh itself */
+    int *lsrc, *ltgt;     /* the landmark vertices on them                   */
+    lmk_set L;
+    corr_input in;        /* the job's input on the coarse pair               */
+} corr_coarse;
+
+/* Whether corr_run takes the coarse path for in. */
+int corr_coarse_wanted(const corr_input *in);
+/* Decimates in's meshes into c (c->in: the coarse pair's input, checked
+ * with corr_validate). CORR_OK, CORR_ENOMEM, CORR_EINIT or CORR_EMESH;
+ * on failure c holds nothing. */
+int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t errsz);
+/* The coarse pair's maps Pc and (Qc, Q not NULL) Qc carried to in's meshes
+ * into *P and *Q, and with repair non-zero repaired as corr_run's last step. */
+int corr_coarse_carry(const corr_input *in, const corr_coarse *c, const bmap *Pc,
+                      const bmap *Qc, int repair, bmap **P, bmap **Q, char *err, size_t errsz);
+void corr_coarse_close(corr_coarse *c);
+
 /* Runs the pipeline: the stages of in->stages (corr_stages_check first).
  * When the chain ends before ECTM, out->P and out->Q are the last stage's
  * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
