@@ -93,7 +93,7 @@ typedef struct mc_job_spec {
      * (NULL or "" = the server's default; "cpu", "opencl", "auto",
      * optionally ":DEVICE", a platform or device name part), stages
      * (MC_STAGES_*), ddm_k, ddm_mode (MC_DDM_PLAIN, MC_DDM_BIJECTIVE),
-     * zoomout. */
+     * zoomout, coarse. */
 #define MC_PARAM_CTYPE_ENUM int
 #define MC_PARAM_CTYPE_BOOL int
 #define MC_PARAM_CTYPE_U32  uint32_t

@@ -42,6 +42,8 @@
 #define PROTO_DDM_MAX_K     300      /* ddm_k's max: the eigenpairs' (LBO_MAX_K) */
 #define PROTO_ZOOMOUT_MIN   51       /* zoomout's min besides 0 (off): RHM_FMAP_K + 1 */
 #define PROTO_ZOOMOUT_MAX   300      /* zoomout's max: the eigenpairs' (LBO_MAX_K) */
+#define PROTO_COARSE_MIN    500      /* coarse's min besides 0 (off) */
+#define PROTO_COARSE_MAX    10000000 /* coarse's max */
 
 #define PROTO_PARAM_OPEN_MIN     1u
 #define PROTO_PARAM_OPEN_MAX     2u
@@ -103,6 +105,11 @@
     X(zoomout, "zoomout", U32, 0, PROTO_ZOOMOUT_MIN, PROTO_ZOOMOUT_MAX, PROTO_PARAM_ZERO_OFF,    \
       RHM, zoomout, "",                                                                          \
       "start fmap (and auto's second run): ZoomOut from the start's 50 basis functions to this " \
-      "many per mesh before DDM deblurring (0: off; else more than 50 and at most vertices - 2)")
+      "many per mesh before DDM deblurring (0: off; else more than 50 and at most vertices - 2)") \
+    X(coarse, "coarse", U32, 6000, PROTO_COARSE_MIN, PROTO_COARSE_MAX, PROTO_PARAM_ZERO_OFF, RHM,   \
+      coarse, "",                                                                                \
+      "coarse to fine, from landmarks: a mesh over twice this many vertices is decimated to "   \
+      "this many, the chain runs on the decimated pair, its maps come back to the meshes and "  \
+      "ECTM finishes them there (0: off, every stage on the meshes as given)")
 
 #endif

@@ -23,11 +23,13 @@
  * far, so the last is the job's), flipped and collapsed triangles and
  * the mean Euclidean distance from each vertex's image to its ground
  * truth over sqrt(target area), a lower bound of the geodesic error
- * (wolf: over the shipped vertices). Pairs over CORR_COARSE_ABOVE run
+ * (wolf: over the shipped vertices). Pairs over twice the coarse size
+ * (job parameter coarse, 6000) run
  * coarse to fine (corr.h): their "start" is the decimation and the
  * coarse start, "rhm+repair" the coarse RHM, "ectm+repair" both ECTM runs.
  * Options: --ectm-iterations=K, --levels=L (the scaling test's most
- * subdivisions, default 2). Prints figures, never fails on time. */
+ * subdivisions, default 2), --coarse=N (the job parameter; 0: every stage
+ * on the meshes as given, as before coarse to fine). Prints figures, never fails on time. */
 #include "support/harness.h"
 #include "support/testapart.h"
 #include "support/testfit.h"
@@ -112,6 +114,9 @@ static void run_pipeline(const mesh *S, const mesh *T, const char *pid_rel, int 
     rhm_params rp;
     rhm_params_init(&rp);
     rp.threads = p.threads;
+    const char *o_c = harness_option("coarse");
+    if (o_c)
+        rp.coarse = atoi(o_c);
     corr_input in = { S, T, "source", "target", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
                       CORR_DDM_PLAIN };
     ectm_result r = {0};

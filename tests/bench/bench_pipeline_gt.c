@@ -57,7 +57,7 @@
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
  * repair (corr_repair); the rhm+ectm row is ECTM's maps after the same
  * repair, as corr_run's stages all returns them (a pair over
- * CORR_COARSE_ABOVE, headA -> headB: the start on the decimated pair
+ * twice the job parameter coarse, headA -> headB: the start on the decimated pair
  * carried to the input meshes, the rhm row as stages rhm returns it, the
  * rhm+ectm row stages all from the landmarks, its time the whole job's).
  * Prints figures, never fails on quality. */
@@ -234,7 +234,7 @@ static void run_pair(const void *arg, void *out)
     if (job->eta > 0)
         ep.eta = job->eta;
 
-    /* the start map (a pair over CORR_COARSE_ABOVE: on the decimated
+    /* the start map (a pair over twice the coarse size, 12 000: on the decimated
      * pair, as corr_run makes it, carried to the input meshes), and T's
      * geodesic solver for scoring */
     corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0, CORR_DDM_PLAIN };
@@ -286,7 +286,7 @@ score:
     e = malloc(sizeof(double) * (size_t)fig->nmaps * (size_t)g.n * 2);
     if (!e)
         FAILF("out of memory");
-    const geod_solver *gT = coarse ? geodT : pb->side[1].geod;
+    geod_solver *gT = coarse ? geodT : pb->side[1].geod;
     if (metric_geodesic_errors(gT, g.T, maps, fig->nmaps, g.src, g.tgt, g.n, e) ||
         (g.tgt_sym && metric_geodesic_errors(gT, g.T, maps, fig->nmaps, g.src,
                                              g.tgt_sym, g.n, e + (size_t)fig->nmaps * g.n)))

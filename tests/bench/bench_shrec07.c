@@ -13,7 +13,8 @@
  * the kept map before its repair, the time of both in that row), ECTM
  * from the repaired maps (corr_run with stages ectm) and the repair of
  * its maps: the calls corr_run makes for stages all. A pair with a mesh
- * over CORR_COARSE_ABOVE vertices runs these on its decimated copies
+ * over twice the coarse size (job parameter coarse, 6000) vertices runs
+ * these on its decimated copies
  * (corr_coarse_open), each stage's map carried to the input meshes to be
  * scored; its ectm row is the pipeline's: the coarse ECTM's maps carried
  * and repaired, ECTM on the input meshes from them and its repair (the
@@ -209,7 +210,7 @@ static void run_pair(const void *arg, void *out)
     if (job->eta > 0)
         ep.eta = job->eta;
 
-    /* a pair over CORR_COARSE_ABOVE: the stages run on the decimated
+    /* a pair over twice the coarse size (12 000): the stages run on the decimated
      * copies as corr_run's, each stage's map carried to the input meshes
      * to be scored (the last one repaired there too, as corr_run does) */
     corr_input in0 = { S, T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };

@@ -216,7 +216,8 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     testgt_close(&g);
 }
 
-/* A pair over CORR_COARSE_ABOVE from landmarks: TOSCA wolf0 -> wolf2
+/* A pair over twice the coarse size (job parameter coarse, 6000 by
+ * default) from landmarks: TOSCA wolf0 -> wolf2
  * (tosca_hires, 4344 vertices, the 21 landmarks of Corrs/wolf.pid) split
  * 1-to-4 (17370 vertices; the shipped vertices keep their indices, so the
  * identity is their ground truth — not the midpoints', as the two meshes'
@@ -232,7 +233,7 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     mesh *S0 = testmesh_read("tosca_hires/Meshes/wolf0.off");
     mesh *T0 = testmesh_read("tosca_hires/Meshes/wolf2.off");
     mesh *S = testmesh_subdivided(S0), *T = testmesh_subdivided(T0);
-    CHECK(S && T && S->nv > CORR_COARSE_ABOVE);
+    CHECK(S && T);
     char err[1024];
     int *ids, n;
     if (lmk_read_ids(harness_data_path("tosca_hires/Corrs/wolf.pid"), 0, S0->nv, 1000, &ids, &n,
@@ -250,7 +251,7 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     rhm_params_init(&rp);
     corr_input in = { S, T, "wolf0", "wolf2", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
                       CORR_DDM_PLAIN };
-    CHECK(corr_coarse_wanted(&in));
+    CHECK(S->nv > 2 * rp.coarse && corr_coarse_wanted(&in));
     ectm_result r = {0};
     stage_log l = {0};
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
@@ -292,6 +293,8 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     printf("  rhm: error %.4f\n", e);
     CHECK(e < 0.03);
     ectm_result_close(&r);
+    rp.coarse = 0;                  /* off: the chain runs on the meshes as given */
+    CHECK(!corr_coarse_wanted(&in));
     lmk_free(L);
     free(ids);
     mesh_free(S);

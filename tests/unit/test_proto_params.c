@@ -219,3 +219,17 @@ TEST(zoomout_is_off_or_larger_than_the_fmap_start_basis)
     w.zoomout = 0;
     CHECK_INT(proto_params_check(&w, err, sizeof err), PROTO_OK);
 }
+
+/* coarse: 0 (off) or PROTO_COARSE_MIN..PROTO_COARSE_MAX, 6000 by default. */
+TEST(coarse_is_off_or_a_vertex_count_in_range)
+{
+    char err[256];
+    proto_params w;
+    proto_params_init(&w);
+    CHECK_INT(w.coarse, 6000);
+    CHECK_INT(proto_param_check(PROTO_P_coarse, 0, err, sizeof err), PROTO_OK);
+    CHECK_INT(proto_param_check(PROTO_P_coarse, PROTO_COARSE_MIN, err, sizeof err), PROTO_OK);
+    CHECK(proto_param_check(PROTO_P_coarse, PROTO_COARSE_MIN - 1, err, sizeof err) != PROTO_OK);
+    CHECK(strstr(err, "coarse") && strstr(err, "500"));
+    CHECK(proto_param_check(PROTO_P_coarse, (double)PROTO_COARSE_MAX + 1, err, sizeof err) != PROTO_OK);
+}

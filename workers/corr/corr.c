@@ -231,8 +231,8 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
 
 /* The chain of in (from landmarks) on the decimated pair, its last maps
  * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL).
- * *ran = 0 (and nothing done) when the decimation left a mesh over
- * CORR_COARSE_ABOVE: collapses refused everywhere (its normals or its
+ * *ran = 0 (and nothing done) when the decimation left a mesh over twice
+ * the coarse size: collapses refused everywhere (its normals or its
  * faces' shapes), the job then runs on in's meshes. */
 static int run_coarse(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
                       void *ctx, bmap **P, bmap **Q, int *ran, char *err, size_t errsz)

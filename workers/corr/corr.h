@@ -175,15 +175,14 @@ int corr_params_from_job(const proto_params *w, int threads, ectm_params *p, rhm
 void corr_params_to_job(const ectm_params *p, const rhm_params *r, proto_params *w, char *backend,
                         size_t bsz);
 
-/* Coarse to fine (corr_coarse.c). A chain from landmarks (no P0, RHM
- * runs) on a pair with a mesh over CORR_COARSE_ABOVE vertices runs on
- * copies of the meshes decimated to CORR_COARSE_VERTICES (ctf_decimate,
- * the landmark vertices kept; a mesh that small already is used as it
- * is); its maps are carried back to the input meshes (ctf_prolong) and
- * repaired there (corr_repair). corr_run does this by itself; the
- * benchmarks call the steps to score each stage. */
-#define CORR_COARSE_ABOVE 12000
-#define CORR_COARSE_VERTICES 6000
+/* Coarse to fine (corr_coarse.c). With c = in->rhm->coarse (the job
+ * parameter coarse, default 6000; 0: off), a chain from landmarks (no P0,
+ * RHM runs) on a pair with a mesh over 2c vertices runs on copies of the
+ * meshes decimated to c vertices (ctf_decimate, the landmark vertices
+ * kept; a mesh of 2c or fewer is used as it is); its maps are carried
+ * back to the input meshes (ctf_prolong) and repaired there
+ * (corr_repair), and ECTM finishes them there. corr_run does this by
+ * itself; the benchmarks call the steps to score each stage. */
 
 typedef struct corr_coarse {
     mesh *S, *T;          /* the decimated copies; NULL: the input mesh itself */

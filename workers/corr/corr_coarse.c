@@ -9,10 +9,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The coarse pair's vertices; 0: off. */
+static int coarse_size(const corr_input *in)
+{
+    rhm_params d;
+    rhm_params_init(&d);
+    return in->rhm ? in->rhm->coarse : d.coarse;
+}
+
 int corr_coarse_wanted(const corr_input *in)
 {
-    return !in->P0 && in->L && (corr_stages_run(in->stages, 0) & CORR_RUN_RHM) &&
-           (in->S->nv > CORR_COARSE_ABOVE || in->T->nv > CORR_COARSE_ABOVE);
+    long c = coarse_size(in);
+    return c > 0 && !in->P0 && in->L && (corr_stages_run(in->stages, 0) & CORR_RUN_RHM) &&
+           (in->S->nv > 2 * c || in->T->nv > 2 * c);
 }
 
 static int from_ctf(int rc)
@@ -22,15 +31,15 @@ static int from_ctf(int rc)
 
 /* m decimated into *out (left NULL when m is small already), with the
  * landmark vertices lmk[0..n) renumbered to the copy's in clmk. */
-static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, mesh **out,
-                       int *clmk, char *err, size_t errsz)
+static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, int c,
+                       mesh **out, int *clmk, char *err, size_t errsz)
 {
     memcpy(clmk, lmk, sizeof(int) * (size_t)n);
-    if (m->nv <= CORR_COARSE_ABOVE)
+    if (m->nv <= 2L * c)
         return CORR_OK;
     char why[512];
     int *fine = NULL;
-    int rc = ctf_decimate(m, CORR_COARSE_VERTICES, lmk, n, out, &fine, why, sizeof why);
+    int rc = ctf_decimate(m, c, lmk, n, out, &fine, why, sizeof why);
     if (rc)
         return errbuf_set(err, errsz, from_ctf(rc), "%s: decimation: %s", name, why);
     int *at = malloc(sizeof(int) * (size_t)m->nv);
@@ -57,9 +66,9 @@ int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t err
     c->ltgt = malloc(sizeof(int) * ((size_t)L->n + 1));
     if (!c->lsrc || !c->ltgt)
         return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory");
-    int rc;
-    if ((rc = coarse_side(in->S, in->S_name, L->src, L->n, &c->S, c->lsrc, err, errsz)) ||
-        (rc = coarse_side(in->T, in->T_name, L->tgt, L->n, &c->T, c->ltgt, err, errsz))) {
+    int rc, nc = coarse_size(in);
+    if ((rc = coarse_side(in->S, in->S_name, L->src, L->n, nc, &c->S, c->lsrc, err, errsz)) ||
+        (rc = coarse_side(in->T, in->T_name, L->tgt, L->n, nc, &c->T, c->ltgt, err, errsz))) {
         corr_coarse_close(c);
         return rc;
     }

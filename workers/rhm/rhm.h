@@ -108,6 +108,7 @@ typedef struct rhm_params {
     double stop_change;    /* relative energy change to stop; 0 = never     */
     int threads;           /* OpenMP threads; 0: all cores                  */
     int zoomout;           /* start fmap: ZoomOut's final basis size; 0 off */
+    int coarse;            /* coarse to fine's vertices (corr.h); 0 off     */
 } rhm_params;
 
 /* The authors' release: α = 5e-4, β = 5e-3·min(k, 100), γ = 0, m = 8,
