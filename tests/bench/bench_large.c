@@ -96,15 +96,7 @@ static void run_pipeline(const mesh *S, const mesh *T, const char *pid_rel, int 
                          run_fig *f)
 {
     char err[1024];
-    int *ids, n;
-    if (lmk_read_ids(harness_data_path(pid_rel), 0, S->nv, 1000, &ids, &n, err, sizeof err))
-        FAILF("%s", err);
-    long ls[1000];
-    for (int r = 0; r < n; r++)
-        ls[r] = ids[r];
-    lmk_set *L = NULL;
-    if (lmk_from_arrays(ls, ls, n, 0, "source", "target", S, T, &L, err, sizeof err))
-        FAILF("%s", err);
+    lmk_set *L = testgt_pid_landmarks(pid_rel, S, T);
     ectm_params p;
     ectm_params_init(&p);
     const char *o_it = harness_option("ectm-iterations");
@@ -139,7 +131,6 @@ static void run_pipeline(const mesh *S, const mesh *T, const char *pid_rel, int 
     }
     ectm_result_close(&r);
     lmk_free(L);
-    free(ids);
 }
 
 static void print_run(const char *what, const run_fig *f)

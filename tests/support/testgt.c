@@ -129,3 +129,22 @@ double testgt_identity_error(const mesh *S, const mesh *T, const bmap *P)
     }
     return e / (S->nv * sqrt(geo_total_area(T)));
 }
+
+lmk_set *testgt_pid_landmarks(const char *pid_rel, const mesh *S, const mesh *T)
+{
+    char err[1024];
+    int *ids, n;
+    if (lmk_read_ids(harness_data_path(pid_rel), 0, S->nv, 1000, &ids, &n, err, sizeof err))
+        FAILF("%s", err);
+    long *ls = malloc(sizeof(long) * ((size_t)n + 1));
+    if (!ls)
+        FAILF("out of memory");
+    for (int r = 0; r < n; r++)
+        ls[r] = ids[r];
+    lmk_set *L = NULL;
+    if (lmk_from_arrays(ls, ls, n, 0, "source", "target", S, T, &L, err, sizeof err))
+        FAILF("%s", err);
+    free(ls);
+    free(ids);
+    return L;
+}

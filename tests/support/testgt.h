@@ -47,5 +47,10 @@ void testgt_close(testgt *g);
  * source vertex's image to the target vertex of the same index, over
  * sqrt(target area): a lower bound of the geodesic error. */
 double testgt_identity_error(const mesh *S, const mesh *T, const bmap *P);
+/* The landmark pairs (v, v) of the vertex ids listed in pid_rel (relative
+ * to the data folder, 0-based, as TOSCA's Corrs/NAME.pid): the identity
+ * pairs of two meshes with the same vertices, by meshcorr match's rule
+ * (lmk_from_arrays). Fails the test on error. */
+lmk_set *testgt_pid_landmarks(const char *pid_rel, const mesh *S, const mesh *T);
 
 #endif

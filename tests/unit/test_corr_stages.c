@@ -235,16 +235,7 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     mesh *S = testmesh_subdivided(S0), *T = testmesh_subdivided(T0);
     CHECK(S && T);
     char err[1024];
-    int *ids, n;
-    if (lmk_read_ids(harness_data_path("tosca_hires/Corrs/wolf.pid"), 0, S0->nv, 1000, &ids, &n,
-                     err, sizeof err))
-        FAILF("%s", err);
-    long ls[1000];
-    for (int r = 0; r < n; r++)
-        ls[r] = ids[r];
-    lmk_set *L = NULL;
-    if (lmk_from_arrays(ls, ls, n, 0, "wolf0", "wolf2", S, T, &L, err, sizeof err))
-        FAILF("%s", err);
+    lmk_set *L = testgt_pid_landmarks("tosca_hires/Corrs/wolf.pid", S, T);
     ectm_params p;
     ectm_params_init(&p);
     rhm_params rp;
@@ -296,7 +287,6 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     rp.coarse = 0;                  /* off: the chain runs on the meshes as given */
     CHECK(!corr_coarse_wanted(&in));
     lmk_free(L);
-    free(ids);
     mesh_free(S);
     mesh_free(T);
     mesh_free(S0);
