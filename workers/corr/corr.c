@@ -231,15 +231,21 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
 
 /* The chain of in (from landmarks) on the decimated pair, its last maps
  * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL).
- * *ran = 0 (and nothing done) when the decimation left a mesh over twice
- * the coarse size: collapses refused everywhere (its normals or its
- * faces' shapes), the job then runs on in's meshes. */
+ * *ran = 0 (and nothing done) when there is no usable decimated pair: a
+ * mesh still over twice the coarse size (collapses refused everywhere by
+ * its normals or its faces' shapes), or a decimation that failed other
+ * than for memory (OpenMesh refusing a face, a copy corr_validate
+ * refuses); the job then runs on in's meshes as given. */
 static int run_coarse(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
                       void *ctx, bmap **P, bmap **Q, int *ran, char *err, size_t errsz)
 {
     corr_coarse c;
     ectm_result cr = {0};
     int rc = corr_coarse_open(in, &c, err, errsz);
+    if (rc && rc != CORR_ENOMEM) {
+        *ran = 0;
+        return CORR_OK;
+    }
     *ran = !rc && !corr_coarse_wanted(&c.in);
     if (rc || !*ran) {
         corr_coarse_close(&c);

@@ -194,8 +194,10 @@ typedef struct corr_coarse {
 /* Whether corr_run takes the coarse path for in. */
 int corr_coarse_wanted(const corr_input *in);
 /* Decimates in's meshes into c (c->in: the coarse pair's input, checked
- * with corr_validate). CORR_OK, CORR_ENOMEM, CORR_EINIT or CORR_EMESH;
- * on failure c holds nothing. */
+ * with corr_validate). CORR_OK, CORR_ENOMEM, CORR_EINPUT or CORR_EFAILED
+ * (the decimation), CORR_EMESH (a copy corr_validate refuses); on failure
+ * c holds nothing. corr_run runs a job whose decimation fails other than
+ * for memory on its meshes as given. */
 int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t errsz);
 /* The coarse pair's maps Pc and (Qc, Q not NULL) Qc carried to in's meshes
  * into *P and *Q, and with repair non-zero repaired as corr_run's last step. */

@@ -26,7 +26,7 @@ int corr_coarse_wanted(const corr_input *in)
 
 static int from_ctf(int rc)
 {
-    return rc == CTF_ENOMEM ? CORR_ENOMEM : rc == CTF_EINPUT ? CORR_EINPUT : CORR_EINIT;
+    return rc == CTF_ENOMEM ? CORR_ENOMEM : rc == CTF_EINPUT ? CORR_EINPUT : CORR_EFAILED;
 }
 
 /* m decimated into *out (left NULL when m is small already), with the
