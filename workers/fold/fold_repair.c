@@ -418,19 +418,29 @@ static int remap(ctx *c, const fold__patch *pS)
         int v = pS->verts[i], f = c->R->face[v];
         uv[2 * i] = uv[2 * i + 1] = 0;
         pin[i] = pinned(c, pS, i);
-        if (c->tloc[T->f[3 * f]] < 0) {
-            if (pin[i] || (c->drag_landmarks && c->fixed[v])) {   /* outside the chart */
-                rc = 1;
-                for (int j = 0; j < pT.nv; j++)
-                    c->tloc[pT.verts[j]] = -1;
-                goto out;
-            }
-            continue;
-        }
+        /* the image's corners in the chart, by their weights (an image
+         * on a face across the chart's edge: its corners inside,
+         * renormalised; none inside: outside the chart) */
+        double win = 0;
         for (int k = 0; k < 3; k++) {
             int j = c->tloc[T->f[3 * f + k]];
+            if (j < 0)
+                continue;
+            win += c->R->w[3 * v + k];
             uv[2 * i] += c->R->w[3 * v + k] * uvT[2 * j];
             uv[2 * i + 1] += c->R->w[3 * v + k] * uvT[2 * j + 1];
+        }
+        if (win > 0) {
+            uv[2 * i] /= win;
+            uv[2 * i + 1] /= win;
+            continue;
+        }
+        uv[2 * i] = uv[2 * i + 1] = 0;
+        if (pin[i] || (c->drag_landmarks && c->fixed[v])) {   /* outside the chart */
+            rc = 1;
+            for (int j = 0; j < pT.nv; j++)
+                c->tloc[pT.verts[j]] = -1;
+            goto out;
         }
     }
     for (int i = 0; i < pT.nv; i++)
