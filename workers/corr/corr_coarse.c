@@ -31,15 +31,15 @@ static int from_ctf(int rc)
 
 /* m decimated into *out (left NULL when m is small already), with the
  * landmark vertices lmk[0..n) renumbered to the copy's in clmk. */
-static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, int c,
+static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, int nc,
                        mesh **out, int *clmk, char *err, size_t errsz)
 {
     memcpy(clmk, lmk, sizeof(int) * (size_t)n);
-    if (m->nv <= 2L * c)
+    if (m->nv <= 2L * nc)
         return CORR_OK;
     char why[512];
     int *fine = NULL;
-    int rc = ctf_decimate(m, c, lmk, n, out, &fine, why, sizeof why);
+    int rc = ctf_decimate(m, nc, lmk, n, out, &fine, why, sizeof why);
     if (rc)
         return errbuf_set(err, errsz, from_ctf(rc), "%s: decimation: %s", name, why);
     int *at = malloc(sizeof(int) * (size_t)m->nv);
@@ -53,9 +53,7 @@ static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, i
         clmk[r] = at[lmk[r]];   /* present: ctf_decimate keeps them */
     free(at);
     free(fine);
-    if ((rc = corr_validate(*out, name, err, errsz)))
-        return rc;
-    return CORR_OK;
+    return corr_validate(*out, name, err, errsz);
 }
 
 int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t errsz)

@@ -435,7 +435,6 @@ static int remap(ctx *c, const fold__patch *pS)
             uv[2 * i + 1] /= win;
             continue;
         }
-        uv[2 * i] = uv[2 * i + 1] = 0;
         if (pin[i] || (c->drag_landmarks && c->fixed[v])) {   /* outside the chart */
             rc = 1;
             for (int j = 0; j < pT.nv; j++)
