@@ -3,7 +3,7 @@
  * landmarks stay put, a crowded cap, a cap whose images jumped and a long
  * part's end collapsed onto a short part's are re-mapped, and a map
  * mirrored as a whole is left as it was (the repair never makes a map
- * worse). */
+ * worse); a thin part's mirrored band with its end collapsed is re-mapped. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "fold/fold.h"
@@ -265,4 +265,53 @@ TEST(long_part_onto_short_part_is_re_mapped_without_crowding)
     bmap_free(P);
     mesh_free(S);
     mesh_free(T);
+}
+
+/* A thin part as the glasses' arms are (52 -> 58): a tube 12.8 times as
+ * long as it is wide mapped onto itself, with a band of 10 rings near its
+ * end mirrored across the tube's axis (flipped) and, beyond it, the last 6
+ * rings and the pole sent to the pole (collapsed). The band's region, its
+ * hole filled, takes the end with it, so its chart must join the images of
+ * its ring and of the end kept beyond the band, 14 rings apart: grown by
+ * at most 6 rings from each side, as it was, it stayed torn and the band
+ * flipped (320 -> 200 bad faces). No bad face is left, and every vertex
+ * lands within a few rings of its own. */
+TEST(mirrored_band_and_collapsed_end_of_a_thin_part_are_re_mapped)
+{
+    int rings = 120, around = 10;
+    double length = 25.6;
+    mesh *m = testmesh_spheroid(length, rings, around);
+    int nv = m->nv;
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, m->v, sizeof(double) * 3 * (size_t)nv);
+    for (int v = 95 * around; v < 105 * around; v++)
+        img[3 * v] = -img[3 * v];
+    for (int v = (rings - 6) * around; v < nv; v++)
+        if (v < rings * around || v == nv - 1)
+            memcpy(img + 3 * v, m->v + 3 * (nv - 1), 3 * sizeof(double));
+    bmap *P = map_of_points(m, img, nv);
+    int flipped = count_bad(m, m, P, METRIC_FACE_FLIPPED),
+        collapsed = count_bad(m, m, P, METRIC_FACE_COLLAPSED);
+    printf("  planted: %d flipped, %d collapsed of %d faces\n", flipped, collapsed, m->nf);
+    CHECK(flipped > 100 && collapsed > 50);
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_OK);
+    printf("  bad faces %d -> %d, %d vertices re-mapped in %d regions\n", rep.bad_before,
+           rep.bad_after, rep.region, rep.regions);
+    CHECK(rep.accepted);
+    CHECK_INT(rep.bad_after, 0);
+    CHECK_INT(count_bad(m, m, P, METRIC_FACE_FLIPPED) + count_bad(m, m, P, METRIC_FACE_COLLAPSED), 0);
+    bmap_apply(P, m->f, m->v, 3, img);
+    double worst = 0;
+    for (int v = 0; v < nv; v++)
+        if (v < rings * around)
+            worst = fmax(worst, fabs(img[3 * v + 2] - m->v[3 * v + 2]));
+    printf("  farthest along the tube from its own ring: %.3f (ring spacing %.3f)\n", worst,
+           length / (rings + 1));
+    CHECK(worst < 5 * length / (rings + 1));
+    free(img);
+    bmap_free(P);
+    mesh_free(m);
 }

@@ -296,34 +296,38 @@ TEST_T(worker_demo_job_gives_the_in_process_map_with_progress_and_metrics, 90)
     testjob_close(&j);
 }
 
-/* FAUST ground truth: line k of tr_reg_000.vts and tr_reg_001.vts are the
- * same body point (1-based vertex ids); 8 lines spread over the body. */
-static unsigned faust_landmarks(proto_landmark *out)
+/* SHREC'07 glasses 52 -> 58 (BIM's landmarks, 0-based vertex ids, line k
+ * of 52.vts and 58.vts the same point, then its position): the even
+ * lines, 5 pairs. A thin shape whose arms the distances start leaves
+ * folded even after the fold repair (bench_shrec07: 8 % flipped), so the
+ * auto start's second run is taken. (FAUST 000 -> 001 from 8 landmarks
+ * no longer is: its repaired maps are under 5 % folded.) */
+static unsigned glasses_landmarks(proto_landmark *out)
 {
-    static const int lines[] = { 1, 600, 1200, 1900, 2600, 3300, 4100, 4900 };
     char a[512], b[512];
-    snprintf(a, sizeof a, "%s", harness_data_path("faust_r/vtx_5k/corres/tr_reg_000.vts"));
-    snprintf(b, sizeof b, "%s", harness_data_path("faust_r/vtx_5k/corres/tr_reg_001.vts"));
+    snprintf(a, sizeof a, "%s", harness_data_path("shrec07_bim/Corrs/52.vts"));
+    snprintf(b, sizeof b, "%s", harness_data_path("shrec07_bim/Corrs/58.vts"));
     FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
     CHECK(fa && fb);
     unsigned n = 0;
     long va, vb;
-    for (int line = 1; fscanf(fa, "%ld", &va) == 1 && fscanf(fb, "%ld", &vb) == 1; line++)
-        if (n < sizeof lines / sizeof lines[0] && line == lines[n])
-            out[n++] = (proto_landmark){ (uint32_t)(va - 1), (uint32_t)(vb - 1) };
+    char la[256], lb[256];      /* a line: the vertex id, then its position */
+    for (int line = 0; fgets(la, sizeof la, fa) && fgets(lb, sizeof lb, fb); line++)
+        if (line % 2 == 0 && n < 8 && sscanf(la, "%ld", &va) == 1 && sscanf(lb, "%ld", &vb) == 1)
+            out[n++] = (proto_landmark){ (uint32_t)va, (uint32_t)vb };
     fclose(fa);
     fclose(fb);
-    CHECK_INT(n, 8);
+    CHECK_INT(n, 5);
     return n;
 }
 
 TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
 {
     char src[512], tgt[512], err[1024];
-    snprintf(src, sizeof src, "%s", harness_data_path("faust_r/vtx_5k/tr_reg_000.off"));
-    snprintf(tgt, sizeof tgt, "%s", harness_data_path("faust_r/vtx_5k/tr_reg_001.off"));
+    snprintf(src, sizeof src, "%s", harness_data_path("shrec07_bim/Meshes/52.off"));
+    snprintf(tgt, sizeof tgt, "%s", harness_data_path("shrec07_bim/Meshes/58.off"));
     proto_landmark L[8];
-    unsigned n = faust_landmarks(L);
+    unsigned n = glasses_landmarks(L);
     ectm_params prm = short_params(2);
     testjob j;
     if (testjob_build(&j, src, tgt, L, n, NULL, NULL, &prm, err, sizeof err))
@@ -340,7 +344,7 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     proto_progress pr[16];
     int np = progress_frames(pbuf, plen, pr, 16);
     /* init; the start map and 3 RHM iterations, twice: after 3 iterations
-     * from 8 landmarks the distances start's maps are still folded (over
+     * from 5 landmarks the distances start's maps are still folded (over
      * 5 % of the triangles), so start auto (the default) runs RHM again
      * from the functional-map start and keeps the less folded; then 2 ECTM
      * iterations */
@@ -364,8 +368,8 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     unsigned char *file;
     read_frame(job_dir(), "result.frame", &m, &file);
     CHECK_INT(m.type, PROTO_MSG_RESULT_OK);
-    CHECK_INT(m.u.result_ok.p.n, 4999);
-    CHECK_INT(m.u.result_ok.q.n, 5000);
+    CHECK_INT(m.u.result_ok.p.n, 1554);
+    CHECK_INT(m.u.result_ok.q.n, 1857);
     proto_msg_free(&m);
     free(file);
 }

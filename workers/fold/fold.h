@@ -7,11 +7,13 @@
  *   region  the bad faces grown by `rings` rings, split into components,
  *           each with its holes filled (a ring of bad faces round a limb
  *           takes the limb's end with it), kept when it is a disk of at
- *           most a quarter of the faces;
+ *           most a quarter of the faces; what the holes bring in stays
+ *           where P maps it unless another region's faces are there;
  *   chart   the target faces P sends the region's boundary and filled
  *           holes into (not its landmarks: a limb's tip may lie far
- *           inside), grown by two to six rings until one piece and
- *           hole-filled, a disk too, placed in the unit disk
+ *           inside), grown by two rings or more until one piece (at most
+ *           30, and half the target) and hole-filled, a disk too, placed
+ *           in the unit disk
  *           by its harmonic map (boundary on the circle by arc length);
  *   remap   the region's boundary and its filled holes (faces that
  *           were not bad) stay where P sends them (their
@@ -31,10 +33,12 @@
  *           or crowded: an image below 1e-4 of its face's area, both
  *           meshes at unit area, as a harmonic map crowds a long part),
  *           and when no vertex whose faces were all good moved farther
- *           than the diameter of the boundary's image (the map was right
- *           there; a foot's ring round a long leg would spread the foot up
- *           the leg); `passes` passes, each growing the regions of what
- *           is left by two rings more. A repair never makes a map worse.
+ *           than the diameter of the image of the boundary and the kept
+ *           holes (the map was right there; a foot's ring round a long leg
+ *           would spread the foot up the leg); `passes` passes, each
+ *           growing the regions of what is left by two rings more, and the
+ *           passes again from `rings` while a round of them lowers the
+ *           count (3 rounds at most). A repair never makes a map worse.
  *
  * Each region is re-mapped twice: with its landmarks free, and with the
  * placement then dragged so that each landmark lands at its image (small

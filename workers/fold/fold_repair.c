@@ -18,7 +18,11 @@
 #define FOLD__MAX_REGION 0.25
 #define FOLD__MAX_CHART 0.5
 #define FOLD__CHART_RINGS 2       /* rings round the boundary image, at least */
-#define FOLD__CHART_MAX_RINGS 6   /* ... and at most */
+/* ... and at most (FOLD__MAX_CHART bounds it as well): the ring round a
+ * thin part and the part's end kept beyond it can land a long way apart on
+ * the target (the glasses' arms, 52 -> 58: more than 6 rings, so no chart
+ * and no repair at all) */
+#define FOLD__CHART_MAX_RINGS 30
 /* A remap with the landmarks free counts only when it puts each of them
  * at most this far (in the chart's unit disk) from its image: farther, it
  * contradicts the landmark, and restoring the landmark's row leaves its
@@ -30,15 +34,24 @@
  * metric's 1e-12. */
 #define FOLD__CROWDED 1e-4
 /* A remap may move a vertex whose faces were all good at most this
- * multiple of the diameter of the region boundary's image: the map was
- * right there, and a remap that carries it farther spreads the region over
- * a larger part the boundary encloses (a foot's ring round a long leg). */
+ * multiple of the diameter of the image of what the region pins (its
+ * boundary and kept holes): the map was right there, and a remap that
+ * carries it farther spreads the region over a larger part the boundary
+ * encloses (a foot's ring round a long leg). The boundary alone is too
+ * small a measure for a band round a thin part with its end kept: its
+ * ring is as wide as the part, and the band's vertices slide along it. */
 #define FOLD__MAX_MOVE 1.0
 /* The reweighting of a region's harmonic map toward its target's area
  * (balance): rounds, and the power of the area ratio each applies. */
 #define FOLD__BALANCE_ROUNDS 8
 #define FOLD__BALANCE_STEP 0.5
 #define FOLD__DRAG_STEPS 200      /* steps of a landmark's drag, at most */
+/* The passes run again from `rings` while a round of them lowers the
+ * count, this many rounds at most: a region refused at first (its chart
+ * crossed a neighbour's folds) is often taken once the neighbour is
+ * repaired. make demo's maps: 128 bad faces after one round, 95 after a
+ * second run of the repair on its output. */
+#define FOLD__ROUNDS 3
 
 const char *fold_strerror(int code)
 {
@@ -538,7 +551,9 @@ static int moved_far(const ctx *c, const taken *r)
 {
     double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     double far = 0, x[3], y[3];
-    for (int i = 0; i < r->p.nb; i++) {
+    for (int i = 0; i < r->p.nv; i++) {
+        if (i >= r->p.nb && !r->kept[i])
+            continue;
         point(c->T, r->face[i], r->w + 3 * i, x);
         for (int d = 0; d < 3; d++) {
             lo[d] = fmin(lo[d], x[d]);
@@ -585,9 +600,12 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     for (int k = 0; k < n; k++) {
         for (int t = 0; t < nf; t++)
             cin[t] = comp[t] == k;
+        /* kept: what the holes fill in that no region's (grown) bad faces
+         * touch; another region inside a hole (a collapsed tip beyond a
+         * flipped band) is re-mapped with this one, not pinned folded */
         memset(c->keep, 1, (size_t)nv);
         for (int t = 0; t < nf; t++)
-            if (cin[t])
+            if (in[t])
                 for (int j = 0; j < 3; j++)
                     c->keep[S->f[3 * t + j]] = 0;
         int size = fold__fill_holes(&c->ES, cin);
@@ -728,11 +746,16 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
         rc = FOLD_EMESH;
         goto out;
     }
-    for (int k = 0; k < p->passes && bad > 0; k++)
-        if ((bad = pass(&c, p->rings + 2 * k, kind, bad, rep)) < 0) {
-            rc = FOLD_ENOMEM;
-            goto out;
-        }
+    for (int round = 0; round < FOLD__ROUNDS && bad > 0; round++) {
+        int start = bad;
+        for (int k = 0; k < p->passes && bad > 0; k++)
+            if ((bad = pass(&c, p->rings + 2 * k, kind, bad, rep)) < 0) {
+                rc = FOLD_ENOMEM;
+                goto out;
+            }
+        if (bad >= start)
+            break;
+    }
     if (bad < rep->bad_before) {
         memcpy(P->face, c.R->face, sizeof(int) * (size_t)P->n);
         memcpy(P->w, c.R->w, sizeof(double) * 3 * (size_t)P->n);
