@@ -12,7 +12,8 @@
 _Static_assert((int)MC_PARAM_ENUM == (int)PROTO_PARAM_ENUM && (int)MC_PARAM_BOOL == (int)PROTO_PARAM_BOOL &&
                (int)MC_PARAM_U32 == (int)PROTO_PARAM_U32 && (int)MC_PARAM_F64 == (int)PROTO_PARAM_F64 &&
                (int)MC_PARAM_STR == (int)PROTO_PARAM_STR, "one numbering of the parameter types");
-_Static_assert((int)MC_DDM_PLAIN == (int)PROTO_DDM_PLAIN && (int)MC_DDM_BIJECTIVE == (int)PROTO_DDM_BIJECTIVE,
+_Static_assert((int)MC_DDM_PLAIN == (int)PROTO_DDM_PLAIN && (int)MC_DDM_BIJECTIVE == (int)PROTO_DDM_BIJECTIVE &&
+                   (int)MC_DDM_AUTO == (int)PROTO_DDM_AUTO,
                "one numbering of ddm_mode");
 
 int mc_param_count(void)

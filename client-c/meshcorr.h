@@ -138,8 +138,9 @@ enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 
 enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM = 3,
        MC_STAGES_DDM_ECTM = 4, MC_STAGES_DDM_RHM = 5, MC_STAGES_DDM_RHM_ECTM = 6,
        MC_STAGES_RHM_ECTM = 7 };
-/* Values of ddm_mode: each given map denoised alone, or p and q together. */
-enum { MC_DDM_PLAIN = 0, MC_DDM_BIJECTIVE = 1 };
+/* Values of ddm_mode: each given map denoised alone, p and q together, or
+ * auto (the default): together when q is given and agrees with p. */
+enum { MC_DDM_PLAIN = 0, MC_DDM_BIJECTIVE = 1, MC_DDM_AUTO = 2 };
 
 /* For stages start and rhm the five terms are RHM's (PROTOCOL.md,
  * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */

@@ -133,7 +133,7 @@ enum proto_stages {
     PROTO_STAGES_RHM_ECTM = 7
 };
 /* DDM denoising of the given maps (workers/ddm/ddm.h) */
-enum proto_ddm_mode { PROTO_DDM_PLAIN = 0, PROTO_DDM_BIJECTIVE = 1 };
+enum proto_ddm_mode { PROTO_DDM_PLAIN = 0, PROTO_DDM_BIJECTIVE = 1, PROTO_DDM_AUTO = 2 };
 
 /* Energy terms reported per direction in PROGRESS (index into terms[d][]). */
 enum proto_term {

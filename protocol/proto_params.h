@@ -99,9 +99,11 @@
       "given map; rhm starts from landmarks or from the given (or denoised) map")                \
     X(ddm_k, "ddm-k", U32, 0, 0, PROTO_DDM_MAX_K, 0, NONE, ddm_k, "",                            \
       "DDM basis size: eigenfunctions per mesh (0: min(100, vertices - 2); at most vertices - 2)") \
-    X(ddm_mode, "ddm-mode", ENUM, 0, 0, 1, 0, NONE, ddm_mode, "plain|bijective",                 \
-      "DDM denoising: plain (each given map alone) or bijective (the map p and its reverse q "   \
-      "denoised together, each made consistent with the other's functional map; needs q)")   \
+    X(ddm_mode, "ddm-mode", ENUM, 2, 0, 2, 0, NONE, ddm_mode, "plain|bijective|auto",            \
+      "DDM denoising: plain (each given map alone), bijective (the map p and its reverse q "     \
+      "denoised together, each made consistent with the other's functional map; needs q), or "  \
+      "auto: bijective when q is given and p and q agree (round trip at most 0.1 of the "       \
+      "shape's size), else plain")                                                             \
     X(zoomout, "zoomout", U32, 0, PROTO_ZOOMOUT_MIN, PROTO_ZOOMOUT_MAX, PROTO_PARAM_ZERO_OFF,    \
       RHM, zoomout, "",                                                                          \
       "start fmap (and auto's second run): ZoomOut from the start's 50 basis functions to this " \

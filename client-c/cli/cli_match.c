@@ -76,13 +76,24 @@ static int on_progress(void *ctx, const corr_progress *cp)
     }
     if (cp->ddm) {               /* directions denoised of total, each one's objective */
         const corr_ddm_report *d = cp->ddm;
-        if (ps->mode == PROGRESS_JSON)
-            fprintf(stderr, "{\"stage\":\"ddm\",\"done\":%d,\"total\":%d,\"k\":%d,"
-                    "\"objective\":[%.17g,%.17g],\"elapsed\":%.3f}\n", d->done, d->total, d->k,
-                    d->cost[0], d->cost[1], cp->elapsed);
-        else if (ps->mode != PROGRESS_NONE)
+        const char *mode = d->mode == CORR_DDM_BIJECTIVE ? "bijective" : "plain";
+        if (ps->mode == PROGRESS_JSON) {
+            fprintf(stderr, "{\"stage\":\"ddm\",\"done\":%d,\"total\":%d,\"k\":%d,\"mode\":\"%s\",",
+                    d->done, d->total, d->k, mode);
+            if (isfinite(d->round_trip))
+                fprintf(stderr, "\"round_trip\":%.17g,", d->round_trip);
+            else
+                fprintf(stderr, "\"round_trip\":null,");
+            fprintf(stderr, "\"objective\":[%.17g,%.17g],\"elapsed\":%.3f}\n", d->cost[0], d->cost[1],
+                    cp->elapsed);
+        } else if (ps->mode != PROGRESS_NONE) {
+            if (d->done == 0 && isfinite(d->round_trip))   /* ddm_mode auto's choice */
+                fprintf(stderr, "ddm: %s (the given maps' round trip %.4f %s %g)\n", mode,
+                        d->round_trip, d->mode == CORR_DDM_BIJECTIVE ? "<=" : ">",
+                        CORR_DDM_AUTO_ROUND_TRIP);
             fprintf(stderr, "ddm %d/%d (k %d) objective %.6g  %.1f s\n", d->done, d->total, d->k,
                     d->done ? d->cost[d->done - 1] : 0.0, cp->elapsed);
+        }
         fflush(stderr);
         return 0;
     }

@@ -4,7 +4,13 @@
  * every face (tests/support/testddm.h): times, speed-up, rows whose cost
  * differs by more than 1e-9 (relative), share of faces solved, and the
  * geodesic error of the precise map and of the vertex map. Prints figures;
- * fails only when something cannot run or a row differs. */
+ * fails only when something cannot run or a row differs.
+ * Measured on 2 cores next to other benchmarks (load about 3): k = 30
+ * 0.400 s against 23.1 s (58x), k = 100 1.135 s against 68.9 s (61x), with
+ * the rows' products taken 8 rows to a pass over Psi2; before that (one
+ * row to a pass, a scalar dot product) 1.19 s (21x) and 2.69 s (28x). Box
+ * hierarchy of proj.h in R^k instead (proj_closest, the same answers):
+ * 0.44 s at k = 30, 8.4 s at k = 100: its boxes stop pruning as k grows. */
 #include "support/harness.h"
 #include "support/testddm.h"
 #include "support/testgt.h"

@@ -52,6 +52,8 @@
  *                         (a check of scale invariance)
  *   --start=NAME          auto (the default), distances, voronoi or fmap
  *   --eta=E               ECTM's bending weight instead of the default
+ *   --zoomout=K           the functional-map start (--start=fmap, and auto's
+ *                         second run) grown by ZoomOut to K functions
  * Each pair runs in its own process (support/testapart.h): a crash or an
  * error becomes that pair's row, and the other pairs still run. The rhm
  * row is corr_run's stages rhm: RHM's maps after the pipeline's fold
@@ -180,6 +182,7 @@ typedef struct pair_job {
     int ectm_iterations;
     double scale;
     double eta;             /* --eta: ECTM's bending weight, 0: the default */
+    int zoomout;            /* --zoomout: rhm_params.zoomout, 0: off */
 } pair_job;
 
 static void run_pair(const void *arg, void *out)
@@ -227,6 +230,7 @@ static void run_pair(const void *arg, void *out)
     rhm_params rp;
     rhm_params_init(&rp);
     rp.start = start_kind;
+    rp.zoomout = job->zoomout;
     ectm_params ep;
     ectm_params_init(&ep);
     if (ectm_iterations > 0)
@@ -368,21 +372,23 @@ TEST_T(pipeline_on_pairs_with_dense_ground_truth, 86400)
     int iters = o_it ? atoi(o_it) : 0;
     double scale = o_scale ? atof(o_scale) : 1;
     double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
+    int zoomout = harness_option("zoomout") ? atoi(harness_option("zoomout")) : 0;
     if ((o_it && iters < 1) || !(scale > 0))
         FAILF("--ectm-iterations takes a positive integer, --scale a positive number");
     ectm_params ep;
     ectm_params_init(&ep);
     printf("start (%s) -> RHM -> ECTM from %d farthest-point landmarks; RHM defaults; ECTM defaults "
-           "with %d outer iterations%s; scale x%g; %s\n", proto_param_value_name(PROTO_P_start, (unsigned)start_kind, start_name, sizeof start_name), NL,
+           "with %d outer iterations%s; scale x%g; ZoomOut %d (0: off); %s\n",
+           proto_param_value_name(PROTO_P_start, (unsigned)start_kind, start_name, sizeof start_name), NL,
            iters ? iters : ep.iterations,
-           iters && iters != ep.iterations ? " (not the default)" : " (the default)", scale,
+           iters && iters != ep.iterations ? " (not the default)" : " (the default)", scale, zoomout,
            harness_data_dir() ? harness_data_dir() : "no data folder");
     static pair_fig figs[NPAIRS];
     int ran[NPAIRS] = {0};
     for (int i = 0; i < NPAIRS; i++) {
         if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
-        pair_job job = { &pairs[i], iters, scale, eta };
+        pair_job job = { &pairs[i], iters, scale, eta, zoomout };
         char why[256];
         if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
             snprintf(figs[i].err, sizeof figs[i].err, "%s", why);

@@ -208,6 +208,7 @@ TEST(parameter_list_as_data_sets_each_member_as_the_cli_parses_its_option)
     CHECK_INT(s.stages, MC_STAGES_DDM_RHM_ECTM);
     CHECK_INT(mc_job_spec_set(&s, "ddm-k", "60", err, sizeof err), 0);
     CHECK_INT(s.ddm_k, 60);
+    CHECK_INT(s.ddm_mode, MC_DDM_AUTO);                                              /* the default */
     CHECK_INT(mc_job_spec_set(&s, "ddm-mode", "bijective", err, sizeof err), 0);
     CHECK_INT(s.ddm_mode, MC_DDM_BIJECTIVE);
     CHECK_INT(mc_job_spec_set(&s, "zoomout", "120", err, sizeof err), 0);

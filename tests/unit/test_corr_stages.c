@@ -4,7 +4,8 @@
  * BCICP vertex map: the ddm stage returns exactly ddm_denoise's map, the
  * ddm,ectm chain reports DDM then every ECTM iteration and keeps the
  * map's error, and ddm,rhm runs RHM from the denoised map with no
- * landmarks. */
+ * landmarks; ddm_mode auto denoises BCICP's map and its reverse (which
+ * agree) together and BIM's (one direction flipped) each alone. */
 #include "support/harness.h"
 #include "support/testddm.h"
 #include "support/testgt.h"
@@ -16,6 +17,7 @@
 #include "map/vmap.h"
 #include "metric/metric.h"
 
+#include <math.h>
 #include <string.h>
 
 TEST(chains_parse_in_order_and_out_of_order_is_refused_with_the_reason)
@@ -64,6 +66,8 @@ TEST(chains_the_inputs_cannot_run_are_refused)
     CHECK_INT(corr_stages_check(CORR_STAGES_DDM, 1, 1, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err), 0);
     CHECK_INT(corr_stages_check(CORR_STAGES_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err),
               0);                                  /* no DDM stage: the mode is not used */
+    CHECK_INT(corr_stages_check(CORR_STAGES_DDM, 1, 0, 0, 0, 0, CORR_DDM_AUTO, err, sizeof err),
+              0);                                  /* auto without a reverse map: plain */
     static const struct { int s, map, rev, nl, inj; double gamma; int mode; const char *msg; } bad[] = {
         {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map"},
         {CORR_STAGES_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map"},
@@ -74,7 +78,7 @@ TEST(chains_the_inputs_cannot_run_are_refused)
         {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model"},
         {CORR_STAGES_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map"},
         {CORR_STAGES_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too"},
-        {CORR_STAGES_DDM, 1, 1, 0, 0, 0, 2, "ddm_mode value 2"},
+        {CORR_STAGES_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3"},
         {8, 1, 0, 0, 0, 0, 0, "stages value 8"}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         err[0] = '\0';
@@ -86,7 +90,7 @@ TEST(chains_the_inputs_cannot_run_are_refused)
 }
 
 typedef struct stage_log {
-    int n, stage[1024], outer[1024];
+    int n, stage[1024], outer[1024], total[1024];
     double ddm_cost;
 } stage_log;
 
@@ -97,6 +101,7 @@ static int record(void *ctx, const corr_progress *p)
         l->stage[l->n] = p->stage;
         l->outer[l->n] = p->ectm ? p->ectm->outer : p->rhm ? p->rhm->iteration
                        : p->ddm ? p->ddm->done : 0;
+        l->total[l->n] = p->ectm ? p->ectm->total : 0;
         l->n++;
     }
     if (p->ddm && p->ddm->done)
@@ -216,14 +221,114 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     testgt_close(&g);
 }
 
+typedef struct ddm_choice {
+    int reports, mode;
+    double round_trip;
+} ddm_choice;
+
+static int record_choice(void *ctx, const corr_progress *p)
+{
+    ddm_choice *c = ctx;
+    if (p->ddm && c->reports++ == 0) {   /* the stage's first report says what runs */
+        c->mode = p->ddm->mode;
+        c->round_trip = p->ddm->round_trip;
+    }
+    return 0;
+}
+
+/* The published pair P0 (gorilla_01 -> man_01), Q0 (back) of one method. */
+static void published_pair(const testgt *g, const char *method, int base, bmap **P0, bmap **Q0)
+{
+    char rel[256], err[1024] = "";
+    snprintf(rel, sizeof rel, "tosca_r_nonisometric/vtx_5k/maps_baseline/%s/8_gorilla_01_8_man_01.map",
+             method);
+    if (vmap_read(harness_data_path(rel), base, g->S, g->T, P0, NULL, err, sizeof err))
+        FAILF("%s", err);
+    snprintf(rel, sizeof rel, "tosca_r_nonisometric/vtx_5k/maps_baseline/%s/8_man_01_8_gorilla_01.map",
+             method);
+    if (vmap_read(harness_data_path(rel), base, g->T, g->S, Q0, NULL, err, sizeof err))
+        FAILF("%s", err);
+}
+
+TEST_T(ddm_auto_denoises_an_agreeing_pair_together_and_a_disagreeing_one_apart, 300)
+{
+    testgt g;
+    testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_man_01", 3);
+    char err[1024] = "";
+    ectm_params p;
+    ectm_params_init(&p);
+    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, NULL, NULL, NULL, CORR_STAGES_DDM, 0,
+                     CORR_DDM_AUTO};
+    ectm_result r = {0}, plain = {0};
+
+    /* BIM's two maps disagree wholesale (gorilla_01 -> man_01 is flipped
+     * left to right, its reverse is not): each is denoised alone, the same
+     * maps as plain's */
+    bmap *P0 = NULL, *Q0 = NULL;
+    published_pair(&g, "BIM", 0, &P0, &Q0);
+    in.P0 = P0;
+    in.Q0 = Q0;
+    ddm_choice c = {0, -1, 0};
+    if (corr_run(&in, &p, record_choice, &c, &r, err, sizeof err))
+        FAILF("%s", err);
+    printf("  BIM: round trip %.4f -> %s\n", c.round_trip, c.mode ? "bijective" : "plain");
+    CHECK_INT(c.mode, CORR_DDM_PLAIN);
+    CHECK(c.round_trip > CORR_DDM_AUTO_ROUND_TRIP);
+    CHECK_INT(c.reports, 3);                /* the start, then each direction */
+    in.ddm_mode = CORR_DDM_PLAIN;
+    if (corr_run(&in, &p, NULL, NULL, &plain, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(r.P && r.Q && plain.P && plain.Q);
+    for (int i = 0; i < r.P->n; i++)
+        CHECK_INT(r.P->face[i], plain.P->face[i]);
+    for (int i = 0; i < r.Q->n; i++)
+        CHECK_INT(r.Q->face[i], plain.Q->face[i]);
+    ectm_result_close(&r);
+    ectm_result_close(&plain);
+    bmap_free(P0);
+    bmap_free(Q0);
+
+    /* BCICP's agree: denoised together, one report when both are done,
+     * and the denoised pair is as consistent as the given one */
+    published_pair(&g, "WKSini_direct_BCICP", 1, &P0, &Q0);
+    in.P0 = P0;
+    in.Q0 = Q0;
+    in.ddm_mode = CORR_DDM_AUTO;
+    c = (ddm_choice){0, -1, 0};
+    if (corr_run(&in, &p, record_choice, &c, &r, err, sizeof err))
+        FAILF("%s", err);
+    double rt0 = NAN, rt1 = NAN;
+    CHECK_INT(metric_round_trip(g.S, g.T, P0, Q0, &rt0), 0);
+    CHECK_INT(metric_round_trip(g.S, g.T, r.P, r.Q, &rt1), 0);
+    printf("  BCICP: round trip %.4f -> %s; denoised pair's round trip %.4f (given %.4f)\n",
+           c.round_trip, c.mode ? "bijective" : "plain", rt1, rt0);
+    CHECK_INT(c.mode, CORR_DDM_BIJECTIVE);
+    CHECK(c.round_trip <= CORR_DDM_AUTO_ROUND_TRIP && c.round_trip >= rt0);
+    CHECK_INT(c.reports, 2);                /* the start, then both together */
+    CHECK(rt1 <= 1.5 * rt0);
+    ectm_result_close(&r);
+
+    /* with no reverse map auto is plain, and says it did not choose */
+    in.Q0 = NULL;
+    c = (ddm_choice){0, -1, 0};
+    if (corr_run(&in, &p, record_choice, &c, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(c.mode, CORR_DDM_PLAIN);
+    CHECK(isnan(c.round_trip));
+    ectm_result_close(&r);
+    bmap_free(P0);
+    bmap_free(Q0);
+    testgt_close(&g);
+}
+
 /* A pair over twice the coarse size (job parameter coarse, 6000 by
  * default) from landmarks: TOSCA wolf0 -> wolf2
  * (tosca_hires, 4344 vertices, the 21 landmarks of Corrs/wolf.pid) split
  * 1-to-4 (17370 vertices; the shipped vertices keep their indices, so the
  * identity is their ground truth — not the midpoints', as the two meshes'
  * face lists differ in 240 faces). The chain runs on the decimated pair
- * (RHM, then ECTM: each ECTM iteration reported once there and once on
- * the input pair), the maps come back on the input meshes with ECTM's
+ * (RHM, then ECTM: its iterations and the input pair's counted as one
+ * run of twice the iterations, so a progress bar does not restart), the maps come back on the input meshes with ECTM's
  * deformation of them, near the identity and unfolded; stages rhm stops
  * after the coarse RHM's maps are carried back. */
 TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
@@ -249,7 +354,11 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
         FAILF("%s", err);
     int ectm = 0, rhm = 0;
     for (int i = 0; i < l.n; i++) {
-        ectm += l.stage[i] == CORR_STAGE_ECTM;
+        if (l.stage[i] == CORR_STAGE_ECTM) {
+            ectm++;
+            CHECK_INT(l.outer[i], ectm);                 /* 1 .. 2K, no restart */
+            CHECK_INT(l.total[i], 2 * p.iterations);
+        }
         rhm += l.stage[i] == CORR_STAGE_RHM;
     }
     CHECK_INT(ectm, 2 * p.iterations);

@@ -2,7 +2,8 @@
  * meshcorrd, meshcorr-worker and libmeshcorr: a job with stages ddm
  * streams the ddm stage and returns the in-process pipeline's map (the
  * same Draco-decoded meshes and map); ddm,ectm streams ddm then ECTM and
- * completes; a chain that cannot run (ddm with no map) and a basis larger
+ * completes, and with the reverse map uploaded too (they agree) ddm_mode
+ * auto says it denoised the two together; a chain that cannot run (ddm with no map) and a basis larger
  * than the meshes allow are refused before SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
  * stretched and bent, the map a vertex map sent as weight-1 rows. */
 #include "support/harness.h"
@@ -13,6 +14,7 @@
 #include "mesh/mesh.h"
 #include "meshcorr.h"
 
+#include <math.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +23,7 @@ typedef struct watch_log {
     int n;
     int stage[256];
     uint32_t outer[256], total[256];
-    double energy[256];
+    double energy[256], beta[256], gamma[256];
 } watch_log;
 
 static int on_progress(void *ctx, const mc_progress *p)
@@ -32,6 +34,8 @@ static int on_progress(void *ctx, const mc_progress *p)
         w->outer[w->n] = p->outer;
         w->total[w->n] = p->total;
         w->energy[w->n] = p->energy[0];
+        w->beta[w->n] = p->beta;
+        w->gamma[w->n] = p->gamma;
         w->n++;
     }
     return 0;
@@ -132,6 +136,8 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     CHECK_INT(w.outer[1], 1);
     CHECK_INT(w.total[1], 1);
     CHECK(w.energy[1] > 0);
+    CHECK(w.beta[0] == MC_DDM_PLAIN && w.beta[1] == MC_DDM_PLAIN);   /* auto, no q: plain */
+    CHECK(isnan(w.gamma[0]));                                        /* and no choice made */
     mc_job_result r;
     CHECK_INT(mc_result(c, id, MC_WANT_P | MC_WANT_Q | MC_WANT_DEFORMED, &r), 0);
     CHECK_INT(r.np, 162);
@@ -153,8 +159,11 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     ectm_result_close(&want);
     mc_result_free(&r);
 
-    /* ddm,ectm: ddm's reports, then ECTM's 3 iterations */
+    /* ddm,ectm with the reverse map too: ddm's report (both together:
+     * the two maps agree), then ECTM's 3 iterations */
     spec_of(&p, MC_STAGES_DDM_ECTM, 1, &s);
+    s.q = p.rows;                  /* the same connectivity: vertex i -> vertex i back */
+    s.nq = (uint32_t)p.T->nv;
     if (mc_submit(c, &s, &id))
         FAILF("SUBMIT: %s", mc_errmsg(c));
     memset(&w, 0, sizeof w);
@@ -164,6 +173,9 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
         FAILF("job ended %s: %s", mc_state_name(state), reason);
     CHECK_INT(w.n, 5);
     CHECK_INT(w.stage[1], MC_STAGE_DDM);
+    CHECK_INT(w.outer[1], 2);                   /* both directions in one report */
+    CHECK(w.beta[0] == MC_DDM_BIJECTIVE && w.beta[1] == MC_DDM_BIJECTIVE);
+    CHECK(w.gamma[0] >= 0 && w.gamma[0] < 1e-9);   /* the identity's round trip */
     for (int i = 2; i < 5; i++) {
         CHECK_INT(w.stage[i], MC_STAGE_ECTM);
         CHECK_INT(w.outer[i], i - 1);

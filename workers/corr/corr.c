@@ -58,6 +58,7 @@ typedef struct relay {
     corr_progress_fn fn;
     void *ctx;
     double t0;
+    int ectm_before, ectm_total;   /* coarse to fine: one count over both ECTM runs */
 } relay;
 
 static int relay_ectm(void *ctx, const ectm_report *r)
@@ -65,7 +66,28 @@ static int relay_ectm(void *ctx, const ectm_report *r)
     relay *rl = ctx;
     if (!rl->fn)
         return 0;
-    corr_progress p = { CORR_STAGE_ECTM, r, now() - rl->t0, NULL, NULL };
+    ectm_report q = *r;
+    if (rl->ectm_total) {            /* the fine run after the coarse one's iterations */
+        q.outer += rl->ectm_before;
+        q.total = rl->ectm_total;
+    }
+    corr_progress p = { CORR_STAGE_ECTM, &q, now() - rl->t0, NULL, NULL };
+    return rl->fn(rl->ctx, &p);
+}
+
+/* The coarse chain's reports as the job's: seconds since the job's start,
+ * ECTM's iterations counted over both runs (rl's ectm_total). */
+static int relay_coarse(void *ctx, const corr_progress *cp)
+{
+    const relay *rl = ctx;
+    corr_progress p = *cp;
+    ectm_report q;
+    if (cp->ectm) {
+        q = *cp->ectm;
+        q.total = rl->ectm_total;
+        p.ectm = &q;
+    }
+    p.elapsed = now() - rl->t0;
     return rl->fn(rl->ctx, &p);
 }
 
@@ -236,8 +258,8 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
  * its normals or its faces' shapes), or a decimation that failed other
  * than for memory (OpenMesh refusing a face, a copy corr_validate
  * refuses); the job then runs on in's meshes as given. */
-static int run_coarse(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
-                      void *ctx, bmap **P, bmap **Q, int *ran, char *err, size_t errsz)
+static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bmap **P,
+                      bmap **Q, int *ran, char *err, size_t errsz)
 {
     corr_coarse c;
     ectm_result cr = {0};
@@ -251,8 +273,11 @@ static int run_coarse(const corr_input *in, const ectm_params *p, corr_progress_
         corr_coarse_close(&c);
         return rc;
     }
-    if (!(rc = corr_run(&c.in, p, progress, ctx, &cr, err, errsz)))
+    rl->ectm_total = 2 * p->iterations;   /* the coarse ECTM's, then the fine one's */
+    if (!(rc = corr_run(&c.in, p, rl->fn ? relay_coarse : NULL, rl, &cr, err, errsz))) {
+        rl->ectm_before = cr.last.outer;   /* fewer than planned if it stopped early */
         rc = corr_coarse_carry(in, &c, cr.P, cr.Q, 1, P, Q, err, errsz);
+    }
     ectm_result_close(&cr);
     corr_coarse_close(&c);
     return rc;
@@ -262,7 +287,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
              void *ctx, ectm_result *out, char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
-    relay rl = { progress, ctx, now() };
+    relay rl = { progress, ctx, now(), 0, 0 };
     int rc = ectm_params_check(p, err, errsz);
     if (rc)
         return CORR_EINPUT;
@@ -310,7 +335,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         if (corr_coarse_wanted(in))
             /* the chain on the decimated pair; ECTM below finishes its
              * maps on in's meshes */
-            rc = run_coarse(in, p, progress, ctx, &init.P12, &init.P21, &coarse, err, errsz);
+            rc = run_coarse(in, p, &rl, &init.P12, &init.P21, &coarse, err, errsz);
         fold_report rep[2];
         if (!rc && !coarse && P)
             rc = rhm_from_maps(in, P, Q, &rp, &rl, &init, err, errsz);

@@ -71,14 +71,32 @@ typedef enum corr_stages {
 unsigned corr_stages_run(corr_stages s, int have_map);
 /* How the DDM stage denoises (job parameter ddm_mode): each given map on
  * its own (ddm_denoise), or P and its reverse Q together, made consistent
- * (ddm_denoise_bijective, DDM_BIJ_ALPHA_DEFAULT, DDM_BIJ_ITERATIONS_DEFAULT). */
-typedef enum corr_ddm_mode { CORR_DDM_PLAIN = 0, CORR_DDM_BIJECTIVE = 1 } corr_ddm_mode;
+ * (ddm_denoise_bijective, DDM_BIJ_ALPHA_DEFAULT, DDM_BIJ_ITERATIONS_DEFAULT),
+ * or auto: bijective when a reverse map is given and the two given maps
+ * agree (the larger of their round trips S->T->S and T->S->T, RMS over the
+ * unit-area mesh, metric_round_trip, at most CORR_DDM_AUTO_ROUND_TRIP),
+ * else plain. Where the two disagree wholesale (one of them a symmetric
+ * flip), making them consistent drags the good one toward the bad one. */
+typedef enum corr_ddm_mode {
+    CORR_DDM_PLAIN = 0, CORR_DDM_BIJECTIVE = 1, CORR_DDM_AUTO = 2
+} corr_ddm_mode;
+/* auto's bound on the given pair's round trip. Measured on the 12
+ * published TOSCA_r maps (tests/bench/bench_refine.c), the larger of a
+ * pair's two round trips: the three BCICP pairs and BIM man_02 <->
+ * gorilla_01 0.011-0.040, where bijective denoising met issue 13's
+ * targets on every map and beat plain's conformal distortion; BIM
+ * gorilla_01 <-> man_01 and <-> woman_01 (one direction flipped left to
+ * right) 0.414 both, where it dragged the good direction from 0.075 to
+ * 0.38 in geodesic error. 0.1 is a tenth of the shape's size: a point
+ * that comes back farther has come back to another part. */
+#define CORR_DDM_AUTO_ROUND_TRIP 0.1
 
 /* Whether the chain can run on these inputs: 0, or CORR_EINPUT with the
  * reason in err (ddm without a map, RHM from landmarks with fewer than
  * PROTO_MIN_LANDMARKS, ECTM or RHM with neither, a reverse map with the
  * injective model, a weak landmark term without landmarks, bijective DDM
- * without a reverse map or a ddm_mode outside the list). The worker's
+ * without a reverse map or a ddm_mode outside the list; auto without a
+ * reverse map runs plain). The worker's
  * SUBMIT check and corr_run use it. */
 int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
                       int injective, double rhm_landmark_weight, corr_ddm_mode ddm_mode,
@@ -102,6 +120,9 @@ int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errs
 typedef struct corr_ddm_report {
     int done, total, k;
     double cost[2];
+    corr_ddm_mode mode;   /* the mode that runs: plain or bijective         */
+    double round_trip;    /* auto with a reverse map: the pair's round trip
+                           * it chose by; NAN otherwise                     */
 } corr_ddm_report;
 
 typedef struct corr_input {

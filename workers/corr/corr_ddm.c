@@ -1,12 +1,15 @@
-/* corr_ddm.c — the pipeline's DDM stage (corr__ddm.h): Laplace–Beltrami
- * bases of both meshes on the intrinsic Delaunay operators the geodesics
- * use (lbo.h), then DDM denoising of the given map(s) (ddm.h). */
+/* corr_ddm.c — the pipeline's DDM stage (corr__ddm.h): the mode chosen
+ * (auto: by the given pair's round trip), Laplace–Beltrami bases of both
+ * meshes on the intrinsic Delaunay operators the geodesics use (lbo.h),
+ * then DDM denoising of the given map(s) (ddm.h). */
 #include "corr/corr__ddm.h"
 #include "ddm/ddm.h"
 #include "geod/geod.h"
 #include "lbo/lbo.h"
+#include "metric/metric.h"
 #include "util/errbuf.h"
 
+#include <math.h>
 #include <string.h>
 
 _Static_assert(PROTO_DDM_MAX_K <= LBO_MAX_K, "ddm_k's range must fit the eigenpairs'");
@@ -45,7 +48,15 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
     int nmin = S->nv < T->nv ? S->nv : T->nv, k = in->ddm_k;   /* in range: corr_check_sizes */
     if (k == 0)
         k = CORR_DDM_K < nmin - 2 ? CORR_DDM_K : nmin - 2;
-    corr_ddm_report r = {0, Q0 ? 2 : 1, k, {0, 0}};
+    corr_ddm_report r = {0, Q0 ? 2 : 1, k, {0, 0}, in->ddm_mode, NAN};
+    if (in->ddm_mode == CORR_DDM_AUTO) {      /* bijective only for a pair that agrees */
+        double st = NAN, ts = NAN;
+        if (Q0 && (metric_round_trip(T, S, Q0, P0, &st) || metric_round_trip(S, T, P0, Q0, &ts)))
+            return errbuf_set(err, errsz, CORR_ENOMEM, "DDM: out of memory");
+        r.round_trip = Q0 ? (st > ts ? st : ts) : NAN;
+        r.mode = Q0 && r.round_trip <= CORR_DDM_AUTO_ROUND_TRIP ? CORR_DDM_BIJECTIVE
+                                                                 : CORR_DDM_PLAIN;
+    }
     if (report && report(ctx, &r))
         return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before DDM");
     basis bs[2];
@@ -54,7 +65,7 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
     if ((rc = basis_open(&bs[0], S, in->S_name, k, err, errsz)) ||
         (rc = basis_open(&bs[1], T, in->T_name, k, err, errsz)))
         goto out;
-    if (in->ddm_mode == CORR_DDM_BIJECTIVE) {   /* P and Q together: one report at the end */
+    if (r.mode == CORR_DDM_BIJECTIVE) {   /* P and Q together: one report at the end */
         char detail[512] = "";
         double energy[DDM_BIJ_ITERATIONS_DEFAULT + 1];
         if (!Q0) {

@@ -30,7 +30,7 @@ int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandma
     unsigned run = corr_stages_run(s, have_map);
     if (!run)
         return errbuf_set(err, errsz, CORR_EINPUT, "stages value %d is not one of the list", (int)s);
-    if (ddm_mode != CORR_DDM_PLAIN && ddm_mode != CORR_DDM_BIJECTIVE)
+    if (ddm_mode != CORR_DDM_PLAIN && ddm_mode != CORR_DDM_BIJECTIVE && ddm_mode != CORR_DDM_AUTO)
         return errbuf_set(err, errsz, CORR_EINPUT, "ddm_mode value %d is not one of the list",
                           (int)ddm_mode);
     if (have_reverse && !have_map)

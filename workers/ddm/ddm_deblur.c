@@ -1,7 +1,8 @@
 /* ddm_deblur.c — DDM's precise map from a functional map: per vertex of
  * M1, the exact nearest point of M2 embedded in R^k2 (or, for
  * ddm_nearest_points, in any R^d), with App. A.2's candidate-face bound;
- * see ddm.h. */
+ * see ddm.h. The rows' products with every vertex, which the bound needs,
+ * are taken DDM__ROWS rows to a pass over A (tests/bench/bench_ddm.c). */
 #include "ddm/ddm.h"
 #include "util/errbuf.h"
 
@@ -23,6 +24,9 @@ const char *ddm_strerror(int code)
 /* Per face of M2, in R^k2 with corners A0, A1, A2 and e1 = A1 - A0,
  * e2 = A2 - A0: the Gram entries a = e1.e1, h = e1.e2, c = e2.e2, the
  * products p1 = e1.A0, p2 = e2.A0, and the longest edge. */
+#define DDM__ROWS 8   /* rows of B per pass over A: four pairs */
+typedef double ddm__v2 __attribute__((vector_size(16)));   /* GCC's and Clang's vectors */
+
 typedef struct face_pre {
     double a, h, c, p1, p2, lmax;
 } face_pre;
@@ -121,58 +125,91 @@ int ddm_nearest_points(const double *A, int d, const mesh *T, const double *B, i
     }
 #pragma omp parallel reduction(+ : solved, cost)
     {
-        double *g = malloc((size_t)n2 * sizeof *g), *d2 = malloc((size_t)n2 * sizeof *d2);
-        if (!g || !d2) {
+        /* DDM__ROWS rows at a time: their products with every A_j in one
+         * pass over A (each A_j read once for the block, the block's
+         * columns in registers) */
+        double *g = malloc((size_t)n2 * DDM__ROWS * sizeof *g);
+        double *d2 = malloc((size_t)n2 * DDM__ROWS * sizeof *d2);
+        double *bt = aligned_alloc(16, (size_t)d * DDM__ROWS * sizeof *bt);
+        if (!g || !d2 || !bt) {
 #pragma omp atomic write
             fail = 1;
         }
-#pragma omp for schedule(dynamic, 16)
-        for (int i = 0; i < n1; i++) {
-            if (!g || !d2)
+#pragma omp for schedule(dynamic, 2)
+        for (int i0 = 0; i0 < n1; i0 += DDM__ROWS) {
+            if (!g || !d2 || !bt)
                 continue;
-            const double *b = B + (size_t)i * d;
-            double bb = dot(b, b, d), best = INFINITY;
-            int vbest = 0;
+            int nr = n1 - i0 < DDM__ROWS ? n1 - i0 : DDM__ROWS;
+            double bb[DDM__ROWS];
+            for (int r = 0; r < DDM__ROWS; r++) {  /* B's rows transposed, the block padded */
+                const double *b = B + (size_t)(i0 + (r < nr ? r : 0)) * d;
+                bb[r] = dot(b, b, d);
+                for (int c = 0; c < d; c++)
+                    bt[(size_t)c * DDM__ROWS + r] = b[c];
+            }
+            const ddm__v2 *bv = (const ddm__v2 *)bt;
             for (int j = 0; j < n2; j++) {
-                g[j] = dot(A + (size_t)j * d, b, d);
-                d2[j] = fmax(norm2[j] - 2 * g[j] + bb, 0);
-                if (d2[j] < best && vface[j] >= 0) {
-                    best = d2[j];
-                    vbest = j;
+                const double *aj = A + (size_t)j * d;
+                ddm__v2 acc[DDM__ROWS / 2] = {{0, 0}};   /* 4 registers, not memory */
+                for (int c = 0; c < d; c++) {
+                    ddm__v2 a = {aj[c], aj[c]};
+                    acc[0] += a * bv[4 * c];
+                    acc[1] += a * bv[4 * c + 1];
+                    acc[2] += a * bv[4 * c + 2];
+                    acc[3] += a * bv[4 * c + 3];
+                }
+                for (int r = 0; r < DDM__ROWS; r++) {
+                    double x = acc[r / 2][r % 2], e = norm2[j] - 2 * x + bb[r];
+                    g[(size_t)r * n2 + j] = x;
+                    d2[(size_t)r * n2 + j] = e > 0 ? e : 0;
                 }
             }
-            /* the nearest vertex (Delta_min), as a point of its lowest face */
-            int bf = vface[vbest] / 3, corner = vface[vbest] % 3;
-            double bw[3] = {corner == 0, corner == 1, corner == 2};
-            double rbest = sqrt(best);
-            for (int f = 0; f < nf; f++) {   /* the bound, squared: dmin^2 > (rbest + lmax)^2 */
-                const int *fv = T->f + 3 * f;
-                double dmin2 = fmin(fmin(d2[fv[0]], d2[fv[1]]), d2[fv[2]]), r = rbest + fp[f].lmax;
-                if (dmin2 > r * r)
-                    continue;
-                solved++;
-                double D = fp[f].p1 - (g[fv[1]] - g[fv[0]]), E = fp[f].p2 - (g[fv[2]] - g[fv[0]]);
-                double s = 0, t = 0, v = triangle_min(fp + f, D, E, d2[fv[0]], &s, &t);
-                if (v < best) {
-                    best = fmax(v, 0);
-                    rbest = sqrt(best);
-                    bf = f;
-                    bw[0] = 1 - s - t;
-                    bw[1] = s;
-                    bw[2] = t;
+            for (int r = 0; r < nr; r++) {
+                int i = i0 + r;
+                const double *gi = g + (size_t)r * n2, *di = d2 + (size_t)r * n2;
+                double best = INFINITY;
+                int vbest = 0;
+                for (int j = 0; j < n2; j++)
+                    if (di[j] < best && vface[j] >= 0) {
+                        best = di[j];
+                        vbest = j;
+                    }
+                /* the nearest vertex (Delta_min), as a point of its lowest face */
+                int bf = vface[vbest] / 3, corner = vface[vbest] % 3;
+                double bw[3] = {corner == 0, corner == 1, corner == 2};
+                double rbest = sqrt(best);
+                for (int f = 0; f < nf; f++) {   /* the bound, squared: dmin^2 > (rbest + lmax)^2 */
+                    const int *fv = T->f + 3 * f;
+                    double x0 = di[fv[0]], x1 = di[fv[1]], x2 = di[fv[2]];
+                    double dmin2 = x0 < x1 ? x0 : x1, rr = rbest + fp[f].lmax;   /* d2 has no NaN */
+                    dmin2 = x2 < dmin2 ? x2 : dmin2;
+                    if (dmin2 > rr * rr)
+                        continue;
+                    solved++;
+                    double D = fp[f].p1 - (gi[fv[1]] - gi[fv[0]]), E = fp[f].p2 - (gi[fv[2]] - gi[fv[0]]);
+                    double ss = 0, tt = 0, v = triangle_min(fp + f, D, E, di[fv[0]], &ss, &tt);
+                    if (v < best) {
+                        best = fmax(v, 0);
+                        rbest = sqrt(best);
+                        bf = f;
+                        bw[0] = 1 - ss - tt;
+                        bw[1] = ss;
+                        bw[2] = tt;
+                    }
                 }
+                P->face[i] = bf;
+                double ws = 0;
+                for (int q = 0; q < 3; q++)
+                    ws += bw[q] = bw[q] < 0 ? 0 : bw[q];
+                for (int q = 0; q < 3; q++)
+                    P->w[3 * i + q] = bw[q] / ws;
+                if (m1)
+                    cost += m1[i] * best;
             }
-            P->face[i] = bf;
-            double ws = 0;
-            for (int q = 0; q < 3; q++)
-                ws += bw[q] = bw[q] < 0 ? 0 : bw[q];
-            for (int q = 0; q < 3; q++)
-                P->w[3 * i + q] = bw[q] / ws;
-            if (m1)
-                cost += m1[i] * best;
         }
         free(g);
         free(d2);
+        free(bt);
     }
     if (fail) {
         errbuf_set(err, errsz, DDM_ENOMEM, "nearest points: out of memory for a row's work");

@@ -119,6 +119,8 @@ void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, doub
         const corr_ddm_report *d = cp->ddm;
         out->outer = (uint32_t)d->done;
         out->total = (uint32_t)d->total;
+        out->beta = d->mode;               /* the denoising that runs (PROTOCOL.md) */
+        out->gamma = d->round_trip;        /* auto's round trip, NaN when none */
         for (int k = 0; k < 2; k++)
             out->terms[k][PROTO_TERM_MISMATCH] = out->terms[k][PROTO_TERM_ENERGY] = d->cost[k];
         return;
