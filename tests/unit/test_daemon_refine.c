@@ -3,8 +3,9 @@
  * streams the ddm stage and returns the in-process pipeline's map (the
  * same Draco-decoded meshes and map); ddm,ectm streams ddm then ECTM and
  * completes, and with the reverse map uploaded too (they agree) ddm_mode
- * auto says it denoised the two together; a chain that cannot run (ddm with no map) and a basis larger
- * than the meshes allow are refused before SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
+ * auto says it denoised the two together; a chain that cannot run (ddm
+ * with no map) and a basis larger than the meshes allow are refused before
+ * SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
  * stretched and bent, the map a vertex map sent as weight-1 rows. */
 #include "support/harness.h"
 #include "support/testdaemon.h"

@@ -21,12 +21,12 @@ const char *ddm_strerror(int code)
     return "unknown DDM error";
 }
 
+#define DDM__ROWS 8   /* rows of B per pass over A: the four pairs the kernel unrolls */
+typedef double ddm__v2 __attribute__((vector_size(16)));   /* GCC's and Clang's vectors */
+
 /* Per face of M2, in R^k2 with corners A0, A1, A2 and e1 = A1 - A0,
  * e2 = A2 - A0: the Gram entries a = e1.e1, h = e1.e2, c = e2.e2, the
  * products p1 = e1.A0, p2 = e2.A0, and the longest edge. */
-#define DDM__ROWS 8   /* rows of B per pass over A: four pairs */
-typedef double ddm__v2 __attribute__((vector_size(16)));   /* GCC's and Clang's vectors */
-
 typedef struct face_pre {
     double a, h, c, p1, p2, lmax;
 } face_pre;
@@ -150,6 +150,7 @@ int ddm_nearest_points(const double *A, int d, const mesh *T, const double *B, i
             const ddm__v2 *bv = (const ddm__v2 *)bt;
             for (int j = 0; j < n2; j++) {
                 const double *aj = A + (size_t)j * d;
+                _Static_assert(DDM__ROWS == 8, "the four accumulators below");
                 ddm__v2 acc[DDM__ROWS / 2] = {{0, 0}};   /* 4 registers, not memory */
                 for (int c = 0; c < d; c++) {
                     ddm__v2 a = {aj[c], aj[c]};
