@@ -22,6 +22,23 @@
  *           chart as points of T. A limb end turned about its axis is
  *           untwisted this way: its boundary ring is only rotated, and the
  *           harmonic map inside a rotated ring does not fold;
+ *   tube    a region deeper than twice its boundary's radius (a part's
+ *           end behind a ring round it: a hoof below a leg's ring, a
+ *           glasses arm's tip) is re-mapped by depth as well: the region
+ *           and its chart each laid in a disk by their harmonic height
+ *           (0 on the boundary, 1 at the deepest vertex) and its conjugate
+ *           as the angle, the radius one minus the depth share (fold__patch.h);
+ *           the region's share s goes to the chart's t_b + s (1 - t_b)
+ *           inside its boundary's images (at t_b), so the end goes to the
+ *           end. A harmonic disk map would crowd both ends toward a point,
+ *           exponentially in length over girth (below what double
+ *           precision resolves on the glasses' arms), and the two parts'
+ *           proportions decide where the end lands (fourleg 381 -> 393:
+ *           the hoof half-way up the target's leg). Such a region takes
+ *           the tube's remap when it has one, moved-far or not, and a
+ *           region holding vertices a tube remap placed takes only a tube
+ *           remap in later passes (a disk remap of it would crowd the end
+ *           again);
  *   balance the harmonic map then reweighted toward the target's area, a
  *           few rounds (each face's weights scaled by a power of its
  *           image's area ratio; any positive weights keep Tutte's

@@ -1,6 +1,8 @@
 /* fold_harmonic.c — fold__harmonic (fold__patch.h): a patch placed in the
  * plane by the discrete harmonic (Tutte) map with clamped cotangent
- * weights, solved by Jacobi-preconditioned conjugate gradients. */
+ * weights, solved by Jacobi-preconditioned conjugate gradients; and
+ * fold__disk_place, the patch in the unit disk by it; fold__conjugate,
+ * a harmonic function's conjugate. */
 #include "fold/fold__patch.h"
 
 #include <math.h>
@@ -196,5 +198,113 @@ out:
     free(diag);
     free(work);
     free(ea);
+    return rc;
+}
+
+int fold__disk_place(const mesh *m, const geo_edges *E, const fold__patch *p, int *loc, double *uv)
+{
+    unsigned char *pin = calloc((size_t)p->nv + 1, 1);
+    if (!pin)
+        return -1;
+    memset(uv, 0, sizeof(double) * 2 * (size_t)p->nv);
+    /* the loop on the circle by arc length (uv[2i] holds the length run
+     * up to vertex i until the angles are set) */
+    double len = 0;
+    for (int i = 0; i < p->nb; i++) {
+        const double *a = m->v + 3 * p->verts[i], *b = m->v + 3 * p->verts[(i + 1) % p->nb];
+        uv[2 * i] = len;
+        len += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                    (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    for (int i = 0; i < p->nb; i++) {
+        double th = len > 0 ? 2 * M_PI * uv[2 * i] / len : 2 * M_PI * i / p->nb;
+        uv[2 * i] = cos(th);
+        uv[2 * i + 1] = sin(th);
+        pin[i] = 1;
+    }
+    int rc = fold__harmonic(m, E, p, pin, NULL, loc, uv);
+    free(pin);
+    return rc;
+}
+
+int fold__conjugate(const mesh *m, const geo_edges *E, const fold__patch *p, const double *u,
+                    int *loc, double *theta, double *flux)
+{
+    int nf = p->nf, rc = -1;
+    ew *list = malloc(sizeof(ew) * ((size_t)nf * 3 + 1));
+    int *fq = malloc(sizeof(int) * ((size_t)m->nf + 1)), *queue = malloc(sizeof(int) * ((size_t)nf + 1));
+    unsigned char *seen = calloc((size_t)nf + 1, 1);
+    if (!list || !fq || !queue || !seen)
+        goto out;
+    for (int i = 0; i < p->nv; i++)
+        loc[p->verts[i]] = i;
+    /* the edges' weights, as fold__harmonic takes them */
+    for (int q = 0; q < nf; q++) {
+        int t = p->faces[q];
+        const int *f = m->f + 3 * t;
+        for (int k = 0; k < 3; k++) {
+            list[3 * q + k].e = E->fe[3 * t + k];
+            list[3 * q + k].w = 0.5 * cot_at(m->v + 3 * f[k], m->v + 3 * f[(k + 1) % 3],
+                                             m->v + 3 * f[(k + 2) % 3]);
+        }
+    }
+    for (int t = 0; t < m->nf; t++)
+        fq[t] = -1;
+    for (int q = 0; q < nf; q++)
+        fq[p->faces[q]] = q;
+    qsort(list, (size_t)nf * 3, sizeof(ew), cmp_ew);
+    int ne = 0;
+    for (int i = 0; i < 3 * nf; i++) {
+        if (ne && list[ne - 1].e == list[i].e)
+            list[ne - 1].w += list[i].w;
+        else
+            list[ne++] = list[i];
+    }
+    for (int i = 0; i < p->nv; i++)
+        flux[i] = 0;
+    for (int k = 0; k < ne; k++) {
+        int a = loc[E->ev[2 * list[k].e]], b = loc[E->ev[2 * list[k].e + 1]];
+        double w = list[k].w < FOLD__MIN_WEIGHT ? FOLD__MIN_WEIGHT : list[k].w;
+        flux[a] += w * (u[b] - u[a]);
+        flux[b] += w * (u[a] - u[b]);
+    }
+    /* breadth first over the faces: crossing edge (a, b), a -> b as the
+     * face left runs it, theta falls by w (u_b - u_a), the flux of grad u
+     * through the dual edge */
+    int head = 0, tail = 0;
+    theta[0] = 0;
+    seen[0] = 1;
+    queue[tail++] = 0;
+    while (head < tail) {
+        int q = queue[head++], t = p->faces[q];
+        const int *f = m->f + 3 * t;
+        for (int k = 0; k < 3; k++) {
+            int e = E->fe[3 * t + k];
+            int t2 = E->ef[2 * e] == t ? E->ef[2 * e + 1] : E->ef[2 * e];
+            if (t2 < 0 || t2 >= m->nf || fq[t2] < 0 || seen[fq[t2]])
+                continue;
+            int lo = 0, hi = ne - 1;
+            while (lo < hi) {
+                int mid = (lo + hi) / 2;
+                if (list[mid].e < e)
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            double w = list[lo].w < FOLD__MIN_WEIGHT ? FOLD__MIN_WEIGHT : list[lo].w;
+            int a = loc[f[(k + 1) % 3]], b = loc[f[(k + 2) % 3]];
+            theta[fq[t2]] = theta[q] - w * (u[b] - u[a]);
+            seen[fq[t2]] = 1;
+            queue[tail++] = fq[t2];
+        }
+    }
+    rc = tail == nf ? 0 : 1;
+out:
+    for (int i = 0; i < p->nv; i++)
+        loc[p->verts[i]] = -1;
+    free(list);
+    free(fq);
+    free(queue);
+    free(seen);
     return rc;
 }

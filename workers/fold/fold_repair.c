@@ -45,6 +45,10 @@
  * (balance): rounds, and the power of the area ratio each applies. */
 #define FOLD__BALANCE_ROUNDS 8
 #define FOLD__BALANCE_STEP 0.5
+/* A region deeper than this many times its boundary's radius is a part's
+ * end (tube_like): re-mapped by the tube placement as well (fold__patch.h),
+ * which wins a tie. */
+#define FOLD__TUBE_DEPTH 2.0
 #define FOLD__DRAG_STEPS 200      /* steps of a landmark's drag, at most */
 /* The passes run again from `rings` while a round of them lowers the
  * count, this many rounds at most: a region refused at first (its chart
@@ -76,9 +80,11 @@ typedef struct ctx {
     geo_edges ES, ET;
     const unsigned char *fixed;   /* S->nv: landmark vertices */
     int drag_landmarks;           /* remap drags the landmarks to their images */
+    int tube;                     /* remap by the tube placement (tube_like regions) */
     double shift;                 /* remap's farthest free landmark from its
                                      image, in the chart's unit disk */
     unsigned char *badv;          /* S->nv: vertices of bad faces (pass) */
+    unsigned char *tubed;         /* S->nv: placed by a tube remap (kept) */
     unsigned char *keep;          /* S->nv: the region's vertices that keep
                                      their rows (those of its filled holes) */
     bmap *R;                      /* the map being repaired */
@@ -177,32 +183,8 @@ static int chart(ctx *c, const fold__patch *pS, fold__patch *pT, double **uvT)
     int rc = fold__disk(T, &c->ET, c->tin, c->tloc, pT);
     if (rc)
         return rc;
-    double *uv = calloc(2 * (size_t)pT->nv + 1, sizeof(double));
-    unsigned char *pin = calloc((size_t)pT->nv + 1, 1);
-    if (!uv || !pin) {
-        free(uv);
-        free(pin);
-        fold__patch_close(pT);
-        return -1;
-    }
-    /* the loop on the circle by arc length (uv[2i] holds the length run
-     * up to vertex i until the angles are set) */
-    double len = 0;
-    for (int i = 0; i < pT->nb; i++) {
-        const double *a = T->v + 3 * pT->verts[i], *b = T->v + 3 * pT->verts[(i + 1) % pT->nb];
-        uv[2 * i] = len;
-        len += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                    (a[2] - b[2]) * (a[2] - b[2]));
-    }
-    for (int i = 0; i < pT->nb; i++) {
-        double th = len > 0 ? 2 * M_PI * uv[2 * i] / len : 2 * M_PI * i / pT->nb;
-        uv[2 * i] = cos(th);
-        uv[2 * i + 1] = sin(th);
-        pin[i] = 1;
-    }
-    rc = fold__harmonic(T, &c->ET, pT, pin, NULL, c->tloc, uv);
-    free(pin);
-    if (rc) {
+    double *uv = malloc(sizeof(double) * (2 * (size_t)pT->nv + 1));
+    if (!uv || fold__disk_place(T, &c->ET, pT, c->tloc, uv)) {
         free(uv);
         fold__patch_close(pT);
         return -1;
@@ -396,21 +378,58 @@ static void drag(ctx *c, const fold__patch *pS, const unsigned char *pin, const 
     }
 }
 
+/* Whether region p (depth: its vertices' depth, fold__depth) is a part's
+ * end: deeper than FOLD__TUBE_DEPTH times the radius of the circle as
+ * long as its boundary (a disk's depth is once its radius, a hemisphere's
+ * 1.6 times). */
+static int tube_like(const mesh *S, const fold__patch *p, const double *depth)
+{
+    double len = 0, deepest = 0;
+    for (int i = 0; i < p->nb; i++) {
+        const double *a = S->v + 3 * p->verts[i], *b = S->v + 3 * p->verts[(i + 1) % p->nb];
+        len += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                    (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    for (int i = 0; i < p->nv; i++)
+        deepest = fmax(deepest, depth[i]);
+    return deepest > FOLD__TUBE_DEPTH * len / (2 * M_PI);
+}
+
 /* Re-maps the inner vertices of region pS (see fold.h) in c->R. Returns 0,
  * 1 when it cannot (no chart), -1 when out of memory. */
 static int remap(ctx *c, const fold__patch *pS)
 {
     const mesh *T = c->T;
-    fold__patch pT;
-    double *uvT;
-    int rc = chart(c, pS, &pT, &uvT);
-    if (rc)
-        return rc;
+    fold__patch pT = {0};
+    double *uvT = NULL, *dS = NULL, *own = NULL, *dT = NULL;
+    double *uv = NULL, *lm = NULL;
+    unsigned char *pin = NULL;
+    int *corner = NULL;
+    int rc = -1;
+    double lambda_T = 1;
+    if (c->tube) {
+        if (!(dS = malloc(sizeof(double) * ((size_t)pS->nv + 1))) || fold__depth(c->S, pS, c->sloc, dS))
+            goto out;
+        if (!tube_like(c->S, pS, dS)) {
+            rc = 1;
+            goto out;
+        }
+    }
+    if ((rc = chart(c, pS, &pT, &uvT)))
+        goto out;
     rc = -1;
-    double *uv = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
-    double *lm = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
-    unsigned char *pin = malloc((size_t)pS->nv + 1);
-    int *corner = malloc(sizeof(int) * 3 * ((size_t)pT.nf + 1));
+    if (c->tube) {
+        /* the chart by depth: its deepest vertex (the part's end) at the centre */
+        if (!(dT = malloc(sizeof(double) * ((size_t)pT.nv + 1))) || fold__depth(T, &pT, c->tloc, dT))
+            goto out;
+        if ((rc = fold__tube_chart(T, &c->ET, &pT, c->tloc, dT, uvT, &lambda_T)))
+            goto out;
+        rc = -1;
+    }
+    uv = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
+    lm = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
+    pin = malloc((size_t)pS->nv + 1);
+    corner = malloc(sizeof(int) * 3 * ((size_t)pT.nf + 1));
     if (!uv || !lm || !pin || !corner)
         goto out;
     for (int i = 0; i < pT.nv; i++)
@@ -430,7 +449,7 @@ static int remap(ctx *c, const fold__patch *pS)
     for (int i = 0; i < pS->nv; i++) {
         int v = pS->verts[i], f = c->R->face[v];
         uv[2 * i] = uv[2 * i + 1] = 0;
-        pin[i] = pinned(c, pS, i);
+        pin[i] = c->tube ? i < pS->nb : pinned(c, pS, i);
         /* the image's corners in the chart, by their weights (an image
          * on a face across the chart's edge: its corners inside,
          * renormalised; none inside: outside the chart) */
@@ -458,8 +477,17 @@ static int remap(ctx *c, const fold__patch *pS)
     for (int i = 0; i < pT.nv; i++)
         c->tloc[pT.verts[i]] = -1;
     memcpy(lm, uv, sizeof(double) * 2 * (size_t)pS->nv);
-    if (fold__harmonic(c->S, &c->ES, pS, pin, NULL, c->sloc, uv) ||
-        balance(c, pS, pin, &pT, corner, uvT, uv))
+    if (c->tube) {
+        /* the region's own tube chart, fitted inside its boundary's images */
+        if (!(own = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1))))
+            goto out;
+        double lambda_S;
+        if ((rc = fold__tube_chart(c->S, &c->ES, pS, c->sloc, dS, own, &lambda_S)) ||
+            (rc = fold__tube_fit(pS, own, lambda_S, lambda_T, uv)))
+            goto out;
+        rc = -1;
+    } else if (fold__harmonic(c->S, &c->ES, pS, pin, NULL, c->sloc, uv) ||
+               balance(c, pS, pin, &pT, corner, uvT, uv))
         goto out;
     if (c->drag_landmarks)
         drag(c, pS, pin, lm, uv);
@@ -486,20 +514,28 @@ out:
     free(pin);
     free(corner);
     free(uvT);
+    free(dS);
+    free(dT);
+    free(own);
     fold__patch_close(&pT);
     return rc;
 }
 
+/* The remaps each region gets in a pass: by harmonic maps (disk) or by
+ * the tube placement (tube_like regions only), each with the landmarks
+ * dragged to their images or free. */
+enum { MODE_DISK_DRAGGED, MODE_DISK_FREE, MODE_TUBE_DRAGGED, MODE_TUBE_FREE, MODES };
+
 /* One region taken in a pass: its patch, which of its vertices are kept
- * (c->keep), the rows it had, and the rows of its remap with the
- * landmarks dragged to their images. */
+ * (c->keep), the rows it had, and the rows of each of its remaps. */
 typedef struct taken {
     fold__patch p;
-    double shift;                 /* c->shift of its remap with free landmarks */
-    int pfar;                     /* moved_far of the remap with landmarks dragged */
     unsigned char *kept;
-    int *face, *pface;
-    double *w, *pw;
+    int *face, *mface[MODES];
+    double *w, *mw[MODES];
+    double shift[MODES];          /* c->shift of each remap */
+    int far[MODES];               /* moved_far of each remap */
+    int tube;                     /* a part's end, re-mapped by the tube placement */
 } taken;
 
 /* Rows of the region's vertices: from the map into face/w (save) or back. */
@@ -517,17 +553,21 @@ static void rows(bmap *R, const fold__patch *p, int *face, double *w, int save)
     }
 }
 
-/* Remaps every taken region (landmarks dragged or free); -1 when out of memory. */
-static int remap_all(ctx *c, taken *tk, int ntaken, int drag_landmarks)
+/* Remaps every taken region the way of mode; -1 when out of memory. */
+static int remap_all(ctx *c, taken *tk, int ntaken, int mode)
 {
-    c->drag_landmarks = drag_landmarks;
+    c->drag_landmarks = mode == MODE_DISK_DRAGGED || mode == MODE_TUBE_DRAGGED;
+    c->tube = mode == MODE_TUBE_DRAGGED || mode == MODE_TUBE_FREE;
     for (int k = 0; k < ntaken; k++) {
         for (int i = 0; i < tk[k].p.nv; i++)
             c->keep[tk[k].p.verts[i]] = tk[k].kept[i];
         c->shift = 0;
-        if (remap(c, &tk[k].p) < 0)
+        int rc = remap(c, &tk[k].p);
+        if (rc < 0)
             return -1;
-        tk[k].shift = c->shift;
+        tk[k].shift[mode] = c->shift;
+        if (c->tube && rc == 0)
+            tk[k].tube = 1;
     }
     return 0;
 }
@@ -582,10 +622,10 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     int nf = S->nf, nv = S->nv, rc = -1, ntaken = 0;
     unsigned char *in = malloc((size_t)nf + 1), *cin = malloc((size_t)nf + 1);
     unsigned char *mark = malloc((size_t)nv + 1), *claimed = calloc((size_t)nv + 1, 1);
-    unsigned char *kind2 = malloc((size_t)nf + 1), *kind3 = malloc((size_t)nf + 1);
+    unsigned char *km = malloc((MODES + 1) * ((size_t)nf + 1));   /* each mode's kinds, then the new */
     int *comp = malloc(sizeof(int) * ((size_t)nf + 1));
     taken *tk = NULL;
-    if (!in || !cin || !mark || !claimed || !kind2 || !kind3 || !comp)
+    if (!in || !cin || !mark || !claimed || !km || !comp)
         goto out;
     memset(c->badv, 0, (size_t)nv);
     for (int t = 0; t < nf; t++) {
@@ -629,56 +669,59 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
         size_t m = (size_t)r->p.nv + 1;
         r->kept = malloc(m);
         r->face = malloc(sizeof(int) * m);
-        r->pface = malloc(sizeof(int) * m);
         r->w = malloc(sizeof(double) * 3 * m);
-        r->pw = malloc(sizeof(double) * 3 * m);
         ntaken++;
-        if (!r->kept || !r->face || !r->pface || !r->w || !r->pw)
+        if (!r->kept || !r->face || !r->w)
             goto out;
+        for (int md = 0; md < MODES; md++)
+            if (!(r->mface[md] = malloc(sizeof(int) * m)) || !(r->mw[md] = malloc(sizeof(double) * 3 * m)))
+                goto out;
         for (int i = 0; i < r->p.nv; i++) {
             r->kept[i] = c->keep[r->p.verts[i]];
             claimed[r->p.verts[i]] = 1;
         }
         rows(c->R, &r->p, r->face, r->w, 1);
     }
-    /* each region re-mapped with the landmarks dragged (kind2), then free
-     * (kind3); the better of the three rows kept where it beats the old */
-    if (remap_all(c, tk, ntaken, 1) || kinds(S, c->T, c->R, kind2) < 0)
-        goto out;
-    for (int k = 0; k < ntaken; k++) {
-        tk[k].pfar = moved_far(c, tk + k);
-        rows(c->R, &tk[k].p, tk[k].pface, tk[k].pw, 1);
-        rows(c->R, &tk[k].p, tk[k].face, tk[k].w, 0);
+    /* each region re-mapped each way (its rows and kinds kept per mode) */
+    for (int md = 0; md < MODES; md++) {
+        if (remap_all(c, tk, ntaken, md) || kinds(S, c->T, c->R, km + (size_t)md * nf) < 0)
+            goto out;
+        for (int k = 0; k < ntaken; k++) {
+            tk[k].far[md] = moved_far(c, tk + k);
+            rows(c->R, &tk[k].p, tk[k].mface[md], tk[k].mw[md], 1);
+            rows(c->R, &tk[k].p, tk[k].face, tk[k].w, 0);
+        }
     }
-    if (remap_all(c, tk, ntaken, 0) || kinds(S, c->T, c->R, kind3) < 0)
-        goto out;
+    unsigned char *knew = km + (size_t)MODES * nf;
+    memcpy(knew, kind, (size_t)nf);
     for (int k = 0; k < ntaken; k++) {
         taken *r = tk + k;
-        long before = badness(&r->p, kind), pinned_ = badness(&r->p, kind2),
-             free_ = badness(&r->p, kind3);
-        if (r->pfar)               /* a remap that moved good parts far never wins */
-            pinned_ = LONG_MAX;
-        if (moved_far(c, r))
-            free_ = LONG_MAX;
-        const unsigned char *won = kind3;
-        if (pinned_ <= free_ || r->shift > FOLD__MAX_SHIFT) {
-            rows(c->R, &r->p, r->pface, r->pw, 0);
-            won = kind2;
-            free_ = pinned_;
-        }
-        if (free_ < before) {
+        long before = badness(&r->p, kind), v[MODES];
+        for (int md = 0; md < MODES; md++)   /* a remap that moved good parts far never wins */
+            v[md] = r->far[md] && md < MODE_TUBE_DRAGGED ? LONG_MAX : badness(&r->p, km + (size_t)md * nf);
+        /* per placement, the dragged landmarks unless the free ones do
+         * better and stay near their images; then the tube's on a tie */
+        int disk = v[MODE_DISK_DRAGGED] <= v[MODE_DISK_FREE] ||
+                           r->shift[MODE_DISK_FREE] > FOLD__MAX_SHIFT ? MODE_DISK_DRAGGED : MODE_DISK_FREE;
+        int tube = v[MODE_TUBE_DRAGGED] <= v[MODE_TUBE_FREE] ||
+                           r->shift[MODE_TUBE_FREE] > FOLD__MAX_SHIFT ? MODE_TUBE_DRAGGED : MODE_TUBE_FREE;
+        int tubed = 0;
+        for (int i = r->p.nb; i < r->p.nv && !tubed; i++)
+            tubed = c->tubed[r->p.verts[i]];
+        int won = v[tube] <= v[disk] || r->tube || tubed ? tube : disk;
+        if (v[won] < before) {
+            rows(c->R, &r->p, r->mface[won], r->mw[won], 0);
+            for (int i = r->p.nb; i < r->p.nv && won >= MODE_TUBE_DRAGGED; i++)
+                c->tubed[r->p.verts[i]] = 1;
             rep->regions++;
             rep->region += r->p.nv - r->p.nb;
-        } else {
-            rows(c->R, &r->p, r->face, r->w, 0);
-            won = kind;
+            for (int q = 0; q < r->p.nf; q++)
+                knew[r->p.faces[q]] = km[(size_t)won * nf + r->p.faces[q]];
         }
-        for (int q = 0; q < r->p.nf; q++)
-            kind3[r->p.faces[q]] = won[r->p.faces[q]];
     }
     bad = 0;
     for (int t = 0; t < nf; t++)
-        bad += (kind[t] = kind3[t]) != 0;
+        bad += (kind[t] = knew[t]) != 0;
     rc = bad;
 out:
     if (tk)
@@ -686,17 +729,18 @@ out:
             fold__patch_close(&tk[k].p);
             free(tk[k].kept);
             free(tk[k].face);
-            free(tk[k].pface);
             free(tk[k].w);
-            free(tk[k].pw);
+            for (int md = 0; md < MODES; md++) {
+                free(tk[k].mface[md]);
+                free(tk[k].mw[md]);
+            }
         }
     free(tk);
     free(in);
     free(cin);
     free(mark);
     free(claimed);
-    free(kind2);
-    free(kind3);
+    free(km);
     free(comp);
     return rc;
 }
@@ -722,7 +766,8 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     c.sloc = malloc(sizeof(int) * ((size_t)S->nv + 1));
     c.R = bmap_new(P->n, P->nt);
     c.badv = malloc((size_t)S->nv + 1);
-    if (!c.badv || !kind || !fx || !c.keep || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
+    c.tubed = calloc((size_t)S->nv + 1, 1);
+    if (!c.badv || !c.tubed || !kind || !fx || !c.keep || !c.tin || !c.tmark || !c.tcomp || !c.tloc || !c.sloc || !c.R)
         goto out;
     for (int v = 0; v < T->nv; v++)
         c.tloc[v] = -1;
@@ -767,6 +812,7 @@ out:
     geo_edges_close(&c.ET);
     bmap_free(c.R);
     free(c.badv);
+    free(c.tubed);
     free(kind);
     free(fx);
     free(c.keep);
