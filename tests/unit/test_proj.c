@@ -412,7 +412,10 @@ TEST(closest_matches_brute_381_390_beta1e3_gamma1e4) { run_ectm_case(1e3, 1e4); 
 TEST(closest_matches_brute_381_390_beta1e5_gamma1e4) { run_ectm_case(1e5, 1e4); }
 TEST(closest_matches_brute_381_390_beta500_gamma0) { run_ectm_case(500, 0); }
 
-TEST(closest_matches_brute_381_390_d16_rhm_like)
+/* The R^d search against the brute force on 381 -> 390 at unit area:
+ * columns 0..2 s·X, the rest smooth functions of X (RHM-like embeddings),
+ * the queries' noisy; unseeded, seeded with any face, and rotated. */
+static void hd_matches_brute(int d)
 {
     mesh *src = load_unit_area("shrec07_bim/Meshes/381.off");
     mesh *tg = load_unit_area("shrec07_bim/Meshes/390.off");
@@ -420,7 +423,6 @@ TEST(closest_matches_brute_381_390_d16_rhm_like)
     proj_tree *tree = proj_tree_new(tg, err, sizeof err);
     if (!tree)
         FAILF("%s", err);
-    const int d = 16;
     double s = 2.0, a[13][3], ph[13];
     for (int m = 0; m < 13; m++) {
         for (int k = 0; k < 3; k++)
@@ -437,7 +439,7 @@ TEST(closest_matches_brute_381_390_d16_rhm_like)
             const double *x = m->v + 3 * (pass ? 3 * i : i);
             for (int k = 0; k < 3; k++)
                 out[d * i + k] = s * x[k];
-            for (int j = 0; j < 13; j++)
+            for (int j = 0; j < d - 3; j++)
                 out[d * i + 3 + j] = sin(a[j][0] * x[0] + a[j][1] * x[1] + a[j][2] * x[2] + ph[j]) +
                                      (pass ? 0.05 * srand1() : 0);
         }
@@ -457,18 +459,21 @@ TEST(closest_matches_brute_381_390_d16_rhm_like)
     CHECK_INT(proj_closest(tree, d, Z, s, n, Q, f, w, c), 0);
     check_same(tg, d, Z, n, Q, fb, cb, f, w, c);
     /* from PROJ_HD_MIN_DIM on the search runs in R^d: the first three
-     * columns need not be s·X̃ (here a rotation of all sixteen, the
+     * columns need not be s·X̃ (here a rotation of every column pair, the
      * distances unchanged, so the brute force's costs still hold) */
     double *Zr = malloc(sizeof(double) * d * tg->nv), *Qr = malloc(sizeof(double) * d * n);
     for (int pass = 0; pass < 2; pass++) {
         const double *in = pass ? Q : Z;
         double *out = pass ? Qr : Zr;
-        for (int i = 0; i < (pass ? n : tg->nv); i++)
-            for (int k = 0; k < d; k += 2) {   /* 45 degrees in each plane (k, k + 1) */
+        for (int i = 0; i < (pass ? n : tg->nv); i++) {
+            if (d % 2)
+                out[d * i + d - 1] = in[d * i + d - 1];
+            for (int k = 0; k + 1 < d; k += 2) {   /* 45 degrees in each plane (k, k + 1) */
                 double x = in[d * i + k], y = in[d * i + k + 1];
                 out[d * i + k] = (x - y) / sqrt(2.0);
                 out[d * i + k + 1] = (x + y) / sqrt(2.0);
             }
+        }
     }
     for (int i = 0; i < n; i++)
         f[i] = -1;
@@ -479,6 +484,18 @@ TEST(closest_matches_brute_381_390_d16_rhm_like)
     proj_tree_free(tree);
     mesh_free(src);
     mesh_free(tg);
+}
+
+TEST(closest_matches_brute_381_390_d16_rhm_like)
+{
+    hd_matches_brute(16);
+}
+
+/* a dimension the box bound's steps of eight do not divide (the distances
+ * start's R^{2l} is one) */
+TEST(closest_matches_brute_381_390_d11)
+{
+    hd_matches_brute(11);
 }
 
 TEST(closest_refuses_bad_dimension_scale_and_seed)
