@@ -78,6 +78,10 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
             dup2(fd, 2);
             close(fd);
         }
+        /* as a service manager starts it: the daemon sets the OpenMP wait
+         * policy its workers inherit (the harness's own would hide a
+         * re-exec per job, bench_daemon's small job) */
+        unsetenv("OMP_WAIT_POLICY");
         execv(DAEMON, (char **)argv);
         _exit(127);
     }
