@@ -8,6 +8,7 @@
  * shutdown logic. */
 #include "backend.h"
 #include "mcd.h"
+#include "util/ompenv.h"
 
 #include <signal.h>
 #include <stdlib.h>
@@ -45,11 +46,10 @@ int main(int argc, char **argv)
     }
     dlog_set_level(d.conf.log_level);
     signal(SIGPIPE, SIG_IGN);
-    /* The workers we spawn inherit this: with it set, a worker starts
-     * without its re-exec (util/ompenv.h), one program load less per job
-     * (bench_daemon's 162-vertex job: overhead 63-66 -> 51-53 ms). A value
-     * the user set is kept. */
-    setenv("OMP_WAIT_POLICY", "passive", 0);
+    /* The workers we spawn inherit it and skip their re-exec: one program
+     * load less per job (bench_daemon's 162-vertex job: overhead 63-66 ->
+     * 51-53 ms). */
+    ompenv_set_passive();
     int status = 1;
     d.loop = uv_default_loop();
     if (auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||

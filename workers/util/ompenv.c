@@ -5,11 +5,16 @@
 #include <stdlib.h>
 #include <unistd.h>
 
-void ompenv_ensure_passive(char **argv)
+int ompenv_set_passive(void)
 {
     if (getenv("OMP_WAIT_POLICY"))
-        return;
-    if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0)
+        return 0;
+    return setenv("OMP_WAIT_POLICY", "passive", 1) == 0;
+}
+
+void ompenv_ensure_passive(char **argv)
+{
+    if (!ompenv_set_passive())
         return;
     execv("/proc/self/exe", argv);
     /* exec failed (no /proc): carry on with libgomp's default */

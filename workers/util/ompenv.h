@@ -15,6 +15,11 @@
 
 void ompenv_ensure_passive(char **argv);
 
+/* Sets OMP_WAIT_POLICY=passive in the environment unless the user set it;
+ * 1 when it set it. For a program that runs no OpenMP itself but starts
+ * programs that do (meshcorrd's workers inherit it and skip their re-exec). */
+int ompenv_set_passive(void);
+
 /* Threads for a job whose two meshes have `vertices` vertices together:
  * requested when > 0 (the user's choice, kept), else one thread per
  * OMPENV_VERTICES_PER_THREAD vertices, at least 1 and at most the cores.
