@@ -74,10 +74,16 @@ BENCH_BIN := $(BENCH_C:tests/bench/%.c=$(BUILD)/bench/%)
 FUZZ_C    := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_BIN  := $(FUZZ_C:tests/fuzz/%.c=$(BUILD)/fuzz/%)
 
-WORKER_C   := $(wildcard workers/main/*.c)
-WORKER_OBJ := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
+# workers/main holds two programs: meshcorr-validate is worker_validate.c
+# (its main) with the job's one mapping and the shared option code; the
+# worker is the rest. The validator links --as-needed, so it loads Draco and
+# none of the solvers' libraries (it starts once per SUBMIT).
+VALIDATE_C   := workers/main/worker_validate.c workers/main/worker_job.c workers/main/worker_cli.c
+VALIDATE_OBJ := $(VALIDATE_C:%.c=$(BUILD)/obj/%.o)
+WORKER_C     := $(filter-out workers/main/worker_validate.c,$(wildcard workers/main/*.c))
+WORKER_OBJ   := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
-PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorrd
+PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorr-validate $(BUILD)/meshcorrd
 
 .PHONY: all test bench demo install install-lib install-man install-python clean doc-params
 # Objects built through pattern chains are kept (make would otherwise delete
@@ -134,6 +140,9 @@ $(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PRO
 
 $(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+
+$(BUILD)/meshcorr-validate: $(VALIDATE_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -Wl,--as-needed -o $@ $(VALIDATE_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
 $(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)

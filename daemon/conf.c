@@ -28,6 +28,7 @@ static const struct option_def {
     {"config", K_CONFIG, 0, 0, 0, "FILE of `key = value` lines, read where it appears"},
     {"tokens", K_PATH, OFF(tokens), 0, 0, "FILE of `token user [admin]` lines (TCP users)"},
     {"worker", K_PATH, OFF(worker), 0, 0, "PATH of meshcorr-worker (default: next to meshcorrd)"},
+    {"validator", K_PATH, OFF(validator), 0, 0, "PATH of meshcorr-validate, SUBMIT's check (default: next to meshcorrd)"},
     {"threads-per-worker", K_INT, OFF(threads_per_worker), 0, 4096, "N OpenMP threads per worker (0: all)"},
     {"worker-memory-mb", K_U32, OFF(worker_memory_mb), 0, 1u << 24, "MB of address space per worker (0: no limit)"},
     {"max-frame", K_U32, OFF(max_frame), PROTO_HDR_SIZE + 1, PROTO_MAX_FRAME, "BYTES largest request frame"},
@@ -257,19 +258,29 @@ int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
     return 0;
 }
 
-const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz)
+/* set, or name next to meshcorrd (the name alone when that cannot be read) */
+static const char *next_to_daemon(const char *set, const char *name, char *buf, size_t sz)
 {
-    if (c->worker[0])
-        return c->worker;
-    /* meshcorr-worker next to meshcorrd */
-    static const char name[] = "meshcorr-worker";
-    ssize_t n = readlink("/proc/self/exe", buf, sz - sizeof name);
+    if (set[0])
+        return set;
+    size_t len = strlen(name) + 1;
+    ssize_t n = sz > len ? readlink("/proc/self/exe", buf, sz - len) : -1;
     if (n <= 0)
         return name;
     buf[n] = '\0';
     char *slash = strrchr(buf, '/');
-    memcpy(slash ? slash + 1 : buf, name, sizeof name);
+    memcpy(slash ? slash + 1 : buf, name, len);
     return buf;
+}
+
+const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz)
+{
+    return next_to_daemon(c->worker, "meshcorr-worker", buf, sz);
+}
+
+const char *conf_validator_path(const mcd_conf *c, char *buf, size_t sz)
+{
+    return next_to_daemon(c->validator, "meshcorr-validate", buf, sz);
 }
 
 unsigned long long conf_max_faces(const mcd_conf *c)

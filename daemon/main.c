@@ -13,6 +13,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static int queue_pending(void *ctx, const store_job *j)
 {
@@ -50,6 +51,11 @@ int main(int argc, char **argv)
      * load less per job (bench_daemon's 162-vertex job: overhead 63-66 ->
      * 51-53 ms). */
     ompenv_set_passive();
+    char vbuf[CONF_PATH + 64];
+    const char *validator = conf_validator_path(&d.conf, vbuf, sizeof vbuf);
+    if (access(validator, X_OK) != 0)
+        dlog(DLOG_WARN, "validator program %s is not executable: every SUBMIT is refused until it is",
+             validator);
     int status = 1;
     d.loop = uv_default_loop();
     if (auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||

@@ -80,6 +80,7 @@ typedef struct mcd_conf {
     char state_dir[CONF_PATH];
     char tokens[CONF_PATH];       /* "" = no TCP users */
     char worker[CONF_PATH];       /* "" = meshcorr-worker next to meshcorrd */
+    char validator[CONF_PATH];    /* "" = meshcorr-validate next to meshcorrd */
     char port_file[CONF_PATH];    /* "" = none; else bound TCP addresses, one a line */
     int workers;                  /* worker slots (>= 1) */
     int threads_per_worker;       /* 0 = the worker's default */
@@ -122,6 +123,8 @@ int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz);
 void conf_usage(FILE *fp);
 /* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
 const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz);
+/* The meshcorr-validate program (--validator, or next to meshcorrd). */
+const char *conf_validator_path(const mcd_conf *c, char *buf, size_t sz);
 /* The worker's --max-faces for the configured --max-vertices. */
 unsigned long long conf_max_faces(const mcd_conf *c);
 /* SIGHUP: appends ", name" (or "name" first) to changed when the option
@@ -424,13 +427,13 @@ void reload_close(mcd *d);
 #define VAL_BASE_MEMORY_MB 1024u  /* plus 256 bytes per allowed vertex of both meshes */
 #define VAL_MAX_CPU_S      30u    /* CPU seconds for decoding and checking a pair */
 typedef struct val_conf {         /* a copy taken on the loop, for the thread pool */
-    char worker[CONF_PATH + 64];
+    char validator[CONF_PATH + 64];
     unsigned max_vertices;
     unsigned long long max_faces;
     unsigned max_memory_mb, max_cpu_s;
 } val_conf;
 void val_conf_of(const mcd *d, val_conf *vc);
-/* Runs `meshcorr-worker --validate` on the SUBMIT frame[len] and waits for
+/* Runs meshcorr-validate on the SUBMIT frame[len] and waits for
  * it (thread-pool side; blocks its thread only). 0 when the job can run;
  * else the code (BAD_MESH, BAD_LANDMARKS, BAD_PARAMS, ...) with the message
  * naming the blob or field in msg; PROTO_EINTERNAL when the check itself

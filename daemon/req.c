@@ -9,8 +9,8 @@
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
  * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
  * anything is stored, counting the SUBMITs still being checked or stored.
- * Before the store, val_submit has a short-lived `meshcorr-worker
- * --validate` child decode and check the meshes, the landmarks against
+ * Before the store, val_submit has a short-lived meshcorr-validate child
+ * decode and check the meshes, the landmarks against
  * them, the maps and the parameters, so a job that can never run is refused
  * naming the blob or field and nothing is stored. Draco bytes are never
  * decoded in this process.

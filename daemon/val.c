@@ -1,5 +1,5 @@
 /* val.c — the check of a SUBMIT before SUBMIT_OK: the frame goes through a
- * pipe to `meshcorr-worker --validate`, a short-lived child that decodes
+ * pipe to meshcorr-validate, a short-lived child that decodes
  * both meshes with Draco and builds the job exactly as a run would
  * (workers/main/worker_validate.c), under an address-space and a CPU-time
  * limit, so a mesh that crashes or exhausts Draco costs a child, never the
@@ -34,7 +34,7 @@ void val_conf_of(const mcd *d, val_conf *vc)
 {
     char buf[CONF_PATH + 64];
     memset(vc, 0, sizeof *vc);
-    snprintf(vc->worker, sizeof vc->worker, "%s", conf_worker_path(&d->conf, buf, sizeof buf));
+    snprintf(vc->validator, sizeof vc->validator, "%s", conf_validator_path(&d->conf, buf, sizeof buf));
     vc->max_vertices = d->conf.max_vertices;
     vc->max_faces = conf_max_faces(&d->conf);
     /* a decoded mesh is well under 256 bytes a vertex (Draco's buffers,
@@ -71,7 +71,7 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
     snprintf(maxf, sizeof maxf, "%llu", vc->max_faces);
     snprintf(mem, sizeof mem, "%u", vc->max_memory_mb);
     snprintf(cpu, sizeof cpu, "%u", vc->max_cpu_s);
-    char *argv[] = { (char *)vc->worker, "--validate", "--max-vertices", maxv, "--max-faces", maxf,
+    char *argv[] = { (char *)vc->validator, "--max-vertices", maxv, "--max-faces", maxf,
                      "--max-memory-mb", mem, "--max-cpu-s", cpu, NULL };
     int in[2] = {-1, -1}, out[2] = {-1, -1}, rc = PROTO_EINTERNAL;
     pid_t pid = -1;
@@ -97,8 +97,8 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
         (e = posix_spawn_file_actions_addclosefrom_np(&fa, STDERR_FILENO + 1)) ||
         (e = posix_spawnattr_setsigmask(&at, &none)) || (e = posix_spawnattr_setsigdefault(&at, &dflt)) ||
         (e = posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF)) ||
-        (e = posix_spawn(&pid, vc->worker, &fa, &at, argv, environ))) {
-        snprintf(msg, msz, "the meshes cannot be checked: cannot start %s --validate: %s", vc->worker,
+        (e = posix_spawn(&pid, vc->validator, &fa, &at, argv, environ))) {
+        snprintf(msg, msz, "the meshes cannot be checked: cannot start %s: %s", vc->validator,
                  strerror(e));
         goto done;
     }
@@ -150,7 +150,7 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
         rc = PROTO_EBAD_MESH;        /* Draco aborted or crashed on these bytes */
         snprintf(msg, msz, "a mesh crashed the decoder (%s) while it was checked", strsignal(WTERMSIG(st)));
     } else {
-        snprintf(msg, msz, "the meshes cannot be checked: %s --validate exited %d", vc->worker,
+        snprintf(msg, msz, "the meshes cannot be checked: %s exited %d", vc->validator,
                  WIFEXITED(st) ? WEXITSTATUS(st) : -1);
     }
 done:

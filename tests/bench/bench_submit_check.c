@@ -1,10 +1,10 @@
 /* bench_submit_check.c — what checking a SUBMIT before SUBMIT_OK costs
- * (`meshcorr-worker --validate` in a sandboxed child: both meshes decoded by
+ * (meshcorr-validate in a sandboxed child: both meshes decoded by
  * Draco and checked, landmarks and maps against them): the round trip to
  * SUBMIT_OK of the 10K-vertex-class pair 381 -> 390 (6938 + 9239 vertices,
- * with its initial maps) through a daemon with the real worker, against a
- * daemon whose worker program is /bin/true (the check is then a spawn that
- * does nothing), and the check's own wall time from the daemon's log. Each
+ * with its initial maps) through a daemon with the real programs, against a
+ * daemon whose worker and validator programs are /bin/true (the check is
+ * then a spawn that does nothing), and the check's own wall time from the daemon's log. Each
  * job is cancelled and ended before the next SUBMIT so nothing runs while
  * one is timed. Prints figures from one run, never fails on time. */
 #include "support/harness.h"
@@ -59,25 +59,6 @@ static double round_trips(const char *name, const char *const *args, testdaemon_
     return median(rt, NSUBMIT);
 }
 
-/* Medians of the "checked in X ms (Y ms CPU)" figures of the daemon's log. */
-static double checked_ms(const testdaemon *d, double *cpu)
-{
-    FILE *fp = fopen(d->log, "r");
-    CHECK(fp != NULL);
-    char line[8192];
-    double v[64], c[64];
-    int n = 0;
-    while (n < 64 && fgets(line, sizeof line, fp)) {
-        const char *at = strstr(line, "checked in ");
-        if (at && sscanf(at, "checked in %lf ms (%lf ms CPU)", &v[n], &c[n]) == 2)
-            n++;
-    }
-    fclose(fp);
-    CHECK(n > 0);
-    *cpu = median(c, n);
-    return median(v, n);
-}
-
 TEST_T(submit_check_of_a_10k_vertex_pair, 600)
 {
     testdaemon_need_worker();
@@ -86,9 +67,10 @@ TEST_T(submit_check_of_a_10k_vertex_pair, 600)
     dm.spec.inner_iterations = 1;
     testdaemon d, base;
     double with = round_trips("bench-check", NULL, &dm, &d);
-    const char *args[] = {"--worker", "/bin/true", NULL};
+    const char *args[] = {"--worker", "/bin/true", "--validator", "/bin/true", NULL};
     double without = round_trips("bench-check-true", args, &dm, &base);
-    double cpu, cpu_true, check = checked_ms(&d, &cpu), spawn = checked_ms(&base, &cpu_true);
+    double cpu, cpu_true, check = testdaemon_checked_ms(&d, &cpu),
+           spawn = testdaemon_checked_ms(&base, &cpu_true);
     printf("SUBMIT 381 -> 390 with maps (%zu + %zu Draco bytes), median of %d:\n"
            "  round trip to SUBMIT_OK: %.1f ms checked, %.1f ms with /bin/true as the check\n"
            "  added by the check: %.1f ms (round trips, ratio %.2f); the check itself %.1f ms wall,\n"

@@ -434,6 +434,32 @@ int testdaemon_log_has(const testdaemon *d, const char *what)
     return found;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double testdaemon_checked_ms(const testdaemon *d, double *cpu_ms)
+{
+    FILE *fp = fopen(d->log, "r");
+    CHECK(fp != NULL);
+    char line[8192];
+    double v[256], c[256];
+    int n = 0;
+    while (n < 256 && fgets(line, sizeof line, fp)) {
+        const char *at = strstr(line, "checked in ");
+        if (at && sscanf(at, "checked in %lf ms (%lf ms CPU)", &v[n], &c[n]) == 2)
+            n++;
+    }
+    fclose(fp);
+    CHECK(n > 0);
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    qsort(c, (size_t)n, sizeof *c, cmp_double);
+    *cpu_ms = c[n / 2];
+    return v[n / 2];
+}
+
 uint64_t testdaemon_submit_ok(mc_client *c, int iterations, int long_job, int32_t priority)
 {
     int rc;

@@ -45,6 +45,9 @@ void testdaemon_kill(testdaemon *d);
 mc_client *testdaemon_client(const testdaemon *d, const char *token);
 /* 1 when a line of the daemon's log contains what. */
 int testdaemon_log_has(const testdaemon *d, const char *what);
+/* Medians of the daemon log's "checked in X ms (Y ms CPU)" figures, one per
+ * SUBMIT check: X, and Y in *cpu_ms (fails the test when there is none). */
+double testdaemon_checked_ms(const testdaemon *d, double *cpu_ms);
 /* Pid of the meshcorr-worker the daemon runs for job id, or -1 (waits up to
  * 10 s for it to appear). */
 pid_t testdaemon_worker_pid(const testdaemon *d, uint64_t id);

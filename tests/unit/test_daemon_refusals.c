@@ -3,7 +3,8 @@
  * an ERROR naming the blob or field, and nothing is stored: a landmark id
  * past the decoded vertex count, random bytes as Draco, half a Draco file,
  * a non-manifold mesh (all four checked in the sandboxed validator), and
- * parameters out of range (the one validator). The daemon keeps serving,
+ * parameters out of range (the one validator), and any SUBMIT when the
+ * validator program is missing. The daemon keeps serving,
  * answers other clients while a check runs, runs a good job, and exits 0
  * on SIGTERM. */
 #include "support/harness.h"
@@ -191,7 +192,27 @@ TEST_T(parameters_out_of_range_are_refused_naming_the_field, 60)
     testdaemon_stop(&d, SIGTERM);
 }
 
-/* Pid of a `--validate` child of the daemon, or -1. */
+/* Without its validator program the daemon starts, says so in its log, and
+ * refuses every SUBMIT (INTERNAL, naming the program) storing nothing; it
+ * keeps serving and exits 0. */
+TEST_T(a_missing_validator_is_logged_and_every_submit_refused_naming_it, 60)
+{
+    testdaemon d;
+    const char *args[] = {"--validator", "/nonexistent/meshcorr-validate", NULL};
+    testdaemon_start(&d, "refuse-novalidator", args);
+    CHECK(testdaemon_log_has(&d, "validator program /nonexistent/meshcorr-validate is not executable"));
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    raw_submit r;
+    raw_init(&r);
+    expect_refusal(c, &r, PROTO_EINTERNAL, "cannot start /nonexistent/meshcorr-validate", NULL);
+    CHECK_INT(mc_ping(c), 0);
+    check_nothing_stored(&d);
+    raw_close(&r);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* Pid of a meshcorr-validate child of the daemon, or -1. */
 static pid_t validator_pid(const testdaemon *d)
 {
     DIR *dp = opendir("/proc");
@@ -216,9 +237,10 @@ static pid_t validator_pid(const testdaemon *d)
             continue;
         size_t n = fread(buf, 1, sizeof buf - 1, fp);
         fclose(fp);
-        for (size_t i = 0; i < n; i += strlen(buf + i) + 1)
-            if (strcmp(buf + i, "--validate") == 0)
-                found = pid;
+        buf[n] = '\0';
+        const char *base = strrchr(buf, '/');
+        if (n && strcmp(base ? base + 1 : buf, "meshcorr-validate") == 0)
+            found = pid;
     }
     if (dp)
         closedir(dp);

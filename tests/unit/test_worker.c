@@ -7,6 +7,8 @@
 #include "support/testjob.h"
 #include "support/testfile.h"
 #include "support/testmesh.h"
+#include "support/testldd.h"
+#include "support/testrun.h"
 #include "corr/corr.h"
 #include "mesh/mesh.h"
 #include "mesh/draco_bridge.h"
@@ -30,6 +32,7 @@
 extern char **environ;
 
 #define WORKER "build/meshcorr-worker"
+#define VALIDATOR "build/meshcorr-validate"
 
 static char s381[512], s390[512], p0[512], q0[512];
 
@@ -671,13 +674,13 @@ TEST_T(worker_sigterm_cancels_within_seconds_with_cancelled_error, 60)
     free(file);
 }
 
-/* `--validate` on dir/job.frame as its stdin and a pipe as its stdout (as
+/* meshcorr-validate on dir/job.frame as its stdin and a pipe as its stdout (as
  * the daemon runs it: the sandbox lets it write no file): the exit status
  * (-signal when killed), and what it wrote in *out (free()d by the caller). */
 static int validate(const char *limits, unsigned char **out, size_t *outlen)
 {
     char cmd[2048];
-    snprintf(cmd, sizeof cmd, "exec %s --validate %s < %s/job.frame", WORKER, limits ? limits : "",
+    snprintf(cmd, sizeof cmd, "exec %s %s < %s/job.frame", VALIDATOR, limits ? limits : "",
              job_dir());
     FILE *p = popen(cmd, "r");
     CHECK(p != NULL);
@@ -744,4 +747,24 @@ TEST(validate_under_a_tiny_memory_limit_does_not_accept)
         printf("  --max-memory-mb 1: status %d, %zu bytes of answer\n", st, n);
     }
     free(out);
+}
+
+/* The validator starts once per SUBMIT: it links Draco and none of the
+ * solvers' libraries (Embree, OpenCL, CHOLMOD, ARPACK, LAPACK, OpenMesh). */
+TEST(validate_links_draco_and_none_of_the_solvers_libraries)
+{
+    testldd_check_slim_and(VALIDATOR, "libgomp.so.");
+}
+
+/* One way to check a SUBMIT: the worker has no --validate mode, and the
+ * validator takes limits only (the frame is on its stdin). */
+TEST(validate_is_its_own_program_with_limits_only)
+{
+    char out[4096];
+    CHECK_INT(testrunf(out, sizeof out, "%s --validate < /dev/null 2>&1", WORKER), SPOOL_EXIT_USAGE);
+    CHECK_INT(testrunf(out, sizeof out, "%s --job-id 3 < /dev/null 2>&1", VALIDATOR), SPOOL_EXIT_USAGE);
+    CHECK_INT(testrunf(out, sizeof out, "%s extra < /dev/null 2>&1", VALIDATOR), SPOOL_EXIT_USAGE);
+    CHECK_STR_HAS(out, "meshcorr-validate: takes limits only");
+    CHECK_INT(testrunf(out, sizeof out, "%s --max-vertices 2 < /dev/null 2>&1", VALIDATOR), SPOOL_EXIT_USAGE);
+    CHECK_STR_HAS(out, "meshcorr-validate: --max-vertices: '2' is not an integer in [3, ");
 }

@@ -31,22 +31,6 @@ const char *corr_stage_name(corr_stage s)
     }
 }
 
-int corr_validate(const mesh *m, const char *name, char *err, size_t errsz)
-{
-    mesh_check_report rep;
-    char detail[512];
-    if (mesh_check_run(m, &rep, detail, sizeof detail))
-        return errbuf_set(err, errsz, CORR_ENOMEM, "%s: %s", name, detail);
-    if (mesh_check_usable(&rep))
-        return CORR_OK;
-    char lines[2048];
-    mesh_check_problems(&rep, name, lines, sizeof lines);
-    size_t n = strlen(lines);
-    if (n && lines[n - 1] == '\n')
-        lines[n - 1] = '\0';
-    return errbuf_set(err, errsz, CORR_EMESH, "%s is not usable by the optimizer:\n%s", name, lines);
-}
-
 static double now(void)
 {
     struct timespec ts;
@@ -218,26 +202,6 @@ static int from_ectm(int rc)
     case ECTM_EMESH: return CORR_EMESH;
     default: return CORR_EFAILED;
     }
-}
-
-int corr_check_sizes(const corr_input *in, char *err, size_t errsz)
-{
-    const mesh *S = in->S, *T = in->T;
-    int most = (S->nv < T->nv ? S->nv : T->nv) - 2;
-    unsigned run = corr_stages_run(in->stages, !!in->P0);
-    if ((run & CORR_RUN_DDM) && in->ddm_k > most)
-        return errbuf_set(err, errsz, CORR_EINPUT,
-                          "params.ddm_k = %d: DDM's basis holds at most vertices - 2 = %d "
-                          "eigenfunctions here (%s: %d vertices, %s: %d)",
-                          in->ddm_k, most, in->S_name, S->nv, in->T_name, T->nv);
-    const rhm_params *rp = in->rhm;
-    int fmap = rp && (rp->start == RHM_START_FMAP || rp->start == RHM_START_AUTO);
-    if ((run & CORR_RUN_RHM) && !in->P0 && fmap && rp->zoomout > most)
-        return errbuf_set(err, errsz, CORR_EINPUT,
-                          "params.zoomout = %d: a basis holds at most vertices - 2 = %d "
-                          "eigenfunctions here (%s: %d vertices, %s: %d)",
-                          rp->zoomout, most, in->S_name, S->nv, in->T_name, T->nv);
-    return CORR_OK;
 }
 
 /* RHM from the given (or denoised) maps P, Q and the repair of its maps. */

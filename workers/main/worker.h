@@ -1,7 +1,10 @@
 /* worker.h — meshcorr-worker, the process that runs one spooled job for the
- * daemon (the contract is workers/WORKER.md). Declarations shared by the
- * worker's own files (prefix wrk_); this folder is not part of the engine
- * library and nothing here is called from outside the worker program.
+ * daemon, and meshcorr-validate, the short-lived check of a SUBMIT before it
+ * is accepted (the contract of both is workers/WORKER.md). Declarations
+ * shared by their files (prefix wrk_); this folder is not part of the engine
+ * library and nothing here is called from outside these two programs.
+ * meshcorr-validate is worker_validate.c with worker_job.c and worker_cli.c
+ * only, so it loads Draco and none of the engine's solvers.
  *
  * Every function that can fail returns 0 or a negative PROTO_E* code (the
  * code that goes into error.frame) with a message naming the field in the
@@ -10,6 +13,7 @@
 #define WORKER_H
 #include <stddef.h>
 #include <stdint.h>
+#include <sys/resource.h>
 #include "proto.h"
 #include "spool.h"        /* file names and exit statuses: SPOOL_* */
 #include "corr/corr.h"
@@ -90,11 +94,27 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
                      double elapsed, wrk_result *r, char *err, size_t errsz);
 void wrk_result_close(wrk_result *r);
 
-/* worker_validate.c — `--validate`: reads one SUBMIT frame from in_fd and
+/* worker_validate.c — meshcorr-validate, the daemon's check of a SUBMIT
+ * (its main is there). wrk_validate reads one SUBMIT frame from in_fd and
  * builds the job from it as a run would (wrk_job_from_submit), running
  * nothing. SPOOL_EXIT_OK when it would run; else one ERROR frame (the code and
  * the message naming the blob or field) on out_fd and SPOOL_EXIT_JOB. */
 int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim);
+
+/* worker_cli.c — shared by both programs' mains. wrk_parse_num: the decimal
+ * s of option --opt in [lo, hi], or -1 with a message naming prog and the
+ * option. wrk_setlimit: resource limit res to v (soft and hard), or -1 with
+ * a message. wrk_error_msg: m as the ERROR message of code, its text msg cut
+ * to the wire's string limit on a UTF-8 boundary into text (m borrows it). */
+int wrk_parse_num(const char *prog, const char *opt, const char *s, unsigned long long lo,
+                  unsigned long long hi, unsigned long long *out);
+int wrk_setlimit(const char *prog, int res, const char *what, rlim_t v);
+/* The options both programs take, by getopt's letter: 'v' --max-vertices
+ * and 'f' --max-faces into lim, 'm' --max-memory-mb into *memory_mb; -1
+ * with a message when arg is out of range. */
+int wrk_limit_option(const char *prog, int opt, const char *arg, wrk_limits *lim,
+                     unsigned long long *memory_mb);
+void wrk_error_msg(proto_msg *m, int code, const char *msg, char text[PROTO_MAX_STRING + 1]);
 
 /* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with
  * fp64, one per line on stdout; 0 when printed. */

@@ -5,19 +5,18 @@
 #include "main/worker.h"
 #include "util/ompenv.h"
 
-#include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
 #include <inttypes.h>
-#include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
+
+#define PROG "meshcorr-worker"
 
 static volatile sig_atomic_t cancel_requested;
 
@@ -41,27 +40,9 @@ static void usage(void)
         "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
         "       meshcorr-worker --list-devices [--threads N]\n"
-        "       meshcorr-worker --validate [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
-        "                       [--max-cpu-s N]   (a SUBMIT frame on stdin; refusal: ERROR on stdout)\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage; 4: neither could be written.\n"
         "See workers/WORKER.md.\n");
-}
-
-/* Decimal in [lo, hi]; -1 (with a message) otherwise. */
-static int parse_num(const char *opt, const char *s, unsigned long long lo, unsigned long long hi,
-                     unsigned long long *out)
-{
-    char *e;
-    errno = 0;
-    unsigned long long v = strtoull(s, &e, 10);
-    if (*s < '0' || *s > '9' || *e || errno || v < lo || v > hi) {
-        fprintf(stderr, "meshcorr-worker: --%s: '%s' is not an integer in [%llu, %llu]\n", opt, s,
-                lo, hi);
-        return -1;
-    }
-    *out = v;
-    return 0;
 }
 
 typedef struct run_ctx {
@@ -96,20 +77,8 @@ static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
 {
     fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": %s: %s\n", job_id, proto_err_name(code), msg);
     proto_msg m;
-    memset(&m, 0, sizeof m);
-    m.type = PROTO_MSG_ERROR;
-    m.u.error.code = code;
     char text[PROTO_MAX_STRING + 1];
-    /* the wire string limit, cut on a UTF-8 character boundary */
-    size_t n = strlen(msg);
-    if (n > PROTO_MAX_STRING) {
-        n = PROTO_MAX_STRING;
-        while (n && ((unsigned char)msg[n] & 0xC0) == 0x80)
-            n--;
-    }
-    memcpy(text, msg, n);
-    text[n] = '\0';
-    m.u.error.message = text;
+    wrk_error_msg(&m, code, msg, text);
     char err[1024];
     int cancelled = code == PROTO_ECANCELLED;
     if (wrk_frame_write(dir, SPOOL_ERROR_FRAME, &m, err, sizeof err)) {
@@ -120,24 +89,9 @@ static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
     return cancelled ? SPOOL_EXIT_CANCELLED : SPOOL_EXIT_JOB;
 }
 
-/* Sets resource limit res to v (soft and hard); -1 with a message. */
-static int limit(int res, const char *what, rlim_t v)
-{
-    struct rlimit rl = { v, v };
-    if (setrlimit(res, &rl) == 0)
-        return 0;
-    fprintf(stderr, "meshcorr-worker: %s: setrlimit: %s\n", what, strerror(errno));
-    return -1;
-}
-
 int main(int argc, char **argv)
 {
-    int validate = 0;
-    for (int i = 1; i < argc; i++)
-        validate |= strcmp(argv[i], "--validate") == 0;
-    /* a validation runs no OpenMP region: it starts at once, no re-exec */
-    if (!validate)
-        ompenv_ensure_passive(argv);
+    ompenv_ensure_passive(argv);
     double t0 = now();
     static const struct option opts[] = {
         {"job", required_argument, 0, 'j'},          {"job-id", required_argument, 0, 'i'},
@@ -145,13 +99,12 @@ int main(int argc, char **argv)
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"list-devices", no_argument, 0, 'L'},
-        {"validate", no_argument, 0, 'V'},           {"max-cpu-s", required_argument, 0, 'C'},
         {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
     uint64_t job_id = 0;
     int have_id = 0, progress_fd = -1, bad = 0, list_devices = 0;
-    unsigned long long max_memory_mb = 0, max_cpu_s = 0;
+    unsigned long long max_memory_mb = 0;
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
     unsigned long long v;
     int c;
@@ -159,61 +112,31 @@ int main(int argc, char **argv)
         switch (c) {
         case 'j': dir = optarg; break;
         case 'i':
-            if (!(bad |= parse_num("job-id", optarg, 1, UINT64_MAX, &v) != 0)) {
+            if (!(bad |= wrk_parse_num(PROG, "job-id", optarg, 1, UINT64_MAX, &v) != 0)) {
                 job_id = v;
                 have_id = 1;
             }
             break;
         case 'p':
-            if (!(bad |= parse_num("progress-fd", optarg, 0, 1 << 20, &v) != 0))
+            if (!(bad |= wrk_parse_num(PROG, "progress-fd", optarg, 0, 1 << 20, &v) != 0))
                 progress_fd = (int)v;
             break;
         case 't':
-            if (!(bad |= parse_num("threads", optarg, 0, 1024, &v) != 0))
+            if (!(bad |= wrk_parse_num(PROG, "threads", optarg, 0, 1024, &v) != 0))
                 lim.threads = (int)v;
             break;
-        case 'v':
-            if (!(bad |= parse_num("max-vertices", optarg, 3, MESH_MAX_VERTICES, &v) != 0))
-                lim.max_vertices = (int)v;
-            break;
-        case 'f':
-            if (!(bad |= parse_num("max-faces", optarg, 1, MESH_MAX_FACES, &v) != 0))
-                lim.max_faces = (int)v;
+        case 'v': case 'f': case 'm':
+            bad |= wrk_limit_option(PROG, c, optarg, &lim, &max_memory_mb) != 0;
             break;
         case 'c': progress_tcp = optarg; break;
         case 's': secret_file = optarg; break;
-        case 'm':
-            bad |= parse_num("max-memory-mb", optarg, 1, 1ull << 24, &max_memory_mb) != 0;
-            break;
         case 'L': list_devices = 1; break;
-        case 'V': break;                       /* seen above */
-        case 'C': bad |= parse_num("max-cpu-s", optarg, 1, 1ull << 20, &max_cpu_s) != 0; break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
         default: bad = 1;
         }
     }
     if (!bad && list_devices)
         return wrk_list_devices(lim.threads) ? SPOOL_EXIT_USAGE : 0;
-    if (!bad && validate) {
-        if (dir || have_id || progress_fd >= 0 || progress_tcp || optind != argc) {
-            fprintf(stderr, "meshcorr-worker: --validate takes limits only (the frame is on stdin)\n");
-            usage();
-            return SPOOL_EXIT_USAGE;
-        }
-        /* the sandbox: bounded memory and CPU time, no files written, no
-         * core dumped, few descriptors; set before any input is read */
-        signal(SIGPIPE, SIG_IGN);
-        /* the two meshes' buffers come and go: keep freed memory for reuse
-         * instead of an mmap and its page faults per large buffer */
-        mallopt(M_MMAP_THRESHOLD, 64 << 20);
-        mallopt(M_TRIM_THRESHOLD, 256 << 20);
-        if ((max_memory_mb && limit(RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20)) ||
-            (max_cpu_s && limit(RLIMIT_CPU, "--max-cpu-s", (rlim_t)max_cpu_s)) ||
-            limit(RLIMIT_FSIZE, "file size", 0) || limit(RLIMIT_CORE, "core size", 0) ||
-            limit(RLIMIT_NOFILE, "descriptors", 16))
-            return SPOOL_EXIT_USAGE;
-        return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim);
-    }
     if (!bad && (!dir || !have_id || optind != argc)) {
         fprintf(stderr, "meshcorr-worker: --job and --job-id are required, nothing else\n");
         bad = 1;
@@ -232,7 +155,7 @@ int main(int argc, char **argv)
         bad = 1;
     }
     /* allocations past the limit fail (NOMEM) instead of waking the OOM killer */
-    if (!bad && max_memory_mb && limit(RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20))
+    if (!bad && max_memory_mb && wrk_setlimit(PROG, RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20))
         bad = 1;
     if (bad) {
         usage();

@@ -1,20 +1,27 @@
-/* worker_validate.c — `meshcorr-worker --validate`: the daemon's check of a
- * SUBMIT before it answers SUBMIT_OK (PROTOCOL.md, SUBMIT). Reads one SUBMIT
- * frame from a descriptor, builds the job exactly as a run would
+/* worker_validate.c — meshcorr-validate, the daemon's check of a SUBMIT
+ * before it answers SUBMIT_OK (PROTOCOL.md, SUBMIT). Reads one SUBMIT frame
+ * from its stdin, builds the job exactly as a run would
  * (wrk_job_from_submit: the parameters by the one validator, both meshes
  * decoded by Draco and checked by corr_validate, the landmarks against the
  * decoded vertex counts, the maps' rows) and runs nothing. The daemon starts
  * it as a short-lived process under memory and CPU-time limits, so that
  * Draco (which throws and aborts on malformed input) never runs inside the
- * daemon. */
+ * daemon. A program of its own, not a mode of meshcorr-worker: it links
+ * worker_job.c and the engine's checks only (Draco, no solver libraries),
+ * so it loads in about half the time, once per SUBMIT. */
 #include "main/worker.h"
 #include "util/errbuf.h"
 
 #include <errno.h>
+#include <getopt.h>
+#include <malloc.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+
+#define PROG "meshcorr-validate"
 
 /* Reads exactly n bytes; 0, or -1 at EOF or on error. */
 static int read_all(int fd, void *buf, size_t n)
@@ -34,19 +41,8 @@ static int read_all(int fd, void *buf, size_t n)
 static int write_error(int fd, int code, const char *msg)
 {
     proto_msg m;
-    memset(&m, 0, sizeof m);
-    m.type = PROTO_MSG_ERROR;
-    m.u.error.code = code;
     char text[PROTO_MAX_STRING + 1];
-    size_t n = strlen(msg);
-    if (n > PROTO_MAX_STRING) {              /* cut on a UTF-8 character boundary */
-        n = PROTO_MAX_STRING;
-        while (n && ((unsigned char)msg[n] & 0xC0) == 0x80)
-            n--;
-    }
-    memcpy(text, msg, n);
-    text[n] = '\0';
-    m.u.error.message = text;
+    wrk_error_msg(&m, code, msg, text);
     proto_buf b;
     proto_buf_init(&b);
     int rc = proto_msg_encode(&b, &m, NULL, 0);
@@ -106,7 +102,56 @@ done:
     if (rc == 0)
         return SPOOL_EXIT_OK;
     if (write_error(out_fd, rc, err))
-        fprintf(stderr, "meshcorr-worker --validate: %s: %s (and the answer could not be written)\n",
+        fprintf(stderr, PROG ": %s: %s (and the answer could not be written)\n",
                 proto_err_name(rc), err);
     return SPOOL_EXIT_JOB;
+}
+
+static void usage(void)
+{
+    fprintf(stderr,
+        "usage: " PROG " [--max-vertices N] [--max-faces N] [--max-memory-mb N] [--max-cpu-s N]\n"
+        "Reads one SUBMIT frame on stdin and checks it as a run would, running nothing:\n"
+        "exit 0 when the job would run; else one ERROR frame on stdout and exit 1.\n"
+        "Exit 2: bad usage. See workers/WORKER.md.\n");
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
+        {"max-memory-mb", required_argument, 0, 'm'}, {"max-cpu-s", required_argument, 0, 'C'},
+        {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
+    wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
+    unsigned long long max_memory_mb = 0, max_cpu_s = 0;
+    int c, bad = 0;
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'v': case 'f': case 'm':
+            bad |= wrk_limit_option(PROG, c, optarg, &lim, &max_memory_mb) != 0;
+            break;
+        case 'C': bad |= wrk_parse_num(PROG, "max-cpu-s", optarg, 1, 1ull << 20, &max_cpu_s) != 0; break;
+        case 'h': usage(); return SPOOL_EXIT_USAGE;
+        default: bad = 1;
+        }
+    }
+    if (bad || optind != argc) {
+        if (!bad)
+            fprintf(stderr, PROG ": takes limits only (the frame is on stdin)\n");
+        usage();
+        return SPOOL_EXIT_USAGE;
+    }
+    /* the sandbox: bounded memory and CPU time, no files written, no core
+     * dumped, few descriptors; set before any input is read */
+    signal(SIGPIPE, SIG_IGN);
+    /* the two meshes' buffers come and go: keep freed memory for reuse
+     * instead of an mmap and its page faults per large buffer */
+    mallopt(M_MMAP_THRESHOLD, 64 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+    if ((max_memory_mb && wrk_setlimit(PROG, RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20)) ||
+        (max_cpu_s && wrk_setlimit(PROG, RLIMIT_CPU, "--max-cpu-s", (rlim_t)max_cpu_s)) ||
+        wrk_setlimit(PROG, RLIMIT_FSIZE, "file size", 0) || wrk_setlimit(PROG, RLIMIT_CORE, "core size", 0) ||
+        wrk_setlimit(PROG, RLIMIT_NOFILE, "descriptors", 16))
+        return SPOOL_EXIT_USAGE;
+    return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim);
 }

@@ -1,0 +1,68 @@
+/* worker_cli.c — what the two programs of this folder (meshcorr-worker and
+ * meshcorr-validate) share around their main: their options' numbers, their
+ * resource limits, and the ERROR message each writes for a refused job. */
+#include "main/worker.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int wrk_parse_num(const char *prog, const char *opt, const char *s, unsigned long long lo,
+                  unsigned long long hi, unsigned long long *out)
+{
+    char *e;
+    errno = 0;
+    unsigned long long v = strtoull(s, &e, 10);
+    if (*s < '0' || *s > '9' || *e || errno || v < lo || v > hi) {
+        fprintf(stderr, "%s: --%s: '%s' is not an integer in [%llu, %llu]\n", prog, opt, s, lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int wrk_setlimit(const char *prog, int res, const char *what, rlim_t v)
+{
+    struct rlimit rl = { v, v };
+    if (setrlimit(res, &rl) == 0)
+        return 0;
+    fprintf(stderr, "%s: %s: setrlimit: %s\n", prog, what, strerror(errno));
+    return -1;
+}
+
+int wrk_limit_option(const char *prog, int opt, const char *arg, wrk_limits *lim,
+                     unsigned long long *memory_mb)
+{
+    unsigned long long v;
+    switch (opt) {
+    case 'v':
+        if (wrk_parse_num(prog, "max-vertices", arg, 3, MESH_MAX_VERTICES, &v))
+            return -1;
+        lim->max_vertices = (int)v;
+        return 0;
+    case 'f':
+        if (wrk_parse_num(prog, "max-faces", arg, 1, MESH_MAX_FACES, &v))
+            return -1;
+        lim->max_faces = (int)v;
+        return 0;
+    default:
+        return wrk_parse_num(prog, "max-memory-mb", arg, 1, 1ull << 24, memory_mb);
+    }
+}
+
+void wrk_error_msg(proto_msg *m, int code, const char *msg, char text[PROTO_MAX_STRING + 1])
+{
+    memset(m, 0, sizeof *m);
+    m->type = PROTO_MSG_ERROR;
+    m->u.error.code = code;
+    size_t n = strlen(msg);
+    if (n > PROTO_MAX_STRING) {              /* cut on a UTF-8 character boundary */
+        n = PROTO_MAX_STRING;
+        while (n && ((unsigned char)msg[n] & 0xC0) == 0x80)
+            n--;
+    }
+    memcpy(text, msg, n);
+    text[n] = '\0';
+    m->u.error.message = text;
+}
