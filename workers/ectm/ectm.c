@@ -379,7 +379,15 @@ static int side_pins(side *a, const side *b, const int *rows, const int *vtx, in
     return ECTM_OK;
 }
 
-/* Sets a's pinned rows of P onto their vertices of b's mesh. */
+/* Sets a's pinned rows of P onto their vertices of b's mesh. Always: a
+ * softer pin was measured and not kept (bench_shrec07, 12 pairs): skipping
+ * a pin in a P-step where it would fold more of the row's faces than the
+ * projection does (image normal against the other mesh's normal at the
+ * pinned vertex) left fourleg at 0.0384 (pinned always 0.0420, unpinned
+ * 0.0385) but pinned only 1 of its 11 landmarks at the end, flipped more
+ * (fourleg 0.27 %, human 0.19 %; always 0.12 %, 0.01 %), and lost what
+ * the pins gain elsewhere (teddy 0.0449, human 0.0319, armadillo 0.0404;
+ * always 0.0430, 0.0305, 0.0398); the same 8 pairs met their targets. */
 static void apply_pins(side *a, const side *b)
 {
     const int *bf = b->X->f;
