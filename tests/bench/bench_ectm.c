@@ -62,7 +62,7 @@ static double run(const testdemo *d, int iterations, int threads, ectm_report *l
     ectm_result r;
     char err[512];
     memset(t, 0, sizeof *t);
-    if (ectm_run(d->S, d->T, d->P0, d->Q0, &p, count, t, &r, err, sizeof err))
+    if (ectm_run(d->S, d->T, d->P0, d->Q0, NULL, &p, count, t, &r, err, sizeof err))
         FAILF("%s", err);
     *last = r.last;
     *uv = testdemo_uv_distance(d, r.P);

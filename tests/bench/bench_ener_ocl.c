@@ -146,7 +146,7 @@ TEST_T(ectm_381_390_full_run_same_map_on_both_backends, 7200)
         strcpy(p.backend, b ? "opencl" : "cpu");
         print_load(p.backend);
         double t0 = now();
-        if (ectm_run(S, T, P0, Q0, &p, on_iter, &l[b], &r[b], err, sizeof err))
+        if (ectm_run(S, T, P0, Q0, NULL, &p, on_iter, &l[b], &r[b], err, sizeof err))
             FAILF("%s: %s", p.backend, err);
         secs[b] = now() - t0;
     }

@@ -269,7 +269,8 @@ static void run_pair(const void *arg, void *out)
     printf("  %s: rhm %d iterations, %.0f s\n", ps->label, w.rhm.iteration, fig->secs[RHM]);
     fflush(stdout);
 
-    corr_input in2 = { g.S, g.T, S_name, T_name, NULL, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
+    /* with the landmarks, which ECTM's P/Q-steps pin, as in stages all */
+    corr_input in2 = { g.S, g.T, S_name, T_name, L, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
     in.stages = CORR_STAGES_ALL;
     t0 = now();
     /* coarse to fine: the ECTM after the carried RHM maps is not the

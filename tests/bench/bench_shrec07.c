@@ -11,8 +11,9 @@
  * start auto's second run from the functional map when the repaired maps
  * stay folded; the line after it names the start kept; the rhm row is
  * the kept map before its repair, the time of both in that row), ECTM
- * from the repaired maps (corr_run with stages ectm) and the repair of
- * its maps: the calls corr_run makes for stages all. A pair with a mesh
+ * from the repaired maps (corr_run with stages ectm and the given
+ * landmarks, which its P/Q-steps pin) and the repair of its maps: the
+ * calls corr_run makes for stages all. A pair with a mesh
  * over twice the coarse size (job parameter coarse, 6000) vertices runs
  * these on its decimated copies
  * (corr_coarse_open), each stage's map carried to the input meshes to be
@@ -257,7 +258,9 @@ static void run_pair(const void *arg, void *out)
     if (job->last == REPAIR)
         goto score;
 
-    corr_input in2 = { ri->S, ri->T, S_name, T_name, NULL, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0,
+    /* the given landmarks (of the pair the stages run on), as corr_run's
+     * ECTM gets them in a job from landmarks: pinned in its P/Q-steps */
+    corr_input in2 = { ri->S, ri->T, S_name, T_name, ri->L, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0,
                        CORR_DDM_PLAIN };
     t0 = now();
     if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
@@ -272,7 +275,7 @@ static void run_pair(const void *arg, void *out)
         ectm_result fr = {0};
         if (corr_coarse_carry(&in0, &cc, er.P, er.Q, 1, &cP, &cQ, err, sizeof err))
             FAILF("%s", err);
-        corr_input in3 = { S, T, S_name, T_name, NULL, cP, cQ, &rp, CORR_STAGES_ECTM, 0,
+        corr_input in3 = { S, T, S_name, T_name, L, cP, cQ, &rp, CORR_STAGES_ECTM, 0,
                            CORR_DDM_PLAIN };
         if (corr_run(&in3, &ep, on_progress, NULL, &fr, err, sizeof err))
             FAILF("%s", err);

@@ -76,7 +76,7 @@ TEST(map_sized_for_other_meshes_is_refused)
     ectm_params_init(&p);
     ectm_result r;
     char err[256];
-    CHECK_INT(ectm_run(d.T, d.S, d.P0, NULL, &p, NULL, NULL, &r, err, sizeof err), ECTM_EMAP);
+    CHECK_INT(ectm_run(d.T, d.S, d.P0, NULL, NULL, &p, NULL, NULL, &r, err, sizeof err), ECTM_EMAP);
     CHECK_STR_HAS(err, "6938 -> 9239");
     testdemo_free(&d);
 }
@@ -92,7 +92,7 @@ TEST_T(energy_never_increases_at_fixed_beta, 300)
     trace t = {0};
     ectm_result r;
     char err[256];
-    if (ectm_run(d.S, d.T, d.P0, d.Q0, &p, record, &t, &r, err, sizeof err))
+    if (ectm_run(d.S, d.T, d.P0, d.Q0, NULL, &p, record, &t, &r, err, sizeof err))
         FAILF("%s", err);
     CHECK_INT(t.n, 6);
     for (int k = 1; k < t.n; k++) {
@@ -115,7 +115,7 @@ TEST_T(progress_callback_cancels_run, 300)
     t.cancel_at = 2;
     ectm_result r;
     char err[256];
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &p, record, &t, &r, err, sizeof err), ECTM_ECANCELED);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, NULL, &p, record, &t, &r, err, sizeof err), ECTM_ECANCELED);
     CHECK_INT(t.n, 2);
     CHECK(r.P == NULL);
     CHECK_STR_HAS(err, "cancelled");
@@ -133,7 +133,7 @@ TEST_T(injective_model_runs_and_improves_area_distortion, 300)
     trace t = {0};
     ectm_result r;
     char err[256];
-    if (ectm_run(d.S, d.T, d.P0, NULL, &p, record, &t, &r, err, sizeof err))
+    if (ectm_run(d.S, d.T, d.P0, NULL, NULL, &p, record, &t, &r, err, sizeof err))
         FAILF("%s", err);
     CHECK(r.Q == NULL && r.Yt == NULL);
     metric_summary m0, m1;
@@ -154,7 +154,7 @@ TEST_T(missing_reverse_map_is_built_by_nearest_neighbour, 300)
     p.iterations = 2;
     ectm_result r;
     char err[256];
-    if (ectm_run(d.S, d.T, d.P0, NULL, &p, NULL, NULL, &r, err, sizeof err))
+    if (ectm_run(d.S, d.T, d.P0, NULL, NULL, &p, NULL, NULL, &r, err, sizeof err))
         FAILF("%s", err);
     CHECK(r.Q != NULL);
     CHECK_INT(r.Q->n, d.T->nv);
@@ -176,7 +176,7 @@ TEST_T(partial_matching_keeps_scale_and_runs, 300)
     p.iterations = 2;
     ectm_result r;
     char err[256];
-    if (ectm_run(d.S, d.T, d.P0, d.Q0, &p, NULL, NULL, &r, err, sizeof err))
+    if (ectm_run(d.S, d.T, d.P0, d.Q0, NULL, &p, NULL, NULL, &r, err, sizeof err))
         FAILF("%s", err);
     CHECK(r.P && r.Q);
     CHECK(isfinite(r.last.energy));
@@ -195,7 +195,7 @@ TEST_T(demo_381_390_matches_authors_result, 1800)
     trace t = {0};
     ectm_result r;
     char err[256];
-    if (ectm_run(d.S, d.T, d.P0, d.Q0, &p, record, &t, &r, err, sizeof err))
+    if (ectm_run(d.S, d.T, d.P0, d.Q0, NULL, &p, record, &t, &r, err, sizeof err))
         FAILF("%s", err);
     double uv0 = testdemo_uv_distance(&d, d.P0), uv1 = testdemo_uv_distance(&d, r.P);
     metric_summary m0, m1;

@@ -248,7 +248,7 @@ TEST_T(ectm_five_iterations_give_same_maps_on_opencl_and_cpu, 300)
         p.iterations = 5;
         p.threads = 2;
         strcpy(p.backend, b ? "opencl" : "cpu");
-        if (ectm_run(S, T, P0, Q0, &p, record, &log[b], &r[b], err, sizeof err))
+        if (ectm_run(S, T, P0, Q0, NULL, &p, record, &log[b], &r[b], err, sizeof err))
             FAILF("%s backend: %s", p.backend, err);
     }
     CHECK_INT(log[0].n, 5);

@@ -70,7 +70,7 @@ static void faust_pipeline(int start, double ge[3], metric_summary ms[3])
     ectm_params_init(&ep);
     ep.iterations = 30;
     ectm_result er = {0};
-    if (ectm_run(g.S, g.T, res.P12, res.P21, &ep, NULL, NULL, &er, err, sizeof err))
+    if (ectm_run(g.S, g.T, res.P12, res.P21, NULL, &ep, NULL, NULL, &er, err, sizeof err))
         FAILF("%s", err);
     const bmap *maps[3] = { pb->side[0].P, res.P12, er.P };
     double *e = malloc(sizeof(double) * 3 * g.n);

@@ -316,7 +316,10 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         P = init.P12;
         Q = bij ? init.P21 : NULL;
     }
-    rc = from_ectm(ectm_run(in->S, in->T, P, Q, p, relay_ectm, &rl, out, err, errsz));
+    /* the job's landmarks, pinned in ECTM's P- and Q-steps (issue 12) */
+    ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
+                          in->L ? in->L->n : 0 };
+    rc = from_ectm(ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, &rl, out, err, errsz));
     if (rc == CORR_OK && !in->P0) {
         /* ECTM's projection folds where its deformed surface passes a thin
          * part at an angle: the same repair, on the maps it returns, in

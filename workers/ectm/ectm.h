@@ -111,12 +111,27 @@ typedef struct ectm_result {
 } ectm_result;
 void ectm_result_close(ectm_result *r);
 
+/* Landmark pairs (source vertex src[k] <-> target vertex tgt[k], 0-based,
+ * k < n) that the P- and Q-steps pin: after each projection, the row of
+ * src[k] in P is set to the target vertex tgt[k] itself (a face of the
+ * target at that vertex, weights 1 at its corner, 0 at the others) and,
+ * bijective, the row of tgt[k] in Q to src[k]. A target vertex given twice
+ * pins Q to the first pair's source vertex. The caller keeps the arrays. */
+typedef struct ectm_landmarks {
+    const int *src;   /* n source vertices, each in [0, S->nv), no repeat */
+    const int *tgt;   /* n target vertices, each in [0, T->nv)           */
+    int n;            /* number of pairs, >= 0                            */
+} ectm_landmarks;
+
 /* Runs the optimisation. P0 is required; Q0 may be NULL (bijective: then it
  * is built by nearest neighbour — each target vertex goes to the closest
- * point of the source's image P0·X̃). The meshes must be manifold with no
- * degenerate faces (validate with mesh_check first). */
+ * point of the source's image P0·X̃). L: the landmarks to pin, or NULL (as
+ * L->n = 0: none); a bad one is refused with ECTM_EPARAM before anything
+ * runs, the pair and field named in err ("landmarks.src[3] = 9999 out of
+ * range [0, 6938)"). The meshes must be manifold with no degenerate faces
+ * (validate with mesh_check first). */
 int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
-             const ectm_params *p, ectm_progress_fn progress, void *ctx,
-             ectm_result *out, char *err, size_t errsz);
+             const ectm_landmarks *L, const ectm_params *p, ectm_progress_fn progress,
+             void *ctx, ectm_result *out, char *err, size_t errsz);
 
 #endif
