@@ -4,7 +4,9 @@
 #include "support/harness.h"
 #include "util/ompenv.h"
 
+#include <ftw.h>
 #include <signal.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -76,15 +78,23 @@ int harness_list_has(const char *list, const char *item)
     return 0;
 }
 
+static char tmp_dir[256];
+
 const char *harness_tmpdir(void)
 {
-    static char dir[256];
-    if (!dir[0]) {
-        snprintf(dir, sizeof dir, "/tmp/meshcorr-test-XXXXXX");
-        if (!mkdtemp(dir))
+    if (!tmp_dir[0]) {
+        snprintf(tmp_dir, sizeof tmp_dir, "/tmp/meshcorr-test-XXXXXX");
+        if (!mkdtemp(tmp_dir))
             FAILF("mkdtemp failed");
     }
-    return dir;
+    return tmp_dir;
+}
+
+static int remove_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
+{
+    (void)sb, (void)flag, (void)ftw;
+    remove(path);
+    return 0;
 }
 
 static int run_one(const char *prog, int i)
@@ -101,6 +111,9 @@ static int run_one(const char *prog, int i)
         alarm((unsigned)tests[i].timeout);
         tests[i].fn();
         fflush(stdout);
+        /* a passing test's files go with it; a failing one's stay to be read */
+        if (tmp_dir[0])
+            nftw(tmp_dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
         _exit(0);
     }
     setpgid(pid, pid);               /* the test's own process group (either side may win) */

@@ -52,7 +52,8 @@ const char *harness_option(const char *name);
 /* 1 when list (an option's value, "a,b,c") is NULL or names item among
  * its comma-separated entries; else 0 (benchmarks' --pairs). */
 int harness_list_has(const char *list, const char *item);
-/* A fresh temporary directory for this test (removed by nobody: /tmp). */
+/* A fresh temporary directory for this test under /tmp, removed when the test
+ * passes (a failing test's stays, to be looked at). */
 const char *harness_tmpdir(void);
 
 #endif
