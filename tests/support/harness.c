@@ -83,6 +83,7 @@ static char tmp_dir[256];
 const char *harness_tmpdir(void)
 {
     if (!tmp_dir[0]) {
+        /* mkdtemp replaces the six X with a unique suffix */
         snprintf(tmp_dir, sizeof tmp_dir, "/tmp/meshcorr-test-XXXXXX");
         if (!mkdtemp(tmp_dir))
             FAILF("mkdtemp failed");

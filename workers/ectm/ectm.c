@@ -57,10 +57,10 @@ typedef struct side {
     double mem_beta;
     double *mass3;
     /* Pinned rows (the given landmarks): row pin_row[k] of P goes to the
-     * other mesh's vertex pin_vtx[k], on pin_face[k] (a face of the other
-     * mesh at that vertex) unless the projection's face has it too. */
+     * other mesh's vertex pin_vtx[k], on the projection's face when it has
+     * that vertex, else on the lowest-numbered face there (its E). */
     int npin;
-    int *pin_row, *pin_vtx, *pin_face;
+    int *pin_row, *pin_vtx;
 } side;
 
 static void side_close(side *s)
@@ -84,7 +84,6 @@ static void side_close(side *s)
     free(s->mass3);
     free(s->pin_row);
     free(s->pin_vtx);
-    free(s->pin_face);
 }
 
 static double now(void)
@@ -270,13 +269,20 @@ static int check_landmarks(const ectm_landmarks *L, const mesh *S, const mesh *T
                               "landmarks.tgt[%d] = %d out of range [0, %d) (target vertices)", k,
                               L->tgt[k], T->nv);
     }
-    for (int k = 1; k < L->n; k++)     /* at most PROTO_MAX_LANDMARKS pairs: quadratic is fine */
-        for (int j = 0; j < k; j++)
-            if (L->src[j] == L->src[k])
-                return errbuf_set(err, errsz, ECTM_EPARAM,
-                                  "landmarks.src[%d] = %d repeats landmarks.src[%d]", k,
-                                  L->src[k], j);
-    return ECTM_OK;
+    int *first = malloc(sizeof(int) * (size_t)S->nv);   /* each source vertex's first pair */
+    if (!first)
+        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory checking the landmarks");
+    for (int v = 0; v < S->nv; v++)
+        first[v] = -1;
+    int rc = ECTM_OK;
+    for (int k = 0; k < L->n && !rc; k++) {
+        if (first[L->src[k]] >= 0)
+            rc = errbuf_set(err, errsz, ECTM_EPARAM, "landmarks.src[%d] = %d repeats landmarks.src[%d]",
+                            k, L->src[k], first[L->src[k]]);
+        first[L->src[k]] = k;
+    }
+    free(first);
+    return rc;
 }
 
 /* a's pinned rows: row rows[k] to the vertex vtx[k] of b's mesh, k < n; a row
@@ -285,31 +291,21 @@ static int side_pins(side *a, const side *b, const int *rows, const int *vtx, in
 {
     if (n <= 0)
         return ECTM_OK;
-    const mesh *o = b->X;
     a->pin_row = malloc(sizeof(int) * (size_t)n);
     a->pin_vtx = malloc(sizeof(int) * (size_t)n);
-    a->pin_face = malloc(sizeof(int) * (size_t)n);
-    int *face_at = malloc(sizeof(int) * ((size_t)o->nv + 1));   /* a face at each vertex */
-    int *taken = calloc((size_t)a->X->nv + 1, sizeof(int));
-    if (!a->pin_row || !a->pin_vtx || !a->pin_face || !face_at || !taken) {
-        free(face_at);
+    char *taken = calloc((size_t)a->X->nv, 1);
+    if (!a->pin_row || !a->pin_vtx || !taken) {
         free(taken);
         return ECTM_ENOMEM;
     }
-    for (int v = 0; v < o->nv; v++)
-        face_at[v] = -1;
-    for (int t = o->nf - 1; t >= 0; t--)   /* the lowest face index at each vertex */
-        for (int c = 0; c < 3; c++)
-            face_at[o->f[3 * t + c]] = t;
+    const int *vf = b->E.vf_start;
     for (int k = 0; k < n; k++) {
-        if (taken[rows[k]] || face_at[vtx[k]] < 0)   /* an isolated vertex: nothing to pin to */
+        if (taken[rows[k]] || vf[vtx[k]] == vf[vtx[k] + 1])   /* no face there: nothing to pin to */
             continue;
         taken[rows[k]] = 1;
         a->pin_row[a->npin] = rows[k];
-        a->pin_vtx[a->npin] = vtx[k];
-        a->pin_face[a->npin++] = face_at[vtx[k]];
+        a->pin_vtx[a->npin++] = vtx[k];
     }
-    free(face_at);
     free(taken);
     return ECTM_OK;
 }
@@ -329,7 +325,7 @@ static void apply_pins(side *a, const side *b)
     for (int k = 0; k < a->npin; k++) {
         int i = a->pin_row[k], v = a->pin_vtx[k], f = a->P->face[i];
         if (bf[3 * f] != v && bf[3 * f + 1] != v && bf[3 * f + 2] != v)
-            f = a->pin_face[k];
+            f = b->E.vf_face[b->E.vf_start[v]];     /* the lowest-numbered face at v */
         a->P->face[i] = f;
         for (int c = 0; c < 3; c++)
             a->P->w[3 * i + c] = bf[3 * f + c] == v ? 1.0 : 0.0;
