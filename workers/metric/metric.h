@@ -61,9 +61,18 @@ void metric_verdict_text(int verdict, double flipped_fraction, double collapsed_
  * out of memory (out is then NaN-filled). */
 int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary *out);
 
-/* The mean-curvature error ‖P·H̃ − H‖_X with H, H̃ the mean curvatures
- * (geo_curvature.h) of S and T after scaling each to unit area, and the
- * norm weighted by S's unit-area lumped mass: √(Σ_i m_i (PH̃ − H)_i²). */
+/* The mean-curvature error ‖P·H̃ − H‖_X with H, H̃ the mean curvatures of
+ * S and T after scaling each to unit area, and the norm weighted by S's
+ * unit-area lumped mass: √(Σ_i m_i (PH̃ − H)_i²). The curvatures are the
+ * neighbourhood fit of geo_curvature.h (the paper's estimator, [KSNS07])
+ * with one radius for both meshes: METRIC_CURVATURE_EDGES mean edge
+ * lengths of the coarser one (at unit area), so two triangulations of one
+ * shape compare at the same scale (test_geo_curvature: on a jittered
+ * sphere the fit within 3 edges is 2.7 % off at worst, within 2 edges 9 %,
+ * the cotan formula 22 %). (The cotan formula's per-vertex noise
+ * on irregular meshes, uncorrelated between S and T, used to dominate this
+ * figure: an exact map scored nearly what a rough one did.) */
+#define METRIC_CURVATURE_EDGES 3.0
 int metric_curvature_error(const mesh *S, const mesh *T, const bmap *P, double *out);
 
 /* Coverage of the target by the map P: the fraction of T's area (lumped
