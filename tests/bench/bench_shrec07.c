@@ -40,7 +40,10 @@
  * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
  * the default, for comparing), --start=NAME (a start map of
  * proto_params.h's start list instead of the default),
- * --rhm-landmark-weight=G (RHM's weak landmark term, default off). Last,
+ * --rhm-landmark-weight=G (RHM's weak landmark term, default off),
+ * --per-landmark=1 (after each SHREC'07 pair's rows, each held-out
+ * landmark's error per stage, by its 0-based line in the .vts: which part
+ * of a pair a mean comes from). Last,
  * the job time (start + RHM and repair + ECTM and repair) per pair, its
  * median, and the exponent of a least-squares fit of log time against
  * log(source + target vertices) per stage, over the pairs run: issue 16's
@@ -75,10 +78,13 @@ static const pair_spec pairs[] = {
 enum { START, RHM, REPAIR, ECTM, NSTAGES };
 static const char *const stage_name[NSTAGES] = { "start", "rhm", "repair", "ectm" };
 
+#define HELD_SHOWN 32   /* held-out landmarks --per-landmark prints (SHREC'07: at most 18) */
+
 typedef struct pair_fig {
     int nS, nT, given, held;
     int nmaps;
     double err[NSTAGES], curv[NSTAGES], secs[NSTAGES];
+    double lerr[NSTAGES][HELD_SHOWN];  /* --per-landmark: the first HELD_SHOWN held out */
     metric_summary ms[NSTAGES];
     char why[1024];          /* non-empty: the run stopped there */
 } pair_fig;
@@ -313,6 +319,8 @@ score:
         for (int k = 0; k < hs_n; k++)
             s += e[(size_t)a * hs_n + k];
         fig->err[a] = s / hs_n;
+        for (int k = 0; ps->a && k < hs_n && k < HELD_SHOWN; k++)
+            fig->lerr[a][k] = e[(size_t)a * hs_n + k];
         if (metric_summarize(S, T, maps[a], &fig->ms[a]) ||
             metric_curvature_error(S, T, maps[a], &fig->curv[a]))
             FAILF("out of memory");
@@ -366,6 +374,23 @@ static void print_rows(const pair_spec *ps, const pair_fig *f)
             if (*c == '\n')
                 *c = ' ';
         printf("%-12s error after %s: %s\n", ps->label, f->nmaps ? stage_name[f->nmaps - 1] : "loading", one);
+    }
+}
+
+/* --per-landmark: held-out landmark k is line 2k + 1 of the pair's .vts. */
+static void print_landmarks(const pair_spec *ps, const pair_fig *f)
+{
+    if (!ps->a || !f->nmaps)
+        return;
+    printf("%-12s held-out landmarks (.vts line):", ps->label);
+    for (int a = 0; a < f->nmaps; a++)
+        printf(" %7s", stage_name[a]);
+    printf("\n");
+    for (int k = 0; k < f->held && k < HELD_SHOWN; k++) {
+        printf("%-12s   line %2d %21s", ps->label, 2 * k + 1, "");
+        for (int a = 0; a < f->nmaps; a++)
+            printf(" %7.4f", f->lerr[a][k]);
+        printf("\n");
     }
 }
 
@@ -455,6 +480,8 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     double eta = harness_option("eta") ? atof(harness_option("eta")) : 0;
     const char *o_start = harness_option("start");
     const char *o_rg = harness_option("rhm-landmark-weight");
+    const char *o_pl = harness_option("per-landmark");
+    int per_landmark = o_pl && atoi(o_pl) != 0;
     double rhm_gamma = o_rg ? atof(o_rg) : -1;
     proto_params w;                      /* the start's names are the list's */
     char perr[256];
@@ -487,6 +514,8 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
         ran[i] = 1;
         print_header();
         print_rows(&pairs[i], &figs[i]);
+        if (per_landmark)
+            print_landmarks(&pairs[i], &figs[i]);
         fflush(stdout);
     }
     printf("\nheld err: mean geodesic error of the held-out landmarks / sqrt(target area) "
