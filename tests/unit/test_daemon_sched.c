@@ -93,8 +93,14 @@ TEST_T(daemon_starts_second_users_job_before_first_users_third, 90)
     CHECK_INT(testdaemon_wait_state(b, bid, -1, 60), MC_COMPLETED);
     mc_job_status bs, a3;
     CHECK_INT(mc_status(b, bid, &bs), 0);
-    testdaemon_wait_state(a, ids[2], MC_RUNNING, 60);
-    CHECK_INT(mc_status(a, ids[2], &a3), 0);
+    /* alice's third started (running, or on a loaded machine already done) */
+    for (int i = 0; i < 60 * 50; i++) {
+        CHECK_INT(mc_status(a, ids[2], &a3), 0);
+        if (a3.state != MC_PENDING)
+            break;
+        usleep(20000);
+    }
+    CHECK(a3.state == MC_RUNNING || a3.state == MC_COMPLETED);
     CHECK(bs.start_ms > 0 && a3.start_ms > 0);
     if (!(bs.start_ms < a3.start_ms))
         FAILF("bob's job started at %lld, alice's third at %lld", (long long)bs.start_ms, (long long)a3.start_ms);
