@@ -36,9 +36,25 @@
  *    Measured on all six (28b7902, 300 iterations): ectm and ddm,ectm
  *    lower the error of every map, alone or with the reverse map (ddm,ectm
  *    with it gains most: 0.0384-0.0519 from 0.0432-0.0564); ddm,rhm,ectm
- *    lowers 4 of 6 alone and 5 of 6 with it (gorilla_01 -> woman_01 0.0527
- *    -> 0.0600): RHM from a map without landmarks drifts. The refined maps
- *    are 4-20 % flipped: the fold repair does not run on given maps' chains.
+ *    lowered 4 of 6 alone and 5 of 6 with it (gorilla_01 -> woman_01 0.0527
+ *    -> 0.0600): RHM from a map without landmarks drifts. At 83e8f0d
+ *    (before the anchors) alone all 6 (0.0435, 0.0424, 0.0496, 0.0413,
+ *    0.0415, 0.0448 in the order of pairs[]), with the reverse map 5 of 6
+ *    (0.0436, 0.0427, 0.0569 from 0.0527, 0.0412, 0.0400, 0.0437; RHM
+ *    alone took that map 0.0502 -> 0.0627). With RHM's anchors (rhm.h,
+ *    RHM_ANCHORS farthest points held softly to the given map's images):
+ *    ddm,rhm,ectm lowers all 12: alone 0.0417, 0.0472, 0.0456, 0.0412,
+ *    0.0457, 0.0428 (4.1-8.0 % flipped), with the reverse map 0.0427,
+ *    0.0468, 0.0475, 0.0388, 0.0438, 0.0424 (0.8-7.7 % flipped); the
+ *    man_02 maps keep less of the unanchored RHM's gain (0.0424 -> 0.0472,
+ *    0.0415 -> 0.0457 alone), the mean over the six moves 0.0439 -> 0.0440
+ *    alone and 0.0447 -> 0.0437 with the reverse map. ectm and ddm,ectm
+ *    run no RHM and are unchanged (at 83e8f0d alone 0.0445, 0.0536, 0.0481,
+ *    0.0417, 0.0474, 0.0433 and 0.0425, 0.0537, 0.0471, 0.0403, 0.0474,
+ *    0.0434; with the reverse map 0.0445, 0.0535, 0.0485, 0.0418, 0.0493,
+ *    0.0437 and 0.0409, 0.0519, 0.0464, 0.0384, 0.0481, 0.0419). The
+ *    refined maps are 4-20 % flipped: the fold repair does not run on given
+ *    maps' chains' ECTM (RHM's maps are repaired).
  * --ddm-table=no skips the DDM table (the chains only).
  * --ddm-k=K sets DDM's basis size (default CORR_DDM_K). --pairs=A_B,... (names as in maps_baseline, e.g. 8_gorilla_01_8_man_01)
  * picks the maps for both parts; --refine-pairs=... the maps the chains run

@@ -5,7 +5,8 @@
  * ddm,ectm chain reports DDM then every ECTM iteration and keeps the
  * map's error, and ddm,rhm runs RHM from the denoised map with no
  * landmarks; ddm_mode auto denoises BCICP's map and its reverse (which
- * agree) together and BIM's (one direction flipped) each alone. */
+ * agree) together and BIM's (one direction flipped) each alone; RHM from
+ * a given map stays near it by its anchors. */
 #include "support/harness.h"
 #include "support/testddm.h"
 #include "support/testgt.h"
@@ -316,6 +317,49 @@ TEST_T(ddm_auto_denoises_an_agreeing_pair_together_and_a_disagreeing_one_apart, 
     CHECK_INT(c.mode, CORR_DDM_PLAIN);
     CHECK(isnan(c.round_trip));
     ectm_result_close(&r);
+    bmap_free(P0);
+    bmap_free(Q0);
+    testgt_close(&g);
+}
+
+/* RHM from a given map is held to it by its anchors (rhm.h, RHM_ANCHORS):
+ * the published BCICP pair gorilla_01 <-> woman_01, denoised together by
+ * DDM (0.0502), then RHM with no landmarks: measured 0.0476 with the
+ * anchors, 0.0627 without (rp.anchor 0: nothing holds RHM to the map, it
+ * drifts above the input's 0.0527). */
+TEST_T(rhm_from_a_given_map_is_held_to_it_by_its_anchors, 300)
+{
+    testgt g;
+    testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_woman_01", 3);
+    char err[1024] = "";
+    bmap *P0 = NULL, *Q0 = NULL;
+    if (vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
+                                    "8_gorilla_01_8_woman_01.map"),
+                  VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err) ||
+        vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
+                                    "8_woman_01_8_gorilla_01.map"),
+                  VMAP_BASE_AUTO, g.T, g.S, &Q0, NULL, err, sizeof err))
+        FAILF("%s", err);
+    ectm_params p;
+    ectm_params_init(&p);
+    rhm_params rp;
+    rhm_params_init(&rp);
+    CHECK(rp.anchor > 0 && rp.anchors > 0);
+    double e0 = mean_error(&g, P0), e[2];
+    for (int k = 0; k < 2; k++) {
+        if (k)
+            rp.anchor = 0;
+        corr_input in = {g.S, g.T, "gorilla_01", "woman_01", NULL, P0, Q0, &rp,
+                         CORR_STAGES_DDM_RHM, 0, CORR_DDM_AUTO};
+        ectm_result r = {0};
+        if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err))
+            FAILF("%s", err);
+        e[k] = mean_error(&g, r.P);
+        ectm_result_close(&r);
+    }
+    printf("  BCICP %.4f; ddm,rhm with anchors %.4f, without %.4f\n", e0, e[0], e[1]);
+    CHECK(e[0] < e0);
+    CHECK(e[1] > e[0] + 0.005);
     bmap_free(P0);
     bmap_free(Q0);
     testgt_close(&g);

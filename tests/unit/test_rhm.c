@@ -347,6 +347,90 @@ TEST_T(x_step_solution_zeroes_the_energy_gradient, 60)
     testgt_close(&g);
 }
 
+/* From given maps (rhm_run_from_maps) each side's anchors: a farthest-point
+ * sample of the embedding from vertex 0, weight n/k, held at the X_ij they
+ * were taken from; the X-step minimises the energy with the anchor term
+ * (its central difference along a random direction vanishes, either side
+ * costs more), and a heavy anchor holds X_ij there. */
+TEST_T(anchors_are_a_farthest_point_sample_that_the_x_step_holds, 60)
+{
+    testgt g;
+    rhm__problem *pb = faust_problem(&g, 2);
+    int k = 50, m = pb->dim;
+    pb->p.anchor = 0.5;
+    for (int i = 0; i < 2; i++) {
+        rhm__side *a = &pb->side[i];
+        CHECK_INT(rhm__anchors_set(pb, a, k), RHM_OK);
+        int count = 0;
+        for (int l = 0; l < a->n; l++) {
+            CHECK(a->anchor_w[l] == 0 || a->anchor_w[l] == (double)a->n / k);
+            count += a->anchor_w[l] > 0;
+        }
+        CHECK_INT(count, k);
+        CHECK(a->anchor_w[0] > 0);
+        for (size_t q = 0; q < (size_t)a->n * m; q++)
+            CHECK(a->anchor[q] == a->Xij[q]);
+        /* the second anchor is the vertex farthest from vertex 0 */
+        int far = 0;
+        double best = -1;
+        for (int l = 0; l < a->n; l++) {
+            double d = 0;
+            for (int c = 0; c < m; c++)
+                d += (a->X[(size_t)l * m + c] - a->X[c]) * (a->X[(size_t)l * m + c] - a->X[c]);
+            if (d > best) {
+                best = d;
+                far = l;
+            }
+        }
+        CHECK(a->anchor_w[far] > 0);
+    }
+    double beta = 0.05;
+    rhm_terms t[2];
+    for (int i = 0; i < 2; i++) {
+        rhm__side *a = &pb->side[i];
+        CHECK_INT(rhm__step_p(pb, i, beta), 0);
+        CHECK_INT(rhm__step_x(pb, i, beta), 0);
+        double e0 = rhm__energy(pb, beta, t);
+        CHECK(t[i].landmark > 0);            /* the anchor term, counted there */
+        size_t nm = (size_t)a->n * m;
+        double *x0 = malloc(sizeof(double) * nm), *d = malloc(sizeof(double) * nm);
+        memcpy(x0, a->Xij, sizeof(double) * nm);
+        unsigned seed = 7;
+        for (size_t q = 0; q < nm; q++)
+            d[q] = (double)(seed = seed * 1103515245u + 12345u) / 4294967296.0 - 0.5;
+        double h = 1e-4, e[2];
+        for (int sgn = 0; sgn < 2; sgn++) {
+            for (size_t q = 0; q < nm; q++)
+                a->Xij[q] = x0[q] + (sgn ? -h : h) * d[q];
+            e[sgn] = rhm__energy(pb, beta, t);
+        }
+        memcpy(a->Xij, x0, sizeof(double) * nm);
+        printf("  direction %d: central difference %.3g, curvature %.3g\n", i,
+               (e[0] - e[1]) / (2 * h), (e[0] + e[1] - 2 * e0) / (h * h));
+        CHECK(e[0] > e0 && e[1] > e0);
+        CHECK(fabs(e[0] - e[1]) < 1e-6 * (e[0] + e[1] - 2 * e0));
+        free(x0);
+        free(d);
+    }
+    /* a heavy anchor: X_ij at the anchors stays within 1e-3 of where they were set */
+    pb->p.anchor = 1e6;
+    for (int i = 0; i < 2; i++) {
+        rhm__side *a = &pb->side[i];
+        CHECK_INT(rhm__step_p(pb, i, beta), 0);
+        CHECK_INT(rhm__step_x(pb, i, beta), 0);
+        double worst = 0;
+        for (int l = 0; l < a->n; l++)
+            for (int c = 0; c < m && a->anchor_w[l] > 0; c++) {
+                double u = fabs(a->Xij[(size_t)l * m + c] - a->anchor[(size_t)l * m + c]);
+                worst = u > worst ? u : worst;
+            }
+        printf("  direction %d: heavy anchors moved at most %.3g\n", i, worst);
+        CHECK(worst < 1e-3);
+    }
+    rhm__problem_free(pb);
+    testgt_close(&g);
+}
+
 TEST_T(p_step_equals_brute_force_projection, 60)
 {
     testgt g;

@@ -10,6 +10,10 @@
  *   Ē_L = (1/(s_i s_j)) Σ_r M_i(a_r) ‖X_ij(a_r) − X_j(b_r)‖²   (weak
  *         landmarks (3.13), a_r on M_i and b_r on M_j; the 1/(s_i s_j) is
  *         ours, for the same scale invariance as Ē_Q)
+ *   and from given maps only [+ δ·Ē_A(X_ij)], ours (rhm_run_from_maps):
+ *   Ē_A = (1/(s_i s_j)) Σ_{a ∈ A_i} (n_i/|A_i|) M_i(a) ‖X_ij(a) − (P⁰_ij X_j)(a)‖²
+ *         (anchors: weak landmarks whose partners are the given map's
+ *         images, A_i a farthest-point sample of M_i's embedding)
  * X_i: nv_i by m embedding of M_i's geodesic distances (embed.h: SMACOF
  * of a farthest-point sample, biharmonic extension); W_i: cotan Laplacian (geo_cotan.h, xᵀWx = ∫|∇x|²); M_i: lumped
  * mass; s_i: total area. All in the meshes' own units (the energy is
@@ -109,11 +113,36 @@ typedef struct rhm_params {
     int threads;           /* OpenMP threads; 0: all cores                  */
     int zoomout;           /* start fmap: ZoomOut's final basis size; 0 off */
     int coarse;            /* coarse to fine's vertices (corr.h); 0 off     */
+    double anchor;         /* from given maps: weight δ of the anchor term
+                              Ē_A (rhm_run_from_maps); 0: off       (>= 0)  */
+    int anchors;           /* anchors per side; 0: every vertex     (>= 0)  */
 } rhm_params;
+
+/* The anchor term of RHM from given maps (rhm_run_from_maps), ours: δ =
+ * RHM_ANCHOR_WEIGHT on RHM_ANCHORS vertices per side. Without it nothing
+ * holds RHM to the map it starts from (the thesis' RHM takes a map only
+ * as its start, §3.3.2, and its β ramp starts small so that a degenerate
+ * start can change a lot), and from a good map it drifts: the published
+ * BCICP map gorilla_01 -> woman_01 with its reverse, denoised by DDM,
+ * 0.0502 -> 0.0627 after RHM, 0.0569 after ECTM (input 0.0527); with
+ * the anchors 0.0475 after ECTM, and the chain ddm,rhm,ectm lowers the
+ * error of all six BCICP maps alone and with their reverse maps
+ * (tests/bench/bench_refine.c). Sparse anchors leave the map free to
+ * smooth between them; their weight n_i/|A_i| makes δ the weight of a
+ * term over the whole mesh, a tenth of β's final value. Anchoring every
+ * vertex at the same δ was measured too (RHM's map alone): 11 of the 12
+ * maps lower than the input, but gorilla_01 -> man_01 with its reverse
+ * 0.0474 -> 0.0550 (200 anchors: 0.0418; every vertex at δ = 0.01: 0.0456,
+ * at 0.2: 0.0443); and a β without its ramp (β's final value from the
+ * first iteration) did not hold it (gorilla_01 -> woman_01 with its
+ * reverse, RHM alone: 0.0543). */
+#define RHM_ANCHOR_WEIGHT 0.05
+#define RHM_ANCHORS 200
 
 /* The authors' release: α = 5e-4, β = 5e-3·min(k, 100), γ = 0, m = 8,
  * K = 200, stop when the relative change is below 1e-9 after iteration 110;
- * start: auto (ours, see above). */
+ * start: auto (ours, see above); anchor RHM_ANCHOR_WEIGHT on RHM_ANCHORS
+ * (given maps only). */
 void rhm_params_init(rhm_params *p);
 /* 0 or RHM_EPARAM with the offending field named in err (zoomout from 1 to
  * RHM_FMAP_K: ZoomOut only grows the start's basis). */
@@ -164,6 +193,9 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
  * (T -> S, or NULL: then each vertex v of T goes to the source vertex u
  * whose image P12(u), in T's embedding, is nearest to v's, as the Voronoi
  * start's reverse does; brute force, O(n1 n2 m)); X_ij = P_ij X_j, then
+ * the anchors (p->anchor, p->anchors: a farthest-point sample of each
+ * side's embedding, the first at vertex 0, each held by the anchor term to
+ * its start X_ij = P_ij X_j), then
  * the iterations of rhm_run. L may be NULL or hold any number of pairs:
  * landmarks serve only the weak landmark term, so p->gamma > 0 needs at
  * least one. p->start is unused. The maps are copied, not kept. Errors as

@@ -28,6 +28,9 @@ typedef struct rhm__side {
     /* direction from this side (i) to the other (j): */
     bmap *P;                /* n rows onto the other side's faces */
     double *Xij;            /* n by dim: the split variable X_ij */
+    double *anchor;         /* n by dim: the given map's image P⁰_ij X_j, or NULL */
+    double *anchor_w;       /* n: the anchor term's weight per vertex: n/k at
+                               the k anchors, 0 elsewhere (1 everywhere: k = 0) */
     cholmod_sparse *A;      /* upper triangle, W's pattern: the X-step matrix */
     cholmod_factor *F;      /* analysed once, factorised per X-step */
 } rhm__side;
@@ -50,6 +53,12 @@ int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_p
 int rhm__problem_new_maps(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
                           rhm__problem **out, char *err, size_t errsz);
 void rhm__problem_free(rhm__problem *pb);
+
+/* The anchors of side sd from its current X_ij (rhm_given.c): anchor =
+ * X_ij, weight n/k at k farthest points of the embedding X (Euclidean in
+ * R^m, the first at vertex 0, ties to the lower vertex), or 1 at every
+ * vertex when k is 0 or at least n. RHM_OK or RHM_ENOMEM. */
+int rhm__anchors_set(rhm__problem *pb, rhm__side *sd, int k);
 
 /* The loop (rhm_run.c) from the current state, maps and X_ij set: reports
  * iteration 0, iterates, moves the maps into out. t0: rhm__now() at the
@@ -75,9 +84,11 @@ int rhm__init_start(rhm__problem *pb, char *err, size_t errsz);
  * (closest point in R^{2m}, exact, seeded with the current P_ij). */
 int rhm__step_p(rhm__problem *pb, int i, double beta);
 /* X_ij <- argmin over R^{n_i × m} of αĒ_D + (1−α)Ē_R(P_ji, ·) + βĒ_Q(P_ij, ·)
- * + γĒ_L: the sparse SPD system (CHOLMOD, numeric factorisation only). */
+ * + γĒ_L [+ δĒ_A when the side has anchors]: the sparse SPD system
+ * (CHOLMOD, numeric factorisation only). */
 int rhm__step_x(rhm__problem *pb, int i, double beta);
-/* The weighted terms of (3.11) at the current state; returns their sum. */
+/* The weighted terms of (3.11) at the current state; returns their sum.
+ * The anchor term δĒ_A is counted in landmark (the weak correspondences). */
 double rhm__energy(const rhm__problem *pb, double beta, rhm_terms dir[2]);
 
 /* The projection of direction i as rhm__step_p sets it up: Z (n_j by 2m),

@@ -1,6 +1,7 @@
 /* rhm_given.c — RHM from given maps (rhm.h, rhm_run_from_maps): the maps
  * checked and copied in, the missing reverse by nearest neighbour in the
- * embedding, X_ij = P_ij X_j, then the loop of rhm_run.c. */
+ * embedding, X_ij = P_ij X_j, the anchors that hold X_ij to that start
+ * (the anchor term, rhm_step.c), then the loop of rhm_run.c. */
 #include "rhm/rhm__problem.h"
 #include "util/errbuf.h"
 
@@ -63,6 +64,45 @@ static int reverse_by_nearest(rhm__problem *pb)
     return RHM_OK;
 }
 
+int rhm__anchors_set(rhm__problem *pb, rhm__side *sd, int k)
+{
+    int n = sd->n, m = pb->dim;
+    sd->anchor = malloc(sizeof(double) * (size_t)n * m);
+    sd->anchor_w = calloc((size_t)n, sizeof(double));
+    double *d = k > 0 ? malloc(sizeof(double) * (size_t)n) : NULL;
+    if (!sd->anchor || !sd->anchor_w || (k > 0 && !d)) {
+        free(d);
+        return RHM_ENOMEM;
+    }
+    memcpy(sd->anchor, sd->Xij, sizeof(double) * (size_t)n * m);
+    if (k <= 0 || k >= n) {
+        for (int l = 0; l < n; l++)
+            sd->anchor_w[l] = 1;
+        return RHM_OK;
+    }
+    for (int l = 0; l < n; l++)
+        d[l] = DBL_MAX;
+    int v = 0;
+    for (int r = 0; r < k; r++) {
+        sd->anchor_w[v] = (double)n / k;
+        int next = 0;
+        for (int l = 0; l < n; l++) {
+            double e = 0;
+            for (int c = 0; c < m; c++) {
+                double t = sd->X[(size_t)l * m + c] - sd->X[(size_t)v * m + c];
+                e += t * t;
+            }
+            if (e < d[l])
+                d[l] = e;
+            if (d[l] > d[next])
+                next = l;
+        }
+        v = next;
+    }
+    free(d);
+    return RHM_OK;
+}
+
 int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap *P12,
                       const bmap *P21, const rhm_params *p, rhm_progress_fn progress, void *ctx,
                       rhm_result *out, char *err, size_t errsz)
@@ -100,6 +140,11 @@ int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap
         goto out;
     }
     bmap_apply(b->P, a->m->f, a->X, pb->dim, b->Xij);
+    if (p->anchor > 0 && ((rc = rhm__anchors_set(pb, a, p->anchors)) ||
+                          (rc = rhm__anchors_set(pb, b, p->anchors)))) {
+        errbuf_set(err, errsz, rc, "out of memory");
+        goto out;
+    }
     rc = rhm__iterate(pb, t0, progress, ctx, out, err, errsz);
 out:
     rhm__problem_free(pb);

@@ -41,6 +41,8 @@ void rhm_params_init(rhm_params *p)
     p->beta_ramp = 100;
     p->min_iterations = 110;
     p->stop_change = 1e-9;
+    p->anchor = RHM_ANCHOR_WEIGHT;
+    p->anchors = RHM_ANCHORS;
 }
 
 int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
@@ -57,6 +59,8 @@ int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
     NEED(p->beta_ramp >= 1, "beta-ramp", "an integer >= 1");
     NEED(p->min_iterations >= 1, "min-iterations", "an integer >= 1");
     NEED(isfinite(p->stop_change) && p->stop_change >= 0, "stop-change", "a finite number >= 0");
+    NEED(isfinite(p->anchor) && p->anchor >= 0, "anchor", "a finite number >= 0");
+    NEED(p->anchors >= 0, "anchors", "an integer >= 0");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");
 #undef NEED
     return RHM_OK;

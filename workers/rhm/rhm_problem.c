@@ -24,6 +24,8 @@ static void side_close(rhm__side *sd, cholmod_common *cc, int cc_started)
     free(sd->lmk);
     bmap_free(sd->P);
     free(sd->Xij);
+    free(sd->anchor);
+    free(sd->anchor_w);
     if (cc_started) {
         cholmod_free_sparse(&sd->A, cc);
         cholmod_free_factor(&sd->F, cc);

@@ -132,6 +132,11 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
     }
     for (int r = 0; r < pb->nl; r++)
         x[entry(A, a->lmk[r], a->lmk[r])] += cL * a->mass[a->lmk[r]];
+    double cA = pb->p.anchor / (a->s * b->s);
+    if (a->anchor && cA > 0)
+        for (int l = 0; l < n; l++)
+            if (a->anchor_w[l] > 0)
+                x[entry(A, l, l)] += cA * a->mass[l] * a->anchor_w[l];
     /* (1−α)/s_j² P_jiᵀ M_j P_ji */
     const bmap *Pji = b->P;
     for (int l = 0; l < b->n; l++) {
@@ -166,6 +171,10 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
         for (int c = 0; c < m; c++)
             bx[(size_t)c * n + l] += cL * a->mass[l] * b->X[(size_t)b->lmk[r] * m + c];
     }
+    if (a->anchor && cA > 0)
+        for (int l = 0; l < n; l++)
+            for (int c = 0; c < m && a->anchor_w[l] > 0; c++)
+                bx[(size_t)c * n + l] += cA * a->mass[l] * a->anchor_w[l] * a->anchor[(size_t)l * m + c];
     rc = RHM_ENUMERIC;
     if (!cholmod_factorize(A, a->F, &pb->cc) || pb->cc.status != CHOLMOD_OK)
         goto out;
@@ -231,6 +240,18 @@ double rhm__energy(const rhm__problem *pb, double beta, rhm_terms dir[2])
             lm += a->mass[a->lmk[r]] * d2;
         }
         t->landmark = pb->p.gamma / (a->s * b->s) * lm;
+        if (a->anchor && pb->p.anchor > 0) {
+            double an = 0;
+            for (int l = 0; l < a->n; l++) {
+                double d2 = 0;
+                for (int c = 0; c < m; c++) {
+                    double u = a->Xij[(size_t)l * m + c] - a->anchor[(size_t)l * m + c];
+                    d2 += u * u;
+                }
+                an += a->mass[l] * a->anchor_w[l] * d2;
+            }
+            t->landmark += pb->p.anchor / (a->s * b->s) * an;
+        }
         total += t->dirichlet + t->reverse + t->mismatch + t->landmark;
         free(WX);
         free(PY);
