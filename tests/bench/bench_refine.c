@@ -52,9 +52,17 @@
  *    run no RHM and are unchanged (at 83e8f0d alone 0.0445, 0.0536, 0.0481,
  *    0.0417, 0.0474, 0.0433 and 0.0425, 0.0537, 0.0471, 0.0403, 0.0474,
  *    0.0434; with the reverse map 0.0445, 0.0535, 0.0485, 0.0418, 0.0493,
- *    0.0437 and 0.0409, 0.0519, 0.0464, 0.0384, 0.0481, 0.0419). The
- *    refined maps are 4-20 % flipped: the fold repair does not run on given
- *    maps' chains' ECTM (RHM's maps are repaired).
+ *    0.0437 and 0.0409, 0.0519, 0.0464, 0.0384, 0.0481, 0.0419; those
+ *    maps 7.7-18.9 % flipped, as ECTM leaves them). ECTM's maps after RHM
+ *    get the fold repair when folded (over 5 %, corr.c): ddm,rhm,ectm
+ *    alone 0.0417, 0.0478, 0.0456, 0.0408, 0.0451, 0.0430, flipped 4.3,
+ *    0.2, 4.1, 0.2, 0.1, 0.0 % (unrepaired: 4.3, 5.6, 4.1, 5.2, 8.0,
+ *    5.4 %); with the reverse map 0.0427, 0.0471, 0.0475, 0.0388, 0.0432,
+ *    0.0423, flipped 4.1, 0.2, 0.8, 4.6, 0.3, 0.1 % (unrepaired 5.1, 7.7,
+ *    6.5 % on the three repaired): every map still lower than its input,
+ *    none left folded. The repair after ectm or ddm,ectm (measured, not
+ *    used) made those maps 0-12 % flipped but raised the error of 10 of
+ *    the 12 (ectm on gorilla_01 -> man_02 0.0535 -> 0.0734).
  * --ddm-table=no skips the DDM table (the chains only).
  * --ddm-k=K sets DDM's basis size (default CORR_DDM_K). --pairs=A_B,... (names as in maps_baseline, e.g. 8_gorilla_01_8_man_01)
  * picks the maps for both parts; --refine-pairs=... the maps the chains run

@@ -113,7 +113,7 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char
     fold_params_init(&fp);
     memset(rep, 0, 2 * sizeof *rep);
     int n = in->L ? in->L->n : 0;
-    int rc = fold_repair(in->S, in->T, in->L ? in->L->src : NULL, n, &fp, P, &rep[0]);
+    int rc = P ? fold_repair(in->S, in->T, in->L ? in->L->src : NULL, n, &fp, P, &rep[0]) : 0;
     if (!rc && Q)
         rc = fold_repair(in->T, in->S, in->L ? in->L->tgt : NULL, n, &fp, Q, &rep[1]);
     if (rc)
@@ -122,16 +122,27 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char
     return CORR_OK;
 }
 
-/* The share of bad triangles (flipped plus collapsed) of the more folded
- * of the two maps; 2 (worse than any) when it cannot be measured. */
+/* The share of bad triangles (flipped plus collapsed) of the map P from
+ * A onto B; 2 (worse than any) when it cannot be measured. */
+static double folded_map(const mesh *A, const mesh *B, const bmap *P)
+{
+    metric_summary m;
+    if (metric_summarize(A, B, P, &m))
+        return 2;
+    return m.flipped_fraction + m.collapsed_fraction;
+}
+
+/* That share for the more folded of RHM's two maps. */
 static double folded(const corr_input *in, const rhm_result *r)
 {
-    metric_summary m1, m2;
-    if (metric_summarize(in->S, in->T, r->P12, &m1) || metric_summarize(in->T, in->S, r->P21, &m2))
-        return 2;
-    double f1 = m1.flipped_fraction + m1.collapsed_fraction;
-    double f2 = m2.flipped_fraction + m2.collapsed_fraction;
+    double f1 = folded_map(in->S, in->T, r->P12), f2 = folded_map(in->T, in->S, r->P21);
     return f1 > f2 ? f1 : f2;
+}
+
+/* m when the map m from A onto B would be returned folded (metric_verdict), else NULL. */
+static bmap *if_folded(const mesh *A, const mesh *B, bmap *m)
+{
+    return m && metric_verdict(folded_map(A, B, m), 0) != METRIC_VERDICT_OK ? m : NULL;
 }
 
 /* One RHM run from q and its repair; raw: a copy of P12 before it. */
@@ -320,15 +331,24 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
     ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
                           in->L ? in->L->n : 0 };
     rc = from_ectm(ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, &rl, out, err, errsz));
-    if (rc == CORR_OK && !in->P0) {
+    if (rc == CORR_OK) {
         /* ECTM's projection folds where its deformed surface passes a thin
          * part at an angle: the same repair, on the maps it returns, in
-         * the landmark pipeline where it was measured (bench_shrec07). Not
-         * on a given map's chains: there it re-mapped large regions of
-         * scattered flips and raised the error (the BCICP map gorilla ->
-         * man, ddm,ectm: 0.049 -> 0.083, test_corr_stages) */
+         * the landmark pipeline where it was measured (bench_shrec07), and
+         * on a given map's chain through RHM each map that would be
+         * returned folded (over 5 %; bench_refine, ddm,rhm,ectm: see
+         * its header). Not on chains where ECTM starts from the given
+         * (or only denoised) map: its folds are scattered over 8-19 % of
+         * the triangles, and the repair's regions raised the error of
+         * every map but one (ddm,ectm 0.0409 -> 0.0448, ectm 0.0535 ->
+         * 0.0734 on gorilla_01 -> man_02) */
+        bmap *rP = out->P, *rQ = out->Q;
+        if (in->P0) {
+            rP = run & CORR_RUN_RHM ? if_folded(in->S, in->T, out->P) : NULL;
+            rQ = run & CORR_RUN_RHM ? if_folded(in->T, in->S, out->Q) : NULL;
+        }
         fold_report rep[2];
-        if ((rc = corr_repair(in, out->P, out->Q, rep, err, errsz)))
+        if ((rP || rQ) && (rc = corr_repair(in, rP, rQ, rep, err, errsz)))
             ectm_result_close(out);
     }
 done:

@@ -9,9 +9,11 @@
  *     denoised maps (rhm_run_from_maps, anchored to them: rhm.h's
  *     RHM_ANCHORS), giving P and Q, whose folds are
  *     then repaired (corr_repair, fold.h)
- *   ECTM refinement, then (from landmarks, not from a given map) the
- *     same fold repair of the maps it returns (the rows of bad regions
- *     change; out->Y stays ECTM's deformation)
+ *   ECTM refinement, then the same fold repair of the maps it returns
+ *     (the rows of bad regions change; out->Y stays ECTM's deformation):
+ *     from landmarks always; on a given map's chain only after RHM, each
+ *     map that is folded (metric_verdict), not when ECTM starts
+ *     from the given or denoised map (corr.c says what was measured)
  *
  * Stages report progress through one callback; a non-zero return cancels.
  * This module reads no files and knows no sockets: callers load meshes,
@@ -178,7 +180,7 @@ int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progres
              rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz);
 
 /* The fold repair the pipeline applies to RHM's maps and to ECTM's: fold_repair of P
- * (S -> T) and, when Q is not NULL, of Q (T -> S), the landmarks fixed
+ * (S -> T) when it is not NULL and of Q (T -> S) when it is not NULL, the landmarks fixed
  * (in->L may be NULL), with fold_params_init's values. rep[0], rep[1]:
  * P's and Q's reports. CORR_OK, CORR_ENOMEM or CORR_EINIT. */
 int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char *err,
