@@ -52,12 +52,10 @@
  *
  * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm|repair
  * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for
- * ../shared/tools' pictures), --eta=E (ECTM's bending weight instead of
- * the default, for comparing; likewise --alpha, --beta0, --beta1 (β's ramp
- * from beta0 to beta1), --gamma), --start=NAME (a start map of
- * proto_params.h's start list instead of the default),
- * --rhm-landmark-weight=G (RHM's weak landmark term, default off),
- * --per-landmark=1 (after each SHREC'07 pair's rows, each held-out
+ * ../shared/tools' pictures), any job parameter of the one list
+ * (proto_params.h) by its CLI name instead of its default, for comparing
+ * (--eta=E, --alpha, --beta0, --beta1, --gamma, --start=NAME,
+ * --rhm-landmark-weight=G, ...; checked as a job's), --per-landmark=1 (after each SHREC'07 pair's rows, each held-out
  * landmark's error per stage, by its 0-based line in the .vts: which part
  * of a pair a mean comes from). Last,
  * the job time (start + RHM and repair + ECTM and repair) per pair, its
@@ -143,11 +141,10 @@ typedef struct pair_fig {
 
 typedef struct pair_job {
     const pair_spec *ps;
-    const ectm_params *ectm;   /* the defaults with the --ectm-iterations, --eta, ... given */
+    const ectm_params *ectm;   /* the job parameters: defaults, and those given */
+    const rhm_params *rhm;
     int last;               /* the last stage to run (--stop) */
     const char *out_dir;    /* --out-dir: each stage's map is written there */
-    int start;              /* --start: RHM_START_*, -1: the default */
-    double rhm_gamma;       /* --rhm-landmark-weight, < 0: the default */
 } pair_job;
 
 static double now(void)
@@ -255,12 +252,7 @@ static void run_pair(const void *arg, void *out)
     if (lmk_from_arrays(gs, gt, fig->given, 0, S_name, T_name, S, T, &L, err, sizeof err) ||
         corr_validate(S, S_name, err, sizeof err) || corr_validate(T, T_name, err, sizeof err))
         goto out;
-    rhm_params rp;
-    rhm_params_init(&rp);
-    if (job->start >= 0)
-        rp.start = job->start;
-    if (job->rhm_gamma >= 0)
-        rp.gamma = job->rhm_gamma;
+    rhm_params rp = *job->rhm;
     ectm_params ep = *job->ectm;
 
     /* a pair over twice the coarse size (12 000): the stages run on the decimated
@@ -523,48 +515,41 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
         SKIP("../shared/data is absent");
     const char *o_it = harness_option("ectm-iterations"), *o_pairs = harness_option("pairs");
     const char *o_stop = harness_option("stop"), *o_out = harness_option("out-dir");
-    const char *o_start = harness_option("start");
-    const char *o_rg = harness_option("rhm-landmark-weight");
     const char *o_pl = harness_option("per-landmark");
     int per_landmark = o_pl && atoi(o_pl) != 0;
-    double rhm_gamma = o_rg ? atof(o_rg) : -1;
-    proto_params w;                      /* the start's names are the list's */
+    /* every job parameter by its CLI name (--eta=0.1, --start=fmap, ...),
+     * parsed, checked and mapped to the engine as a job's are;
+     * --ectm-iterations is --iterations */
+    proto_params w;
     char perr[256];
     proto_params_init(&w);
-    if (o_start && proto_param_parse(&w, PROTO_P_start, o_start, perr, sizeof perr))
-        FAILF("--start: %s", perr);
-    int start = o_start ? (int)w.start : -1;
-    int iters = o_it ? atoi(o_it) : 0, last = ECTM;
+    for (int i = 0; i < PROTO_NPARAMS; i++) {
+        const char *o = harness_option(proto_param_infos[i].cli);
+        if (o && proto_param_parse(&w, i, o, perr, sizeof perr))
+            FAILF("--%s: %s", proto_param_infos[i].cli, perr);
+    }
+    if (o_it && proto_param_parse(&w, PROTO_P_iterations, o_it, perr, sizeof perr))
+        FAILF("--ectm-iterations: %s", perr);
+    ectm_params ep;
+    rhm_params rp;
+    if (corr_params_from_job(&w, 0, &ep, &rp, perr, sizeof perr))
+        FAILF("%s", perr);
+    int last = ECTM;
     if (o_stop)
         last = !strcmp(o_stop, "start") ? START : !strcmp(o_stop, "rhm") ? RHM
                                        : !strcmp(o_stop, "repair") ? REPAIR : -1;
     if (last < 0)
         FAILF("--stop takes start, rhm or repair");
-    if (o_it && iters < 1)
-        FAILF("--ectm-iterations takes a positive integer");
-    ectm_params ep;
-    ectm_params_init(&ep);
+    int dflt = (int)proto_param_infos[PROTO_P_iterations].dflt;
     printf("landmarks -> start -> RHM -> ECTM, meshcorr match's defaults, ECTM %d outer "
-           "iterations%s; %s\n", iters ? iters : ep.iterations,
-           iters && iters != ep.iterations ? " (not the default)" : "", harness_data_dir());
-    if (iters)
-        ep.iterations = iters;
-    /* the weights given, for comparing; a value <= 0 keeps the default */
-    struct { const char *name; double *field; } weights[] = {
-        { "eta", &ep.eta }, { "alpha", &ep.alpha }, { "beta0", &ep.beta0 },
-        { "beta1", &ep.beta1 }, { "gamma", &ep.gamma },
-    };
-    for (size_t k = 0; k < sizeof weights / sizeof weights[0]; k++) {
-        const char *o = harness_option(weights[k].name);
-        if (o && atof(o) > 0)
-            *weights[k].field = atof(o);
-    }
+           "iterations%s; %s\n", ep.iterations, ep.iterations != dflt ? " (not the default)" : "",
+           harness_data_dir());
     static pair_fig figs[NPAIRS];
     int ran[NPAIRS] = {0};
     for (int i = 0; i < NPAIRS; i++) {
         if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
-        pair_job job = { &pairs[i], &ep, last, o_out, start, rhm_gamma };
+        pair_job job = { &pairs[i], &ep, &rp, last, o_out };
         char why[256];
         if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
             snprintf(figs[i].why, sizeof figs[i].why, "%s", why);

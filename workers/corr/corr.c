@@ -343,9 +343,11 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
          * every map but one (ddm,ectm 0.0409 -> 0.0448, ectm 0.0535 ->
          * 0.0734 on gorilla_01 -> man_02) */
         bmap *rP = out->P, *rQ = out->Q;
-        if (in->P0) {
-            rP = run & CORR_RUN_RHM ? if_folded(in->S, in->T, out->P) : NULL;
-            rQ = run & CORR_RUN_RHM ? if_folded(in->T, in->S, out->Q) : NULL;
+        if (in->P0 && !(run & CORR_RUN_RHM))
+            rP = rQ = NULL;
+        else if (in->P0) {
+            rP = if_folded(in->S, in->T, out->P);
+            rQ = if_folded(in->T, in->S, out->Q);
         }
         fold_report rep[2];
         if ((rP || rQ) && (rc = corr_repair(in, rP, rQ, rep, err, errsz)))
