@@ -6,7 +6,8 @@
  * map's error, and ddm,rhm runs RHM from the denoised map with no
  * landmarks; ddm_mode auto denoises BCICP's map and its reverse (which
  * agree) together and BIM's (one direction flipped) each alone; RHM from
- * a given map stays near it by its anchors. */
+ * a given map stays near it by its anchors; ECTM's folded maps are
+ * repaired on ddm,rhm,ectm (only those folded) and not on ddm,ectm. */
 #include "support/harness.h"
 #include "support/testddm.h"
 #include "support/testgt.h"
@@ -362,6 +363,95 @@ TEST_T(rhm_from_a_given_map_is_held_to_it_by_its_anchors, 300)
     CHECK(e[1] > e[0] + 0.005);
     bmap_free(P0);
     bmap_free(Q0);
+    testgt_close(&g);
+}
+
+/* The bad share (flipped plus collapsed) of the map P from A onto B. */
+static double bad_share(const mesh *A, const mesh *B, const bmap *P)
+{
+    metric_summary m;
+    CHECK_INT(metric_summarize(A, B, P, &m), 0);
+    return m.flipped_fraction + m.collapsed_fraction;
+}
+
+static int same_map(const bmap *a, const bmap *b)
+{
+    return a->n == b->n && !memcmp(a->face, b->face, sizeof(int) * (size_t)a->n) &&
+           !memcmp(a->w, b->w, sizeof(double) * 3 * (size_t)a->n);
+}
+
+/* Which of ECTM's maps a given map's chain repairs (corr_run): through RHM
+ * (ddm,rhm,ectm), each map that ECTM leaves folded (metric_verdict: over
+ * 5 % flipped plus collapsed) and only those, exactly as corr_repair does
+ * it; from the given map itself (ddm,ectm), none, folded or not. The
+ * published BCICP map gorilla_01 -> man_02 (no reverse given), ECTM's 30
+ * iterations with β ramped over them: ECTM run by hand from the chain's
+ * own inputs (ddm,rhm's maps, DDM's map) must leave a map folded for the
+ * rule to be tested, and the test says so when it does not. */
+TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
+{
+    testgt g;
+    testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_man_02", 3);
+    char err[1024] = "";
+    bmap *P0 = NULL;
+    if (vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
+                                    "8_gorilla_01_8_man_02.map"),
+                  VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err))
+        FAILF("%s", err);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 30;
+    p.beta_ramp = 30;
+    rhm_params rp;
+    rhm_params_init(&rp);
+    corr_input in = {g.S, g.T, "gorilla_01", "man_02", NULL, P0, NULL, &rp,
+                     CORR_STAGES_DDM_RHM, 0, CORR_DDM_AUTO};
+    ectm_landmarks none = {NULL, NULL, 0};
+
+    /* through RHM: ECTM by hand from ddm,rhm's maps, then the chain */
+    ectm_result r = {0}, e = {0}, c = {0};
+    if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err) ||
+        ectm_run(g.S, g.T, r.P, r.Q, &none, &p, NULL, NULL, &e, err, sizeof err))
+        FAILF("%s", err);
+    double fP = bad_share(g.S, g.T, e.P), fQ = bad_share(g.T, g.S, e.Q);
+    printf("  ddm,rhm then ECTM: bad %.2f %% forward, %.2f %% reverse\n", 100 * fP, 100 * fQ);
+    if (metric_verdict(fP, 0) == METRIC_VERDICT_OK && metric_verdict(fQ, 0) == METRIC_VERDICT_OK)
+        FAILF("ECTM from ddm,rhm's maps left no map folded: the rule is not tested");
+    fold_report rep[2];
+    if (corr_repair(&in, metric_verdict(fP, 0) ? e.P : NULL, metric_verdict(fQ, 0) ? e.Q : NULL,
+                    rep, err, sizeof err))
+        FAILF("%s", err);
+    in.stages = CORR_STAGES_DDM_RHM_ECTM;
+    if (corr_run(&in, &p, NULL, NULL, &c, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(same_map(c.P, e.P));
+    CHECK(same_map(c.Q, e.Q));
+    double gP = bad_share(g.S, g.T, c.P), gQ = bad_share(g.T, g.S, c.Q);
+    printf("  ddm,rhm,ectm returns: bad %.2f %% forward, %.2f %% reverse\n", 100 * gP, 100 * gQ);
+    CHECK_INT(metric_verdict(gP, 0), METRIC_VERDICT_OK);
+    CHECK_INT(metric_verdict(gQ, 0), METRIC_VERDICT_OK);
+    ectm_result_close(&r);
+    ectm_result_close(&e);
+    ectm_result_close(&c);
+
+    /* from the given map: ECTM by hand from DDM's map, then the chain */
+    in.stages = CORR_STAGES_DDM;
+    if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err) ||
+        ectm_run(g.S, g.T, r.P, NULL, &none, &p, NULL, NULL, &e, err, sizeof err))
+        FAILF("%s", err);
+    fP = bad_share(g.S, g.T, e.P);
+    printf("  ddm then ECTM: bad %.2f %% forward\n", 100 * fP);
+    if (metric_verdict(fP, 0) == METRIC_VERDICT_OK)
+        FAILF("ECTM from DDM's map left it unfolded: the rule is not tested");
+    in.stages = CORR_STAGES_DDM_ECTM;
+    if (corr_run(&in, &p, NULL, NULL, &c, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(same_map(c.P, e.P));
+    CHECK(same_map(c.Q, e.Q));
+    ectm_result_close(&r);
+    ectm_result_close(&e);
+    ectm_result_close(&c);
+    bmap_free(P0);
     testgt_close(&g);
 }
 
