@@ -57,7 +57,10 @@
  * (--eta=E, --alpha, --beta0, --beta1, --gamma, --start=NAME,
  * --rhm-landmark-weight=G, ...; checked as a job's), --per-landmark=1 (after each SHREC'07 pair's rows, each held-out
  * landmark's error per stage, by its 0-based line in the .vts: which part
- * of a pair a mean comes from). Last,
+ * of a pair a mean comes from), --within-given=1 (only the landmarks given
+ * above, every other one of them given and the rest scored: lines 0, 4,
+ * 8, ... given and 2, 6, 10, ... scored, the wolf's 21 by odd and even;
+ * what a job could measure of itself without the held-out ones). Last,
  * the job time (start + RHM and repair + ECTM and repair) per pair, its
  * median, and the exponent of a least-squares fit of log time against
  * log(source + target vertices) per stage, over the pairs run: issue 16's
@@ -113,7 +116,48 @@
  * hand and glasses lose held-out accuracy to it from the first 100
  * iterations on (hand 0.0169, 0.0184, 0.0189, 0.0197). On wolf0 ->
  * wolf2 the exact map (the identity) scores 1.431 (meshcorr eval), 0.49
- * of the repaired RHM map's 2.907; ECTM's 2.023 is 0.70 of it. */
+ * of the repaired RHM map's 2.907; ECTM's 2.023 is 0.70 of it.
+ *
+ * What the landmarks decide (fb5ea94, meshcorr match and eval on the same
+ * pairs). The whole pipeline given all the landmarks, held-out ones
+ * included, ends at nearly the curvature error of the pipeline given half
+ * of them; against the repaired map from half of them: glasses 4.653
+ * (ratio 1.01), airplane 2.627 (0.70), ant 2.733 (0.80), teddy 5.492
+ * (0.70), hand 3.642 (0.94), plier 3.283 (0.98), fish 1.655 (0.67), bird
+ * 5.278 (0.98), human 5.247 (0.88), armadillo 8.218 (0.82), fourleg 8.122
+ * (1.01): the same 3 classes at <= 0.75. And ECTM given half the
+ * landmarks, started from RHM's maps made with all of them (meshcorr
+ * match --stages rhm, then --init those maps --stages ectm), moves the
+ * held-out landmarks to about where it takes them from this pipeline's
+ * maps: glasses 0.0208 -> 0.0238 (pipeline 0.0232), ant 0.0173 -> 0.0209
+ * (0.0208), hand 0.0115 -> 0.0220 (0.0189), airplane 0.0093 -> 0.0122
+ * (0.0126), fish 0.0232 -> 0.0233 (0.0234), teddy 0.0742 -> 0.0408
+ * (0.0430), human 0.0437 -> 0.0304 (0.0305). A better start does not
+ * move where ECTM ends on these pairs: ECTM's energy with the given
+ * landmarks pinned does. A mismatch term that lets the deformed surface
+ * slide along the target within a Y-step (point-to-plane, tangential
+ * weight 0.1 or 0.001 of the normal one; not kept) moved no held-out
+ * error of glasses, hand, airplane and fish by more than 0.0008.
+ *
+ * So the weights decide, and no one set meets the error target on every
+ * pair (ECTM rows, held-out error; the target RHM + 0.003): --eta=0.1
+ * brings ant (0.0177) and hand (0.0139) within it and glasses to 0.0228
+ * (target 0.0225), teddy 0.0472, but loses armadillo (0.0564 > 0.05) and
+ * wolf (0.0147 > 0.01); --eta=0.01: ant 0.0194, hand 0.0172 (target
+ * 0.0159), glasses 0.0228, armadillo 0.0463, wolf 0.0150; --eta=0.03:
+ * ant 0.0181, hand 0.0171, armadillo 0.0561, wolf 0.0147; --gamma=20000
+ * or --beta0=1000 --beta1=200000 alone move none of glasses, ant, hand
+ * by more than 0.0003. A large bending weight holds ECTM near its input
+ * (wolf at η 0.01: |log a| 0.501 against its input's 0.492, error 0.0154
+ * -> 0.0150), which is what hand and ant want and wolf and armadillo do
+ * not. Choosing η per job by what the job can see does not work either:
+ * with --within-given=1 (half the given landmarks given, the other half
+ * scored) the default η scores lower than η = 0.1 on ant (0.0067 against
+ * 0.0232) and hand (0.0280, 0.0327) and higher on armadillo (0.0361,
+ * 0.0299), the opposite of their held-out errors; it picks right on
+ * wolf (0.0040, 0.0160) and teddy (0.0312, 0.0320): what ECTM does to
+ * the given landmarks' neighbourhoods does not tell what it does to the
+ * held-out points (bird's wing roots, hand's wrist end). */
 #include "support/harness.h"
 #include "support/testapart.h"
 #include "support/testfit.h"
@@ -159,6 +203,7 @@ typedef struct pair_job {
     const rhm_params *rhm;
     int last;               /* the last stage to run (--stop) */
     const char *out_dir;    /* --out-dir: each stage's map is written there */
+    int within_given;       /* --within-given */
 } pair_job;
 
 static double now(void)
@@ -229,18 +274,20 @@ static void run_pair(const void *arg, void *out)
     }
     fig->nS = S->nv;
     fig->nT = T->nv;
-    /* given: even lines (all for the wolf); held: odd lines (the wolf: every vertex) */
+    /* given: even lines (all for the wolf); held: odd lines (the wolf: every
+     * vertex). --within-given: only the lines given above, every other one
+     * of them given and the rest held out (what a job could score itself on) */
     long gs[256], gt[256];
     int hs_n = 0, *hs, *ht;
-    for (int k = 0; k < n && fig->given < 256; k++)
-        if (!ps->a || k % 2 == 0) {
-            gs[fig->given] = ls[k];
-            gt[fig->given++] = lt[k];
-        }
-    if (ps->a) {
+    int step = ps->a ? 2 : 1, w = job->within_given ? 2 : 1;
+    for (int k = 0; k < n && fig->given < 256; k += step * w) {
+        gs[fig->given] = ls[k];
+        gt[fig->given++] = lt[k];
+    }
+    if (ps->a || w > 1) {
         hs = malloc(sizeof(int) * (size_t)n);
         ht = malloc(sizeof(int) * (size_t)n);
-        for (int k = 1; k < n; k += 2) {
+        for (int k = w > 1 ? step : 1; k < n; k += w > 1 ? 2 * step : 2) {
             hs[hs_n] = ls[k];
             ht[hs_n++] = lt[k];
         }
@@ -531,6 +578,8 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     const char *o_stop = harness_option("stop"), *o_out = harness_option("out-dir");
     const char *o_pl = harness_option("per-landmark");
     int per_landmark = o_pl && atoi(o_pl) != 0;
+    const char *o_wg = harness_option("within-given");
+    int within_given = o_wg && atoi(o_wg) != 0;
     /* every job parameter by its CLI name (--eta=0.1, --start=fmap, ...),
      * parsed, checked and mapped to the engine as a job's are;
      * --ectm-iterations is --iterations */
@@ -563,7 +612,7 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
     for (int i = 0; i < NPAIRS; i++) {
         if (!harness_list_has(o_pairs, pairs[i].label))
             continue;
-        pair_job job = { &pairs[i], &ep, &rp, last, o_out };
+        pair_job job = { &pairs[i], &ep, &rp, last, o_out, within_given };
         char why[256];
         if (testapart_run(run_pair, &job, &figs[i], sizeof figs[i], why, sizeof why))
             snprintf(figs[i].why, sizeof figs[i].why, "%s", why);

@@ -122,16 +122,26 @@ static double mean_error(const testgt *g, const bmap *P)
     return e;
 }
 
+/* The published map of METHOD from 8_A onto 8_B (TOSCA_r non-isometric),
+ * on the meshes S (8_A) and T (8_B). */
+static bmap *published_map(const mesh *S, const mesh *T, const char *method, int base,
+                           const char *a, const char *b)
+{
+    char rel[256], err[1024] = "";
+    snprintf(rel, sizeof rel, "tosca_r_nonisometric/vtx_5k/maps_baseline/%s/8_%s_8_%s.map",
+             method, a, b);
+    bmap *P = NULL;
+    if (vmap_read(harness_data_path(rel), base, S, T, &P, NULL, err, sizeof err))
+        FAILF("%s", err);
+    return P;
+}
+
 TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
 {
     testgt g;
     testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_man_01", 3);
     char err[1024] = "";
-    bmap *P0 = NULL;
-    if (vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
-                                    "8_gorilla_01_8_man_01.map"),
-                  VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err))
-        FAILF("%s", err);
+    bmap *P0 = published_map(g.S, g.T, "WKSini_direct_BCICP", VMAP_BASE_AUTO, "gorilla_01", "man_01");
     ectm_params p;
     ectm_params_init(&p);
     p.iterations = 4;
@@ -241,15 +251,8 @@ static int record_choice(void *ctx, const corr_progress *p)
 /* The published pair P0 (gorilla_01 -> man_01), Q0 (back) of one method. */
 static void published_pair(const testgt *g, const char *method, int base, bmap **P0, bmap **Q0)
 {
-    char rel[256], err[1024] = "";
-    snprintf(rel, sizeof rel, "tosca_r_nonisometric/vtx_5k/maps_baseline/%s/8_gorilla_01_8_man_01.map",
-             method);
-    if (vmap_read(harness_data_path(rel), base, g->S, g->T, P0, NULL, err, sizeof err))
-        FAILF("%s", err);
-    snprintf(rel, sizeof rel, "tosca_r_nonisometric/vtx_5k/maps_baseline/%s/8_man_01_8_gorilla_01.map",
-             method);
-    if (vmap_read(harness_data_path(rel), base, g->T, g->S, Q0, NULL, err, sizeof err))
-        FAILF("%s", err);
+    *P0 = published_map(g->S, g->T, method, base, "gorilla_01", "man_01");
+    *Q0 = published_map(g->T, g->S, method, base, "man_01", "gorilla_01");
 }
 
 TEST_T(ddm_auto_denoises_an_agreeing_pair_together_and_a_disagreeing_one_apart, 300)
@@ -333,14 +336,8 @@ TEST_T(rhm_from_a_given_map_is_held_to_it_by_its_anchors, 300)
     testgt g;
     testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_woman_01", 3);
     char err[1024] = "";
-    bmap *P0 = NULL, *Q0 = NULL;
-    if (vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
-                                    "8_gorilla_01_8_woman_01.map"),
-                  VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err) ||
-        vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
-                                    "8_woman_01_8_gorilla_01.map"),
-                  VMAP_BASE_AUTO, g.T, g.S, &Q0, NULL, err, sizeof err))
-        FAILF("%s", err);
+    bmap *P0 = published_map(g.S, g.T, "WKSini_direct_BCICP", VMAP_BASE_AUTO, "gorilla_01", "woman_01");
+    bmap *Q0 = published_map(g.T, g.S, "WKSini_direct_BCICP", VMAP_BASE_AUTO, "woman_01", "gorilla_01");
     ectm_params p;
     ectm_params_init(&p);
     rhm_params rp;
@@ -393,11 +390,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
     testgt g;
     testgt_vts(&g, "tosca_r_nonisometric/vtx_5k", "8_gorilla_01", "8_man_02", 3);
     char err[1024] = "";
-    bmap *P0 = NULL;
-    if (vmap_read(harness_data_path("tosca_r_nonisometric/vtx_5k/maps_baseline/WKSini_direct_BCICP/"
-                                    "8_gorilla_01_8_man_02.map"),
-                  VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err))
-        FAILF("%s", err);
+    bmap *P0 = published_map(g.S, g.T, "WKSini_direct_BCICP", VMAP_BASE_AUTO, "gorilla_01", "man_02");
     ectm_params p;
     ectm_params_init(&p);
     p.iterations = 30;
