@@ -49,6 +49,57 @@ static int coefficients(const lbo_basis *b, const double *mass, const double *F,
     return 1;
 }
 
+static void mat_mul(const double *A, const double *B, int n, int m, int p, double *out)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < p; j++) {
+            double s = 0;
+            for (int q = 0; q < m; q++)
+                s += A[(size_t)i * m + q] * B[(size_t)q * p + j];
+            out[(size_t)i * p + j] = s;
+        }
+}
+
+/* out (n by p) = A^T B, A: m by n, B: m by p. */
+static void mat_mul_tn(const double *A, const double *B, int m, int n, int p, double *out)
+{
+    memset(out, 0, (size_t)n * p * sizeof *out);
+    for (int q = 0; q < m; q++)
+        for (int i = 0; i < n; i++) {
+            double a = A[(size_t)q * n + i];
+            for (int j = 0; j < p; j++)
+                out[(size_t)i * p + j] += a * B[(size_t)q * p + j];
+        }
+}
+
+/* out (n by p) = A B^T, A: n by m, B: p by m. */
+static void mat_mul_nt(const double *A, const double *B, int n, int m, int p, double *out)
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < p; j++) {
+            double s = 0;
+            for (int q = 0; q < m; q++)
+                s += A[(size_t)i * m + q] * B[(size_t)j * m + q];
+            out[(size_t)i * p + j] = s;
+        }
+}
+
+/* D (k1 by k2): D_ac = (λ1_a − λ2_c)², the commutativity penalty of the
+ * coefficient C_ac; returns its Frobenius norm (1 when 0), which the
+ * solvers divide it by (weights of any basis sizes on one scale). */
+static double commutator_weights(const lbo_basis *b1, const lbo_basis *b2, int k1, int k2,
+                                 double *D)
+{
+    double dn = 0;
+    for (int a = 0; a < k1; a++)
+        for (int c = 0; c < k2; c++) {
+            double d = b1->lambda[a] - b2->lambda[c];
+            D[(size_t)a * k2 + c] = d * d;
+            dn += d * d * d * d;
+        }
+    return dn > 0 ? sqrt(dn) : 1;
+}
+
 int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F1,
                           const lbo_basis *b2, const double *m2, const double *F2, int nd,
                           int k1, int k2, double mu, double *C, char *err, size_t errsz)
@@ -69,21 +120,8 @@ int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F
         errbuf_set(err, errsz, FMAP_ENOMEM, "functional map: out of memory (%d descriptors)", nd);
         goto out;
     }
-    for (int a = 0; a < k2; a++)      /* G = A2 A2^T */
-        for (int c = 0; c < k2; c++) {
-            double s = 0;
-            for (int q = 0; q < nd; q++)
-                s += A2[(size_t)a * nd + q] * A2[(size_t)c * nd + q];
-            G[(size_t)a * k2 + c] = s;
-        }
-    double dn = 0;
-    for (int a = 0; a < k1; a++)
-        for (int c = 0; c < k2; c++) {
-            double d = b1->lambda[a] - b2->lambda[c];
-            D[(size_t)a * k2 + c] = d * d;
-            dn += d * d * d * d;
-        }
-    dn = dn > 0 ? sqrt(dn) : 1;
+    mat_mul_nt(A2, A2, k2, nd, k2, G);   /* G = A2 A2^T */
+    double dn = commutator_weights(b1, b2, k1, k2, D);
     for (int a = 0; a < k1; a++) {
         double *row = C + (size_t)a * k2;
         memcpy(S, G, (size_t)k2 * k2 * sizeof *S);
@@ -243,41 +281,6 @@ typedef struct normal_system {
     double *tmp, *tmp2;
 } normal_system;
 
-static void mat_mul(const double *A, const double *B, int n, int m, int p, double *out)
-{
-    for (int i = 0; i < n; i++)
-        for (int j = 0; j < p; j++) {
-            double s = 0;
-            for (int q = 0; q < m; q++)
-                s += A[(size_t)i * m + q] * B[(size_t)q * p + j];
-            out[(size_t)i * p + j] = s;
-        }
-}
-
-/* out (n by p) = A^T B, A: m by n, B: m by p. */
-static void mat_mul_tn(const double *A, const double *B, int m, int n, int p, double *out)
-{
-    memset(out, 0, (size_t)n * p * sizeof *out);
-    for (int q = 0; q < m; q++)
-        for (int i = 0; i < n; i++) {
-            double a = A[(size_t)q * n + i];
-            for (int j = 0; j < p; j++)
-                out[(size_t)i * p + j] += a * B[(size_t)q * p + j];
-        }
-}
-
-/* out (n by p) = A B^T, A: n by m, B: p by m. */
-static void mat_mul_nt(const double *A, const double *B, int n, int m, int p, double *out)
-{
-    for (int i = 0; i < n; i++)
-        for (int j = 0; j < p; j++) {
-            double s = 0;
-            for (int q = 0; q < m; q++)
-                s += A[(size_t)i * m + q] * B[(size_t)j * m + q];
-            out[(size_t)i * p + j] = s;
-        }
-}
-
 static void normal_apply(const normal_system *ns, const double *X, double *out)
 {
     int k1 = ns->k1, k2 = ns->k2, n = k1 * k2;
@@ -365,30 +368,11 @@ int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const 
         errbuf_set(err, errsz, FMAP_ENOMEM, "functional map: out of memory (%d descriptors)", nd);
         goto out;
     }
-    for (int a = 0; a < k2; a++)
-        for (int c = 0; c < k2; c++) {
-            double s = 0;
-            for (int q = 0; q < nd; q++)
-                s += A2[(size_t)a * nd + q] * A2[(size_t)c * nd + q];
-            G[(size_t)a * k2 + c] = s;
-        }
-    double dn = 0;
-    for (int a = 0; a < k1; a++)
-        for (int c = 0; c < k2; c++) {
-            double d = b1->lambda[a] - b2->lambda[c];
-            D[(size_t)a * k2 + c] = d * d;
-            dn += d * d * d * d;
-        }
-    dn = dn > 0 ? sqrt(dn) : 1;
+    mat_mul_nt(A2, A2, k2, nd, k2, G);   /* G = A2 A2^T */
+    double dn = commutator_weights(b1, b2, k1, k2, D);
     for (int q = 0; q < n; q++)
         D[q] /= dn;
-    for (int a = 0; a < k1; a++)      /* B = A1 A2^T */
-        for (int c = 0; c < k2; c++) {
-            double s = 0;
-            for (int q = 0; q < nd; q++)
-                s += A1[(size_t)a * nd + q] * A2[(size_t)c * nd + q];
-            B[(size_t)a * k2 + c] = s;
-        }
+    mat_mul_nt(A1, A2, k1, nd, k2, B);   /* B = A1 A2^T */
     double nn = mu_n > 0 ? frob(N1, k1 * k1) * frob(N2, k2 * k2) : 0;
     for (int d = 0; d < no; d++) {   /* each operator pair at mu_o / no / (||O1_d|| ||O2_d||) */
         double on = frob(O1 + (size_t)d * k1 * k1, k1 * k1) *
