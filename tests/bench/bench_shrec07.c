@@ -3,7 +3,13 @@
  * even-numbered BIM landmarks, 0-based line 0, 2, 4, ..., given; the
  * odd-numbered ones held out and scored), plus TOSCA wolf0 -> wolf2
  * (tosca_r_isometric: the same connectivity; all 21 landmarks of
- * tosca_hires/Corrs/wolf.pid given; dense identity ground truth scored).
+ * tosca_hires/Corrs/wolf.pid given; dense identity ground truth scored),
+ * and make demo's job: cow -> camel from Debian's libcgal-demo
+ * (/usr/share/doc/libcgal-dev/data.tar.gz, extracted into the test's
+ * directory) with deploy/demo/cow-camel.landmarks, all 16 given, none
+ * held out (no ground truth): its folds are the figure, the issue's
+ * make demo target (run from the repository's root). Its row is left out
+ * of the job-time statistics (issue 16's were over the others).
  *
  * Stages as meshcorr match runs them with its defaults: the start map
  * (rebuilt by the RHM internals rhm_run begins with: with start auto the
@@ -157,7 +163,22 @@
  * 0.0299), the opposite of their held-out errors; it picks right on
  * wolf (0.0040, 0.0160) and teddy (0.0312, 0.0320): what ECTM does to
  * the given landmarks' neighbourhoods does not tell what it does to the
- * held-out points (bird's wing roots, hand's wrist end). */
+ * held-out points (bird's wing roots, hand's wrist end).
+ *
+ * make demo's pair (0a2fa4a): 6.31 % flipped, 2.31 % collapsed after ECTM
+ * and its repair (the figures meshcorr match and make demo print), over
+ * the issue's 2 % and 0.5 %. Met at 4c9addb (0.96 %, 0 %); 56f2326 (the
+ * tube remap of a part's end) left 5.15 %, 2.17 %, and with ECTM's pins
+ * (566689d) it is 6.31 %, 2.31 %. The repair has not lost what it could
+ * do: today's repair takes 4c9addb's ECTM output (10.27 %, 4.31 %) to
+ * 0.95 %, 0 %, as 4c9addb's did (0.96 %). ECTM's output now (9.82 %,
+ * 2.72 %) holds a region it cannot repair: the cow's hind right leg with
+ * its tail, 647 vertices and four landmarks (hip, knee, hoof, tail tip),
+ * collapsed, where the remaps with the landmarks dragged to their images
+ * gain nothing and the free one gains a little but moves landmarks past
+ * a quarter of the chart's radius. Today's ECTM from 4c9addb's RHM maps
+ * repairs to 8.29 %, 3.34 %: with the pins, the old start does not
+ * rescue it either. */
 #include "support/harness.h"
 #include "support/testapart.h"
 #include "support/testfit.h"
@@ -172,7 +193,7 @@
 
 typedef struct pair_spec {
     const char *label;
-    int a, b;               /* SHREC'07 ids; 0: the wolf pair */
+    int a, b;               /* SHREC'07 ids; 0: the wolf pair; -1: make demo's */
 } pair_spec;
 
 static const pair_spec pairs[] = {
@@ -180,7 +201,11 @@ static const pair_spec pairs[] = {
     { "teddy", 162, 165 },   { "hand", 184, 185 },   { "plier", 203, 214 },
     { "fish", 222, 226 },    { "bird", 241, 245 },   { "human", 1, 2 },
     { "armadillo", 293, 298 }, { "fourleg", 381, 393 }, { "wolf0-wolf2", 0, 0 },
+    { "cow-camel", -1, -1 },
 };
+/* make demo's pair: its meshes from Debian's libcgal-demo, its landmarks */
+#define DEMO_ARCHIVE "/usr/share/doc/libcgal-dev/data.tar.gz"
+#define DEMO_LANDMARKS "deploy/demo/cow-camel.landmarks"
 #define NPAIRS ((int)(sizeof pairs / sizeof pairs[0]))
 
 enum { START, RHM, REPAIR, ECTM, NSTAGES };
@@ -250,7 +275,30 @@ static void run_pair(const void *arg, void *out)
     char p[256], S_name[64], T_name[64];
     mesh *S, *T;
     int *ls, *lt, n;
-    if (ps->a) {
+    if (ps->a < 0) {
+        char cmd[1024];
+        snprintf(cmd, sizeof cmd, "tar -xzf %s -C %s --strip-components=2 data/meshes/cow.off "
+                 "data/meshes/camel.off", DEMO_ARCHIVE, harness_tmpdir());
+        if (system(cmd))
+            FAILF("%s: cannot extract cow.off and camel.off (package libcgal-demo)", DEMO_ARCHIVE);
+        snprintf(S_name, sizeof S_name, "cow.off");
+        snprintf(T_name, sizeof T_name, "camel.off");
+        char err[512];
+        lmk_set *D = NULL;
+        snprintf(p, sizeof p, "%s/cow.off", harness_tmpdir());
+        if (mesh_read(p, &S, err, sizeof err))
+            FAILF("%s", err);
+        snprintf(p, sizeof p, "%s/camel.off", harness_tmpdir());
+        if (mesh_read(p, &T, err, sizeof err) ||
+            lmk_read_pairs(DEMO_LANDMARKS, 0, S, T, &D, err, sizeof err))
+            FAILF("%s", err);
+        n = D->n;
+        ls = malloc(sizeof(int) * (size_t)n);
+        lt = malloc(sizeof(int) * (size_t)n);
+        memcpy(ls, D->src, sizeof(int) * (size_t)n);
+        memcpy(lt, D->tgt, sizeof(int) * (size_t)n);
+        lmk_free(D);
+    } else if (ps->a) {
         snprintf(S_name, sizeof S_name, "%d.off", ps->a);
         snprintf(T_name, sizeof T_name, "%d.off", ps->b);
         snprintf(p, sizeof p, "shrec07_bim/Meshes/%d.off", ps->a);
@@ -279,15 +327,15 @@ static void run_pair(const void *arg, void *out)
      * of them given and the rest held out (what a job could score itself on) */
     long gs[256], gt[256];
     int hs_n = 0, *hs, *ht;
-    int step = ps->a ? 2 : 1, w = job->within_given ? 2 : 1;
+    int step = ps->a > 0 ? 2 : 1, w = job->within_given ? 2 : 1;
     for (int k = 0; k < n && fig->given < 256; k += step * w) {
         gs[fig->given] = ls[k];
         gt[fig->given++] = lt[k];
     }
-    if (ps->a || w > 1) {
+    if (ps->a > 0 || w > 1 || ps->a < 0) {   /* the demo: none held out unless --within-given */
         hs = malloc(sizeof(int) * (size_t)n);
         ht = malloc(sizeof(int) * (size_t)n);
-        for (int k = w > 1 ? step : 1; k < n; k += w > 1 ? 2 * step : 2) {
+        for (int k = w > 1 ? step : 1; k < n && (ps->a >= 0 || w > 1); k += w > 1 ? 2 * step : 2) {
             hs[hs_n] = ls[k];
             ht[hs_n++] = lt[k];
         }
@@ -408,16 +456,16 @@ score:
         if (bmap_write(p, maps[a], stage_name[a], err, sizeof err))
             FAILF("%s", err);
     }
-    e = malloc(sizeof(double) * (size_t)fig->nmaps * (size_t)hs_n);
+    e = malloc(sizeof(double) * ((size_t)fig->nmaps * (size_t)hs_n + 1));
     if (!e)
         FAILF("out of memory");
-    if (metric_geodesic_errors(coarse ? geodT : pb->side[1].geod, T, maps, fig->nmaps, hs, ht, hs_n, e))
+    if (hs_n && metric_geodesic_errors(coarse ? geodT : pb->side[1].geod, T, maps, fig->nmaps, hs, ht, hs_n, e))
         FAILF("%s: geodesic errors failed", ps->label);
     for (int a = 0; a < fig->nmaps; a++) {
         double s = 0;
         for (int k = 0; k < hs_n; k++)
             s += e[(size_t)a * hs_n + k];
-        fig->err[a] = s / hs_n;
+        fig->err[a] = hs_n ? s / hs_n : NAN;   /* the demo: nothing held out */
         for (int k = 0; ps->a && k < hs_n && k < HELD_SHOWN; k++)
             fig->lerr[a][k] = e[(size_t)a * hs_n + k];
         if (metric_summarize(S, T, maps[a], &fig->ms[a]) ||
@@ -460,9 +508,12 @@ static void print_rows(const pair_spec *ps, const pair_fig *f)
         char ratio[16] = "-";
         if (a > START)
             snprintf(ratio, sizeof ratio, "%.2f", f->curv[a] / f->curv[a - 1]);
+        char held[16] = "-";          /* the demo: nothing held out */
+        if (!isnan(f->err[a]))
+            snprintf(held, sizeof held, "%.4f", f->err[a]);
         const metric_summary *m = &f->ms[a];
-        printf("%-12s %-11s %5s %-6s %8.4f %7.2f %7.2f %8.3f %6s %7.3f %8.3f %7.1f\n", ps->label,
-               v, lm, stage_name[a], f->err[a], 100 * m->flipped_fraction,
+        printf("%-12s %-11s %5s %-6s %8s %7.2f %7.2f %8.3f %6s %7.3f %8.3f %7.1f\n", ps->label,
+               v, lm, stage_name[a], held, 100 * m->flipped_fraction,
                100 * m->collapsed_fraction, f->curv[a], ratio, m->mean_abs_log_area,
                m->median_conformal, f->secs[a]);
     }
@@ -479,7 +530,7 @@ static void print_rows(const pair_spec *ps, const pair_fig *f)
 /* --per-landmark: held-out landmark k is line 2k + 1 of the pair's .vts. */
 static void print_landmarks(const pair_spec *ps, const pair_fig *f)
 {
-    if (!ps->a || !f->nmaps)
+    if (ps->a <= 0 || !f->nmaps)
         return;
     printf("%-12s held-out landmarks (.vts line):", ps->label);
     for (int a = 0; a < f->nmaps; a++)
@@ -505,7 +556,8 @@ static void print_targets(const int *ran, const pair_fig *figs)
     int classes = 0, ratio_ok = 0, all = 0;
     double errs[NPAIRS];
     printf("\ntargets (full pipeline): flipped <= 2 %%, collapsed <= 0.5 %%, error <= RHM + 0.003, "
-           "|log a| below ECTM's input's, error <= 0.05 (wolf: <= 0.01, flipped <= 1 %%)\n");
+           "|log a| below ECTM's input's, error <= 0.05 (wolf: <= 0.01, flipped <= 1 %%; cow-camel: flipped "
+           "and collapsed)\n");
     for (int i = 0; i < NPAIRS; i++) {
         const pair_fig *f = &figs[i];
         if (!ran[i])
@@ -515,12 +567,17 @@ static void print_targets(const int *ran, const pair_fig *figs)
             continue;
         }
         const metric_summary *m = &f->ms[ECTM], *r = &f->ms[ECTM - 1];   /* ECTM's input */
-        int wolf = !pairs[i].a;
+        int wolf = !pairs[i].a, demo = pairs[i].a < 0;
         int flip = m->flipped_fraction <= (wolf ? 0.01 : 0.02);
         int coll = m->collapsed_fraction <= 0.005;
         int keep = f->err[ECTM] <= f->err[RHM] + 0.003;
         int area = m->mean_abs_log_area < r->mean_abs_log_area;
         int acc = f->err[ECTM] <= (wolf ? 0.01 : 0.05);
+        if (demo) {       /* make demo: flipped and collapsed only */
+            printf("  %-12s %s  flipped %s  collapsed %s\n", pairs[i].label,
+                   flip && coll ? "MET " : "open", flip ? "ok" : "NO", coll ? "ok" : "NO");
+            continue;
+        }
         int ok = flip && coll && (wolf || (keep && area)) && acc;
         all += ok;
         if (!wolf) {
@@ -550,7 +607,7 @@ static void print_cost(const int *ran, const pair_fig *figs)
     int n = 0;
     for (int i = 0; i < NPAIRS; i++) {
         const pair_fig *f = &figs[i];
-        if (!ran[i] || f->nmaps < NSTAGES)
+        if (!ran[i] || f->nmaps < NSTAGES || pairs[i].a < 0)   /* the SHREC'07 pairs and the wolf */
             continue;
         const double secs[NSERIES] = { f->secs[START], f->secs[RHM], f->secs[ECTM],
                                        f->secs[START] + f->secs[RHM] + f->secs[ECTM] };
