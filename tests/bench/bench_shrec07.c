@@ -322,29 +322,27 @@ static void run_pair(const void *arg, void *out)
     }
     fig->nS = S->nv;
     fig->nT = T->nv;
-    /* given: even lines (all for the wolf); held: odd lines (the wolf: every
-     * vertex). --within-given: only the lines given above, every other one
-     * of them given and the rest held out (what a job could score itself on) */
+    /* given: even lines (SHREC'07; the wolf and the demo: all); held: odd
+     * lines (the wolf: every vertex; the demo: none). --within-given: only
+     * the lines given above, every other one of them given and the rest
+     * held out (what a job could score itself on) */
     long gs[256], gt[256];
-    int hs_n = 0, *hs, *ht;
     int step = ps->a > 0 ? 2 : 1, w = job->within_given ? 2 : 1;
+    int dense = !ps->a && w == 1;      /* the wolf against its identity */
     for (int k = 0; k < n && fig->given < 256; k += step * w) {
         gs[fig->given] = ls[k];
         gt[fig->given++] = lt[k];
     }
-    if (ps->a > 0 || w > 1 || ps->a < 0) {   /* the demo: none held out unless --within-given */
-        hs = malloc(sizeof(int) * (size_t)n);
-        ht = malloc(sizeof(int) * (size_t)n);
-        for (int k = w > 1 ? step : 1; k < n && (ps->a >= 0 || w > 1); k += w > 1 ? 2 * step : 2) {
+    int hs_n = 0, *hs = malloc(sizeof(int) * ((size_t)(dense ? S->nv : n) + 1));
+    int *ht = malloc(sizeof(int) * ((size_t)(dense ? S->nv : n) + 1));
+    if (dense)
+        for (int v = 0; v < S->nv; v++)
+            hs[hs_n] = ht[hs_n] = v, hs_n++;
+    else if (w > 1 || ps->a > 0)
+        for (int k = w > 1 ? step : 1; k < n; k += step * w) {   /* between the given ones */
             hs[hs_n] = ls[k];
             ht[hs_n++] = lt[k];
         }
-    } else {
-        hs = malloc(sizeof(int) * (size_t)S->nv);
-        ht = malloc(sizeof(int) * (size_t)S->nv);
-        for (int v = 0; v < S->nv; v++)
-            hs[hs_n] = ht[hs_n] = v, hs_n++;
-    }
     fig->held = hs_n;
     for (int a = 0; a < NSTAGES; a++)
         fig->err[a] = fig->curv[a] = NAN;
