@@ -3,7 +3,9 @@
  * landmarks stay put, a crowded cap, a cap whose images jumped and a long
  * part's end collapsed onto a short part's are re-mapped, and a map
  * mirrored as a whole is left as it was (the repair never makes a map
- * worse); a thin part's mirrored band with its end collapsed is re-mapped. */
+ * worse); a thin part's mirrored band with its end collapsed is re-mapped,
+ * and so is a collapsed region with a landmark far beyond its boundary's
+ * image (the landmarks dragged to their images). */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "fold/fold.h"
@@ -313,6 +315,83 @@ TEST(mirrored_band_and_collapsed_end_of_a_thin_part_are_re_mapped)
     printf("  farthest along the tube from its own ring: %.3f (ring spacing %.3f)\n", worst,
            length / (rings + 1));
     CHECK(worst < 5 * length / (rings + 1));
+    free(img);
+    bmap_free(P);
+    mesh_free(m);
+}
+
+/* A conformal map of the unit sphere onto itself that crowds the north
+ * cap toward a point of the equator: the stereographic coordinate (from
+ * the south pole) divided by k, then a quarter turn that takes the north
+ * pole to +x. One-to-one and orientation-preserving. */
+static void squeeze(const double *x, double k, double *y)
+{
+    if (x[2] < -1 + 1e-12) {            /* the south pole: to -x */
+        y[0] = -1;
+        y[1] = y[2] = 0;
+        return;
+    }
+    double wx = x[0] / (1 + x[2]) / k, wy = x[1] / (1 + x[2]) / k, r2 = wx * wx + wy * wy;
+    y[0] = (1 - r2) / (1 + r2);
+    y[1] = 2 * wy / (1 + r2);
+    y[2] = -2 * wx / (1 + r2);
+}
+
+/* make demo's cow -> camel in small: a region whose boundary lands round a
+ * small disk while a landmark's image lies far outside it. The sphere onto
+ * itself by squeeze (k = 3) but for the cap z > 0.7, collapsed onto the
+ * north pole's image, and two landmarks in the cap: the north pole, kept
+ * at its own place (far beyond the disk the cap's boundary lands round),
+ * and a vertex near z = 0.8 on the +x side, sent to the image of its
+ * mirror point across x = 0 (the free harmonic remap leaves it far from
+ * that). The remap with the landmarks dragged must reach the pole's
+ * image, so its chart takes the landmarks' images in; grown from the
+ * boundary's image alone it left the pole outside, the dragged remap gave
+ * up, the free one was refused, and all 792 collapsed faces stayed. None
+ * is left collapsed now; what the drag past the boundary's image costs is
+ * a few flips round the pole (32 of 5120 faces). */
+TEST(collapsed_region_whose_landmark_lies_beyond_its_boundarys_image_is_dragged)
+{
+    mesh *m = testmesh_icosphere(4);
+    int nv = m->nv, lm[2] = { 0, -1 };
+    for (int v = 1; v < nv; v++)
+        if (m->v[3 * v + 2] > m->v[3 * lm[0] + 2])
+            lm[0] = v;
+    double best = INFINITY;
+    for (int v = 0; v < nv; v++)
+        if (m->v[3 * v] > 0 && fabs(m->v[3 * v + 1]) < 0.1 && fabs(m->v[3 * v + 2] - 0.8) < best) {
+            best = fabs(m->v[3 * v + 2] - 0.8);
+            lm[1] = v;
+        }
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv), pole[3];
+    squeeze(m->v + 3 * lm[0], 3, pole);
+    for (int v = 0; v < nv; v++) {
+        if (m->v[3 * v + 2] > 0.7)
+            memcpy(img + 3 * v, pole, sizeof pole);
+        else
+            squeeze(m->v + 3 * v, 3, img + 3 * v);
+    }
+    memcpy(img + 3 * lm[0], m->v + 3 * lm[0], 3 * sizeof(double));
+    double mirror[3] = { -m->v[3 * lm[1]], m->v[3 * lm[1] + 1], m->v[3 * lm[1] + 2] };
+    squeeze(mirror, 3, img + 3 * lm[1]);
+    bmap *P = map_of_points(m, img, nv);
+    int collapsed = count_bad(m, m, P, METRIC_FACE_COLLAPSED);
+    printf("  planted: %d flipped, %d collapsed of %d faces\n", count_bad(m, m, P, METRIC_FACE_FLIPPED),
+           collapsed, m->nf);
+    CHECK(collapsed > 500);
+    int keep_face[2] = { P->face[lm[0]], P->face[lm[1]] };
+    fold_params fp;
+    fold_params_init(&fp);
+    fold_report rep;
+    CHECK_INT(fold_repair(m, m, lm, 2, &fp, P, &rep), FOLD_OK);
+    int flipped = count_bad(m, m, P, METRIC_FACE_FLIPPED);
+    printf("  bad faces %d -> %d, %d vertices re-mapped in %d regions; %d flipped\n", rep.bad_before,
+           rep.bad_after, rep.region, rep.regions, flipped);
+    CHECK(rep.accepted);
+    CHECK_INT(count_bad(m, m, P, METRIC_FACE_COLLAPSED), 0);
+    CHECK(flipped < 50);
+    CHECK_INT(P->face[lm[0]], keep_face[0]);
+    CHECK_INT(P->face[lm[1]], keep_face[1]);
     free(img);
     bmap_free(P);
     mesh_free(m);

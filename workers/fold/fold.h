@@ -10,8 +10,9 @@
  *           most a quarter of the faces; what the holes bring in stays
  *           where P maps it unless another region's faces are there;
  *   chart   the target faces P sends the region's boundary and filled
- *           holes into (not its landmarks: a limb's tip may lie far
- *           inside), grown by two rings or more until one piece (at most
+ *           holes into (and, for the remap that drags the landmarks, the
+ *           landmarks' images, which the drag must reach), grown by two
+ *           rings or more until one piece (at most
  *           30, and half the target) and hole-filled, a disk too, placed
  *           in the unit disk
  *           by its harmonic map (boundary on the circle by arc length);
@@ -64,9 +65,9 @@
  * pinned inside a harmonic map would fold it round the pin when it is not
  * where that map puts it). Landmarks get their rows back either way. The
  * free one counts only when it puts every landmark within 0.25 of the
- * chart's radius of its image, and a tie goes to the dragged one. A
- * landmark whose image is outside the chart leaves the region to the free
- * remap.
+ * chart's radius of its image, and a tie goes to the dragged one. The
+ * dragged one's chart takes the landmarks' images in; when that chart is
+ * torn apart or too large the region is left to the free remap.
  *
  * Landmark source vertices (when given) keep their rows. What it
  * cannot undo: a part mirrored as a whole (its boundary is mapped the
