@@ -61,7 +61,8 @@
  * Each region is re-mapped twice: with its landmarks free, and with the
  * placement then dragged so that each landmark lands at its image (small
  * steps of a smooth displacement about it that stops short of the pinned
- * vertices and the other landmarks, each a diffeomorphism; a landmark
+ * vertices and the other landmarks, each a diffeomorphism, halved where
+ * the coarse triangles would fold under it; a landmark
  * pinned inside a harmonic map would fold it round the pin when it is not
  * where that map puts it). Landmarks get their rows back either way. The
  * free one counts only when it puts every landmark within 0.25 of the

@@ -50,6 +50,7 @@
  * which wins a tie. */
 #define FOLD__TUBE_DEPTH 2.0
 #define FOLD__DRAG_STEPS 200      /* steps of a landmark's drag, at most */
+#define FOLD__DRAG_HALVINGS 8     /* of a step that would fold the placement */
 /* The passes run again from `rings` while a round of them lowers the
  * count, this many rounds at most: a region refused at first (its chart
  * crossed a neighbour's folds) is often taken once the neighbour is
@@ -340,6 +341,22 @@ out:
     return rc;
 }
 
+/* The region's faces folded in the placement uv (not of positive area,
+ * the chart being oriented as T). */
+static int placed_folds(ctx *c, const fold__patch *pS, const double *uv)
+{
+    int n = 0;
+    for (int i = 0; i < pS->nv; i++)
+        c->sloc[pS->verts[i]] = i;
+    for (int q = 0; q < pS->nf; q++) {
+        const int *f = c->S->f + 3 * pS->faces[q];
+        n += !(area2(uv + 2 * c->sloc[f[0]], uv + 2 * c->sloc[f[1]], uv + 2 * c->sloc[f[2]]) > 0);
+    }
+    for (int i = 0; i < pS->nv; i++)
+        c->sloc[pS->verts[i]] = -1;
+    return n;
+}
+
 /* Moves each landmark of the region from its place in uv to its image's
  * in the chart (lm), carrying its neighbourhood along: small steps of the
  * displacement x -> x + (1 - s^2)^2 d, s = |x - a| / R, about the
@@ -347,10 +364,20 @@ out:
  * other landmarks, |d| below R / 3 so that each step is a diffeomorphism
  * (its Jacobian's determinant 1 + d·grad stays above 1/2). A landmark
  * pinned inside a harmonic map folds it round the pin when the map would
- * put it elsewhere; this leaves the placement fold-free but for the
- * triangles' coarseness. */
-static void drag(ctx *c, const fold__patch *pS, const unsigned char *pin, const double *lm, double *uv)
+ * put it elsewhere. The triangles are coarse next to the bump, though, and
+ * a step the linear triangles cannot follow folds some of them: such a
+ * step is halved (FOLD__DRAG_HALVINGS times at most) until the placement
+ * has no more folded faces than before it, and the landmark stays where
+ * it got when no step will do (its row comes back anyway). Unchecked,
+ * make demo's hind leg with its tail, four landmarks dragged down the
+ * camel's leg, kept 232 bad faces, and the map 2.15 % flipped; checked,
+ * 1.79 %. Returns 0, or -1 when out of memory. */
+static int drag(ctx *c, const fold__patch *pS, const unsigned char *pin, const double *lm, double *uv)
 {
+    double *before = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));
+    if (!before)
+        return -1;
+    int folds = placed_folds(c, pS, uv);
     for (int l = 0; l < pS->nv; l++) {
         if (pin[l] || !c->fixed[pS->verts[l]])
             continue;
@@ -370,19 +397,30 @@ static void drag(ctx *c, const fold__patch *pS, const unsigned char *pin, const 
             double f = fmin(1, R / 3 / len);
             d[0] *= f;
             d[1] *= f;
-            for (int i = 0; i < pS->nv; i++) {
-                if (pin[i])
-                    continue;
-                double s2 = ((uv[2 * i] - a[0]) * (uv[2 * i] - a[0]) +
-                             (uv[2 * i + 1] - a[1]) * (uv[2 * i + 1] - a[1])) / (R * R);
-                if (s2 >= 1)
-                    continue;
-                double phi = (1 - s2) * (1 - s2);
-                uv[2 * i] += phi * d[0];
-                uv[2 * i + 1] += phi * d[1];
+            memcpy(before, uv, sizeof(double) * 2 * (size_t)pS->nv);
+            int moved = 0;
+            for (int h = 0; h <= FOLD__DRAG_HALVINGS && !moved; h++, d[0] *= 0.5, d[1] *= 0.5) {
+                for (int i = 0; i < pS->nv; i++) {
+                    if (pin[i])
+                        continue;
+                    double s2 = ((before[2 * i] - a[0]) * (before[2 * i] - a[0]) +
+                                 (before[2 * i + 1] - a[1]) * (before[2 * i + 1] - a[1])) / (R * R);
+                    double phi = s2 < 1 ? (1 - s2) * (1 - s2) : 0;
+                    uv[2 * i] = before[2 * i] + phi * d[0];
+                    uv[2 * i + 1] = before[2 * i + 1] + phi * d[1];
+                }
+                int n = placed_folds(c, pS, uv);
+                if ((moved = n <= folds))
+                    folds = n;
+            }
+            if (!moved) {
+                memcpy(uv, before, sizeof(double) * 2 * (size_t)pS->nv);
+                break;
             }
         }
     }
+    free(before);
+    return 0;
 }
 
 /* Whether region p (depth: its vertices' depth, fold__depth) is a part's
@@ -496,8 +534,8 @@ static int remap(ctx *c, const fold__patch *pS)
     } else if (fold__harmonic(c->S, &c->ES, pS, pin, NULL, c->sloc, uv) ||
                balance(c, pS, pin, &pT, corner, uvT, uv))
         goto out;
-    if (c->drag_landmarks)
-        drag(c, pS, pin, lm, uv);
+    if (c->drag_landmarks && drag(c, pS, pin, lm, uv))
+        goto out;
     c->shift = 0;
     for (int i = 0; i < pS->nv; i++)
         if (!pin[i] && c->fixed[pS->verts[i]])
