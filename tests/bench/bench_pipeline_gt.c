@@ -287,7 +287,7 @@ static void run_pair(const void *arg, void *out)
     /* from landmarks, corr_run repairs ECTM's maps too (a run from given
      * maps, as in2 is, does not): the same call */
     fold_report rep[2];
-    if (!coarse && corr_repair(&in, er.P, er.Q, rep, err, sizeof err))
+    if (!coarse && corr_repair(&in, er.P, er.Q, 1, rep, err, sizeof err))
         FAILF("%s", err);
     fig->secs[ECTM] = now() - t0;
     fig->iters[ECTM] = er.last.outer;

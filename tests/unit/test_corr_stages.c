@@ -411,7 +411,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
     if (metric_verdict(fP, 0) == METRIC_VERDICT_OK && metric_verdict(fQ, 0) == METRIC_VERDICT_OK)
         FAILF("ECTM from ddm,rhm's maps left no map folded: the rule is not tested");
     fold_report rep[2];
-    if (corr_repair(&in, metric_verdict(fP, 0) ? e.P : NULL, metric_verdict(fQ, 0) ? e.Q : NULL,
+    if (corr_repair(&in, metric_verdict(fP, 0) ? e.P : NULL, metric_verdict(fQ, 0) ? e.Q : NULL, 1,
                     rep, err, sizeof err))
         FAILF("%s", err);
     in.stages = CORR_STAGES_DDM_RHM_ECTM;

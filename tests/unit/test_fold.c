@@ -5,11 +5,16 @@
  * mirrored as a whole is left as it was (the repair never makes a map
  * worse); a thin part's mirrored band with its end collapsed is re-mapped,
  * and so is a collapsed region with a landmark far beyond its boundary's
- * image (the landmarks dragged to their images). */
+ * image (the landmarks dragged to their images); the last step moves
+ * single vertices whose faces fold back into place, the landmarks not,
+ * judged face by face by the metric's own rule. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "fold/fold.h"
 #include "fold/fold__patch.h"
+#include "geo/geo_area.h"
+#include "geo/geo_edges.h"
+#include "geo/geo_normals.h"
 #include "metric/metric.h"
 #include "proj/proj.h"
 
@@ -72,7 +77,8 @@ TEST(planted_fold_is_found_and_relaxed_away)
     fold_params_init(&fp);
     fold_report rep;
     CHECK_INT(fold_repair(m, m, &fixed, 1, &fp, P, &rep), FOLD_OK);
-    printf("  bad faces %d -> %d, %d vertices relaxed\n", rep.bad_before, rep.bad_after, rep.region);
+    printf("  bad faces %d -> %d, %d vertices re-mapped, %d moved alone\n", rep.bad_before,
+           rep.bad_after, rep.region, rep.relaxed);
     CHECK(rep.accepted);
     CHECK_INT(rep.bad_before, flipped);
     CHECK_INT(rep.bad_after, 0);
@@ -125,8 +131,12 @@ TEST(refuses_bad_arguments)
     fold_params_init(&fp);
     fold_report rep;
     CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
+    CHECK_INT(fold_relax(m, m, NULL, 0, P, &rep), FOLD_EINVAL);
     bmap_free(P);
     P = bmap_new(m->nv, m->nv);
+    P->face[0] = m->nf;   /* a row off the target */
+    CHECK_INT(fold_relax(m, m, NULL, 0, P, &rep), FOLD_EINVAL);
+    P->face[0] = 0;
     fp.passes = 0;
     CHECK_INT(fold_repair(m, m, NULL, 0, &fp, P, &rep), FOLD_EINVAL);
     bmap_free(P);
@@ -395,6 +405,118 @@ TEST(collapsed_region_whose_landmark_lies_beyond_its_boundarys_image_is_dragged)
     CHECK_INT(P->face[lm[1]], keep_face[1]);
     free(img);
     bmap_free(P);
+    mesh_free(m);
+}
+
+static double dist3(const double *a, const double *b)
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/* The identity of a sphere onto itself with a few scattered vertices'
+ * images pushed past a neighbour's (1.6 times the way to it): each such
+ * star folds over (the region remaps are not run here). The relaxation
+ * (fold_relax) leaves no face bad, and moves only vertices of bad faces,
+ * each to within its star's reach of its true place; the first pushed
+ * vertex is a landmark and keeps its row (its neighbours move round it).
+ * metric_face_kind, which it judges by, agrees with metric_fold_faces on
+ * every face, before and after. The identity onto the mirror image, all
+ * of whose faces are flipped, it leaves as it is: no star has a good face
+ * to relax against. */
+TEST(relaxation_moves_single_folded_vertices_back_but_not_landmarks)
+{
+    mesh *m = testmesh_icosphere(3);
+    int nv = m->nv, nf = m->nf;
+    geo_edges E;
+    char err[128];
+    CHECK(geo_edges_build(m, &E, err, sizeof err) == 0);
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, m->v, sizeof(double) * 3 * (size_t)nv);
+    unsigned char *touched = calloc((size_t)nv, 1), *badv = calloc((size_t)nv, 1);
+    int lm = -1, nmoved = 0;
+    for (int v = 0; v < nv && nmoved < 8; v += 37) {
+        int free_star = !touched[v];
+        for (int i = E.vf_start[v]; i < E.vf_start[v + 1] && free_star; i++)
+            for (int k = 0; k < 3; k++)
+                free_star &= !touched[m->f[3 * E.vf_face[i] + k]];
+        if (!free_star)
+            continue;
+        const int *f = m->f + 3 * E.vf_face[E.vf_start[v]];
+        int u = f[0] == v ? f[1] : f[0];
+        for (int d = 0; d < 3; d++)
+            img[3 * v + d] = m->v[3 * v + d] + 1.6 * (m->v[3 * u + d] - m->v[3 * v + d]);
+        for (int i = E.vf_start[v]; i < E.vf_start[v + 1]; i++)
+            for (int k = 0; k < 3; k++)
+                touched[m->f[3 * E.vf_face[i] + k]] = 1;
+        if (lm < 0)
+            lm = v;
+        nmoved++;
+    }
+    CHECK(nmoved >= 4);
+    bmap *P = map_of_points(m, img, nv), *before = map_of_points(m, img, nv);
+    unsigned char *kind = malloc((size_t)nf), *k2 = malloc((size_t)nf);
+    double *tn = malloc(sizeof(double) * 3 * (size_t)nv);
+    geo_vertex_normals(m, tn);
+    double area = geo_total_area(m);
+    int bad = metric_fold_faces(m, m, P, kind);
+    for (int t = 0; t < nf; t++) {
+        CHECK_INT(metric_face_kind(m, m, P, img, tn, area, area, t, NULL), kind[t]);
+        for (int k = 0; k < 3 && kind[t]; k++)
+            badv[m->f[3 * t + k]] = 1;
+    }
+    printf("  %d stars pushed over: %d bad faces\n", nmoved, bad);
+    CHECK(bad >= 2 * nmoved);
+    CHECK(badv[lm]);
+
+    fold_report rep;
+    CHECK_INT(fold_relax(m, m, &lm, 1, P, &rep), FOLD_OK);
+    printf("  relaxed: %d -> %d bad faces, %d moves\n", rep.bad_before, rep.bad_after, rep.relaxed);
+    CHECK_INT(rep.bad_before, bad);
+    CHECK_INT(rep.bad_after, 0);
+    CHECK(rep.accepted);
+    CHECK_INT(metric_fold_faces(m, m, P, k2), 0);
+    bmap_apply(P, m->f, m->v, 3, img);
+    for (int t = 0; t < nf; t++)
+        CHECK_INT(metric_face_kind(m, m, P, img, tn, area, area, t, NULL), METRIC_FACE_OK);
+    for (int v = 0; v < nv; v++) {
+        if (!badv[v] || v == lm) {
+            CHECK_INT(P->face[v], before->face[v]);
+            CHECK(memcmp(P->w + 3 * v, before->w + 3 * v, 3 * sizeof(double)) == 0);
+            continue;
+        }
+        double far = 0;   /* the star's reach: its farthest neighbour */
+        const double *x = m->v + 3 * v, *y = img + 3 * v;
+        for (int i = E.vf_start[v]; i < E.vf_start[v + 1]; i++)
+            for (int k = 0; k < 3; k++) {
+                const double *z = m->v + 3 * m->f[3 * E.vf_face[i] + k];
+                far = fmax(far, dist3(x, z));
+            }
+        CHECK(dist3(x, y) < far);
+    }
+
+    mesh *r = testmesh_mirrored(m);
+    bmap *M = map_of_points(r, r->v, nv), *M0 = map_of_points(r, r->v, nv);
+    CHECK_INT(metric_fold_faces(m, r, M, kind), nf);
+    CHECK_INT(fold_relax(m, r, NULL, 0, M, &rep), FOLD_OK);
+    CHECK_INT(rep.bad_after, nf);
+    CHECK_INT(rep.relaxed, 0);
+    CHECK(!rep.accepted);
+    CHECK(memcmp(M->face, M0->face, sizeof(int) * (size_t)nv) == 0);
+    CHECK(memcmp(M->w, M0->w, sizeof(double) * 3 * (size_t)nv) == 0);
+    bmap_free(M);
+    bmap_free(M0);
+    mesh_free(r);
+
+    geo_edges_close(&E);
+    free(img);
+    free(touched);
+    free(badv);
+    free(kind);
+    free(k2);
+    free(tn);
+    bmap_free(P);
+    bmap_free(before);
     mesh_free(m);
 }
 

@@ -106,16 +106,26 @@ static int from_rhm(int rc)
     }
 }
 
-int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char *err,
-                size_t errsz)
+int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
+                char *err, size_t errsz)
 {
     fold_params fp;
     fold_params_init(&fp);
     memset(rep, 0, 2 * sizeof *rep);
     int n = in->L ? in->L->n : 0;
-    int rc = P ? fold_repair(in->S, in->T, in->L ? in->L->src : NULL, n, &fp, P, &rep[0]) : 0;
+    const int *ls = in->L ? in->L->src : NULL, *lt = in->L ? in->L->tgt : NULL;
+    fold_report r;
+    int rc = P ? fold_repair(in->S, in->T, ls, n, &fp, P, &rep[0]) : 0;
     if (!rc && Q)
-        rc = fold_repair(in->T, in->S, in->L ? in->L->tgt : NULL, n, &fp, Q, &rep[1]);
+        rc = fold_repair(in->T, in->S, lt, n, &fp, Q, &rep[1]);
+    if (!rc && relax && P && !(rc = fold_relax(in->S, in->T, ls, n, P, &r))) {
+        rep[0].relaxed = r.relaxed;
+        rep[0].bad_after = r.bad_after;
+    }
+    if (!rc && relax && Q && !(rc = fold_relax(in->T, in->S, lt, n, Q, &r))) {
+        rep[1].relaxed = r.relaxed;
+        rep[1].bad_after = r.bad_after;
+    }
     if (rc)
         return errbuf_set(err, errsz, rc == FOLD_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
                           "repairing the folds of the maps: %s", fold_strerror(rc));
@@ -159,7 +169,7 @@ static int rhm_repaired(const corr_input *in, const rhm_params *q, rhm_progress_
         memcpy((*raw)->face, out->P12->face, sizeof(int) * (size_t)out->P12->n);
         memcpy((*raw)->w, out->P12->w, sizeof(double) * 3 * (size_t)out->P12->n);
     }
-    return corr_repair(in, out->P12, out->P21, rep, err, errsz);
+    return corr_repair(in, out->P12, out->P21, 0, rep, err, errsz);
 }
 
 int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
@@ -223,7 +233,7 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
     fold_report rep[2];
     int rc = from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err,
                                         errsz));
-    return rc ? rc : corr_repair(in, out->P12, out->P21, rep, err, errsz);
+    return rc ? rc : corr_repair(in, out->P12, out->P21, 0, rep, err, errsz);
 }
 
 /* The chain of in (from landmarks) on the decimated pair, its last maps
@@ -350,7 +360,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
             rQ = if_folded(in->T, in->S, out->Q);
         }
         fold_report rep[2];
-        if ((rP || rQ) && (rc = corr_repair(in, rP, rQ, rep, err, errsz)))
+        if ((rP || rQ) && (rc = corr_repair(in, rP, rQ, 1, rep, err, errsz)))
             ectm_result_close(out);
     }
 done:

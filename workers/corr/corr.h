@@ -181,10 +181,14 @@ int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progres
 
 /* The fold repair the pipeline applies to RHM's maps and to ECTM's: fold_repair of P
  * (S -> T) when it is not NULL and of Q (T -> S) when it is not NULL, the landmarks fixed
- * (in->L may be NULL), with fold_params_init's values. rep[0], rep[1]:
- * P's and Q's reports. CORR_OK, CORR_ENOMEM or CORR_EINIT. */
-int corr_repair(const corr_input *in, bmap *P, bmap *Q, fold_report rep[2], char *err,
-                size_t errsz);
+ * (in->L may be NULL), with fold_params_init's values; with relax, then
+ * fold_relax of each: on ECTM's maps, which the pipeline returns, not on
+ * RHM's, whose folds corr_rhm reads to choose the start and which ECTM
+ * moves anyway. rep[0], rep[1]: P's and Q's reports (bad_after and
+ * relaxed: after fold_relax when it ran). CORR_OK, CORR_ENOMEM or
+ * CORR_EINIT. */
+int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
+                char *err, size_t errsz);
 
 /* A job's parameters (the wire form of the one list, proto_params.h) as the
  * engine's: checked with proto_params_check (CORR_EINPUT, "params.NAME ..."

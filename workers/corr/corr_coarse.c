@@ -92,7 +92,7 @@ int corr_coarse_carry(const corr_input *in, const corr_coarse *c, const bmap *Pc
         rc = errbuf_set(err, errsz, from_ctf(rc), "carrying the coarse maps to the meshes: %s", why);
     fold_report rep[2];
     if (!rc && repair)
-        rc = corr_repair(in, *P, Q ? *Q : NULL, rep, err, errsz);
+        rc = corr_repair(in, *P, Q ? *Q : NULL, 0, rep, err, errsz);
     if (rc) {
         bmap_free(*P);
         *P = NULL;

@@ -3,6 +3,7 @@
  * accept-if-better rule per region. */
 #include "fold/fold.h"
 #include "fold/fold__patch.h"
+#include "fold/fold__kinds.h"
 #include "geo/geo_area.h"
 #include "geo/geo_tri.h"
 #include "metric/metric.h"
@@ -28,11 +29,6 @@
  * contradicts the landmark, and restoring the landmark's row leaves its
  * neighbourhood mapped elsewhere. */
 #define FOLD__MAX_SHIFT 0.25
-/* A face whose image (both meshes at unit area) has less than this share
- * of its own area counts as collapsed for the repair: a harmonic map
- * crowds a long part toward a point, exponentially, without reaching the
- * metric's 1e-12. */
-#define FOLD__CROWDED 1e-4
 /* A remap may move a vertex whose faces were all good at most this
  * multiple of the diameter of the image of what the region pins (its
  * boundary and kept holes): the map was right there, and a remap that
@@ -92,33 +88,6 @@ typedef struct ctx {
     unsigned char *tin, *tmark;   /* T->nf, T->nv scratch */
     int *tcomp, *tloc, *sloc;     /* T->nf, T->nv (-1), S->nv (-1) */
 } ctx;
-
-enum { FOLD__FACE_CROWDED = 3 };   /* beside metric.h's METRIC_FACE_* */
-
-/* metric_fold_faces' kinds of P's faces, and FOLD__FACE_CROWDED for an
- * OK one whose image is crowded (FOLD__CROWDED); the number not OK, or -1
- * when out of memory. */
-static int kinds(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind)
-{
-    int bad = metric_fold_faces(S, T, P, kind);
-    double *img = malloc(sizeof(double) * (3 * (size_t)S->nv + 1));
-    double *lr = malloc(sizeof(double) * ((size_t)S->nf + 1));
-    if (bad < 0 || !img || !lr) {
-        free(img);
-        free(lr);
-        return -1;
-    }
-    bmap_apply(P, T->f, T->v, 3, img);
-    metric_area_distortion(S, img, geo_total_area(S), geo_total_area(T), lr);
-    for (int t = 0; t < S->nf; t++)
-        if (kind[t] == METRIC_FACE_OK && !(lr[t] >= log(FOLD__CROWDED))) {
-            kind[t] = FOLD__FACE_CROWDED;
-            bad++;
-        }
-    free(img);
-    free(lr);
-    return bad;
-}
 
 /* Whether the region's vertex i is pinned where it is mapped: its boundary
  * and the holes filled in (their faces were not bad: a limb's end beyond a
@@ -729,7 +698,7 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     }
     /* each region re-mapped each way (its rows and kinds kept per mode) */
     for (int md = 0; md < MODES; md++) {
-        if (remap_all(c, tk, ntaken, md) || kinds(S, c->T, c->R, km + (size_t)md * nf) < 0)
+        if (remap_all(c, tk, ntaken, md) || fold__kinds(S, c->T, c->R, km + (size_t)md * nf) < 0)
             goto out;
         for (int k = 0; k < ntaken; k++) {
             tk[k].far[md] = moved_far(c, tk + k);
@@ -794,12 +763,8 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
                 const fold_params *p, bmap *P, fold_report *rep)
 {
     memset(rep, 0, sizeof *rep);
-    if (!S || !T || !P || !p || P->n != S->nv || P->nt != T->nv || p->rings < 0 ||
-        p->passes < 1 || nfixed < 0)
+    if (!fold__map_ok(S, T, P) || !p || p->rings < 0 || p->passes < 1 || nfixed < 0)
         return FOLD_EINVAL;
-    for (int v = 0; v < P->n; v++)
-        if (P->face[v] < 0 || P->face[v] >= T->nf)
-            return FOLD_EINVAL;
     ctx c = { .S = S, .T = T, .area_S = geo_total_area(S), .area_T = geo_total_area(T) };
     int rc = FOLD_ENOMEM;
     unsigned char *kind = malloc((size_t)S->nf + 1), *fx = calloc((size_t)S->nv + 1, 1);
@@ -824,18 +789,9 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
     c.fixed = fx;
     memcpy(c.R->face, P->face, sizeof(int) * (size_t)P->n);
     memcpy(c.R->w, P->w, sizeof(double) * 3 * (size_t)P->n);
-    int bad = kinds(S, T, P, kind);
-    if (bad < 0)
+    int bad;
+    if ((rc = fold__open(S, T, P, kind, &c.ES, &c.ET, rep, &bad)) || bad == 0)
         goto out;
-    rep->bad_before = rep->bad_after = bad;
-    rc = FOLD_OK;
-    if (bad == 0)
-        goto out;
-    char err[128];
-    if (geo_edges_build(S, &c.ES, err, sizeof err) || geo_edges_build(T, &c.ET, err, sizeof err)) {
-        rc = FOLD_EMESH;
-        goto out;
-    }
     for (int round = 0; round < FOLD__ROUNDS && bad > 0; round++) {
         int start = bad;
         for (int k = 0; k < p->passes && bad > 0; k++)

@@ -19,16 +19,22 @@ static void tri_frame(const double *a, const double *b, const double *c,
     *area = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
+/* Face t's log area ratio (metric_area_distortion). */
+static double face_logratio(const mesh *S, const double *img, double src_area, double tgt_area,
+                            int t)
+{
+    const int *f = S->f + 3 * t;
+    double e1[3], e2[3], a0, a1;
+    tri_frame(S->v + 3 * f[0], S->v + 3 * f[1], S->v + 3 * f[2], e1, e2, &a0);
+    tri_frame(img + 3 * f[0], img + 3 * f[1], img + 3 * f[2], e1, e2, &a1);
+    return log((a1 / tgt_area) / (a0 / src_area));
+}
+
 void metric_area_distortion(const mesh *S, const double *img, double src_area,
                             double tgt_area, double *logratio)
 {
-    for (int t = 0; t < S->nf; t++) {
-        const int *f = S->f + 3 * t;
-        double e1[3], e2[3], a0, a1;
-        tri_frame(S->v + 3 * f[0], S->v + 3 * f[1], S->v + 3 * f[2], e1, e2, &a0);
-        tri_frame(img + 3 * f[0], img + 3 * f[1], img + 3 * f[2], e1, e2, &a1);
-        logratio[t] = log((a1 / tgt_area) / (a0 / src_area));
-    }
+    for (int t = 0; t < S->nf; t++)
+        logratio[t] = face_logratio(S, img, src_area, tgt_area, t);
 }
 
 /* First fundamental form of (e1, e2): g = [[e1·e1, e1·e2], [e1·e2, e2·e2]]. */
@@ -39,23 +45,28 @@ static void fform(const double e1[3], const double e2[3], double g[3])
     g[2] = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
 }
 
+/* Face t's conformal distortion (metric_conformal_distortion). */
+static double face_conformal(const mesh *S, const double *img, int t)
+{
+    const int *f = S->f + 3 * t;
+    double e1[3], e2[3], a0, a1, g0[3], g1[3];
+    tri_frame(S->v + 3 * f[0], S->v + 3 * f[1], S->v + 3 * f[2], e1, e2, &a0);
+    fform(e1, e2, g0);
+    tri_frame(img + 3 * f[0], img + 3 * f[1], img + 3 * f[2], e1, e2, &a1);
+    fform(e1, e2, g1);
+    /* σ₁², σ₂² are the eigenvalues of G = g0⁻¹ g1: tr and det give
+     * σ₁/σ₂ + σ₂/σ₁ = tr/√det, since (σ₁² + σ₂²)/(σ₁σ₂). */
+    double det0 = g0[0] * g0[2] - g0[1] * g0[1];
+    double det1 = g1[0] * g1[2] - g1[1] * g1[1];
+    double tr = (g0[2] * g1[0] - 2 * g0[1] * g1[1] + g0[0] * g1[2]) / det0;
+    double detG = det1 / det0;
+    return detG > 0 ? tr / sqrt(detG) - 2 : INFINITY;
+}
+
 void metric_conformal_distortion(const mesh *S, const double *img, double *conf)
 {
-    for (int t = 0; t < S->nf; t++) {
-        const int *f = S->f + 3 * t;
-        double e1[3], e2[3], a0, a1, g0[3], g1[3];
-        tri_frame(S->v + 3 * f[0], S->v + 3 * f[1], S->v + 3 * f[2], e1, e2, &a0);
-        fform(e1, e2, g0);
-        tri_frame(img + 3 * f[0], img + 3 * f[1], img + 3 * f[2], e1, e2, &a1);
-        fform(e1, e2, g1);
-        /* σ₁², σ₂² are the eigenvalues of G = g0⁻¹ g1: tr and det give
-         * σ₁/σ₂ + σ₂/σ₁ = tr/√det, since (σ₁² + σ₂²)/(σ₁σ₂). */
-        double det0 = g0[0] * g0[2] - g0[1] * g0[1];
-        double det1 = g1[0] * g1[2] - g1[1] * g1[1];
-        double tr = (g0[2] * g1[0] - 2 * g0[1] * g1[1] + g0[0] * g1[2]) / det0;
-        double detG = det1 / det0;
-        conf[t] = detG > 0 ? tr / sqrt(detG) - 2 : INFINITY;
-    }
+    for (int t = 0; t < S->nf; t++)
+        conf[t] = face_conformal(S, img, t);
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -87,6 +98,15 @@ static int face_kind(const mesh *S, const mesh *T, const bmap *P, const double *
                 dot += P->w[3 * row + j] * tn[3 * tf[j] + d] * n[d];
     }
     return dot < 0 ? METRIC_FACE_FLIPPED : METRIC_FACE_OK;
+}
+
+int metric_face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                     const double *tn, double src_area, double tgt_area, int t, double *lr)
+{
+    double l = face_logratio(S, img, src_area, tgt_area, t);
+    if (lr)
+        *lr = l;
+    return face_kind(S, T, P, img, tn, t, l, face_conformal(S, img, t));
 }
 
 /* img, tn, lr, cf of the map (see face_kind); 0, or -1 when out of memory

@@ -43,6 +43,12 @@ typedef struct metric_summary {
  * memory. */
 enum { METRIC_FACE_OK = 0, METRIC_FACE_FLIPPED = 1, METRIC_FACE_COLLAPSED = 2 };
 int metric_fold_faces(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind);
+/* That rule on face t alone, for a caller that moves one image at a time:
+ * img the images P·X̃ (3 per source vertex, P's rows), tn T's vertex
+ * normals (geo_vertex_normals), src_area and tgt_area the total areas;
+ * lr (may be NULL) gets the face's log area ratio (unit-area scale). */
+int metric_face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                     const double *tn, double src_area, double tgt_area, int t, double *lr);
 
 /* The verdict a result carries (the one rule for the worker and the
  * clients): METRIC_VERDICT_REVERSED when more than half of the triangles
