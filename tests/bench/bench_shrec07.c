@@ -233,6 +233,7 @@
  * collapses onto the rump. */
 #include "support/harness.h"
 #include "support/testapart.h"
+#include "support/testcowcamel.h"
 #include "support/testfit.h"
 #include "corr/corr.h"
 #include "metric/metric.h"
@@ -255,9 +256,6 @@ static const pair_spec pairs[] = {
     { "armadillo", 293, 298 }, { "fourleg", 381, 393 }, { "wolf0-wolf2", 0, 0 },
     { "cow-camel", -1, -1 },
 };
-/* make demo's pair: its meshes from Debian's libcgal-demo, its landmarks */
-#define DEMO_ARCHIVE "/usr/share/doc/libcgal-dev/data.tar.gz"
-#define DEMO_LANDMARKS "deploy/demo/cow-camel.landmarks"
 #define NPAIRS ((int)(sizeof pairs / sizeof pairs[0]))
 
 enum { START, RHM, REPAIR, ECTM, NSTAGES };
@@ -328,22 +326,10 @@ static void run_pair(const void *arg, void *out)
     mesh *S, *T;
     int *ls, *lt, n;
     if (ps->a < 0) {
-        char cmd[1024];
-        snprintf(cmd, sizeof cmd, "tar -xzf %s -C %s --strip-components=2 data/meshes/cow.off "
-                 "data/meshes/camel.off", DEMO_ARCHIVE, harness_tmpdir());
-        if (system(cmd))
-            FAILF("%s: cannot extract cow.off and camel.off (package libcgal-demo)", DEMO_ARCHIVE);
+        lmk_set *D = NULL;
+        testcowcamel_load(&S, &T, &D);
         snprintf(S_name, sizeof S_name, "cow.off");
         snprintf(T_name, sizeof T_name, "camel.off");
-        char err[512];
-        lmk_set *D = NULL;
-        snprintf(p, sizeof p, "%s/cow.off", harness_tmpdir());
-        if (mesh_read(p, &S, err, sizeof err))
-            FAILF("%s", err);
-        snprintf(p, sizeof p, "%s/camel.off", harness_tmpdir());
-        if (mesh_read(p, &T, err, sizeof err) ||
-            lmk_read_pairs(DEMO_LANDMARKS, 0, S, T, &D, err, sizeof err))
-            FAILF("%s", err);
         n = D->n;
         ls = malloc(sizeof(int) * (size_t)n);
         lt = malloc(sizeof(int) * (size_t)n);
