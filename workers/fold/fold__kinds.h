@@ -12,9 +12,14 @@
 #define FOLD__CROWDED 1e-4
 enum { FOLD__FACE_CROWDED = 3 };   /* beside metric.h's METRIC_FACE_* */
 
-/* metric_fold_faces' kinds of P's faces (S->nf), and FOLD__FACE_CROWDED
- * for an OK one whose image is crowded; the number not OK, or -1 when out
- * of memory. */
+/* Face t's kind under the images img (3 per source vertex, P's rows; tn:
+ * T's vertex normals, area_S, area_T: the total areas): metric_face_kind,
+ * and FOLD__FACE_CROWDED for an OK face whose image is crowded. */
+int fold__face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                    const double *tn, double area_S, double area_T, int t);
+
+/* That kind of each of P's faces (S->nf); the number not OK, or -1 when
+ * out of memory. */
 int fold__kinds(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind);
 
 /* Whether P is a map from S onto T (its rows on T's faces): 1 or 0. */

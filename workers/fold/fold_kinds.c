@@ -2,30 +2,36 @@
  * checks and tables the repair and the relaxation start with. */
 #include "fold/fold__kinds.h"
 #include "geo/geo_area.h"
+#include "geo/geo_normals.h"
 #include "metric/metric.h"
 
 #include <math.h>
 #include <stdlib.h>
 
+int fold__face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                    const double *tn, double area_S, double area_T, int t)
+{
+    double lr;
+    int k = metric_face_kind(S, T, P, img, tn, area_S, area_T, t, &lr);
+    return k == METRIC_FACE_OK && !(lr >= log(FOLD__CROWDED)) ? FOLD__FACE_CROWDED : k;
+}
+
 int fold__kinds(const mesh *S, const mesh *T, const bmap *P, unsigned char *kind)
 {
-    int bad = metric_fold_faces(S, T, P, kind);
     double *img = malloc(sizeof(double) * (3 * (size_t)S->nv + 1));
-    double *lr = malloc(sizeof(double) * ((size_t)S->nf + 1));
-    if (bad < 0 || !img || !lr) {
-        free(img);
-        free(lr);
-        return -1;
+    double *tn = malloc(sizeof(double) * (3 * (size_t)T->nv + 1));
+    int bad = -1;
+    if (img && tn) {
+        bmap_apply(P, T->f, T->v, 3, img);
+        geo_vertex_normals(T, tn);
+        double aS = geo_total_area(S), aT = geo_total_area(T);
+        bad = 0;
+        for (int t = 0; t < S->nf; t++)
+            bad += (kind[t] = (unsigned char)fold__face_kind(S, T, P, img, tn, aS, aT, t)) !=
+                   METRIC_FACE_OK;
     }
-    bmap_apply(P, T->f, T->v, 3, img);
-    metric_area_distortion(S, img, geo_total_area(S), geo_total_area(T), lr);
-    for (int t = 0; t < S->nf; t++)
-        if (kind[t] == METRIC_FACE_OK && !(lr[t] >= log(FOLD__CROWDED))) {
-            kind[t] = FOLD__FACE_CROWDED;
-            bad++;
-        }
     free(img);
-    free(lr);
+    free(tn);
     return bad;
 }
 

@@ -36,9 +36,7 @@ typedef struct relax {
 /* Face t's kind for the repair under the current images. */
 static int kind_of(const relax *r, int t)
 {
-    double lr;
-    int k = metric_face_kind(r->S, r->T, r->R, r->img, r->tn, r->area_S, r->area_T, t, &lr);
-    return k == METRIC_FACE_OK && !(lr >= log(FOLD__CROWDED)) ? FOLD__FACE_CROWDED : k;
+    return fold__face_kind(r->S, r->T, r->R, r->img, r->tn, r->area_S, r->area_T, t);
 }
 
 /* The bad faces round vertex v, a collapsed one counting as more than all
