@@ -503,7 +503,8 @@ static void run_pair(const void *arg, void *out)
 
     /* the given landmarks (of the pair the stages run on), as corr_run's
      * ECTM gets them in a job from landmarks: pinned in its P/Q-steps
-     * (--from-exact: every other one of the pair's, which are all of them) */
+     * (--from-exact: ri->L holds all of the pair's; the given ones are
+     * taken from it with gs and gt's stride) */
     lmk_set Lg = *ri->L;
     if (L_all) {
         g_src = malloc(sizeof(int) * (size_t)n);
@@ -511,7 +512,7 @@ static void run_pair(const void *arg, void *out)
         if (!g_src || !g_tgt)
             FAILF("out of memory");
         Lg = (lmk_set){ 0, g_src, g_tgt };
-        for (int k = 0; k < ri->L->n; k += step, Lg.n++)
+        for (int k = 0; k < ri->L->n; k += step * w, Lg.n++)
             g_src[Lg.n] = ri->L->src[k], g_tgt[Lg.n] = ri->L->tgt[k];
     }
     corr_input ing = in, in0g = in0;     /* ECTM's repairs: with the given ones */
