@@ -23,7 +23,7 @@ CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(B
 PIC      = -fPIC -fno-semantic-interposition
 CFLAGS   += -std=c11 $(OPT) $(WARN) $(PIC) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) $(PIC) -pthread $(shell pkg-config --cflags draco)
-LDLIBS   += $(shell pkg-config --libs $(PKGS)) -lembree3 -lOpenMeshTools -lOpenMeshCore -lcholmod -larpack -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
+LDLIBS   += $(shell pkg-config --libs $(PKGS) gnutls libseccomp) -lembree3 -lOpenMeshTools -lOpenMeshCore -lcholmod -larpack -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
 
 # The engine library: everything under workers/ except the worker main.
 ENGINE_C   := $(filter-out workers/main/%,$(wildcard workers/*/*.c))
@@ -69,6 +69,9 @@ TEST_SUPPORT_C   := $(wildcard tests/support/*.c)
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_C:%.c=$(BUILD)/obj/%.o)
 TEST_C    := $(wildcard tests/unit/test_*.c)
 TEST_BIN  := $(TEST_C:tests/unit/%.c=$(BUILD)/tests/%)
+# tests/security/: attacks on a real daemon, each one that must fail.
+SEC_C     := $(wildcard tests/security/test_*.c)
+SEC_BIN   := $(SEC_C:tests/security/%.c=$(BUILD)/tests/security/%)
 BENCH_C   := $(wildcard tests/bench/bench_*.c)
 BENCH_BIN := $(BENCH_C:tests/bench/%.c=$(BUILD)/bench/%)
 FUZZ_C    := $(wildcard tests/fuzz/fuzz_*.c)
@@ -148,6 +151,10 @@ $(BUILD)/tests/%: tests/unit/%.c $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(RENDER_CFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS) $(RENDER_LIBS)
 
+$(BUILD)/tests/security/%: tests/security/%.c $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(DAEMON_LIBS) $(RENDER_LIBS)
+
 $(BUILD)/bench/%: tests/bench/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
@@ -156,8 +163,8 @@ $(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) 
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-test: $(PROGRAMS) $(CLIENT_SO) $(TEST_BIN) $(FUZZ_BIN)
-	@sh tests/run-tests.sh $(TEST_BIN) $(FUZZ_BIN)
+test: $(PROGRAMS) $(CLIENT_SO) $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
+	@sh tests/run-tests.sh $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
 
 bench: $(PROGRAMS) $(BENCH_BIN)
 	@for b in $(BENCH_BIN); do echo "== $$b"; ./$$b || exit 1; done

@@ -16,10 +16,12 @@ libuv1-dev
 libsqlite3-dev
 libmodbus-dev libmicrohttpd-dev mbpoll
 slurmctld slurmd slurm-client munge
-libsystemd-dev
+libsystemd-dev systemd
+libgnutls28-dev gnutls-bin
+libseccomp-dev
 mandoc man-db python3-prometheus-client
 libpng-dev
-python3 python3-numpy
+python3 python3-numpy python3-setuptools python3-pip python3-venv python3-wheel
 "
 
 SUDO=""
