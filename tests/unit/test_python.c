@@ -5,8 +5,8 @@
  * build/libmeshcorr.so.1. A case fails when the script exits non-zero, and
  * the test fails when the daemon died or exits non-zero. Then the two ways
  * users install it: `make install PREFIX=tmp` (no root) with README's
- * example script run from PYTHONPATH against the installed library, whose
- * ldd is slim; and `pip install ./client-c/python` into a fresh venv (made
+ * example script and match() run from PYTHONPATH against the installed
+ * libraries (libmeshcorr's ldd slim); and `pip install ./client-c/python` into a fresh venv (made
  * with --system-site-packages for Debian's numpy; offline), whose match()
  * gives a daemon's map. /usr/bin/python3 is Debian's interpreter (the one
  * with python3-numpy): pyenv's or a venv's python3 on PATH may lack numpy. */
@@ -254,5 +254,14 @@ TEST_T(installed_package_runs_the_readme_example_against_meshcorrd, 240)
     char *text = (char *)testfile_read(map, &(size_t){0});
     CHECK_STR_HAS(text, "# meshcorr-map 1\n# meshcorrd job 1\n162 162\n");
     free(text);
+    /* the installed engine library, next to the installed libmeshcorr: match() in-process */
+    rc = testrunf(out, sizeof out, "%s -c 'import meshcorr, meshcorr._lib as l; "
+                  "r = meshcorr.match(\"%s\", \"%s\", landmarks=[[i, i] for i in range(6)], iterations=2); "
+                  "print(len(r.p), l.engine()._name)' 2>&1", env, getenv("MESHCORR_TEST_SRC"),
+                  getenv("MESHCORR_TEST_TGT"));
+    if (rc)
+        FAILF("meshcorr.match from the installed package exited %d:\n%s", rc, out);
+    snprintf(path, sizeof path, "162 %s/lib/libmeshcorr-engine.so.1\n", dest);
+    CHECK_STR_HAS(out, path);
     testdaemon_stop(&d, SIGTERM);
 }
