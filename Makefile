@@ -17,6 +17,10 @@ PKGS     = draco
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
 CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(BUILD)/gen
+# The project's version, kept in one place: the VERSION file (mc_version(),
+# the Python package's metadata, meshcorr.pc).
+MC_VERSION := $(shell cat VERSION)
+CPPFLAGS += -DMC_VERSION='"$(MC_VERSION)"'
 # -fPIC everywhere so libmeshcorr.so can take engine objects from the same
 # archives; Debian's gcc builds PIE by default, so with
 # -fno-semantic-interposition the code is the same as before.
@@ -45,6 +49,14 @@ CLIENT_LIB := $(BUILD)/libmeshcorr.a
 # members they need (the linker takes only those from the archives); it
 # exports mc_* only (client-c/meshcorr.map).
 CLIENT_SO  := $(BUILD)/libmeshcorr.so.1
+# libmeshcorr-engine.so.1: mc_match, a job run in the caller's process
+# (client-c/local/) the way a worker runs it: the worker's job mapping, the
+# engine and the codec linked in; exports mc_match only. The Python
+# package loads it for meshcorr.match(), so libmeshcorr.so stays slim.
+LOCAL_C    := $(wildcard client-c/local/*.c)
+LOCAL_OBJ  := $(LOCAL_C:%.c=$(BUILD)/obj/%.o) \
+  $(addprefix $(BUILD)/obj/workers/main/,worker_job.o worker_result.o worker_progress.o)
+ENGINE_SO  := $(BUILD)/libmeshcorr-engine.so.1
 
 # meshcorrd: daemon/*.c; every file but main.c also goes into libmcdaemon.a
 # so tests can drive a module (the scheduler) directly.
@@ -131,6 +143,15 @@ $(CLIENT_SO): $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) client-c/meshcorr.map
 	  -Wl,--version-script=client-c/meshcorr.map -o $@ $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 	ln -sf libmeshcorr.so.1 $(BUILD)/libmeshcorr.so
 
+$(ENGINE_SO): $(LOCAL_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) client-c/local/meshcorr-engine.map
+	$(CC) $(CFLAGS) -shared -Wl,-soname,libmeshcorr-engine.so.1 -Wl,--no-undefined \
+	  -Wl,--version-script=client-c/local/meshcorr-engine.map -o $@ $(LOCAL_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) \
+	  $(PROTO_LIB) $(LDLIBS)
+	ln -sf libmeshcorr-engine.so.1 $(BUILD)/libmeshcorr-engine.so
+
+# mc_version() is rebuilt when the version changes.
+$(BUILD)/obj/client-c/mc_version.o: VERSION
+
 $(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
@@ -163,7 +184,7 @@ $(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) 
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-test: $(PROGRAMS) $(CLIENT_SO) $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
+test: $(PROGRAMS) $(CLIENT_SO) $(ENGINE_SO) $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
 	@sh tests/run-tests.sh $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
 
 bench: $(PROGRAMS) $(BENCH_BIN)
@@ -207,16 +228,17 @@ install-man:
 
 # libmeshcorr: header, static and shared libraries, pkg-config file (the
 # engine and codec archives too: static users link them, see Libs.private).
-all: $(CLIENT_SO)
+all: $(CLIENT_SO) $(ENGINE_SO)
 install: install-lib
-install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_LIB) $(PROTO_LIB)
+install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_SO) $(ENGINE_LIB) $(PROTO_LIB)
 	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
 	install -m 644 client-c/meshcorr.h protocol/proto_params.h $(DESTDIR)$(PREFIX)/include/
 	install -m 644 $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DESTDIR)$(PREFIX)/lib/
-	install -m 755 $(CLIENT_SO) $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(CLIENT_SO) $(ENGINE_SO) $(DESTDIR)$(PREFIX)/lib/
 	ln -sf libmeshcorr.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr.so
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(strip $(LDLIBS))|' client-c/meshcorr.pc.in \
-	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/meshcorr.pc
+	ln -sf libmeshcorr-engine.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr-engine.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(MC_VERSION)|' -e 's|@LIBS@|$(strip $(LDLIBS))|' \
+	  client-c/meshcorr.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/meshcorr.pc
 
 # The Python package (client-c/python/meshcorr) where Debian's python3 finds
 # it: /usr/lib/python3/dist-packages for PREFIX=/usr, else
@@ -227,7 +249,7 @@ PYTHON_SITE ?= $(if $(filter /usr,$(PREFIX)),$(PREFIX)/lib/python3/dist-packages
 install: install-python
 install-python: install-lib
 	install -d $(DESTDIR)$(PYTHON_SITE)/meshcorr
-	install -m 644 client-c/python/meshcorr/*.py $(DESTDIR)$(PYTHON_SITE)/meshcorr/
+	install -m 644 client-c/python/meshcorr/*.py client-c/python/meshcorr/py.typed $(DESTDIR)$(PYTHON_SITE)/meshcorr/
 	printf '"""_libpath.py — written by make install: the installed libmeshcorr."""\nLIBMESHCORR = "%s"\n' \
 	  '$(PREFIX)/lib/libmeshcorr.so.1' > $(DESTDIR)$(PYTHON_SITE)/meshcorr/_libpath.py
 

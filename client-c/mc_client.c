@@ -2,8 +2,7 @@
  * request at a time with blocking I/O under a timeout, replies decoded by
  * the protocol codec and copied into the public structs of meshcorr.h. Holds
  * no mesh code (mc_mesh.c) and no command-line code (cli/). */
-#include "meshcorr.h"
-#include "proto.h"
+#include "mc__wire.h"
 
 #include <errno.h>
 #include <netdb.h>
@@ -55,6 +54,8 @@ const char *mc_state_name(int state) { return proto_state_name(state); }
 
 int mc_state_parse(const char *name)
 {
+    if (!name)
+        return -1;
     for (int i = 0; i <= PROTO_STATE_LAST; i++)
         if (strcasecmp(name, proto_state_name(i)) == 0)
             return i;
@@ -70,13 +71,24 @@ static int fail(mc_client *c, int code, const char *fmt, ...)
     return code;
 }
 
-void mc_set_timeout(mc_client *c, int ms) { c->timeout_ms = ms; }
-const char *mc_errmsg(const mc_client *c) { return c->errmsg; }
-const char *mc_user(const mc_client *c) { return c->user; }
-int mc_is_admin(const mc_client *c) { return c->admin; }
+/* Every call refuses a NULL client (never connected, or one a binding has
+ * closed) with MC_EARG instead of dereferencing it; the getters answer as
+ * for no user. */
+#define MC_NEED_CLIENT(c) do { if (!(c)) return MC_EARG; } while (0)
+
+void mc_set_timeout(mc_client *c, int ms)
+{
+    if (c)
+        c->timeout_ms = ms;
+}
+const char *mc_errmsg(const mc_client *c) { return c ? c->errmsg : "no client (NULL)"; }
+const char *mc_user(const mc_client *c) { return c ? c->user : ""; }
+int mc_is_admin(const mc_client *c) { return c ? c->admin : 0; }
 
 void mc_job_spec_init(mc_job_spec *s)
 {
+    if (!s)
+        return;
     memset(s, 0, sizeof *s);
 #define MC_DEFAULT_STR(name, dflt) s->name = NULL;
 #define MC_DEFAULT_NUM(name, dflt) s->name = dflt;
@@ -306,6 +318,10 @@ static int connect_tcp(mc_client *c, const char *hostport)
 
 int mc_connect(const char *address, const char *token, mc_client **out, char *err, size_t errsz)
 {
+    if (!out) {
+        snprintf(err, errsz, "mc_connect: out is NULL");
+        return MC_EARG;
+    }
     *out = NULL;
     mc_client *c = calloc(1, sizeof *c);
     if (!c) {
@@ -357,57 +373,21 @@ void mc_close(mc_client *c)
 
 int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
 {
-    if (!s || !s->source || !s->target || s->source_len > UINT32_MAX || s->target_len > UINT32_MAX)
-        return fail(c, MC_EARG, "the job needs source and target Draco bytes");
+    MC_NEED_CLIENT(c);
+    if (!job_id)
+        return fail(c, MC_EARG, "mc_submit: job_id is NULL");
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
     req.type = PROTO_MSG_SUBMIT;
-    proto_submit *m = &req.u.submit;
-    m->source = (proto_blob){s->source, (uint32_t)s->source_len};
-    m->target = (proto_blob){s->target, (uint32_t)s->target_len};
-    m->landmarks = (proto_landmark *)s->landmarks;   /* (src, tgt) u32 pairs: the same layout */
-    m->nlandmarks = s->nlandmarks;
-    m->p = (proto_map){(proto_map_row *)s->p, s->np};
-    m->q = (proto_map){(proto_map_row *)s->q, s->nq};
-    proto_params *p = &m->params;
-    /* one assignment per row of the list; an int that does not fit a u8
-     * becomes 255, which the server refuses naming the field */
-#define MC_WIRE_U8(v) (uint8_t)((v) < 0 || (v) > 255 ? 255 : (v))
-#define MC_WIRE_ENUM(name) p->name = MC_WIRE_U8(s->name);
-#define MC_WIRE_BOOL(name) p->name = MC_WIRE_U8(s->name);
-#define MC_WIRE_U32(name)  p->name = s->name;
-#define MC_WIRE_F64(name)  p->name = s->name;
-#define MC_WIRE_STR(name)  p->name = s->name ? s->name : "";
-#define MC_WIRE(name, cli, type, ...) MC_WIRE_##type(name)
-    PROTO_PARAMS(MC_WIRE)
-#undef MC_WIRE
-    m->priority = s->priority;
-    m->label = s->label ? s->label : "";
-    int rc = request(c, &req, PROTO_MSG_SUBMIT_OK, &rep);
+    int rc = mc__submit_of(s, &req.u.submit, c->errmsg, sizeof c->errmsg);
+    if (rc)
+        return rc;
+    rc = request(c, &req, PROTO_MSG_SUBMIT_OK, &rep);
     if (!rc) {
         *job_id = rep.u.submit_ok.job_id;
         proto_msg_free(&rep);
     }
     return rc;
-}
-
-static void copy_progress(mc_progress *o, const proto_progress *p)
-{
-    o->job_id = p->job_id;
-    o->stage = p->stage;
-    o->outer = p->outer;
-    o->total = p->total;
-    for (int d = 0; d < 2; d++) {
-        o->inner[d] = p->inner[d];
-        o->membrane[d] = p->terms[d][PROTO_TERM_MEMBRANE];
-        o->bending[d] = p->terms[d][PROTO_TERM_BENDING];
-        o->mismatch[d] = p->terms[d][PROTO_TERM_MISMATCH];
-        o->reverse[d] = p->terms[d][PROTO_TERM_REVERSE];
-        o->energy[d] = p->terms[d][PROTO_TERM_ENERGY];
-    }
-    o->beta = p->beta;
-    o->gamma = p->gamma;
-    o->elapsed_s = p->elapsed_s;
 }
 
 static int job_request(mc_client *c, int type, int want, uint64_t id, proto_msg *rep)
@@ -427,6 +407,9 @@ const char *mc_quality_name(int verdict)
 
 int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
 {
+    MC_NEED_CLIENT(c);
+    if (!o)
+        return fail(c, MC_EARG, "mc_status: out is NULL");
     proto_msg rep;
     int rc = job_request(c, PROTO_MSG_STATUS, PROTO_MSG_STATUS_OK, id, &rep);
     if (rc)
@@ -444,7 +427,7 @@ int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
     o->end_ms = s->end_ms;
     o->has_progress = s->has_progress;
     if (s->has_progress)
-        copy_progress(&o->progress, &s->progress);
+        mc__progress_of(&o->progress, &s->progress);
     o->quality = (mc_quality){s->quality.verdict, s->quality.flipped, s->quality.collapsed};
     proto_msg_free(&rep);
     return 0;
@@ -452,6 +435,7 @@ int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
 
 int mc_cancel(mc_client *c, uint64_t id)
 {
+    MC_NEED_CLIENT(c);
     proto_msg rep;
     int rc = job_request(c, PROTO_MSG_CANCEL, PROTO_MSG_OK, id, &rep);
     if (!rc)
@@ -461,6 +445,7 @@ int mc_cancel(mc_client *c, uint64_t id)
 
 int mc_delete(mc_client *c, uint64_t id)
 {
+    MC_NEED_CLIENT(c);
     proto_msg rep;
     int rc = job_request(c, PROTO_MSG_DELETE, PROTO_MSG_OK, id, &rep);
     if (!rc)
@@ -470,6 +455,7 @@ int mc_delete(mc_client *c, uint64_t id)
 
 int mc_ping(mc_client *c)
 {
+    MC_NEED_CLIENT(c);
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
     req.type = PROTO_MSG_PING;
@@ -481,6 +467,9 @@ int mc_ping(mc_client *c)
 
 int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **jobs, uint32_t *n)
 {
+    MC_NEED_CLIENT(c);
+    if (!jobs || !n)
+        return fail(c, MC_EARG, "mc_list: jobs or n is NULL");
     *jobs = NULL;
     *n = 0;
     uint64_t after = 0;
@@ -532,6 +521,7 @@ int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **j
 int mc_watch(mc_client *c, uint64_t id, uint32_t from_outer, mc_progress_fn cb, void *ctx,
              int *end_state, char *reason, size_t reasonsz)
 {
+    MC_NEED_CLIENT(c);
     proto_msg req;
     memset(&req, 0, sizeof req);
     req.type = PROTO_MSG_WATCH;
@@ -566,7 +556,7 @@ int mc_watch(mc_client *c, uint64_t id, uint32_t from_outer, mc_progress_fn cb, 
             return 0;
         }
         mc_progress p;
-        copy_progress(&p, &m.u.progress);
+        mc__progress_of(&p, &m.u.progress);
         proto_msg_free(&m);
         if (cb && (rc = cb(ctx, &p)) != 0) {
             close(c->fd);
@@ -576,37 +566,11 @@ int mc_watch(mc_client *c, uint64_t id, uint32_t from_outer, mc_progress_fn cb, 
     }
 }
 
-static int copy_map(const proto_map *m, mc_map_row **out, uint32_t *n)
-{
-    *n = m->n;
-    *out = NULL;
-    if (!m->n)
-        return 0;
-    if (!(*out = malloc((size_t)m->n * sizeof **out)))
-        return -1;
-    for (uint32_t i = 0; i < m->n; i++) {
-        (*out)[i].face = m->rows[i].face;
-        memcpy((*out)[i].w, m->rows[i].w, sizeof (*out)[i].w);
-    }
-    return 0;
-}
-
-void mc_result_free(mc_job_result *r)
-{
-    if (!r)
-        return;
-    free(r->p);
-    free(r->q);
-    free(r->deformed);
-    for (uint32_t i = 0; r->metric_keys && i < r->nmetrics; i++)
-        free(r->metric_keys[i]);
-    free(r->metric_keys);
-    free(r->metric_values);
-    memset(r, 0, sizeof *r);
-}
-
 int mc_result(mc_client *c, uint64_t id, unsigned what, mc_job_result *out)
 {
+    MC_NEED_CLIENT(c);
+    if (!out)
+        return fail(c, MC_EARG, "mc_result: out is NULL");
     memset(out, 0, sizeof *out);
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
@@ -615,30 +579,9 @@ int mc_result(mc_client *c, uint64_t id, unsigned what, mc_job_result *out)
     int rc = request(c, &req, PROTO_MSG_RESULT_OK, &rep);
     if (rc)
         return rc;
-    const proto_result_ok *r = &rep.u.result_ok;
-    int bad = copy_map(&r->p, &out->p, &out->np) || copy_map(&r->q, &out->q, &out->nq);
-    if (!bad && r->deformed.len) {
-        out->deformed_len = r->deformed.len;
-        bad = !(out->deformed = malloc(r->deformed.len));
-        if (!bad)
-            memcpy(out->deformed, r->deformed.data, r->deformed.len);
-    }
-    if (!bad && r->nmetrics) {
-        out->metric_keys = calloc(r->nmetrics, sizeof *out->metric_keys);
-        out->metric_values = calloc(r->nmetrics, sizeof *out->metric_values);
-        bad = !out->metric_keys || !out->metric_values;
-        for (uint32_t i = 0; !bad && i < r->nmetrics; i++) {
-            bad = !(out->metric_keys[i] = strdup(r->metrics[i].key));
-            out->metric_values[i] = r->metrics[i].value;
-            out->nmetrics = i + 1;
-        }
-    }
+    rc = mc__result_of(&rep.u.result_ok, ~0u, out);     /* every part the server sent */
     proto_msg_free(&rep);
-    if (bad) {
-        mc_result_free(out);
-        return fail(c, MC_ENOMEM, "out of memory for the result");
-    }
-    return 0;
+    return rc ? fail(c, rc, "out of memory for the result") : 0;
 }
 
 void mc_stats_free(mc_server_stats *s)
@@ -652,6 +595,9 @@ void mc_stats_free(mc_server_stats *s)
 
 int mc_stats(mc_client *c, mc_server_stats *out)
 {
+    MC_NEED_CLIENT(c);
+    if (!out)
+        return fail(c, MC_EARG, "mc_stats: out is NULL");
     memset(out, 0, sizeof *out);
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
@@ -690,6 +636,9 @@ int mc_stats(mc_client *c, mc_server_stats *out)
 
 int mc_send_raw(mc_client *c, const void *bytes, size_t len)
 {
+    MC_NEED_CLIENT(c);
+    if (!bytes && len)
+        return fail(c, MC_EARG, "mc_send_raw: bytes is NULL");
     c->errmsg[0] = '\0';
     int rc = send_all(c, bytes, len);
     if (rc)
@@ -699,4 +648,10 @@ int mc_send_raw(mc_client *c, const void *bytes, size_t len)
     if (!rc)
         proto_msg_free(&m);
     return rc;
+}
+
+void mc_interrupt(mc_client *c)
+{
+    if (c && c->fd >= 0)
+        shutdown(c->fd, SHUT_RDWR);     /* poll() wakes, recv() sees the end */
 }

@@ -47,6 +47,8 @@ enum mc_error {
     /* the server's codes, the same numbers as the protocol's */
     MC_EUNAUTHORIZED = -13, MC_EFORBIDDEN = -14, MC_ENOT_FOUND = -15,
     MC_EBAD_STATE = -16, MC_EQUEUE_FULL = -17, MC_EUSER_LIMIT = -18,
+    MC_EBAD_MESH = -19, MC_EBAD_LANDMARKS = -20, MC_EBAD_PARAMS = -21,
+    MC_ECANCELLED = -25,       /* mc_match: stopped by its progress callback */
     MC_EBUSY = -26,            /* a connection limit: retry later (at connect) */
     MC_ETIMED_OUT = -27,       /* the server cut a silent, slow or idle connection */
 #define MC_ENUM(name, val, msg) name = val,
@@ -54,6 +56,9 @@ enum mc_error {
 #undef MC_ENUM
 };
 const char *mc_strerror(int code);
+/* The project's version, "MAJOR.MINOR.PATCH" (the VERSION file of the
+ * source tree the library was built from). */
+const char *mc_version(void);
 /* The code's name: "BAD_PARAMS" (the protocol's name of a server code), "MC_EARG"
  * (this library's); "UNKNOWN" for others. */
 const char *mc_err_name(int code);
@@ -240,6 +245,12 @@ int mc_delete(mc_client *c, uint64_t job_id);
 int mc_stats(mc_client *c, mc_server_stats *out);
 int mc_ping(mc_client *c);
 
+/* The one call another thread may make on a client while a call on it
+ * blocks (mc_watch waiting for progress): shuts the connection down, so
+ * that call returns MC_EIO at once. The client is then unusable: close it
+ * once that call has returned. NULL ok. */
+void mc_interrupt(mc_client *c);
+
 /* Sends raw bytes as they are (testing and tools): one request, and waits
  * for one reply frame of any kind; returns its error code if it is ERROR. */
 int mc_send_raw(mc_client *c, const void *bytes, size_t len);
@@ -265,6 +276,13 @@ int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char 
 int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, int **f, int *nf, char *err,
                    size_t errsz);
 
+/* A mesh file (.off .obj .ply .drc, by extension) as arrays, read by the
+ * engine's readers as mc_encode_mesh_file reads it (vertex order kept,
+ * triangles only): *v nv by 3 doubles, *f nf by 3 0-based indices, both
+ * malloc()ed, free() them. A file that cannot be opened or read: MC_EFILE,
+ * the file named in err. */
+int mc_read_mesh(const char *path, double **v, int *nv, int **f, int *nf, char *err, size_t errsz);
+
 /* Position coding of the two calls below: MC_QUANTIZATION_LOSSLESS (what
  * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate
  * over the bounding box. Quantizing trades the server's exact view of the
@@ -283,6 +301,20 @@ int mc_encode_mesh_file_quantized(const char *path, int quantization_bits, unsig
 /* mc_encode_mesh with quantization_bits. */
 int mc_encode_mesh_quantized(const double *v, int nv, const int *f, int nf, int quantization_bits,
                              unsigned char **bytes, size_t *len, char *err, size_t errsz);
+
+/* In-process jobs: libmeshcorr-engine.so.1 (link -lmeshcorr-engine; it
+ * holds the engine, libmeshcorr.so holds none). Runs the job of spec in
+ * this process as a meshcorrd worker runs it: the same SUBMIT checks
+ * (meshes decoded and validated, landmarks, parameters: the server's codes
+ * and messages, MC_EBAD_PARAMS ...), the same engine, and the same answer
+ * in out as mc_result gives for that job (the parts `what` names: MC_WANT_*;
+ * mc_result_free). threads: OpenMP threads, 0 = by the pair's size as the
+ * worker does. cb (may be NULL) gets each progress record as mc_watch
+ * delivers it (job_id 0); a non-zero return stops the job: MC_ECANCELLED. Detail of a failure in err. Blocks
+ * until the job ends; one job per call, calls from several threads at once
+ * share OpenMP's thread count. */
+int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn cb, void *ctx,
+             mc_job_result *out, char *err, size_t errsz);
 
 #ifdef __cplusplus
 }

@@ -2,7 +2,10 @@
  * daemon, and meshcorr-validate, the short-lived check of a SUBMIT before it
  * is accepted (the contract of both is workers/WORKER.md). Declarations
  * shared by their files (prefix wrk_); this folder is not part of the engine
- * library and nothing here is called from outside these two programs.
+ * library; outside these two programs only libmeshcorr-engine.so
+ * (client-c/local/mc_match.c) links the job's mapping (worker_job.c,
+ * worker_result.c, worker_progress.c), to run a job in-process as a
+ * worker does.
  * meshcorr-validate is worker_validate.c with worker_job.c and worker_cli.c
  * only, so it loads Draco and none of the engine's solvers.
  *
@@ -48,6 +51,10 @@ typedef struct wrk_job {
 int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
                         char *err, size_t errsz);
 void wrk_job_close(wrk_job *job);
+/* The ERROR code of corr_run's failure corr_rc (BAD_MESH, BAD_PARAMS,
+ * BAD_LANDMARKS, NOMEM, CANCELLED, else INTERNAL): the worker's, and the
+ * in-process job's (client-c/local/mc_match.c). */
+int wrk_code_of_corr(int corr_rc);
 /* The job as corr_run's input (pointers into job; the meshes named
  * "source mesh" and "target mesh", as in every message of a job). */
 void wrk_job_input(const wrk_job *job, corr_input *in);

@@ -163,3 +163,15 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
     omp_set_num_threads(threads);
     return 0;
 }
+
+int wrk_code_of_corr(int corr_rc)
+{
+    switch (corr_rc) {
+    case CORR_EMESH: return PROTO_EBAD_MESH;
+    case CORR_EINPUT: return PROTO_EBAD_PARAMS;
+    case CORR_EINIT: return PROTO_EBAD_LANDMARKS;
+    case CORR_ENOMEM: return PROTO_ENOMEM;
+    case CORR_ECANCELED: return PROTO_ECANCELLED;
+    default: return PROTO_EINTERNAL;
+    }
+}

@@ -60,18 +60,6 @@ static int on_progress(void *ctx, const corr_progress *cp)
     return cancel_requested != 0;
 }
 
-static int proto_code_of(int corr_rc)
-{
-    switch (corr_rc) {
-    case CORR_EMESH: return PROTO_EBAD_MESH;
-    case CORR_EINPUT: return PROTO_EBAD_PARAMS;
-    case CORR_EINIT: return PROTO_EBAD_LANDMARKS;
-    case CORR_ENOMEM: return PROTO_ENOMEM;
-    case CORR_ECANCELED: return PROTO_ECANCELLED;
-    default: return PROTO_EINTERNAL;
-    }
-}
-
 /* Writes error.frame; returns the exit status for code. */
 static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
 {
@@ -214,7 +202,7 @@ int main(int argc, char **argv)
         snprintf(err, sizeof err, "cancelled by SIGTERM after %d of %d outer iterations",
                  ctx.last_outer, job.params.iterations);
     if (rc) {
-        status = fail(dir, job_id, proto_code_of(rc), err);
+        status = fail(dir, job_id, wrk_code_of_corr(rc), err);
         goto done;
     }
     if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err))) {
