@@ -127,24 +127,29 @@ class Result:
 
 
 class Client:
-    """One connection to meshcorrd. server: "unix:PATH" or "tcp:HOST:PORT"
-    (default $MESHCORR_SERVER, else unix:$XDG_RUNTIME_DIR/meshcorr.sock);
-    token: the user's token for TCP (default $MESHCORR_TOKEN; a Unix socket
-    needs none); timeout: seconds a request waits (None: libmeshcorr's 30 s;
-    0: forever). Use it from one thread at a time; close() or `with`."""
+    """One connection to meshcorrd. server: "unix:PATH", "tls:HOST:PORT" or
+    "tcp:HOST:PORT" (default $MESHCORR_SERVER, else
+    unix:$XDG_RUNTIME_DIR/meshcorr.sock); token: the user's token for TCP
+    (default $MESHCORR_TOKEN; a Unix socket needs none); ca: for tls:, the
+    PEM file of the CA the server's certificate must chain to (default
+    $MESHCORR_CA, else the system's trust store; an untrusted certificate
+    raises MeshcorrError MC_ETLS); timeout: seconds a request waits (None:
+    libmeshcorr's 30 s; 0: forever). Use it from one thread at a time;
+    close() or `with`."""
 
-    def __init__(self, server=None, token=None, timeout=None):
+    def __init__(self, server=None, token=None, timeout=None, ca=None):
         self.server = server or _default_server()
         self.token = token if token is not None else os.environ.get("MESHCORR_TOKEN")
         self.timeout = timeout
+        self.ca = ca
         self._c = self._connect()
         self.user = lib.mc_user(self._c).decode()
         self.is_admin = bool(lib.mc_is_admin(self._c))
 
     def _connect(self):
         c, err = _lib.c_client_p(), errbuf()
-        rc = lib.mc_connect(self.server.encode(), self.token.encode() if self.token else None,
-                            ctypes.byref(c), err, len(err))
+        rc = lib.mc_connect_ca(self.server.encode(), self.token.encode() if self.token else None,
+                               os.fsencode(self.ca) if self.ca else None, ctypes.byref(c), err, len(err))
         check(rc, err.value)
         if self.timeout is not None:
             lib.mc_set_timeout(c, int(self.timeout * 1000))
