@@ -40,7 +40,8 @@ extern "C" {
     X(MC_ETIMEOUT, -104, "timed out waiting for the server")                \
     X(MC_EPROTO,   -105, "the server's reply does not follow the protocol") \
     X(MC_ENOMEM,   -106, "out of memory")                                   \
-    X(MC_EFILE,    -107, "cannot read or encode the file")
+    X(MC_EFILE,    -107, "cannot read or encode the file")                  \
+    X(MC_ETLS,     -108, "TLS failed: the server's certificate is not trusted, or no TLS session")
 
 enum mc_error {
     MC_OK = 0,
@@ -215,11 +216,19 @@ typedef struct mc_server_stats {
 } mc_server_stats;
 void mc_stats_free(mc_server_stats *s);
 
-/* address: "unix:PATH" or "tcp:HOST:PORT" (HOST a name or numeric address).
- * token: NULL or "" on a Unix socket (the server asks the kernel who you
- * are); the user's token on TCP. Sends HELLO; a refused token is
- * MC_EUNAUTHORIZED. Detail in err. */
+/* address: "unix:PATH", "tls:HOST:PORT" or "tcp:HOST:PORT" (HOST a name or
+ * numeric address). token: NULL or "" on a Unix socket (the server asks the
+ * kernel who you are); the user's token on TCP. Sends HELLO; a refused token
+ * is MC_EUNAUTHORIZED. Detail in err.
+ * tls: the server's certificate must chain to a CA of $MESHCORR_CA (a PEM
+ * file) when set, else of the system's trust store, and must name HOST (a
+ * DNS name, or an IP address the certificate lists); TLS 1.2 at least. A
+ * certificate that fails, or a server that speaks no TLS, is MC_ETLS. */
 int mc_connect(const char *address, const char *token, mc_client **out, char *err, size_t errsz);
+/* mc_connect trusting the CAs of ca_file (PEM) for a tls: address instead
+ * of $MESHCORR_CA and the system's store (NULL or "": as mc_connect). */
+int mc_connect_ca(const char *address, const char *token, const char *ca_file, mc_client **out, char *err,
+                  size_t errsz);
 void mc_close(mc_client *c);
 void mc_set_timeout(mc_client *c, int ms);     /* <= 0: wait forever */
 const char *mc_errmsg(const mc_client *c);     /* detail of the last failure; "" after success */

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
-enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT };
+enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT, K_FLAG };
 
 #define OFF(f) offsetof(mcd_conf, f)
 static const struct option_def {
@@ -22,7 +22,10 @@ static const struct option_def {
     long long min, max;   /* numeric range */
     const char *help;
 } options[] = {
-    {"listen", K_LISTEN, 0, 0, 0, "unix:PATH | tcp:HOST:PORT (repeatable; PORT 0 = any free port)"},
+    {"listen", K_LISTEN, 0, 0, 0, "unix:PATH | tls:HOST:PORT | tcp:HOST:PORT (repeatable; PORT 0 = any free port; tcp: loopback only)"},
+    {"tls-cert", K_PATH, OFF(tls_cert), 0, 0, "FILE PEM certificate chain for tls: listeners and HTTPS --metrics"},
+    {"tls-key", K_PATH, OFF(tls_key), 0, 0, "FILE PEM private key of --tls-cert"},
+    {"insecure-tcp", K_FLAG, OFF(insecure_tcp), 0, 1, "let a tcp: listener bind a non-loopback address (tokens in clear)"},
     {"state-dir", K_PATH, OFF(state_dir), 0, 0, "DIR: jobs.db and spool/ (required)"},
     {"workers", K_INT, OFF(workers), 1, 1024, "N worker slots (default 1)"},
     {"config", K_CONFIG, 0, 0, 0, "FILE of `key = value` lines, read where it appears"},
@@ -48,10 +51,10 @@ static const struct option_def {
     {"idle-timeout", K_U32, OFF(idle_timeout_s), 0, 100000000, "SECONDS a session with nothing going on is kept (default 600; 0 forever)"},
     {"fd-reserve", K_U32, OFF(fd_reserve), 0, 1000000, "N descriptors kept free for workers (default 0: 32 + 4 per slot)"},
     {"admin-uid", K_LONG, OFF(admin_uid), -1, INT_MAX, "UID treated as admin on the Unix socket (root always is)"},
-    {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp:HOST:PORT addresses to"},
+    {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp: and tls:HOST:PORT addresses to"},
     {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
     {"modbus", K_ENDPOINT, OFF(modbus), 0, 0, "[HOST:]PORT Modbus TCP status registers (off; 1502 suits; host 127.0.0.1)"},
-    {"metrics", K_ENDPOINT, OFF(metrics), 0, 0, "[HOST:]PORT Prometheus GET /metrics over HTTP (off; host 127.0.0.1)"},
+    {"metrics", K_ENDPOINT, OFF(metrics), 0, 0, "[HOST:]PORT Prometheus GET /metrics over HTTP, HTTPS with --tls-cert (off; host 127.0.0.1)"},
     {"backend", K_PATH, OFF(backend), 0, 0, "local|slurm: where jobs run (default local)"},
     {"slurm-partition", K_PATH, OFF(slurm_partition), 0, 0, "NAME sbatch --partition (default: Slurm's)"},
     {"slurm-account", K_PATH, OFF(slurm_account), 0, 0, "NAME sbatch --account"},
@@ -152,13 +155,21 @@ int conf_set(mcd_conf *c, const char *key, const char *v, char *err, size_t errs
     case K_LISTEN:
         if (c->nlisten == CONF_MAX_LISTEN)
             return errbuf_set(err, errsz, -1, "--listen: more than %d addresses", CONF_MAX_LISTEN);
-        if (strncmp(v, "unix:", 5) != 0 && strncmp(v, "tcp:", 4) != 0)
-            return errbuf_set(err, errsz, -1, "--listen: '%s' is not unix:PATH or tcp:HOST:PORT", v);
+        if (strncmp(v, "unix:", 5) != 0 && strncmp(v, "tcp:", 4) != 0 && strncmp(v, "tls:", 4) != 0)
+            return errbuf_set(err, errsz, -1, "--listen: '%s' is not unix:PATH, tls:HOST:PORT or tcp:HOST:PORT", v);
         return set_path(c->listen[c->nlisten++], o->name, v, err, errsz);
     case K_CONFIG:
         return conf_load_file(c, v, err, errsz);
     case K_ENDPOINT:
         return set_endpoint((conf_endpoint *)field, o->name, v, err, errsz);
+    case K_FLAG:
+        if (!strcmp(v, "1") || !strcmp(v, "yes") || !strcmp(v, "true"))
+            *(int *)field = 1;
+        else if (!strcmp(v, "0") || !strcmp(v, "no") || !strcmp(v, "false"))
+            *(int *)field = 0;
+        else
+            return errbuf_set(err, errsz, -1, "--%s: '%s' is not yes or no (1 or 0)", o->name, v);
+        return 0;
     case K_LEVEL: {
         static const char *names[] = {"error", "warn", "info", "debug"};
         for (int i = 0; i < 4; i++)
@@ -224,6 +235,14 @@ int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz)
     return rc;
 }
 
+static int is_flag(const char *key)
+{
+    for (size_t i = 0; i < NOPTIONS; i++)
+        if (strcmp(options[i].name, key) == 0)
+            return options[i].kind == K_FLAG;
+    return 0;
+}
+
 int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
 {
     for (int i = 1; i < argc; i++) {
@@ -241,6 +260,8 @@ int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz)
         key[klen] = '\0';
         if (eq) {
             val = eq + 1;
+        } else if (is_flag(key)) {
+            val = "1";                 /* --insecure-tcp alone turns it on */
         } else {
             if (i + 1 >= argc)
                 return errbuf_set(err, errsz, -1, "--%s needs a value", key);

@@ -70,9 +70,10 @@ int main(int argc, char **argv)
     }
     job_init(&d);
     req_init(&d);
-    if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
+    if (tls_init(&d, err, sizeof err) || bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
+        srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
-        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.snap, &d.metrics, err, sizeof err))) {
+        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.tls, d.snap, &d.metrics, err, sizeof err))) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }
@@ -102,6 +103,7 @@ done:
     }
     mbus_stop(d.mbus);
     metrics_stop(d.metrics);
+    tls_close(&d);
     snap_free(d.snap);
     uv_loop_close(d.loop);
     store_close(d.store);

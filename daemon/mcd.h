@@ -14,6 +14,7 @@
  *   bk_prog.c        progress connections from workers on Slurm nodes
  *   bk_cmd.c         external commands run without blocking the loop
  *   srv.c    srv_    libuv loop, listeners, connections, bounded buffers
+ *   tls.c    tls_    GnuTLS credentials and one session per tls: connection
  *   req.c    req_    one handler per request type, WATCH fan-out
  *   snap.c   snap_   the status snapshot: STATS and the dashboards read it
  *   dash.c   dash_   listening sockets of the dashboard servers
@@ -75,8 +76,11 @@ typedef struct conf_endpoint {
 } conf_endpoint;
 
 typedef struct mcd_conf {
-    char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH" or "tcp:HOST:PORT" */
+    char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH", "tcp:HOST:PORT" or "tls:HOST:PORT" */
     int nlisten;
+    char tls_cert[CONF_PATH];     /* PEM certificate chain of tls: listeners and --metrics; "" = none */
+    char tls_key[CONF_PATH];      /* its private key */
+    int insecure_tcp;             /* a tcp: listener may bind a non-loopback address */
     char state_dir[CONF_PATH];
     char tokens[CONF_PATH];       /* "" = no TCP users */
     char worker[CONF_PATH];       /* "" = meshcorr-worker next to meshcorrd */
@@ -329,9 +333,62 @@ void mbus_fill(const mcd_snapshot *s, uint16_t *regs);
 int mbus_start(const conf_endpoint *e, snap *s, mbus **out, char *err, size_t errsz);
 void mbus_stop(mbus *m);          /* joins the thread; NULL ok */
 
+/* ---- tls_ ----------------------------------------------------------------- */
+/* TLS 1.2 at least, 1.3 preferred; no renegotiation (tls.c). */
+#define TLS_PRIORITY "NORMAL:-VERS-ALL:+VERS-TLS1.3:+VERS-TLS1.2"
+#define TLS_MAX_FILE (1u << 20)   /* bytes of a --tls-cert or --tls-key file */
+#define TLS_MAX_INPUT (1u << 20)  /* ciphertext fed to a session and not yet taken */
+typedef struct tls_creds tls_creds;
+typedef struct tls_conn tls_conn;
+/* Start: checks that every tls: listener has --tls-cert and --tls-key and
+ * reads them into d->tls (NULL without them). 0, or -1 with err naming the
+ * option and the file. */
+int tls_init(mcd *d, char *err, size_t errsz);
+/* SIGHUP: the files read again; a pair that loads serves the connections
+ * accepted from now on (1), one that does not keeps the running pair and
+ * is logged (0, as when TLS is off). */
+int tls_reload(mcd *d);
+void tls_close(mcd *d);           /* drops d->tls; live sessions keep theirs */
+/* SIGHUP: turning TLS on or off and --insecure-tcp wait for the next start. */
+void tls_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
+/* The certificate chain and key as PEM text (libmicrohttpd takes them so),
+ * owned by t. */
+const char *tls_creds_cert_pem(const tls_creds *t);
+const char *tls_creds_key_pem(const tls_creds *t);
+/* A session's records go out through push(ctx, bytes, len): 0, or -1 when
+ * they cannot be queued. */
+typedef int (*tls_push_fn)(void *ctx, const void *data, size_t len);
+/* A server session on creds (a reference is held until tls_conn_free);
+ * peer names the client in log lines. 0 or -1. */
+int tls_conn_new(tls_creds *creds, const char *peer, tls_push_fn push, void *ctx, tls_conn **out);
+void tls_conn_free(tls_conn *t);  /* NULL ok */
+const char *tls_conn_peer(const tls_conn *t);
+int tls_conn_ready(const tls_conn *t);    /* 1 once the handshake is done */
+/* Ciphertext from the peer, kept until the calls below take it; more than
+ * TLS_MAX_INPUT waiting is an error. 0 or -1 with msg. */
+int tls_conn_feed(tls_conn *t, const void *data, size_t len, char *msg, size_t msgsz);
+/* Runs the handshake on what was fed: 1 done, 0 waiting for the peer, -1
+ * failed (the reason in msg; an alert is pushed for the peer). */
+int tls_conn_handshake(tls_conn *t, char *msg, size_t msgsz);
+/* Appends the plaintext of every whole record fed to out: 0, 1 when the
+ * peer closed the session (close_notify), -1 on an error (msg; a
+ * renegotiation request is one). */
+int tls_conn_read(tls_conn *t, proto_buf *out, char *msg, size_t msgsz);
+/* Seals len bytes into records pushed out: 0 or -1 with msg. */
+int tls_conn_write(tls_conn *t, const void *data, size_t len, char *msg, size_t msgsz);
+/* Pushes close_notify once; 1 when it did, 0 when not (before the
+ * handshake, or already sent). */
+int tls_conn_bye(tls_conn *t);
+/* "TLS1.3 AES-256-GCM" of a ready session into buf. */
+const char *tls_conn_desc(const tls_conn *t, char *buf, size_t sz);
+
 /* ---- metrics_ ------------------------------------------------------------- */
 typedef struct metrics metrics;
-int metrics_start(const conf_endpoint *e, snap *s, metrics **out, char *err, size_t errsz);
+/* Serves HTTPS with tls's certificate and key when tls is not NULL. */
+int metrics_start(const conf_endpoint *e, const tls_creds *tls, snap *s, metrics **out, char *err, size_t errsz);
+/* SIGHUP: new connections get tls's certificate (the listening socket
+ * stays); 0, or -1 with err (the running one goes on). */
+int metrics_set_tls(metrics *m, const tls_creds *tls, char *err, size_t errsz);
 void metrics_stop(metrics *m);    /* NULL ok */
 
 /* ---- the daemon ------------------------------------------------------------ */
@@ -362,6 +419,7 @@ struct mcd {
     snap *snap;                   /* the status snapshot */
     mbus *mbus;                   /* NULL unless --modbus */
     metrics *metrics;             /* NULL unless --metrics */
+    tls_creds *tls;               /* NULL unless --tls-cert and --tls-key */
     const bk_ops *bk;             /* the backend (backend.h) */
     int argc;                     /* the command line, parsed again on SIGHUP */
     char **argv;

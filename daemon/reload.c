@@ -1,7 +1,8 @@
 /* reload.c — SIGHUP: the command line is parsed again (so --config files are
  * read again, later options still winning), the reloadable options take
- * effect and the tokens file is read again. A config that no longer parses,
- * or a tokens file that does not load, keeps the old one and logs why;
+ * effect and the tokens file is read again, as are the TLS certificate and
+ * key (tls.c). A config that no longer parses, a tokens file or a
+ * certificate that does not load, keeps the old one and logs why;
  * options that need a restart (listeners, state dir, dashboards, and what
  * the backend says it sets up once: its slots above all) keep their running
  * values with a warning naming them. Opens no sockets, touches no
@@ -16,7 +17,7 @@
 static void keep_restart_only(mcd *d, mcd_conf *n)
 {
     static void (*const keep[])(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz) = {
-        srv_keep_on_reload, store_keep_on_reload, dash_keep_on_reload,
+        srv_keep_on_reload, store_keep_on_reload, dash_keep_on_reload, tls_keep_on_reload,
     };
     char changed[512] = "";
     for (size_t i = 0; i < sizeof keep / sizeof keep[0]; i++)
@@ -45,6 +46,8 @@ static void on_sighup(uv_signal_t *h, int sig)
         dlog_set_level(d->conf.log_level);
         job_sweep_start(d);   /* result-ttl may have changed: sweep now, then at its period */
         dlog(DLOG_INFO, "reload: options applied");
+        if (tls_reload(d) && d->metrics && metrics_set_tls(d->metrics, d->tls, err, sizeof err) != 0)
+            dlog(DLOG_ERROR, "reload: %s: --metrics keeps the running certificate", err);
     }
     auth_tokens *t = NULL;
     if (auth_tokens_load(d->conf.tokens, &t, err, sizeof err) != 0) {

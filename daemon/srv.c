@@ -37,10 +37,24 @@
  * each gets ERROR TIMED_OUT and a log line. What clients have half sent is
  * bounded in all: a frame counts against --max-request-memory from its
  * header to its end (admit), one that does not fit is refused BUSY the
- * same way, and a buffer grown for a large frame is freed once it is done. */
+ * same way, and a buffer grown for a large frame is freed once it is done.
+ *
+ * DESIGN: a tls: listener's connections carry the same frames inside a
+ * GnuTLS session (tls.c). What libuv reads is fed to the session and the
+ * plaintext it yields goes to the framing code as a plain connection's
+ * bytes would; what the framing code queues in `out` is sealed into records
+ * (tls_out) once the handshake is done, and those are what uv_write sends.
+ * Every bound above holds over TLS: queued output counts the records, the
+ * read stops as for a plain connection, a half-done handshake is an
+ * unauthenticated connection (cut by --hello-timeout, counted under
+ * --max-unauthenticated), and a refused client completes its handshake to
+ * read its ERROR. A failed handshake is logged with the peer's address and
+ * GnuTLS's reason, and the connection closes after the alert. A plain tcp:
+ * listener binds loopback only unless --insecure-tcp says otherwise. */
 #include "mcd.h"
 #include "backend.h"
 
+#include <arpa/inet.h>
 #include <dirent.h>
 #include <errno.h>
 #include <poll.h>
@@ -76,6 +90,8 @@ struct conn {
     uint64_t frame_ms;        /* when the incomplete frame in `in` began; 0: none */
     uint64_t active_ms;       /* last byte read, write done or request finished */
     size_t admitted;          /* the incomplete frame's length, counted in admitted_total */
+    tls_conn *tls;            /* a tls: listener's session; in and out hold plaintext */
+    proto_buf tls_out;        /* records sealed, not yet handed to uv_write */
 };
 
 /* Bytes of the frames being received (admitted, not yet consumed), all
@@ -84,6 +100,10 @@ static size_t admitted_total;
 
 static uv_timer_t sweep_timer;     /* the connection timeouts (one loop) */
 static int sweep_on;
+
+/* The tls: listeners (one loop). */
+static const uv_handle_t *tls_listeners[CONF_MAX_LISTEN];
+static int ntls_listeners;
 
 conn_auth *srv_conn_auth(conn *c) { return &c->auth; }
 mcd *srv_conn_daemon(conn *c) { return c->d; }
@@ -96,7 +116,7 @@ int srv_conn_fd(conn *c)
 
 static size_t queued(const conn *c)
 {
-    return c->inflight + c->out.len;
+    return c->inflight + c->out.len + c->tls_out.len;
 }
 
 /* The frame at the front of c->in is consumed (or c is gone): its bytes
@@ -118,6 +138,8 @@ static void conn_free(conn *c)
     c->admitted = 0;
     proto_buf_free(&c->in);
     proto_buf_free(&c->out);
+    proto_buf_free(&c->tls_out);
+    tls_conn_free(c->tls);
     free(c->wdata);
     free(c);
 }
@@ -150,6 +172,7 @@ static void process_input(conn *c);
 static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf);
 static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf);
 static void flush(conn *c);
+static int tls_goodbye(conn *c);
 
 /* Reads while nothing stops it: a close under way, output over the limit
  * (paused), or a request whose work is in flight (holds). */
@@ -189,7 +212,8 @@ static void on_write(uv_write_t *w, int status)
     if (c->closing)
         return;
     if (!c->writing && c->close_after_write) {
-        srv_close(c);
+        if (!tls_goodbye(c))
+            srv_close(c);
         return;
     }
     if (c->paused && queued(c) <= c->d->conf.max_output / 2) {
@@ -201,13 +225,44 @@ static void on_write(uv_write_t *w, int status)
     }
 }
 
+/* TLS: the plaintext queued in c->out becomes records in c->tls_out once
+ * the handshake is done (before, it waits). 0 when that failed and c is
+ * closed. */
+static int seal(conn *c)
+{
+    if (!tls_conn_ready(c->tls) || c->out.len == 0)
+        return 1;
+    char msg[256];
+    int rc = tls_conn_write(c->tls, c->out.data, c->out.len, msg, sizeof msg);
+    proto_buf_free(&c->out);
+    if (rc || c->tls_out.err) {
+        dlog(DLOG_WARN, "conn %lu (tls %s): TLS: %s: closing", c->id, tls_conn_peer(c->tls),
+             rc ? msg : "out of memory for the output");
+        srv_close(c);
+        return 0;
+    }
+    return 1;
+}
+
+static int tls_push(void *ctx, const void *data, size_t len)
+{
+    conn *c = ctx;
+    proto_buf_put(&c->tls_out, data, len);
+    return c->tls_out.err ? -1 : 0;
+}
+
 static void flush(conn *c)
 {
-    if (c->writing || c->closing || c->out.len == 0)
+    /* while a write is in flight frames gather in out (over TLS: sealed
+     * together into fewer records once it is done) */
+    if (c->writing || c->closing || (c->tls && !seal(c)))
         return;
-    c->wdata = c->out.data;
-    c->inflight = c->out.len;
-    proto_buf_init(&c->out);           /* the bytes now belong to the write */
+    proto_buf *src = c->tls ? &c->tls_out : &c->out;
+    if (src->len == 0)
+        return;
+    c->wdata = src->data;
+    c->inflight = src->len;
+    proto_buf_init(src);               /* the bytes now belong to the write */
     uv_buf_t b = uv_buf_init((char *)c->wdata, (unsigned)c->inflight);
     c->wreq.data = c;
     c->writing = 1;
@@ -286,8 +341,24 @@ void srv_close_soon(conn *c)
         return;
     c->close_after_write = 1;
     update_reading(c);
-    if (!c->writing)
+    if (!c->writing && !tls_goodbye(c))
         srv_close(c);
+}
+
+/* A closing TLS connection says close_notify after its last record: 1
+ * when the caller has nothing more to do (it is being written, and
+ * on_write closes after it; or c is closed already), 0 when the caller
+ * closes c now. */
+static int tls_goodbye(conn *c)
+{
+    if (!c->tls || c->closing || !tls_conn_ready(c->tls))
+        return 0;
+    if (!seal(c))
+        return 1;                      /* closed on the failure */
+    if (!tls_conn_bye(c->tls))
+        return 0;                      /* said before */
+    flush(c);
+    return c->writing || c->closing;
 }
 
 /* Byte-stream errors: ERROR, then close once it is written. */
@@ -415,16 +486,77 @@ static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
     *buf = uv_buf_init(chunk, sizeof chunk);
 }
 
+/* TLS: ciphertext read from the client goes to its session (the handshake,
+ * then records); the plaintext is appended to c->in for the framing. */
+static void tls_input(conn *c, const void *data, size_t n)
+{
+    char msg[512];
+    const char *peer = tls_conn_peer(c->tls);
+    if (c->refused && tls_conn_ready(c->tls))
+        return;                        /* a refused client's requests are dropped */
+    if (tls_conn_feed(c->tls, data, n, msg, sizeof msg) != 0) {
+        dlog(DLOG_WARN, "conn %lu (tls %s): %s: closing", c->id, peer, msg);
+        srv_close(c);
+        return;
+    }
+    if (!tls_conn_ready(c->tls)) {
+        int rc = tls_conn_handshake(c->tls, msg, sizeof msg);
+        flush(c);                      /* the handshake's records; a refusal's ERROR once sealed */
+        if (c->closing)
+            return;
+        if (rc < 0) {
+            dlog(DLOG_WARN, "conn %lu (tls %s): TLS handshake failed: %s: closing", c->id, peer, msg);
+            srv_close_soon(c);         /* after the alert */
+            return;
+        }
+        if (rc == 0)
+            return;
+        char desc[64];
+        dlog(DLOG_DEBUG, "conn %lu (tls %s): TLS handshake done: %s", c->id, peer,
+             tls_conn_desc(c->tls, desc, sizeof desc));
+        if (c->refused)
+            return;
+    }
+    size_t before = c->in.len;
+    int rc = tls_conn_read(c->tls, &c->in, msg, sizeof msg);
+    if (c->in.len > before) {
+        c->active_ms = uv_now(c->d->loop);
+        if (before == 0)
+            c->frame_ms = c->active_ms;
+    }
+    if (rc < 0) {
+        dlog(DLOG_WARN, "conn %lu (tls %s): TLS: %s: closing", c->id, peer, msg);
+        flush(c);                      /* an alert */
+        srv_close_soon(c);
+        return;
+    }
+    flush(c);                          /* records the session answers with itself (a key update) */
+    if (c->closing)
+        return;
+    process_input(c);
+    if (rc == 1 && !c->closing)        /* close_notify: the client is done, as at EOF */
+        srv_close(c);
+}
+
 static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf)
 {
     conn *c = s->data;
     if (n < 0) {
         if (n != UV_EOF)
             dlog(DLOG_INFO, "conn %lu: read: %s", c->id, uv_strerror((int)n));
+        else if (c->tls && !tls_conn_ready(c->tls) && !c->refused)
+            dlog(DLOG_INFO, "conn %lu (tls %s): the client left during the TLS handshake", c->id,
+                 tls_conn_peer(c->tls));
         srv_close(c);
         return;
     }
-    if (n == 0 || c->closing || c->close_after_write || c->refused)
+    if (n == 0 || c->closing || c->close_after_write)
+        return;
+    if (c->tls) {
+        tls_input(c, buf->base, (size_t)n);
+        return;
+    }
+    if (c->refused)
         return;                        /* a refused client's bytes are dropped */
     c->active_ms = uv_now(c->d->loop);
     if (c->in.len == 0)
@@ -435,6 +567,43 @@ static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf)
         return;
     }
     process_input(c);
+}
+
+/* sa's address as text into ip (64 bytes); its port. */
+static int addr_name(const struct sockaddr_storage *sa, char ip[64])
+{
+    if (sa->ss_family == AF_INET6) {
+        uv_ip6_name((const struct sockaddr_in6 *)sa, ip, 64);
+        return ntohs(((const struct sockaddr_in6 *)sa)->sin6_port);
+    }
+    uv_ip4_name((const struct sockaddr_in *)sa, ip, 64);
+    return ntohs(((const struct sockaddr_in *)sa)->sin_port);
+}
+
+/* A connection accepted on a tls: listener gets its session: 0, or -1
+ * (logged) when it cannot. */
+static int conn_tls_start(conn *c)
+{
+    struct sockaddr_storage sa;
+    int len = sizeof sa, port = 0;
+    char ip[64] = "?", peer[80];
+    if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) == 0)
+        port = addr_name(&sa, ip);
+    snprintf(peer, sizeof peer, strchr(ip, ':') ? "[%s]:%d" : "%s:%d", ip, port);
+    if (!c->d->tls || tls_conn_new(c->d->tls, peer, tls_push, c, &c->tls) != 0) {
+        dlog(DLOG_ERROR, "conn %lu (tls %s): cannot start a TLS session: closing", c->id, peer);
+        return -1;
+    }
+    dlog(DLOG_DEBUG, "conn %lu (tls %s): TLS session started", c->id, peer);
+    return 0;
+}
+
+static int is_tls_listener(const uv_stream_t *server)
+{
+    for (int i = 0; i < ntls_listeners; i++)
+        if (tls_listeners[i] == (const uv_handle_t *)server)
+            return 1;
+    return 0;
 }
 
 /* Descriptors still free under the soft RLIMIT_NOFILE: the limit less
@@ -535,7 +704,7 @@ static void on_connection(uv_stream_t *server, int status)
     else
         uv_tcp_init(d->loop, &c->u.tcp);
     c->u.h.data = c;
-    if (uv_accept(server, &c->u.s) != 0) {
+    if (uv_accept(server, &c->u.s) != 0 || (is_tls_listener(server) && conn_tls_start(c) != 0)) {
         uv_close(&c->u.h, on_closed);
         return;
     }
@@ -616,7 +785,11 @@ static void on_sweep(uv_timer_t *t)
             if (now - c->refused_ms >= SRV_REFUSE_LINGER_MS)
                 srv_close(c);
         } else if (!c->auth.authed && k->hello_timeout_s && now - c->accepted_ms >= 1000ull * k->hello_timeout_s) {
-            time_out(c, "no HELLO within %u s (--hello-timeout)", k->hello_timeout_s);
+            if (c->tls && !tls_conn_ready(c->tls))
+                time_out(c, "TLS handshake with %s not done within %u s (--hello-timeout)", tls_conn_peer(c->tls),
+                         k->hello_timeout_s);
+            else
+                time_out(c, "no HELLO within %u s (--hello-timeout)", k->hello_timeout_s);
         } else if (c->frame_ms && !c->holds && !c->paused &&
                    now - c->frame_ms >= 1000ull * k->request_timeout_s && k->request_timeout_s) {
             size_t want = frame_size(c);
@@ -662,13 +835,24 @@ static int listen_unix(mcd *d, const char *path, uv_handle_t **out, char *err, s
     return 0;
 }
 
-static int listen_tcp(mcd *d, const char *hostport, uv_handle_t **out, FILE *portfp,
+/* 127.0.0.0/8, ::1, or 127.0.0.0/8 mapped into IPv6. */
+static int is_loopback(const struct sockaddr_storage *sa)
+{
+    if (sa->ss_family == AF_INET)
+        return (ntohl(((const struct sockaddr_in *)sa)->sin_addr.s_addr) >> 24) == 127;
+    const struct in6_addr *a = &((const struct sockaddr_in6 *)sa)->sin6_addr;
+    return IN6_IS_ADDR_LOOPBACK(a) || (IN6_IS_ADDR_V4MAPPED(a) && a->s6_addr[12] == 127);
+}
+
+/* A tcp: listener (tls 0) or a tls: one: scheme:HOST:PORT, HOST numeric. */
+static int listen_tcp(mcd *d, const char *hostport, int tls, uv_handle_t **out, FILE *portfp,
                       char *err, size_t errsz)
 {
     char host[256];
+    const char *scheme = tls ? "tls" : "tcp";
     const char *colon = strrchr(hostport, ':');
     if (!colon || colon == hostport || (size_t)(colon - hostport) >= sizeof host)
-        return snprintf(err, errsz, "tcp:%s: expected tcp:HOST:PORT", hostport), -1;
+        return snprintf(err, errsz, "%s:%s: expected %s:HOST:PORT", scheme, hostport, scheme), -1;
     memcpy(host, hostport, (size_t)(colon - hostport));
     host[colon - hostport] = '\0';
     if (host[0] == '[' && host[strlen(host) - 1] == ']') {
@@ -678,11 +862,18 @@ static int listen_tcp(mcd *d, const char *hostport, uv_handle_t **out, FILE *por
     char *e;
     long port = strtol(colon + 1, &e, 10);
     if (*e || port < 0 || port > 65535)
-        return snprintf(err, errsz, "tcp:%s: bad port", hostport), -1;
+        return snprintf(err, errsz, "%s:%s: bad port", scheme, hostport), -1;
     struct sockaddr_storage sa;
     if (uv_ip4_addr(host, (int)port, (struct sockaddr_in *)&sa) != 0 &&
         uv_ip6_addr(host, (int)port, (struct sockaddr_in6 *)&sa) != 0)
-        return snprintf(err, errsz, "tcp:%s: '%s' is not a numeric IP address", hostport, host), -1;
+        return snprintf(err, errsz, "%s:%s: '%s' is not a numeric IP address", scheme, hostport, host), -1;
+    if (!tls && !is_loopback(&sa)) {
+        if (!d->conf.insecure_tcp)
+            return snprintf(err, errsz, "tcp:%s is not loopback: tokens would cross the network in clear; use "
+                            "tls:HOST:PORT with --tls-cert/--tls-key, or --insecure-tcp to allow it", hostport), -1;
+        dlog(DLOG_WARN, "tcp:%s is not loopback: tokens, meshes and maps cross the network in clear "
+             "(--insecure-tcp)", hostport);
+    }
     uv_tcp_t *t = calloc(1, sizeof *t);
     if (!t)
         return snprintf(err, errsz, "out of memory"), -1;
@@ -693,22 +884,17 @@ static int listen_tcp(mcd *d, const char *hostport, uv_handle_t **out, FILE *por
     if (!rc)
         rc = uv_listen((uv_stream_t *)t, 128, on_connection);
     if (rc)
-        return snprintf(err, errsz, "tcp:%s: %s", hostport, uv_strerror(rc)), -1;
+        return snprintf(err, errsz, "%s:%s: %s", scheme, hostport, uv_strerror(rc)), -1;
+    if (tls)
+        tls_listeners[ntls_listeners++] = (uv_handle_t *)t;
     struct sockaddr_storage bound;
     int len = sizeof bound;
     uv_tcp_getsockname(t, (struct sockaddr *)&bound, &len);
     char ip[64];
-    int bport;
-    if (bound.ss_family == AF_INET6) {
-        uv_ip6_name((struct sockaddr_in6 *)&bound, ip, sizeof ip);
-        bport = ntohs(((struct sockaddr_in6 *)&bound)->sin6_port);
-    } else {
-        uv_ip4_name((struct sockaddr_in *)&bound, ip, sizeof ip);
-        bport = ntohs(((struct sockaddr_in *)&bound)->sin_port);
-    }
-    dlog(DLOG_INFO, "listening on tcp:%s:%d", ip, bport);
+    int bport = addr_name(&bound, ip);
+    dlog(DLOG_INFO, "listening on %s:%s:%d", scheme, ip, bport);
     if (portfp)
-        fprintf(portfp, "tcp:%s:%d\n", ip, bport);
+        fprintf(portfp, "%s:%s:%d\n", scheme, ip, bport);
     return 0;
 }
 
@@ -734,7 +920,7 @@ int srv_listen(mcd *d, char *err, size_t errsz)
         const char *a = d->conf.listen[i];
         uv_handle_t *h = NULL;
         rc = strncmp(a, "unix:", 5) == 0 ? listen_unix(d, a + 5, &h, err, errsz)
-                                         : listen_tcp(d, a + 4, &h, portfp, err, errsz);
+                                         : listen_tcp(d, a + 4, strncmp(a, "tls:", 4) == 0, &h, portfp, err, errsz);
         if (h)
             d->listeners[d->nlisteners++] = h;
     }
@@ -776,6 +962,7 @@ void srv_stop_listening(mcd *d)
         uv_close(h, free_handle);
     }
     d->nlisteners = 0;
+    ntls_listeners = 0;
     if (!d->conns)
         sweep_stop();              /* else the timeouts go on until srv_close_all */
 }

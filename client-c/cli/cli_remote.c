@@ -1,8 +1,9 @@
 /* cli_remote.c — the `meshcorr` subcommands that talk to meshcorrd through
  * libmeshcorr: submit, status, watch, result, cancel, delete, list, stats.
- * They share the server options (--server ADDR, --token T, --token-file F;
- * defaults $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock, and
- * $MESHCORR_TOKEN) and print one line per fact, or JSON where asked. No
+ * They share the server options (--server ADDR, --token T, --token-file F,
+ * --ca FILE; defaults $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock,
+ * $MESHCORR_TOKEN, and $MESHCORR_CA, read by libmeshcorr) and print one line
+ * per fact, or JSON where asked. No
  * numerics, no protocol details: meshcorr.h is the whole interface. */
 #include "cli/cli.h"
 #include "metric/metric.h"
@@ -24,6 +25,7 @@
 typedef struct remote {
     const char *server, *token;
     const char *token_file;    /* when set, the token is this file's first line */
+    const char *ca;            /* --ca: the CA file a tls: server's certificate must chain to */
     char def[4200];
 } remote;
 
@@ -32,6 +34,7 @@ static void remote_defaults(remote *r)
     r->server = getenv("MESHCORR_SERVER");
     r->token = getenv("MESHCORR_TOKEN");
     r->token_file = NULL;
+    r->ca = NULL;
     if (!r->server || !*r->server) {
         const char *xdg = getenv("XDG_RUNTIME_DIR");
         snprintf(r->def, sizeof r->def, "unix:%s/meshcorr.sock", xdg && *xdg ? xdg : "/tmp");
@@ -68,7 +71,7 @@ static mc_client *remote_connect(const char *cmd, const remote *r)
             return NULL;
         token = tok;
     }
-    int rc = mc_connect(r->server, token, &c, err, sizeof err);
+    int rc = mc_connect_ca(r->server, token, r->ca, &c, err, sizeof err);
     if (rc) {
         fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, r->server, err);
         if (rc == MC_EUNAUTHORIZED)
@@ -99,11 +102,11 @@ static int parse_id(const char *cmd, const char *s, uint64_t *id)
 }
 
 /* Options every remote subcommand takes; 1 when handled. */
-enum { O_SERVER = 1000, O_TOKEN, O_TOKEN_FILE };
+enum { O_SERVER = 1000, O_TOKEN, O_TOKEN_FILE, O_CA };
 #define REMOTE_OPTS {"server", required_argument, 0, O_SERVER}, {"token", required_argument, 0, O_TOKEN}, \
-                    {"token-file", required_argument, 0, O_TOKEN_FILE}
-#define REMOTE_NOPTS 3
-#define REMOTE_USAGE "         [--server ADDR] [--token T | --token-file F]\n"
+                    {"token-file", required_argument, 0, O_TOKEN_FILE}, {"ca", required_argument, 0, O_CA}
+#define REMOTE_NOPTS 4
+#define REMOTE_USAGE "         [--server ADDR] [--token T | --token-file F] [--ca FILE]\n"
 
 /* The last of --token and --token-file wins; either overrides $MESHCORR_TOKEN. */
 static int remote_opt(remote *r, int c)
@@ -111,6 +114,7 @@ static int remote_opt(remote *r, int c)
     if (c == O_SERVER) r->server = optarg;
     else if (c == O_TOKEN) r->token = optarg, r->token_file = NULL;
     else if (c == O_TOKEN_FILE) r->token_file = optarg;
+    else if (c == O_CA) r->ca = optarg;
     else return 0;
     return 1;
 }

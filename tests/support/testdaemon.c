@@ -88,7 +88,13 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     for (int i = 0; i < 1000; i++) {      /* up to 10 s */
         fp = fopen(port, "r");
         if (fp) {
+            /* the tcp: listener's line first, then those of args */
             int ok = fscanf(fp, "%63s", d->tcp_addr) == 1;
+            char more[64];
+            d->tls_addr[0] = '\0';
+            while (ok && fscanf(fp, "%63s", more) == 1)
+                if (!d->tls_addr[0] && strncmp(more, "tls:", 4) == 0)
+                    snprintf(d->tls_addr, sizeof d->tls_addr, "%s", more);
             fclose(fp);
             if (ok)
                 return;

@@ -1,7 +1,8 @@
 /* testdaemon.h — the real build/meshcorrd for black-box tests: started with
  * its own state directory under harness_tmpdir(), a Unix socket and a TCP
  * listener on 127.0.0.1 (a free port the daemon picks and writes to its
- * port file), and a tokens file with three users:
+ * port file; a test may add a tls: listener, tests/support/testtls.h), and
+ * a tokens file with three users:
  *   TESTDAEMON_ALICE (user alice), TESTDAEMON_BOB (user bob),
  *   TESTDAEMON_ADMIN (user boss, admin).
  * The daemon dies with the test process (PR_SET_PDEATHSIG). Jobs it runs:
@@ -23,6 +24,7 @@ typedef struct testdaemon {
     char state[600];           /* dir/state */
     char unix_addr[600];       /* "unix:dir/sock" */
     char tcp_addr[64];         /* "tcp:127.0.0.1:PORT" */
+    char tls_addr[64];         /* "tls:127.0.0.1:PORT" of the first tls: listener in args; "" none */
     char log[600];             /* the daemon's stderr (appended across restarts) */
 } testdaemon;
 

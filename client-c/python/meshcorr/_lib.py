@@ -184,6 +184,8 @@ _declare("mc_job_spec_set", ctypes.c_int, ctypes.POINTER(JobSpec), ctypes.c_char
          c_err, ctypes.c_size_t)
 _declare("mc_connect", ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(c_client_p),
          c_err, ctypes.c_size_t)
+_declare("mc_connect_ca", ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p,
+         ctypes.POINTER(c_client_p), c_err, ctypes.c_size_t)
 _declare("mc_close", None, c_client_p)
 _declare("mc_set_timeout", None, c_client_p, ctypes.c_int)
 _declare("mc_errmsg", ctypes.c_char_p, c_client_p)

@@ -38,36 +38,40 @@ def _state_name(state: int) -> str:
 
 
 class Client:
-    """One connection to meshcorrd. server: "unix:PATH" or "tcp:HOST:PORT"
-    (default $MESHCORR_SERVER, else unix:$XDG_RUNTIME_DIR/meshcorr.sock);
-    token: the user's token for TCP (default $MESHCORR_TOKEN; a Unix socket
-    needs none); timeout: seconds connecting and each request may take
-    (MeshcorrTimeoutError past it; None: libmeshcorr's 30 s per request;
-    0: no limit). Use it from one thread at a time; close() it, or use it in
-    a `with` block. Every call after close() raises ClientClosedError."""
+    """One connection to meshcorrd. server: "unix:PATH", "tls:HOST:PORT" or
+    "tcp:HOST:PORT" (default $MESHCORR_SERVER, else
+    unix:$XDG_RUNTIME_DIR/meshcorr.sock); token: the user's token for TCP
+    (default $MESHCORR_TOKEN; a Unix socket needs none); ca: for tls:, the
+    PEM file of the CA the server's certificate must chain to (default
+    $MESHCORR_CA, else the system's trust store); timeout: seconds
+    connecting and each request may take (MeshcorrTimeoutError past it;
+    None: libmeshcorr's 30 s per request; 0: no limit). Use it from one
+    thread at a time; close() it, or use it in a `with` block. Every call
+    after close() raises ClientClosedError."""
 
     server: str
     user: str
     is_admin: bool
 
     def __init__(self, server: Optional[str] = None, token: Optional[str] = None,
-                 timeout: Optional[float] = None) -> None:
+                 timeout: Optional[float] = None, ca: Optional[str] = None) -> None:
         self._c: Optional[int] = None
         self.server = server or _default_server()
-        if not self.server.startswith(("unix:", "tcp:")):
-            raise _lib.error(MC_EADDRESS, "server %r: expected unix:PATH or tcp:HOST:PORT" % self.server,
+        if not self.server.startswith(("unix:", "tcp:", "tls:")):
+            raise _lib.error(MC_EADDRESS, "server %r: expected unix:PATH, tls:HOST:PORT or tcp:HOST:PORT" % self.server,
                              InvalidInputError, "server")
         self.token = token if token is not None else os.environ.get("MESHCORR_TOKEN")
         self.timeout = timeout
         self.user, self.is_admin = "", False
+        self.ca = ca
         self._c = self._connect()
         self.user = lib.mc_user(self._c).decode()
         self.is_admin = bool(lib.mc_is_admin(self._c))
 
     def _connect_now(self) -> int:
         c, err = _lib.c_client_p(), errbuf()
-        rc = lib.mc_connect(self.server.encode(), self.token.encode() if self.token else None,
-                            ctypes.byref(c), err, len(err))
+        rc = lib.mc_connect_ca(self.server.encode(), self.token.encode() if self.token else None,
+                               os.fsencode(self.ca) if self.ca else None, ctypes.byref(c), err, len(err))
         check(rc, err.value)
         if self.timeout is not None:
             lib.mc_set_timeout(c, int(self.timeout * 1000))

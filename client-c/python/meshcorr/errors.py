@@ -28,7 +28,7 @@ import re
 from typing import Optional
 
 # libmeshcorr's own codes (meshcorr.h, MC_ERRORS)
-MC_EARG, MC_EADDRESS, MC_ECONNECT, MC_EIO, MC_ETIMEOUT, MC_EPROTO, MC_ENOMEM, MC_EFILE = range(-100, -108, -1)
+MC_EARG, MC_EADDRESS, MC_ECONNECT, MC_EIO, MC_ETIMEOUT, MC_EPROTO, MC_ENOMEM, MC_EFILE, MC_ETLS = range(-100, -109, -1)
 
 
 class MeshcorrError(Exception):
@@ -138,7 +138,7 @@ _CLASSES = {
     -24: ServerConnectionError, -25: JobCancelledError, -26: ServerBusyError, -27: ServerConnectionError,
     MC_EARG: InvalidInputError, MC_EADDRESS: ServerConnectionError, MC_ECONNECT: ServerConnectionError,
     MC_EIO: ServerConnectionError, MC_ETIMEOUT: MeshcorrTimeoutError, MC_EPROTO: ProtocolError,
-    MC_ENOMEM: MeshcorrMemoryError, MC_EFILE: BadMeshError,
+    MC_ENOMEM: MeshcorrMemoryError, MC_EFILE: BadMeshError, MC_ETLS: ServerConnectionError,
 }
 
 # The argument a server message names by its first words (PROTOCOL.md's
