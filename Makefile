@@ -218,6 +218,7 @@ install: $(PROGRAMS)
 	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	test -e $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf || \
 	  install -m 644 deploy/meshcorrd.conf $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf
+	test -e $(DESTDIR)$(SYSCONFDIR)/meshcorr/tokens || install -m 600 /dev/null $(DESTDIR)$(SYSCONFDIR)/meshcorr/tokens
 
 # The man pages (deploy/man/NAME.SECTION), each into its section's folder.
 MAN_PAGES := $(wildcard deploy/man/*.[1-8])

@@ -29,7 +29,7 @@ static const struct option_def {
     {"state-dir", K_PATH, OFF(state_dir), 0, 0, "DIR: jobs.db and spool/ (required)"},
     {"workers", K_INT, OFF(workers), 1, 1024, "N worker slots (default 1)"},
     {"config", K_CONFIG, 0, 0, 0, "FILE of `key = value` lines, read where it appears"},
-    {"tokens", K_PATH, OFF(tokens), 0, 0, "FILE of `token user [admin]` lines (TCP users)"},
+    {"tokens", K_PATH, OFF(tokens), 0, 0, "FILE of `sha256:HEX user [admin]` lines (TCP users; `meshcorrd token new`)"},
     {"worker", K_PATH, OFF(worker), 0, 0, "PATH of meshcorr-worker (default: next to meshcorrd)"},
     {"validator", K_PATH, OFF(validator), 0, 0, "PATH of meshcorr-validate, SUBMIT's check (default: next to meshcorrd)"},
     {"threads-per-worker", K_INT, OFF(threads_per_worker), 0, 4096, "N OpenMP threads per worker (0: all)"},
@@ -43,9 +43,11 @@ static const struct option_def {
     {"result-ttl", K_U32, OFF(result_ttl_s), 1, 100000000, "SECONDS a finished job is kept"},
     {"max-output", K_U32, OFF(max_output), 4096, 1u << 31, "BYTES queued to one client before a watcher is dropped"},
     {"max-request-memory", K_U32, OFF(max_request_memory), 65536, 0xFFFFFFFFu, "BYTES of request frames being received from all clients at once (default 1 GiB)"},
-    {"max-connections", K_U32, OFF(max_connections), 1, 1000000, "N client connections in all (default 512)"},
+    {"max-connections", K_U32, OFF(max_connections), 1, 1000000, "N sessions of non-admin users in all (default 512)"},
     {"max-connections-per-user", K_U32, OFF(max_connections_per_user), 1, 1000000, "N sessions of one user, admins exempt (default 64)"},
-    {"max-unauthenticated", K_U32, OFF(max_unauthenticated), 1, 1000000, "N connections before HELLO (default 64)"},
+    {"max-unauthenticated", K_U32, OFF(max_unauthenticated), 1, 1000000, "N TCP connections before HELLO (default 64)"},
+    {"max-unauthenticated-per-address", K_U32, OFF(max_unauth_per_address), 1, 1000000, "N of them from one address, IPv6 /64 or local uid (default 8)"},
+    {"admin-reserve", K_U32, OFF(admin_reserve), 0, 1000000, "N descriptors beyond fd-reserve only the Unix socket and admins use (default 32)"},
     {"hello-timeout", K_U32, OFF(hello_timeout_s), 0, 86400, "SECONDS from connect to HELLO (default 10; 0 none)"},
     {"request-timeout", K_U32, OFF(request_timeout_s), 0, 86400, "SECONDS a request frame may take to arrive (default 300; 0 none)"},
     {"idle-timeout", K_U32, OFF(idle_timeout_s), 0, 100000000, "SECONDS a session with nothing going on is kept (default 600; 0 forever)"},
@@ -65,7 +67,7 @@ static const struct option_def {
     {"slurm-extra", K_PATH, OFF(slurm_extra), 0, 0, "ARGS more sbatch arguments, split on blanks"},
     {"slurm-spool", K_PATH, OFF(slurm_spool), 0, 0, "DIR <state-dir>/spool as the nodes see it"},
     {"slurm-worker", K_PATH, OFF(slurm_worker), 0, 0, "PATH of meshcorr-worker on the nodes"},
-    {"slurm-progress", K_PATH, OFF(slurm_progress), 0, 0, "HOST:PORT the workers' progress listener binds (default 0.0.0.0:0)"},
+    {"slurm-progress", K_PATH, OFF(slurm_progress), 0, 0, "HOST:PORT the workers' progress listener binds (default 127.0.0.1:0)"},
     {"slurm-progress-host", K_PATH, OFF(slurm_progress_host), 0, 0, "HOST the workers connect to (default: the bind host, or this host's name)"},
     {"slurm-poll-ms", K_U32, OFF(slurm_poll_ms), 50, 3600000, "MS between squeue polls (default 5000)"},
 };
@@ -87,6 +89,8 @@ void conf_init(mcd_conf *c)
     c->max_connections = CONF_DEFAULT_MAX_CONNECTIONS;
     c->max_connections_per_user = CONF_DEFAULT_MAX_CONNECTIONS_PER_USER;
     c->max_unauthenticated = CONF_DEFAULT_MAX_UNAUTHENTICATED;
+    c->max_unauth_per_address = CONF_DEFAULT_MAX_UNAUTH_PER_ADDRESS;
+    c->admin_reserve = CONF_DEFAULT_ADMIN_RESERVE;
     c->hello_timeout_s = CONF_DEFAULT_HELLO_TIMEOUT_S;
     c->request_timeout_s = CONF_DEFAULT_REQUEST_TIMEOUT_S;
     c->idle_timeout_s = CONF_DEFAULT_IDLE_TIMEOUT_S;
@@ -96,13 +100,15 @@ void conf_init(mcd_conf *c)
     strcpy(c->backend, "local");
     c->slurm_cpus = 1;
     c->slurm_max_jobs = CONF_DEFAULT_SLURM_MAX_JOBS;
-    strcpy(c->slurm_progress, "0.0.0.0:0");
+    strcpy(c->slurm_progress, "127.0.0.1:0");   /* a cluster's nodes need it set */
     c->slurm_poll_ms = CONF_DEFAULT_SLURM_POLL_MS;
 }
 
 void conf_usage(FILE *fp)
 {
-    fprintf(fp, "usage: meshcorrd --state-dir DIR --listen ADDR [options]\n\noptions (also `key = value` in --config):\n");
+    fprintf(fp, "usage: meshcorrd --state-dir DIR --listen ADDR [options]\n"
+                "       meshcorrd token new USER [--admin] | token hash [USER [--admin]] < TOKEN\n"
+                "\noptions (also `key = value` in --config):\n");
     for (size_t i = 0; i < NOPTIONS; i++)
         fprintf(fp, "  --%-20s %s\n", options[i].name, options[i].help);
 }

@@ -2,7 +2,7 @@
  * queue rebuilt from the store, the job bookkeeping (job.c, its expiry
  * sweep included), the backend (backend.h), listeners, the signal handlers
  * (SIGTERM/SIGINT: drain.c; SIGHUP: reload.c), READY=1 to the service
- * manager, then the loop. The loop ends once the drain has closed every
+ * manager, then the loop; or `meshcorrd token ...` (token.c) alone. The loop ends once the drain has closed every
  * handle; only then the store closes (no store_submit can be running) and
  * the dashboard threads (--modbus, --metrics) stop. Holds no request, job or
  * shutdown logic. */
@@ -34,6 +34,8 @@ int main(int argc, char **argv)
 {
     static mcd d;
     char err[1024];
+    if (argc > 1 && strcmp(argv[1], "token") == 0)
+        return token_main(argc - 1, argv + 1);
     conf_init(&d.conf);
     int rc = conf_parse_args(&d.conf, argc, argv, err, sizeof err);
     if (rc == 1) {
@@ -77,6 +79,7 @@ int main(int argc, char **argv)
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }
+    srv_note_tokens(&d);
     job_sweep_start(&d);
     uv_signal_init(d.loop, &d.sigterm);
     uv_signal_init(d.loop, &d.sigint);

@@ -3,7 +3,10 @@
  *
  *   conf.c   conf_   options from the command line and a `key = value` file
  *   dlog.c   dlog_   leveled log lines on stderr
- *   auth.c   auth_   tokens file (TCP) and peer credentials (Unix socket)
+ *   auth.c   auth_   tokens file (TCP, hashed) and peer credentials (Unix socket)
+ *   throttle.c throttle_ failed logins per address: growing waits
+ *   fds.c    fds_    the descriptor budget: free, reserved, the TCP floor
+ *   token.c  token_  `meshcorrd token new|hash`
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
  *   wlock.c  wlock_  a job's worker lock: two workers of one job never run
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
@@ -60,7 +63,9 @@
 /* Connections (srv.c): caps, timeouts, and the descriptors kept free. */
 #define CONF_DEFAULT_MAX_CONNECTIONS 512          /* client connections in all */
 #define CONF_DEFAULT_MAX_CONNECTIONS_PER_USER 64  /* sessions of one user (admins exempt) */
-#define CONF_DEFAULT_MAX_UNAUTHENTICATED 64       /* connections that have not done HELLO */
+#define CONF_DEFAULT_MAX_UNAUTHENTICATED 64       /* TCP connections that have not done HELLO */
+#define CONF_DEFAULT_MAX_UNAUTH_PER_ADDRESS 8     /* of them from one address (IPv6: one /64) or local uid */
+#define CONF_DEFAULT_ADMIN_RESERVE 32             /* descriptors beyond fd-reserve for Unix and admins */
 #define CONF_DEFAULT_HELLO_TIMEOUT_S 10           /* accept -> HELLO done */
 #define CONF_DEFAULT_REQUEST_TIMEOUT_S 300        /* first byte of a frame -> its last */
 #define CONF_DEFAULT_IDLE_TIMEOUT_S 600           /* a session with nothing going on */
@@ -95,6 +100,7 @@ typedef struct mcd_conf {
     uint32_t max_output;          /* output bytes queued per connection */
     uint32_t max_request_memory;  /* bytes of frames being received, all connections */
     uint32_t max_connections, max_connections_per_user, max_unauthenticated;
+    uint32_t max_unauth_per_address, admin_reserve;
     uint32_t hello_timeout_s, request_timeout_s, idle_timeout_s;   /* 0 = none */
     uint32_t fd_reserve;          /* descriptors kept free under RLIMIT_NOFILE; 0 = automatic */
     long admin_uid;               /* Unix-socket uid treated as admin; -1 none (root always) */
@@ -142,15 +148,65 @@ void dlog(int level, const char *fmt, ...) __attribute__((format(printf, 2, 3)))
 
 /* ---- auth_ ---------------------------------------------------------------- */
 #define AUTH_MAX_USER 256
+#define AUTH_MAX_LINE 1023            /* bytes of one tokens-file line, newline excluded */
+#define AUTH_HASH_LEN 32              /* SHA-256 */
+#define AUTH_TOKEN_PREFIX "mc_"       /* the tokens `meshcorrd token new` makes */
+#define AUTH_NEW_TOKEN_BYTES 24       /* their randomness (getrandom): 192 bits */
+#define AUTH_NEW_TOKEN_LEN (3 + 4 * AUTH_NEW_TOKEN_BYTES / 3)   /* prefix and base64url */
 typedef struct auth_tokens auth_tokens;
-/* Lines `token user [admin]`; '#' comments. A missing path gives an empty table. */
+/* Lines `sha256:HEX user [admin]`; '#' comments. The path may start with
+ * ${CREDENTIALS_DIRECTORY}; without one, $CREDENTIALS_DIRECTORY/tokens if it
+ * exists, else an empty table. Refuses a file not owned by the daemon's
+ * user or root, writable by group or others, readable by others, and any
+ * line that is not exactly that form (over AUTH_MAX_LINE, a NUL, a
+ * plaintext token, a token twice), naming the file and line. */
 int auth_tokens_load(const char *path, auth_tokens **out, char *err, size_t errsz);
 void auth_tokens_free(auth_tokens *t);
-/* 0 and the user for a known token, -1 otherwise. */
-int auth_token_user(const auth_tokens *t, const char *token, char user[AUTH_MAX_USER], int *admin);
+int auth_tokens_count(const auth_tokens *t);
+const char *auth_tokens_path(const auth_tokens *t);   /* the file read, "" none */
+/* SHA-256 of a token: 0, or -1. */
+int auth_token_hash(const char *token, uint8_t out[AUTH_HASH_LEN]);
+void auth_hash_hex(const uint8_t h[AUTH_HASH_LEN], char hex[2 * AUTH_HASH_LEN + 1]);
+/* 0 and the user for a known token's hash, -1 otherwise. */
+int auth_token_user(const auth_tokens *t, const uint8_t hash[AUTH_HASH_LEN], char user[AUTH_MAX_USER],
+                    int *admin);
+/* A user name the tokens file may hold: 0, or -1 with why. */
+int auth_user_ok(const char *user, char *err, size_t errsz);
+/* A new random token (AUTH_TOKEN_PREFIX, AUTH_NEW_TOKEN_BYTES from getrandom). */
+int auth_token_new(char tok[AUTH_NEW_TOKEN_LEN + 1], char *err, size_t errsz);
+/* The Unix-socket peer's uid from SO_PEERCRED; root and admin_uid are admin. 0 or -1. */
+int auth_peer_uid(int fd, long admin_uid, unsigned long *uid, int *admin);
 /* The Unix-socket peer's user from SO_PEERCRED; root and admin_uid are admin. */
 int auth_peer_user(int fd, long admin_uid, char user[AUTH_MAX_USER], int *admin,
                    char *err, size_t errsz);
+
+/* ---- throttle_: failed logins per address (throttle.c) ---------------------- */
+#define THROTTLE_FREE_FAILS 5         /* failed HELLOs an address may make in a row, */
+#define THROTTLE_REFILL_S 12          /* one more for every this many quiet seconds; */
+#define THROTTLE_BASE_BLOCK_S 2       /* then its HELLOs are refused this long, doubling */
+#define THROTTLE_MAX_BLOCK_S 600      /* with each further failure up to this */
+#define THROTTLE_LOG_PERIOD_S 10      /* at most one line per address in this time */
+#define THROTTLE_MAX_ADDRS 4096       /* addresses followed at once; the quietest go first */
+/* Loop thread, now_ms: the loop's clock. 0 when peer may try a token now;
+ * else the seconds it must wait (the HELLO is refused unchecked, counted). */
+uint32_t throttle_check(const char *peer, uint64_t now_ms);
+/* A HELLO from peer failed (why: "unknown token"): counted, and logged
+ * with the address at once for the first of a burst, then summed up. */
+void throttle_fail(const char *peer, const char *client, const char *why, uint64_t now_ms);
+/* Writes the sums of bursts due and forgets addresses gone quiet. */
+void throttle_sweep(uint64_t now_ms);
+
+/* ---- fds_: the descriptor budget (fds.c) ------------------------------------ */
+/* Descriptors still free under the soft RLIMIT_NOFILE (INT32_MAX when that
+ * cannot be told, 0 when none). */
+long fds_free(void);
+/* Kept for the workers, the database and the spool (--fd-reserve, or 32 +
+ * 4 per slot of the backend's nslots). */
+long fds_reserve(const mcd_conf *c, int nslots);
+/* Below this many free descriptors no TCP client (nor Slurm progress
+ * connection) is taken: the reserve plus --admin-reserve, kept for the Unix
+ * socket and admin sessions. */
+long fds_tcp_floor(const mcd_conf *c, int nslots);
 
 /* ---- store_ --------------------------------------------------------------- */
 typedef struct store store;
@@ -477,6 +533,10 @@ void notify_reloaded(void);
 void notify_stopping(mcd *d);
 void notify_close(mcd *d);        /* stops the STATUS= timer */
 
+/* ---- token_: `meshcorrd token new|hash` (token.c) ------------------------- */
+/* argv[0] is "token"; the exit status. */
+int token_main(int argc, char **argv);
+
 /* ---- reload_ -------------------------------------------------------------- */
 void reload_init(mcd *d, int argc, char **argv);  /* SIGHUP handler */
 void reload_close(mcd *d);
@@ -517,9 +577,14 @@ void srv_close(conn *c);
 void srv_close_soon(conn *c);
 
 /* What req_ needs to know about a connection. */
+#define SRV_MAX_PEER 64
 typedef struct conn_auth {
     int authed, admin, is_unix;
     char user[AUTH_MAX_USER];
+    char peer[SRV_MAX_PEER];      /* who connects, for logs and the per-address caps: "127.0.0.1",
+                                   * "2001:db8:1:2::/64" (IPv6 by /64), "uid 1000" (Unix socket) */
+    int by_token;                 /* logged in with a token: its hash follows (SIGHUP checks it) */
+    uint8_t token_hash[AUTH_HASH_LEN];
 } conn_auth;
 conn_auth *srv_conn_auth(conn *c);
 mcd *srv_conn_daemon(conn *c);
@@ -532,9 +597,17 @@ void srv_conn_hold(conn *c);
 void srv_conn_release(conn *c);
 int srv_conn_open(const conn *c);     /* not closed or closing: replies can go out */
 /* HELLO, once the user is known and before HELLO_OK: 0 when the session
- * may go on, else PROTO_EBUSY with the reason in msg (logged here): the
- * user already has --max-connections-per-user sessions (admins never do). */
+ * may go on, else PROTO_EBUSY with the reason in msg (logged here): non-admin
+ * sessions are at --max-connections, or the user already has
+ * --max-connections-per-user (admins are never refused either way). */
 int srv_conn_admit_user(conn *c, char *msg, size_t msgsz);
+/* fn(c, ctx) for every open session (after HELLO); fn may end it. */
+void srv_each_session(mcd *d, void (*fn)(conn *c, void *ctx), void *ctx);
+/* Ends a session from the server's side: ERROR code (request id 0) with
+ * why, a warning naming the connection and user, and a close. */
+void srv_end_session(conn *c, int code, const char *why);
+/* With a TCP listener and no token, a warning: no TCP user can log in. */
+void srv_note_tokens(mcd *d);
 /* Closed, or the client has hung up (EOF or an error waits on the socket). */
 int srv_conn_hung_up(conn *c);
 

@@ -109,6 +109,11 @@ static int visible_job(conn *c, uint32_t rid, uint64_t id, store_job *j)
     return -1;
 }
 
+/* HELLO: the Unix socket's peer credentials, or a token, whose SHA-256 is
+ * looked up (the plaintext is wiped from the request at once). An address
+ * that failed too often is refused without a look at its token
+ * (throttle.c); every failure is counted there and logged with the
+ * address. */
 static void on_hello(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -120,12 +125,31 @@ static void on_hello(conn *c, const proto_msg *m)
         return;
     }
     int rc;
-    if (a->is_unix && h->token[0] == '\0')
+    uint64_t now = uv_now(d->loop);
+    if (a->is_unix && h->token[0] == '\0') {
         rc = auth_peer_user(srv_conn_fd(c), d->conf.admin_uid, a->user, &a->admin, err, sizeof err);
-    else if ((rc = auth_token_user(d->tokens, h->token, a->user, &a->admin)) != 0)
-        snprintf(err, sizeof err, "unknown token");
+        if (rc)
+            dlog(DLOG_WARN, "HELLO from %s refused: %s (client '%s')", a->peer, err, h->client);
+    } else {
+        uint32_t wait = throttle_check(a->peer, now);
+        if (wait) {
+            explicit_bzero((char *)h->token, strlen(h->token));
+            srv_send_error(c, m->request_id, PROTO_EBUSY, "too many failed logins from %s: retry in %u s",
+                           a->peer, wait);
+            srv_close_soon(c);
+            return;
+        }
+        int given = h->token[0] != '\0';
+        rc = auth_token_hash(h->token, a->token_hash);
+        explicit_bzero((char *)h->token, strlen(h->token));
+        if (rc == 0 && (rc = auth_token_user(d->tokens, a->token_hash, a->user, &a->admin)) == 0) {
+            a->by_token = 1;
+        } else {
+            snprintf(err, sizeof err, "%s", given ? "unknown token" : "no token");
+            throttle_fail(a->peer, h->client, err, now);
+        }
+    }
     if (rc) {
-        dlog(DLOG_WARN, "HELLO from client '%s' refused: %s", h->client, err);
         srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "authentication failed: %s", err);
         srv_close_soon(c);
         return;
@@ -136,8 +160,8 @@ static void on_hello(conn *c, const proto_msg *m)
         return;
     }
     a->authed = 1;
-    dlog(DLOG_INFO, "session: user %s%s, client '%s' (protocol %u)", a->user, a->admin ? " (admin)" : "",
-         h->client, h->version);
+    dlog(DLOG_INFO, "session: user %s%s from %s, client '%s' (protocol %u)", a->user, a->admin ? " (admin)" : "",
+         a->peer, h->client, h->version);
     proto_msg r;
     memset(&r, 0, sizeof r);
     r.type = PROTO_MSG_HELLO_OK;
@@ -236,6 +260,27 @@ static void submit_run(uv_work_t *w)      /* thread pool */
                          &s->id, s->msg, sizeof s->msg);
 }
 
+/* msg for a client: the server's own paths (a word that starts with '/'
+ * or with the state directory, up to a ':' or blank) become "<path>".
+ * The log keeps the whole message. */
+static const char *without_paths(const mcd *d, const char *msg, char *out, size_t sz)
+{
+    const char *dir = d->conf.state_dir;
+    size_t dl = strlen(dir), o = 0;
+    for (const char *p = msg; *p && o + 8 < sz;) {
+        int word_start = p == msg || p[-1] == ' ' || p[-1] == '(' || p[-1] == '\'';
+        if (word_start && (*p == '/' || (dl && strncmp(p, dir, dl) == 0))) {
+            p += strcspn(p, ": ),'");
+            memcpy(out + o, "<path>", 6);
+            o += 6;
+        } else {
+            out[o++] = *p++;
+        }
+    }
+    out[o] = '\0';
+    return out;
+}
+
 static void submit_done(uv_work_t *w, int status)    /* loop */
 {
     req_submit *s = w->data;
@@ -250,13 +295,14 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
         s->rc = PROTO_EINTERNAL;
         snprintf(s->msg, sizeof s->msg, "the store's work was not run: %s", uv_strerror(status));
     }
+    char shown[sizeof s->msg];           /* a STORAGE message without the server's paths */
     if (s->refused) {
         dlog(s->rc == PROTO_EINTERNAL ? DLOG_ERROR : DLOG_INFO, "SUBMIT from %s refused (%s, checked in %.1f ms, %.1f ms CPU): %s",
              s->user, proto_err_name(s->rc), s->val_ms, s->val_cpu_ms, s->msg);
         srv_send_error(c, s->request_id, s->rc, "%s", s->msg);
     } else if (s->rc) {
         dlog(DLOG_ERROR, "SUBMIT from %s: %s", s->user, s->msg);
-        srv_send_error(c, s->request_id, s->rc, "job not stored: %s", s->msg);
+        srv_send_error(c, s->request_id, s->rc, "job not stored: %s", without_paths(d, s->msg, shown, sizeof shown));
     } else {
         unsigned long long id = (unsigned long long)s->id;
         store_job j;
@@ -656,6 +702,20 @@ static void on_delete(conn *c, const proto_msg *m)
     reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
 }
 
+/* A non-admin's STATS counts that user's ended jobs still in the store, not
+ * everyone's since the store was created. */
+static int count_ended(void *ctx, const store_job *j)
+{
+    proto_stats_ok *s = ctx;
+    if (j->state == PROTO_STATE_COMPLETED)
+        s->completed++;
+    else if (j->state == PROTO_STATE_CANCELLED)
+        s->cancelled++;
+    else if (store_is_terminal(j->state))
+        s->failed++;
+    return 0;
+}
+
 static void on_stats(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -684,9 +744,14 @@ static void on_stats(conn *c, const proto_msg *m)
     s->queued = a->admin ? now->queued : sched_user_pending(d->sched, a->user);
     s->running = a->admin ? now->running : running;
     s->workers = now->workers;
-    s->completed = now->completed;
-    s->failed = now->failed;
-    s->cancelled = now->cancelled;
+    if (a->admin) {
+        s->completed = now->completed;
+        s->failed = now->failed;
+        s->cancelled = now->cancelled;
+    } else if (store_list(d->store, a->user, 0, 0, UINT32_MAX, count_ended, s)) {
+        srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure counting your jobs");
+        goto done;
+    }
     s->slots = slots;
     s->nslots = nslots;
     char dev[64];
@@ -714,7 +779,7 @@ void req_handle(conn *c, const proto_msg *m, const void *frame, size_t len)
 {
     conn_auth *a = srv_conn_auth(c);
     if (!a->authed && m->type != PROTO_MSG_HELLO) {
-        dlog(DLOG_WARN, "%s before HELLO: closing", proto_type_name(m->type));
+        dlog(DLOG_WARN, "%s before HELLO from %s: closing", proto_type_name(m->type), a->peer);
         srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "%s before HELLO", proto_type_name(m->type));
         srv_close_soon(c);
         return;

@@ -22,22 +22,33 @@
  * released, so an after-work callback may always look at it (srv_send to a
  * closed connection is a no-op).
  *
- * DESIGN: idle clients never cost an acknowledged job. A connection is
- * accepted only while more than the descriptor reserve (--fd-reserve) is
- * left under RLIMIT_NOFILE, so starting a worker (its pipes) always finds
- * descriptors, and only under --max-connections in all and
- * --max-unauthenticated before HELLO; HELLO adds --max-connections-per-user.
- * A refused client is told why (ERROR BUSY, request id 0), the refusal is
- * logged, and the connection lingers a moment (reading and dropping what
- * the client sends) so the ERROR is read rather than lost to a reset. A
- * timer cuts connections that hold resources for nothing: no HELLO within
- * --hello-timeout, a frame still incomplete --request-timeout after its
- * first byte, or a session with nothing going on (no request in flight, no
- * live WATCH, nothing unread, no byte from the client) for --idle-timeout;
- * each gets ERROR TIMED_OUT and a log line. What clients have half sent is
- * bounded in all: a frame counts against --max-request-memory from its
- * header to its end (admit), one that does not fit is refused BUSY the
- * same way, and a buffer grown for a large frame is freed once it is done.
+ * DESIGN: idle clients never cost an acknowledged job, and nobody who has
+ * not logged in can keep anyone else out. Budgets are separate: TCP
+ * connections that have not done HELLO are at most --max-unauthenticated
+ * in all and --max-unauthenticated-per-address from one address (an IPv4
+ * address or IPv6 /64; on the Unix socket a local uid, root and
+ * --admin-uid exempt), and
+ * when a new one arrives over either cap the OLDEST such connection (of
+ * that address, or of all) is closed in its place, so a client that does
+ * its HELLO at once always gets in; sessions (after HELLO) count against
+ * --max-connections and --max-connections-per-user, admins against
+ * neither. Descriptors are budgeted in tiers (fds.c): the Unix socket is
+ * served while more than --fd-reserve are free (kept for the workers: their
+ * pipes, the database, the spool), a TCP client only while more than
+ * --admin-reserve beyond that are free, or in the place of the oldest TCP
+ * connection without HELLO. A refused or displaced client is told why
+ * (ERROR BUSY, request id 0), the refusal is logged with the address, and
+ * the connection lingers a moment (reading and dropping what the client
+ * sends) so the ERROR is read rather than lost to a reset; TCP ones linger
+ * only while few do. A timer cuts connections that hold resources for
+ * nothing: no HELLO within --hello-timeout, a frame still incomplete
+ * --request-timeout after its first byte, or a session with nothing going
+ * on (no request in flight, no live WATCH, nothing unread, no byte from
+ * the client) for --idle-timeout; each gets ERROR TIMED_OUT and a log line.
+ * What clients have half sent is bounded in all: a frame counts against
+ * --max-request-memory from its header to its end (admit), one that does
+ * not fit is refused BUSY the same way, and a buffer grown for a large
+ * frame is freed once it is done.
  *
  * DESIGN: a tls: listener's connections carry the same frames inside a
  * GnuTLS session (tls.c). What libuv reads is fed to the session and the
@@ -55,7 +66,6 @@
 #include "backend.h"
 
 #include <arpa/inet.h>
-#include <dirent.h>
 #include <errno.h>
 #include <poll.h>
 #include <stdarg.h>
@@ -67,6 +77,7 @@
 
 #define SRV_SWEEP_MS 250           /* how often the connection timeouts are checked */
 #define SRV_REFUSE_LINGER_MS 2000  /* a refused connection waits this long for the client's EOF */
+#define SRV_MAX_LINGER 64          /* displaced or TCP refused connections lingering at once; more close at once */
 
 struct conn {
     union { uv_handle_t h; uv_stream_t s; uv_tcp_t tcp; uv_pipe_t pipe; } u;
@@ -85,6 +96,7 @@ struct conn {
     size_t held_len;          /* bytes of in.data the held request's frame takes */
     int handle_closed;        /* uv_close finished: free once holds is 0 */
     int refused;              /* told BUSY: input dropped, closed soon */
+    int unix_admin;           /* Unix socket, root or --admin-uid: no per-uid cap */
     uint64_t refused_ms;      /* loop time of the refusal */
     uint64_t accepted_ms;     /* loop time of the accept */
     uint64_t frame_ms;        /* when the incomplete frame in `in` began; 0: none */
@@ -402,7 +414,7 @@ static void process_input(conn *c)
 {
     while (!c->closing && !c->close_after_write && !c->paused && !c->holds && c->in.len) {
         size_t limit = c->auth.authed ? c->d->conf.max_frame : CONF_HELLO_MAX_FRAME;
-        proto_hdr hdr;
+        proto_hdr hdr = {0};           /* a bad magic or header CRC leaves it unread: request id 0 */
         char err[512];
         int rc = proto_frame_scan(c->in.data, c->in.len, limit, &hdr, err, sizeof err);
         if (rc == PROTO_NEED_MORE) {
@@ -411,7 +423,7 @@ static void process_input(conn *c)
             return;
         }
         if (rc < 0) {
-            fatal_error(c, c->in.len >= PROTO_HDR_SIZE ? hdr.request_id : 0, rc, err);
+            fatal_error(c, hdr.request_id, rc, err);
             return;
         }
         size_t flen = PROTO_HDR_SIZE + (size_t)hdr.payload_len;
@@ -606,48 +618,76 @@ static int is_tls_listener(const uv_stream_t *server)
     return 0;
 }
 
-/* Descriptors still free under the soft RLIMIT_NOFILE: the limit less
- * those open (counted in /proc/self/fd, exact; the count's own descriptor
- * is not left out, a margin of one). 0 when not even that can be opened;
- * INT32_MAX when it cannot be counted. */
-static long fds_free(void)
+/* Who connects, into c->auth.peer: the IPv4 address, an IPv6 address's
+ * /64 (one host has a whole /64 to pick from), or "uid N" on the Unix
+ * socket (and whether that uid is root or --admin-uid). */
+static void peer_of(conn *c)
 {
-    struct rlimit rl;
-    if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
-        return INT32_MAX;
-    DIR *dir = opendir("/proc/self/fd");
-    if (!dir)
-        return errno == EMFILE || errno == ENFILE ? 0 : INT32_MAX;
-    long open = 0;
-    while (readdir(dir))
-        open++;
-    closedir(dir);
-    open -= 2;                         /* "." and ".." */
-    return (long)rl.rlim_cur - open;
-}
-
-static long fd_reserve(const mcd *d)
-{
-    if (d->conf.fd_reserve)
-        return d->conf.fd_reserve;
-    return CONF_FD_RESERVE_BASE + (long)CONF_FD_RESERVE_PER_SLOT * bk_nslots(d);
-}
-
-/* Client connections (refused ones not counted): all, and before HELLO. */
-static void count_conns(const mcd *d, uint32_t *all, uint32_t *unauth)
-{
-    *all = *unauth = 0;
-    for (const conn *c = d->conns; c; c = c->next)
-        if (!c->closing && !c->refused) {
-            ++*all;
-            *unauth += !c->auth.authed;
+    char *out = c->auth.peer;
+    snprintf(out, SRV_MAX_PEER, "?");
+    if (c->auth.is_unix) {
+        unsigned long uid;
+        if (auth_peer_uid(srv_conn_fd(c), c->d->conf.admin_uid, &uid, &c->unix_admin) == 0)
+            snprintf(out, SRV_MAX_PEER, "uid %lu", uid);
+        return;
+    }
+    struct sockaddr_storage sa;
+    int len = sizeof sa;
+    if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) != 0)
+        return;
+    if (sa.ss_family == AF_INET) {
+        inet_ntop(AF_INET, &((struct sockaddr_in *)&sa)->sin_addr, out, SRV_MAX_PEER);
+    } else if (sa.ss_family == AF_INET6) {
+        struct in6_addr a = ((struct sockaddr_in6 *)&sa)->sin6_addr;
+        if (IN6_IS_ADDR_V4MAPPED(&a)) {
+            inet_ntop(AF_INET, &a.s6_addr[12], out, SRV_MAX_PEER);
+            return;
         }
+        memset(&a.s6_addr[8], 0, 8);
+        char ip[INET6_ADDRSTRLEN];
+        inet_ntop(AF_INET6, &a, ip, sizeof ip);
+        snprintf(out, SRV_MAX_PEER, "%s/64", ip);
+    }
+}
+
+/* What the accept decides on, c itself not counted. */
+typedef struct census {
+    uint32_t unauth_tcp;      /* TCP connections before HELLO */
+    uint32_t unauth_here;     /* connections before HELLO from c's peer, on c's kind of socket */
+    uint32_t lingering;       /* refused connections not closed yet */
+    conn *oldest_here;        /* the oldest of unauth_here */
+    conn *oldest_tcp;         /* the oldest of unauth_tcp */
+} census;
+
+static void count_conns(const conn *c, census *k)
+{
+    memset(k, 0, sizeof *k);
+    for (conn *o = c->d->conns; o; o = o->next) {
+        if (o == c || o->closing || o->close_after_write)
+            continue;
+        if (o->refused) {
+            k->lingering++;
+            continue;
+        }
+        if (o->auth.authed)
+            continue;
+        if (!o->auth.is_unix) {
+            k->unauth_tcp++;
+            if (!k->oldest_tcp || o->accepted_ms <= k->oldest_tcp->accepted_ms)
+                k->oldest_tcp = o;
+        }
+        if (o->auth.is_unix == c->auth.is_unix && strcmp(o->auth.peer, c->auth.peer) == 0) {
+            k->unauth_here++;
+            if (!k->oldest_here || o->accepted_ms <= k->oldest_here->accepted_ms)
+                k->oldest_here = o;
+        }
+    }
 }
 
 /* Refusals, logged at most once a second per reason (a flood of clients
  * gives one line a second, with the number it stands for). */
-enum { REFUSE_FDS, REFUSE_TOTAL, REFUSE_UNAUTH, REFUSE_USER, REFUSE_KINDS };
-static void log_refusal(const mcd *d, int kind, const char *what, const char *why)
+enum { REFUSE_FDS, REFUSE_TOTAL, REFUSE_UNAUTH, REFUSE_ADDR, REFUSE_USER, REFUSE_KINDS };
+static void log_refusal(const mcd *d, int kind, const char *what, const char *verb, const char *why)
 {
     static uint64_t last_ms[REFUSE_KINDS];
     static unsigned long held_back[REFUSE_KINDS];
@@ -657,11 +697,47 @@ static void log_refusal(const mcd *d, int kind, const char *what, const char *wh
         return;
     }
     if (held_back[kind])
-        dlog(DLOG_WARN, "%s refused: %s (and %lu more like it in the last second)", what, why, held_back[kind]);
+        dlog(DLOG_WARN, "%s %s: %s (and %lu more like it in the last second)", what, verb, why, held_back[kind]);
     else
-        dlog(DLOG_WARN, "%s refused: %s", what, why);
+        dlog(DLOG_WARN, "%s %s: %s", what, verb, why);
     last_ms[kind] = now;
     held_back[kind] = 0;
+}
+
+/* c is told BUSY with why and closed: after a short linger (so it reads the
+ * ERROR), or at once when descriptors are short or too many TCP
+ * connections linger already. */
+static void refuse(conn *c, int kind, const char *verb, const char *why, int linger)
+{
+    char what[SRV_MAX_PEER + 64];
+    snprintf(what, sizeof what, "conn %lu (%s %s)", c->id, c->auth.is_unix ? "unix" : "tcp", c->auth.peer);
+    log_refusal(c->d, kind, what, verb, why);
+    c->refused = 1;
+    c->refused_ms = uv_now(c->d->loop);
+    c->frame_ms = 0;
+    admitted_total -= c->admitted;     /* half a HELLO it sent is dropped */
+    c->admitted = 0;
+    proto_buf_free(&c->in);
+    proto_buf_init(&c->in);
+    srv_send_error(c, 0, PROTO_EBUSY, "server busy: %s; retry later", why);
+    if (linger)
+        update_reading(c);             /* until the client's EOF, or the linger time */
+    else
+        srv_close(c);
+}
+
+/* The oldest TCP connection without HELLO makes room for c: 0, or -1 when
+ * there is none. */
+static int displace(conn *victim, int kind, const char *why, long left, long floor)
+{
+    if (!victim)
+        return -1;
+    census k;
+    count_conns(victim, &k);
+    char msg[320];
+    snprintf(msg, sizeof msg, "%s; the oldest connection without HELLO makes room for a newer one", why);
+    refuse(victim, kind, "closed", msg, k.lingering < SRV_MAX_LINGER && left > floor);
+    return 0;
 }
 
 static void on_connection(uv_stream_t *server, int status)
@@ -672,23 +748,9 @@ static void on_connection(uv_stream_t *server, int status)
         dlog(DLOG_WARN, "accept: %s", uv_strerror(status));
         return;
     }
-    /* the caps, before the accept takes a descriptor */
-    char why[256] = "";
-    int kind = -1;
-    uint32_t all, unauth;
-    count_conns(d, &all, &unauth);
-    long left = fds_free(), reserve = fd_reserve(d);
-    if (left <= reserve) {
-        kind = REFUSE_FDS;
-        snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
-                 "(--fd-reserve)", left, reserve);
-    } else if (all >= d->conf.max_connections) {
-        kind = REFUSE_TOTAL;
-        snprintf(why, sizeof why, "%u connections open, the limit (--max-connections)", all);
-    } else if (unauth >= d->conf.max_unauthenticated) {
-        kind = REFUSE_UNAUTH;
-        snprintf(why, sizeof why, "%u connections without HELLO, the limit (--max-unauthenticated)", unauth);
-    }
+    /* the descriptors, before the accept takes one */
+    long left = fds_free(), reserve = fds_reserve(&d->conf, bk_nslots(d));
+    long floor = fds_tcp_floor(&d->conf, bk_nslots(d));
     conn *c = calloc(1, sizeof *c);
     if (!c) {
         dlog(DLOG_ERROR, "accept: out of memory");
@@ -713,21 +775,46 @@ static void on_connection(uv_stream_t *server, int status)
         d->conns->prev = c;
     d->conns = c;
     c->accepted_ms = c->active_ms = uv_now(d->loop);
-    if (kind < 0) {
-        dlog(DLOG_DEBUG, "conn %lu: accepted (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
-        update_reading(c);
-        return;
+    peer_of(c);
+    const mcd_conf *k = &d->conf;
+    census n;
+    count_conns(c, &n);
+    char why[256];
+    if (c->auth.is_unix) {
+        if (left <= reserve) {
+            snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
+                     "(--fd-reserve)", left, reserve);
+            refuse(c, REFUSE_FDS, "refused", why, left > reserve / 2);
+            return;
+        }
+        if (!c->unix_admin && n.unauth_here >= k->max_unauth_per_address) {
+            snprintf(why, sizeof why, "%u connections without HELLO from %s, the limit "
+                     "(--max-unauthenticated-per-address)", n.unauth_here, c->auth.peer);
+            displace(n.oldest_here, REFUSE_ADDR, why, left, reserve);
+        }
+    } else {
+        if (left <= floor) {
+            snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
+                     "(--fd-reserve) and %u more for the Unix socket and admins (--admin-reserve)", left, reserve,
+                     k->admin_reserve);
+            if (displace(n.oldest_tcp, REFUSE_FDS, why, left, floor)) {
+                refuse(c, REFUSE_FDS, "refused", why, left > reserve && n.lingering < SRV_MAX_LINGER);
+                return;
+            }
+            count_conns(c, &n);
+        }
+        if (n.unauth_here >= k->max_unauth_per_address) {
+            snprintf(why, sizeof why, "%u connections without HELLO from %s, the limit "
+                     "(--max-unauthenticated-per-address)", n.unauth_here, c->auth.peer);
+            displace(n.oldest_here, REFUSE_ADDR, why, left, floor);
+        } else if (n.unauth_tcp >= k->max_unauthenticated) {
+            snprintf(why, sizeof why, "%u TCP connections without HELLO, the limit (--max-unauthenticated)",
+                     n.unauth_tcp);
+            displace(n.oldest_tcp, REFUSE_UNAUTH, why, left, floor);
+        }
     }
-    char what[64];
-    snprintf(what, sizeof what, "conn %lu (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
-    log_refusal(d, kind, what, why);
-    c->refused = 1;
-    c->refused_ms = c->accepted_ms;
-    srv_send_error(c, 0, PROTO_EBUSY, "server busy: %s; retry later", why);
-    if (left <= reserve / 2)
-        srv_close(c);                  /* no descriptor to spare for lingering */
-    else
-        update_reading(c);             /* until the client's EOF, or the linger time */
+    dlog(DLOG_DEBUG, "conn %lu: accepted (%s %s)", c->id, c->auth.is_unix ? "unix" : "tcp", c->auth.peer);
+    update_reading(c);
 }
 
 int srv_conn_admit_user(conn *c, char *msg, size_t msgsz)
@@ -735,17 +822,61 @@ int srv_conn_admit_user(conn *c, char *msg, size_t msgsz)
     const mcd *d = c->d;
     if (c->auth.admin)
         return 0;
-    uint32_t n = 0;
+    uint32_t all = 0, mine = 0;
     for (const conn *o = d->conns; o; o = o->next)
-        n += o != c && !o->closing && !o->refused && o->auth.authed && strcmp(o->auth.user, c->auth.user) == 0;
-    if (n < d->conf.max_connections_per_user)
+        if (o != c && !o->closing && !o->refused && o->auth.authed && !o->auth.admin) {
+            all++;
+            mine += strcmp(o->auth.user, c->auth.user) == 0;
+        }
+    int kind;
+    if (all >= d->conf.max_connections) {
+        kind = REFUSE_TOTAL;
+        snprintf(msg, msgsz, "server busy: %u sessions open, the limit (--max-connections; admins exempt); "
+                 "retry later", all);
+    } else if (mine >= d->conf.max_connections_per_user) {
+        kind = REFUSE_USER;
+        snprintf(msg, msgsz, "server busy: user %s has %u sessions, the limit (--max-connections-per-user); "
+                 "retry later", c->auth.user, mine);
+    } else {
         return 0;
-    snprintf(msg, msgsz, "server busy: user %s has %u sessions, the limit (--max-connections-per-user); "
-             "retry later", c->auth.user, n);
-    char what[AUTH_MAX_USER + 64];
-    snprintf(what, sizeof what, "conn %lu (user %s)", c->id, c->auth.user);
-    log_refusal(d, REFUSE_USER, what, msg);
+    }
+    char what[AUTH_MAX_USER + SRV_MAX_PEER + 64];
+    snprintf(what, sizeof what, "conn %lu (user %s, %s)", c->id, c->auth.user, c->auth.peer);
+    log_refusal(d, kind, what, "refused", msg);
     return PROTO_EBUSY;
+}
+
+void srv_each_session(mcd *d, void (*fn)(conn *c, void *ctx), void *ctx)
+{
+    conn *next;
+    for (conn *c = d->conns; c; c = next) {
+        next = c->next;                /* fn may close c (srv_close unlinks it) */
+        if (c->auth.authed && !c->closing && !c->close_after_write)
+            fn(c, ctx);
+    }
+}
+
+void srv_end_session(conn *c, int code, const char *why)
+{
+    dlog(DLOG_WARN, "conn %lu (user %s%s, %s): session ended: %s", c->id, c->auth.user,
+         c->auth.admin ? ", admin" : "", c->auth.peer, why);
+    srv_send_error(c, 0, code, "%s", why);
+    srv_close_soon(c);
+}
+
+void srv_note_tokens(mcd *d)
+{
+    int tcp = 0;
+    for (int i = 0; i < d->conf.nlisten; i++)
+        tcp |= strncmp(d->conf.listen[i], "tcp:", 4) == 0;
+    const char *path = auth_tokens_path(d->tokens);
+    if (!tcp)
+        return;
+    if (auth_tokens_count(d->tokens) == 0)
+        dlog(DLOG_WARN, "TCP listener without a token (%s%s): no TCP user can log in; make one with "
+             "`meshcorrd token new USER`", path[0] ? "no line in " : "no --tokens file", path);
+    else
+        dlog(DLOG_INFO, "%d token(s) from %s", auth_tokens_count(d->tokens), path);
 }
 
 /* ERROR TIMED_OUT (request id 0), a log line, and a close once it is written. */
@@ -776,6 +907,7 @@ static void on_sweep(uv_timer_t *t)
     mcd *d = t->data;
     const mcd_conf *k = &d->conf;
     uint64_t now = uv_now(d->loop);
+    throttle_sweep(now);
     conn *next;
     for (conn *c = d->conns; c; c = next) {
         next = c->next;                /* srv_close unlinks c */
@@ -913,9 +1045,11 @@ int srv_listen(mcd *d, char *err, size_t errsz)
     int rc = 0;
     struct rlimit rl;
     if (getrlimit(RLIMIT_NOFILE, &rl) == 0)
-        dlog(DLOG_INFO, "file descriptors: soft limit %llu, %ld kept for the workers; at most %u connections "
-             "(%u per user, %u before HELLO)", (unsigned long long)rl.rlim_cur, fd_reserve(d),
-             d->conf.max_connections, d->conf.max_connections_per_user, d->conf.max_unauthenticated);
+        dlog(DLOG_INFO, "file descriptors: soft limit %llu, %ld kept for the workers, %u more for the Unix socket "
+             "and admins; at most %u non-admin sessions (%u per user), %u TCP connections before HELLO (%u per "
+             "address)", (unsigned long long)rl.rlim_cur, fds_reserve(&d->conf, bk_nslots(d)),
+             d->conf.admin_reserve, d->conf.max_connections, d->conf.max_connections_per_user,
+             d->conf.max_unauthenticated, d->conf.max_unauth_per_address);
     for (int i = 0; i < d->conf.nlisten && !rc; i++) {
         const char *a = d->conf.listen[i];
         uv_handle_t *h = NULL;

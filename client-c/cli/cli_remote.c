@@ -3,8 +3,11 @@
  * They share the server options (--server ADDR, --token T, --token-file F,
  * --ca FILE; defaults $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock,
  * $MESHCORR_TOKEN, and $MESHCORR_CA, read by libmeshcorr) and print one line
- * per fact, or JSON where asked. No
- * numerics, no protocol details: meshcorr.h is the whole interface. */
+ * per fact, or JSON where asked. No numerics, no protocol details:
+ * meshcorr.h is the whole interface. Every string the server sends (labels,
+ * user names, reasons, messages, device names) reaches the terminal through
+ * shown() or json_str, which escape control characters, escape sequences
+ * and bidi marks (stresc). */
 #include "cli/cli.h"
 #include "metric/metric.h"
 #include "cli/cli_job.h"
@@ -13,6 +16,7 @@
 #include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
 #include "meshcorr.h"
+#include "util/stresc.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -21,6 +25,17 @@
 #include <string.h>
 #include <strings.h>
 #include <time.h>
+
+/* s, a string from the server, as the terminal may show it (stresc). The
+ * result lives until the fourth call after this one (four buffers in
+ * turn: enough for the strings of one line). */
+static const char *shown(const char *s)
+{
+    static char bufs[4][STRESC_SIZE(2048)];
+    static unsigned next;
+    char *b = bufs[next++ % 4];
+    return stresc(s, b, sizeof bufs[0]);
+}
 
 typedef struct remote {
     const char *server, *token;
@@ -73,7 +88,7 @@ static mc_client *remote_connect(const char *cmd, const remote *r)
     }
     int rc = mc_connect_ca(r->server, token, r->ca, &c, err, sizeof err);
     if (rc) {
-        fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, r->server, err);
+        fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, r->server, shown(err));
         if (rc == MC_EUNAUTHORIZED)
             fprintf(stderr, "meshcorr %s: the server refused the token (from %s)\n", cmd,
                     r->token_file ? "--token-file" : token && *token ? "--token or $MESHCORR_TOKEN" : "nowhere: none given");
@@ -84,7 +99,7 @@ static mc_client *remote_connect(const char *cmd, const remote *r)
 
 static int fail(const char *cmd, mc_client *c, int rc)
 {
-    fprintf(stderr, "meshcorr %s: %s\n", cmd, mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc));
+    fprintf(stderr, "meshcorr %s: %s\n", cmd, shown(mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc)));
     mc_close(c);
     return 1;
 }
@@ -119,17 +134,22 @@ static int remote_opt(remote *r, int c)
     return 1;
 }
 
-/* s as a JSON string, quotes included. */
+/* s as a JSON string, quotes included; what stresc would escape is written
+ * as \\uXXXX (a byte that is not UTF-8 as U+FFFD). */
 static void json_str(const char *s)
 {
     putchar('"');
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            printf("\\%c", *p);
-        else if (*p < 0x20)
-            printf("\\u%04x", *p);
+    for (size_t i = 0, n = strlen(s), len; i < n; i += len) {
+        uint32_t cp;
+        int ok = stresc_char(s + i, n - i, &len, &cp);
+        if (s[i] == '"' || s[i] == '\\')
+            printf("\\%c", s[i]);
+        else if (ok)
+            fwrite(s + i, 1, len, stdout);
+        else if (cp >= 0x80 && len == 1)
+            printf("\\ufffd");
         else
-            putchar(*p);
+            printf("\\u%04x", (unsigned)cp);
     }
     putchar('"');
 }
@@ -218,7 +238,7 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     }
     fflush(stdout);
     fprintf(stderr, "meshcorr %s: job %llu %s%s%s\n", cmd, (unsigned long long)id,
-            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", reason);
+            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", shown(reason));
     return 1;
 }
 
@@ -451,9 +471,9 @@ int cli_status(int argc, char **argv)
     if (rc)
         return fail("status", c, rc);
     printf("job       %llu\nstate     %s\nuser      %s\nlabel     %s\npriority  %d\n", (unsigned long long)s.job_id,
-           mc_state_name(s.state), s.user, s.label, s.priority);
+           mc_state_name(s.state), shown(s.user), shown(s.label), s.priority);
     if (s.reason[0])
-        printf("reason    %s\n", s.reason);
+        printf("reason    %s\n", shown(s.reason));
     print_time("submitted", s.submit_ms);
     print_time("started", s.start_ms);
     print_time("ended", s.end_ms);
@@ -586,7 +606,7 @@ int cli_result(int argc, char **argv)
     for (uint32_t i = 0; i < res.nmetrics; i++) {
         const char *k = res.metric_keys[i];
         double v = res.metric_values[i];
-        printf("%s %.10g\n", k, v);
+        printf("%s %.10g\n", shown(k), v);
         if (!strcmp(k, "quality_verdict"))
             verdict = v;
         for (int r = 0; r < 2; r++) {
@@ -705,8 +725,8 @@ int cli_list(int argc, char **argv)
         snprintf(it, sizeof it, "%u/%u", jobs[i].outer, jobs[i].total);
         int v = jobs[i].quality.verdict;
         printf("%-8llu %-13s %-10s %4d %11s %-8s  %s\n", (unsigned long long)jobs[i].job_id,
-               mc_state_name(jobs[i].state), jobs[i].user, jobs[i].priority, it,
-               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), jobs[i].label);
+               mc_state_name(jobs[i].state), shown(jobs[i].user), jobs[i].priority, it,
+               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), shown(jobs[i].label));
     }
     free(jobs);
     mc_close(cl);
@@ -762,7 +782,7 @@ int cli_stats(int argc, char **argv)
         printf("slot %u    %s%s%.0llu\n", i, slot[s.slot_state[i] & 3], s.slot_job[i] ? " job " : "",
                (unsigned long long)s.slot_job[i]);
     for (uint32_t i = 0; i < s.ndevices; i++)
-        printf("device    %s\n", s.devices[i]);
+        printf("device    %s\n", shown(s.devices[i]));
     mc_stats_free(&s);
     mc_close(cl);
     return 0;

@@ -8,6 +8,8 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <gnutls/crypto.h>
+#include <gnutls/gnutls.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,12 +45,13 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     snprintf(tokens, sizeof tokens, "%s/tokens", d->dir);
     snprintf(port, sizeof port, "%s/port", d->dir);
     snprintf(listen_unix, sizeof listen_unix, "%s", d->unix_addr);
-    FILE *fp = fopen(tokens, "w");
-    if (!fp)
-        FAILF("cannot write %s", tokens);
-    fprintf(fp, "# token user [admin]\n%s alice\n%s bob\n%s boss admin\n", TESTDAEMON_ALICE,
-            TESTDAEMON_BOB, TESTDAEMON_ADMIN);
-    fclose(fp);
+    char lines[3][256], text[1024];
+    testdaemon_token_line(TESTDAEMON_ALICE, "alice", 0, lines[0], sizeof lines[0]);
+    testdaemon_token_line(TESTDAEMON_BOB, "bob", 0, lines[1], sizeof lines[1]);
+    testdaemon_token_line(TESTDAEMON_ADMIN, "boss", 1, lines[2], sizeof lines[2]);
+    snprintf(text, sizeof text, "# sha256:HEX user [admin]\n%s\n%s\n%s\n", lines[0], lines[1], lines[2]);
+    testdaemon_write_tokens(tokens, text);
+    FILE *fp;
     unlink(port);
     const char *argv[64];
     int k = 0;
@@ -105,6 +108,29 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
         sleep_ms(10);
     }
     FAILF("meshcorrd did not write its port file; log %s", d->log);
+}
+
+void testdaemon_token_line(const char *token, const char *user, int admin, char *line, size_t sz)
+{
+    unsigned char h[32];
+    if (gnutls_hash_fast(GNUTLS_DIG_SHA256, token, strlen(token), h) != 0)
+        FAILF("gnutls_hash_fast failed");
+    int n = snprintf(line, sz, "sha256:");
+    for (int i = 0; i < 32; i++)
+        n += snprintf(line + n, sz - (size_t)n, "%02x", h[i]);
+    snprintf(line + n, sz - (size_t)n, " %s%s", user, admin ? " admin" : "");
+}
+
+void testdaemon_write_tokens(const char *path, const char *text)
+{
+    char tmp[1100];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    size_t n = strlen(text);
+    if (fd < 0 || fchmod(fd, 0600) != 0 || write(fd, text, n) != (ssize_t)n || close(fd) != 0)
+        FAILF("cannot write %s: %s", tmp, strerror(errno));
+    if (rename(tmp, path) != 0)
+        FAILF("rename %s: %s", path, strerror(errno));
 }
 
 /* "exit status N" / "killed by signal N (NAME)" for a wait status. */

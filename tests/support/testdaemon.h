@@ -2,7 +2,7 @@
  * its own state directory under harness_tmpdir(), a Unix socket and a TCP
  * listener on 127.0.0.1 (a free port the daemon picks and writes to its
  * port file; a test may add a tls: listener, tests/support/testtls.h), and
- * a tokens file with three users:
+ * a tokens file (hashed, mode 0600) with three users:
  *   TESTDAEMON_ALICE (user alice), TESTDAEMON_BOB (user bob),
  *   TESTDAEMON_ADMIN (user boss, admin).
  * The daemon dies with the test process (PR_SET_PDEATHSIG). Jobs it runs:
@@ -28,6 +28,11 @@ typedef struct testdaemon {
     char log[600];             /* the daemon's stderr (appended across restarts) */
 } testdaemon;
 
+/* The tokens-file line of token: "sha256:HEX user[ admin]" (SHA-256 by
+ * GnuTLS, not by the daemon's code). */
+void testdaemon_token_line(const char *token, const char *user, int admin, char *line, size_t sz);
+/* Writes text to path (mode 0600, replaced whole by a rename). */
+void testdaemon_write_tokens(const char *path, const char *text);
 /* SKIPs the test when build/meshcorr-worker has not been built. */
 void testdaemon_need_worker(void);
 /* Starts meshcorrd (args: extra options, NULL-terminated, or NULL) and waits
