@@ -5,6 +5,7 @@
 #ifndef TESTLDD_H
 #define TESTLDD_H
 void testldd_check_slim(const char *path);
-/* The same with one more library allowed (a name's prefix, "libgomp.so."). */
+/* The same with more libraries allowed: their names' prefixes separated
+ * by blanks ("libgomp.so. libseccomp.so."). */
 void testldd_check_slim_and(const char *path, const char *also);
 #endif
