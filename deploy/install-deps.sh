@@ -1,7 +1,8 @@
 #!/bin/sh
 # install-deps.sh — installs the Debian 12 packages meshcorr builds, tests and
-# demos with. Idempotent and non-interactive; fetches nothing but Debian
-# packages. Must not build or configure anything of the project itself.
+# demos with, and adds the system user the tests run meshcorrd as (below).
+# Idempotent and non-interactive; fetches nothing but Debian packages. Must
+# not build or configure anything of the project itself.
 set -eu
 
 PACKAGES="
@@ -42,4 +43,12 @@ if [ -n "$missing" ]; then
     $SUDO apt-get install -y -qq --no-install-recommends $missing
 else
     echo "install-deps: all packages present"
+fi
+
+# The tests run as root and start meshcorrd with --user meshcorr-test
+# (tests/support/testdaemon.c; meshcorrd refuses root without --user): a
+# system user with no home and no login shell.
+if ! getent passwd meshcorr-test >/dev/null; then
+    echo "install-deps: adding the system user meshcorr-test"
+    $SUDO useradd --system --no-create-home --home-dir /nonexistent --shell /usr/sbin/nologin meshcorr-test
 fi
