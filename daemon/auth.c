@@ -137,39 +137,44 @@ static int resolve_path(const char *conf, char *out, size_t sz, char *err, size_
     return 0;
 }
 
-/* The file's owner and mode, before a byte of it is believed. */
+/* The file's owner and mode (st), before a byte of it is believed. */
+static int check_stat(const struct stat *st, const char *path, char *err, size_t errsz)
+{
+    if (!S_ISREG(st->st_mode))
+        return errbuf_set(err, errsz, -1, "%s: not a regular file", path);
+    uid_t me = geteuid();
+    if (st->st_uid != me && st->st_uid != 0)
+        return errbuf_set(err, errsz, -1, "%s: owned by uid %lu, neither meshcorrd's user (uid %lu) nor root: "
+                          "whoever owns it can give themselves a token; run `chown %lu %s`", path,
+                          (unsigned long)st->st_uid, (unsigned long)me, (unsigned long)me, path);
+    mode_t bad = st->st_mode & (S_IWGRP | S_IWOTH | S_IROTH);
+    if (!bad)
+        return 0;
+    char which[96] = "", fix[16] = "";
+    const char *sep = "";
+    if (st->st_mode & S_IWGRP) {
+        strcat(which, "writable by its group");
+        strcat(fix, "g-w");
+        sep = " and ";
+    }
+    if (st->st_mode & (S_IWOTH | S_IROTH)) {
+        strcat(which, sep);
+        strcat(which, (st->st_mode & S_IWOTH) && (st->st_mode & S_IROTH) ? "readable and writable by others"
+                      : st->st_mode & S_IWOTH ? "writable by others" : "readable by others");
+        strcat(fix, *fix ? ",o-" : "o-");
+        strcat(fix, (st->st_mode & S_IROTH) ? ((st->st_mode & S_IWOTH) ? "rw" : "r") : "w");
+    }
+    return errbuf_set(err, errsz, -1, "%s: mode %04o: %s (who can write it can make themselves admin; who can "
+                      "read it learns the users); run `chmod %s %s`", path, (unsigned)(st->st_mode & 07777),
+                      which, fix, path);
+}
+
 static int check_file(int fd, const char *path, char *err, size_t errsz)
 {
     struct stat st;
     if (fstat(fd, &st) != 0)
         return errbuf_set(err, errsz, -1, "%s: %s", path, strerror(errno));
-    if (!S_ISREG(st.st_mode))
-        return errbuf_set(err, errsz, -1, "%s: not a regular file", path);
-    uid_t me = geteuid();
-    if (st.st_uid != me && st.st_uid != 0)
-        return errbuf_set(err, errsz, -1, "%s: owned by uid %lu, neither meshcorrd's user (uid %lu) nor root: "
-                          "whoever owns it can give themselves a token; run `chown root %s`", path,
-                          (unsigned long)st.st_uid, (unsigned long)me, path);
-    mode_t bad = st.st_mode & (S_IWGRP | S_IWOTH | S_IROTH);
-    if (!bad)
-        return 0;
-    char which[96] = "", fix[16] = "";
-    const char *sep = "";
-    if (st.st_mode & S_IWGRP) {
-        strcat(which, "writable by its group");
-        strcat(fix, "g-w");
-        sep = " and ";
-    }
-    if (st.st_mode & (S_IWOTH | S_IROTH)) {
-        strcat(which, sep);
-        strcat(which, (st.st_mode & S_IWOTH) && (st.st_mode & S_IROTH) ? "readable and writable by others"
-                      : st.st_mode & S_IWOTH ? "writable by others" : "readable by others");
-        strcat(fix, *fix ? ",o-" : "o-");
-        strcat(fix, (st.st_mode & S_IROTH) ? ((st.st_mode & S_IWOTH) ? "rw" : "r") : "w");
-    }
-    return errbuf_set(err, errsz, -1, "%s: mode %04o: %s (who can write it can make themselves admin; who can "
-                      "read it learns the users); run `chmod %s %s`", path, (unsigned)(st.st_mode & 07777),
-                      which, fix, path);
+    return check_stat(&st, path, err, errsz);
 }
 
 /* "sha256:" and 64 hex digits into h; 0, or -1 not that form. */
@@ -259,7 +264,15 @@ int auth_tokens_load(const char *conf_path, auth_tokens **out, char *err, size_t
     const char *path = t->path;
     FILE *fp = fopen(path, "re");
     if (!fp) {
-        errbuf_set(err, errsz, -1, "%s: %s", path, strerror(errno));
+        struct stat st;
+        if (errno == EACCES && stat(path, &st) == 0 && check_stat(&st, path, err, errsz) != 0)
+            ;                              /* its owner or mode is the reason to give */
+        else if (errno == EACCES)
+            errbuf_set(err, errsz, -1, "%s: %s: meshcorrd reads it as uid %lu (its --user), now and at each reload: "
+                       "`chown %lu %s` (mode 0600)", path, strerror(errno), (unsigned long)geteuid(),
+                       (unsigned long)geteuid(), path);
+        else
+            errbuf_set(err, errsz, -1, "%s: %s", path, strerror(errno));
         auth_tokens_free(t);
         return -1;
     }

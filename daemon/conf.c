@@ -33,7 +33,8 @@ static const struct option_def {
     {"worker", K_PATH, OFF(worker), 0, 0, "PATH of meshcorr-worker (default: next to meshcorrd)"},
     {"validator", K_PATH, OFF(validator), 0, 0, "PATH of meshcorr-validate, SUBMIT's check (default: next to meshcorrd)"},
     {"threads-per-worker", K_INT, OFF(threads_per_worker), 0, 4096, "N OpenMP threads per worker (0: all)"},
-    {"worker-memory-mb", K_U32, OFF(worker_memory_mb), 0, 1u << 24, "MB of address space per worker (0: no limit)"},
+    {"worker-memory-mb", K_U32, OFF(worker_memory_mb), 0, 1u << 24, "MB of address space per worker (default 3/4 of the memory over --workers; 0: no limit)"},
+    {"user", K_PATH, OFF(user), 0, 0, "USER to run as after binding the listeners (required when started as root)"},
     {"max-frame", K_U32, OFF(max_frame), PROTO_HDR_SIZE + 1, PROTO_MAX_FRAME, "BYTES largest request frame"},
     {"max-vertices", K_U32, OFF(max_vertices), 3, 20000000, "N vertices per mesh"},
     {"max-landmarks", K_U32, OFF(max_landmarks), 0, PROTO_MAX_LANDMARKS, "N landmark pairs per job"},
@@ -83,6 +84,7 @@ void conf_init(mcd_conf *c)
     c->max_jobs_per_user = CONF_DEFAULT_MAX_JOBS_PER_USER;
     c->max_queue = CONF_DEFAULT_MAX_QUEUE;
     c->job_timeout_s = CONF_DEFAULT_JOB_TIMEOUT_S;
+    c->worker_memory_mb = CONF_WORKER_MEMORY_AUTO;
     c->result_ttl_s = CONF_DEFAULT_RESULT_TTL_S;
     c->max_output = CONF_DEFAULT_MAX_OUTPUT;
     c->max_request_memory = CONF_DEFAULT_MAX_REQUEST_MEMORY;
@@ -314,6 +316,18 @@ unsigned long long conf_max_faces(const mcd_conf *c)
 {
     unsigned long long mf = 4ull * c->max_vertices;
     return mf > 40000000 ? 40000000 : mf;
+}
+
+uint32_t conf_worker_memory_mb(const mcd_conf *c, int nslots)
+{
+    if (c->worker_memory_mb != CONF_WORKER_MEMORY_AUTO)
+        return c->worker_memory_mb;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    double mb = pages > 0 && page > 0 ? (double)pages * (double)page / (1 << 20) : 0;
+    mb = mb * CONF_WORKER_MEMORY_SHARE / (nslots > 0 ? nslots : 1);
+    if (mb < CONF_WORKER_MEMORY_MIN_MB)
+        mb = CONF_WORKER_MEMORY_MIN_MB;
+    return mb > (1u << 24) ? 1u << 24 : (uint32_t)mb;
 }
 
 void conf_note_change(int differs, const char *name, char *changed, size_t sz)

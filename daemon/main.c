@@ -1,6 +1,8 @@
 /* main.c — meshcorrd's main(): options, store recovery, the scheduler's
  * queue rebuilt from the store, the job bookkeeping (job.c, its expiry
- * sweep included), the backend (backend.h), listeners, the signal handlers
+ * sweep included), the backend (backend.h), listeners, the drop from root
+ * to --user (priv.c: the store and the backend are set up as that user,
+ * the listeners bound as root, then root is gone), the signal handlers
  * (SIGTERM/SIGINT: drain.c; SIGHUP: reload.c), READY=1 to the service
  * manager, then the loop; or `meshcorrd token ...` (token.c) alone. The loop ends once the drain has closed every
  * handle; only then the store closes (no store_submit can be running) and
@@ -48,6 +50,11 @@ int main(int argc, char **argv)
         return 2;
     }
     dlog_set_level(d.conf.log_level);
+    priv_user priv;
+    if (priv_init(&d.conf, &priv, err, sizeof err)) {
+        dlog(DLOG_ERROR, "%s", err);
+        return 2;
+    }
     signal(SIGPIPE, SIG_IGN);
     /* The workers we spawn inherit it and skip their re-exec: one program
      * load less per job (bench_daemon's 162-vertex job: overhead 63-66 ->
@@ -60,7 +67,9 @@ int main(int argc, char **argv)
              validator);
     int status = 1;
     d.loop = uv_default_loop();
-    if (auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
+    /* the tokens file is read as the user the daemon runs as: SIGHUP reads it again as that user */
+    if (priv_become(&priv, d.conf.state_dir, err, sizeof err) ||
+        auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
         store_open(d.conf.state_dir, &d.store, err, sizeof err) ||
         store_recover(d.store, strcmp(d.conf.backend, "slurm") == 0, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
@@ -72,10 +81,12 @@ int main(int argc, char **argv)
     }
     job_init(&d);
     req_init(&d);
-    if (tls_init(&d, err, sizeof err) || bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
-        srv_listen(&d, err, sizeof err) ||
+    /* the TLS key is read while root is still at hand, with the binds */
+    if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
+        priv_bind_begin(&priv, err, sizeof err) || tls_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
-        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.tls, d.snap, &d.metrics, err, sizeof err))) {
+        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.tls, d.snap, &d.metrics, err, sizeof err)) ||
+        priv_drop(&priv, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }

@@ -26,6 +26,7 @@
  *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
  *   drain.c  drain_  SIGTERM/SIGINT: the graceful shutdown
  *   reload.c reload_ SIGHUP: options and tokens read again
+ *   priv.c   priv_   started as root: bind, then run as --user for good
  *   main.c          main(): wires the above together
  *
  * The DESIGN rule every module keeps: an acknowledged job is never lost.
@@ -60,6 +61,12 @@
 #define CONF_KILL_GRACE_S 5                  /* SIGTERM -> SIGKILL */
 #define CONF_DEFAULT_SLURM_MAX_JOBS 100
 #define CONF_DEFAULT_SLURM_POLL_MS 5000
+/* --worker-memory-mb not given: CONF_WORKER_MEMORY_SHARE of the physical
+ * memory split between the slots, at least CONF_WORKER_MEMORY_MIN_MB
+ * (conf_worker_memory_mb); 0 given: no limit */
+#define CONF_WORKER_MEMORY_AUTO 0xFFFFFFFFu
+#define CONF_WORKER_MEMORY_SHARE 0.75
+#define CONF_WORKER_MEMORY_MIN_MB 1024
 /* Connections (srv.c): caps, timeouts, and the descriptors kept free. */
 #define CONF_DEFAULT_MAX_CONNECTIONS 512          /* client connections in all */
 #define CONF_DEFAULT_MAX_CONNECTIONS_PER_USER 64  /* sessions of one user (admins exempt) */
@@ -93,7 +100,9 @@ typedef struct mcd_conf {
     char port_file[CONF_PATH];    /* "" = none; else bound TCP addresses, one a line */
     int workers;                  /* worker slots (>= 1) */
     int threads_per_worker;       /* 0 = the worker's default */
-    uint32_t worker_memory_mb;    /* address-space limit per worker; 0 = none */
+    uint32_t worker_memory_mb;    /* address-space limit per worker; 0 = none;
+                                     CONF_WORKER_MEMORY_AUTO = not given */
+    char user[CONF_PATH];         /* --user: run as this user once bound ("" = as started) */
     uint32_t max_frame, max_vertices, max_landmarks;
     uint32_t max_jobs_per_user, max_queue;
     uint32_t job_timeout_s, result_ttl_s;
@@ -137,9 +146,34 @@ const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz);
 const char *conf_validator_path(const mcd_conf *c, char *buf, size_t sz);
 /* The worker's --max-faces for the configured --max-vertices. */
 unsigned long long conf_max_faces(const mcd_conf *c);
+/* The workers' address-space limit in MB, 0 = none: --worker-memory-mb, or
+ * when not given CONF_WORKER_MEMORY_SHARE of the physical memory over
+ * nslots, at least CONF_WORKER_MEMORY_MIN_MB. */
+uint32_t conf_worker_memory_mb(const mcd_conf *c, int nslots);
 /* SIGHUP: appends ", name" (or "name" first) to changed when the option
  * differs (a subsystem naming what it applies only at start). */
 void conf_note_change(int differs, const char *name, char *changed, size_t sz);
+
+/* ---- priv_ ---------------------------------------------------------------- */
+/* The --user meshcorrd drops to when started as root (priv.c). */
+typedef struct priv_user {
+    int active;                   /* 0: not root, nothing to drop */
+    uid_t uid;
+    gid_t gid;
+    char name[256];
+} priv_user;
+/* Resolves --user; refuses root without it, root as --user, and another
+ * user's name when not started as root. 0 or -1 with the reason in err. */
+int priv_init(const mcd_conf *c, priv_user *u, char *err, size_t errsz);
+/* Makes state_dir USER's (created, or an empty one taken over; a used one
+ * of another owner is refused) and USER the effective user, root staying
+ * the real one: the store is opened and the backend set up as USER. */
+int priv_become(const priv_user *u, const char *state_dir, char *err, size_t errsz);
+/* Root effective again, to bind the listeners. */
+int priv_bind_begin(const priv_user *u, char *err, size_t errsz);
+/* USER for good (groups, gid, uid; root cannot be regained, checked). */
+int priv_drop(const priv_user *u, char *err, size_t errsz);
+void priv_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 
 /* ---- dlog_ ---------------------------------------------------------------- */
 enum { DLOG_ERROR, DLOG_WARN, DLOG_INFO, DLOG_DEBUG };

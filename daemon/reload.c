@@ -22,6 +22,7 @@ static void keep_restart_only(mcd *d, mcd_conf *n)
 {
     static void (*const keep[])(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz) = {
         srv_keep_on_reload, store_keep_on_reload, dash_keep_on_reload, tls_keep_on_reload,
+        priv_keep_on_reload,
     };
     char changed[512] = "";
     for (size_t i = 0; i < sizeof keep / sizeof keep[0]; i++)

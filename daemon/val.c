@@ -38,9 +38,11 @@ void val_conf_of(const mcd *d, val_conf *vc)
     vc->max_vertices = d->conf.max_vertices;
     vc->max_faces = conf_max_faces(&d->conf);
     /* a decoded mesh is well under 256 bytes a vertex (Draco's buffers,
-     * positions, faces, the check's tables); the worker's limit when set */
-    vc->max_memory_mb = d->conf.worker_memory_mb
-                            ? d->conf.worker_memory_mb
+     * positions, faces, the check's tables); the worker's limit when one
+     * was given */
+    uint32_t wm = d->conf.worker_memory_mb;
+    vc->max_memory_mb = wm && wm != CONF_WORKER_MEMORY_AUTO
+                            ? wm
                             : VAL_BASE_MEMORY_MB + (unsigned)(2ull * d->conf.max_vertices * 256 >> 20);
     vc->max_cpu_s = VAL_MAX_CPU_S;
 }

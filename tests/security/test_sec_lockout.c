@@ -156,7 +156,7 @@ TEST_T(idle_tcp_sockets_at_the_descriptor_limit_leave_the_unix_socket_and_admins
     testdaemon d;
     testdaemon_start(&d, "fd_floor", args);
     struct rlimit low = {256, 256};
-    if (prlimit(d.pid, RLIMIT_NOFILE, &low, NULL) != 0)
+    if (testdaemon_prlimit(&d, RLIMIT_NOFILE, &low, NULL) != 0)
         FAILF("prlimit: %s", strerror(errno));
     static int fds[NIDLE];
     open_idle(&d, fds, NIDLE, from_one);
@@ -224,7 +224,7 @@ TEST_T(idle_sockets_on_the_slurm_progress_listener_are_capped_and_cut, 90)
     CHECK_STR_HAS(host, "127.0.0.1");               /* loopback unless configured */
     snprintf(addr, sizeof addr, "tcp:127.0.0.1:%d", port);
     struct rlimit low = {256, 256};
-    if (prlimit(d.pid, RLIMIT_NOFILE, &low, NULL) != 0)
+    if (testdaemon_prlimit(&d, RLIMIT_NOFILE, &low, NULL) != 0)
         FAILF("prlimit: %s", strerror(errno));
     static int fds[NPROG];
     for (int i = 0; i < NPROG; i++)

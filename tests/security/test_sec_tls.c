@@ -527,8 +527,14 @@ static int run_daemon(const char *name, const char *const *args, char *out, size
     snprintf(state, sizeof state, "%s/state", dir);
     snprintf(log, sizeof log, "%s/stderr", dir);
     mkdir(dir, 0700);
+    testdaemon_give(harness_tmpdir());
+    testdaemon_give(dir);
     const char *argv[32] = {DAEMON, "--state-dir", state};
     int k = 3;
+    if (testdaemon_user()) {
+        argv[k++] = "--user";
+        argv[k++] = testdaemon_user();
+    }
     for (int i = 0; args[i] && k < 31; i++)
         argv[k++] = args[i];
     argv[k] = NULL;
@@ -671,13 +677,15 @@ static void replace_file(const char *path, const char *from)
     snprintf(tmp, sizeof tmp, "%s.new", path);
     snprintf(cmd, sizeof cmd, "cp '%s' '%s' && mv '%s' '%s'", from, tmp, tmp, path);
     CHECK_INT(testrun(cmd, out, sizeof out), 0);
+    testdaemon_give(path);            /* a reload reads it as the daemon's --user */
 }
 
 TEST_T(sighup_serves_a_renewed_certificate_and_keeps_the_old_one_when_the_new_is_bad, 120)
 {
     testtls t;
     testtls_make(&t, "certs");
-    /* the daemon's files are copies the test renews */
+    /* the daemon's files are copies the test renews, in a folder its user reaches */
+    testdaemon_give(t.dir);
     char cert[700], key[700], cert2[700], key2[700];
     snprintf(cert, sizeof cert, "%s/live.pem", t.dir);
     snprintf(key, sizeof key, "%s/live.key", t.dir);

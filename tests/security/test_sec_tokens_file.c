@@ -14,6 +14,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
+#include <pwd.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -49,6 +50,7 @@ static void write_file(const char *dir, const char *name, const void *text, size
     CHECK(write(fd, text, n) == (ssize_t)n);
     CHECK_INT(fchmod(fd, mode), 0);
     close(fd);
+    testdaemon_give(path);                        /* the daemon's user reads it */
 }
 
 /* meshcorrd with tokens file path must refuse to start: exit 1, and its
@@ -57,8 +59,10 @@ static void refused_at_start(const char *path, const char *const *what)
 {
     char state[600];
     snprintf(state, sizeof state, "%s/state-refused", harness_tmpdir());
-    int rc = testrunf(out, sizeof out, "timeout 10 " DAEMON " --state-dir %s --listen tcp:127.0.0.1:0 --tokens %s 2>&1", state,
-                      path);
+    testdaemon_give(harness_tmpdir());
+    const char *user = testdaemon_user();
+    int rc = testrunf(out, sizeof out, "timeout 10 " DAEMON " %s%s --state-dir %s --listen tcp:127.0.0.1:0 --tokens %s 2>&1",
+                      user ? "--user " : "", user ? user : "", state, path);
     printf("  %s\n", strstr(out, "error: ") ? strstr(out, "error: ") : out);
     CHECK_INT(rc, 1);
     for (int i = 0; what[i]; i++)
@@ -160,6 +164,11 @@ TEST(a_tokens_file_others_can_read_or_change_is_refused_with_the_fix)
 
     /* the group may read it (root:meshcorr 0640) */
     write_file(harness_tmpdir(), "tokens", text, strlen(text), 0640, path, sizeof path);
+    if (geteuid() == 0) {
+        struct passwd *pw = getpwnam(TESTDAEMON_USER);
+        CHECK(pw != NULL);
+        CHECK_INT(chown(path, 0, pw->pw_gid), 0);     /* root's, the daemon's group */
+    }
     const char *args[] = {"--tokens", path, NULL};
     testdaemon d;
     testdaemon_start(&d, "mode_0640", args);
@@ -179,6 +188,7 @@ TEST_T(the_tokens_file_is_found_as_a_systemd_credential, 60)
     testdaemon_token_line("mc_credential", "erin", 0, line, sizeof line);
     snprintf(text, sizeof text, "%s\n", line);
     write_file(dir, "tokens", text, strlen(text), 0400, path, sizeof path);
+    testdaemon_give(dir);                         /* systemd makes the folder the service user's too */
     CHECK_INT(setenv("CREDENTIALS_DIRECTORY", dir, 1), 0);
     const char *explicit_args[] = {"--tokens", "${CREDENTIALS_DIRECTORY}/tokens", NULL};
     const char *default_args[] = {"--tokens", "", NULL};

@@ -10,10 +10,12 @@
 #include <fcntl.h>
 #include <gnutls/crypto.h>
 #include <gnutls/gnutls.h>
+#include <pwd.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -32,6 +34,35 @@ void testdaemon_need_worker(void)
 {
     if (access(WORKER, X_OK) != 0)
         SKIP("%s not built (the worker branch provides it)", WORKER);
+}
+
+const char *testdaemon_user(void)
+{
+    return geteuid() == 0 ? TESTDAEMON_USER : NULL;
+}
+
+void testdaemon_give(const char *path)
+{
+    if (geteuid() != 0)
+        return;
+    struct passwd *pw = getpwnam(TESTDAEMON_USER);
+    if (!pw)
+        FAILF("no user %s to run meshcorrd as (tests run as root): deploy/install-deps.sh creates it",
+              TESTDAEMON_USER);
+    if (chown(path, pw->pw_uid, pw->pw_gid) != 0)
+        FAILF("chown %s to %s: %s", path, TESTDAEMON_USER, strerror(errno));
+}
+
+/* Run as root: the daemon's --user is TESTDAEMON_USER, and the harness's
+ * directory and d's (its socket, port file and tokens) are that user's, so
+ * it can reach its state directory and read its files on SIGHUP after the
+ * drop. NULL when not root (the daemon runs as the test does). */
+static const char *run_as(const testdaemon *d, const char *tokens)
+{
+    const char *mine[] = {harness_tmpdir(), d->dir, tokens};
+    for (size_t i = 0; i < sizeof mine / sizeof mine[0]; i++)
+        testdaemon_give(mine[i]);
+    return testdaemon_user();
 }
 
 void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
@@ -63,6 +94,10 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     argv[k++] = "--tokens";    argv[k++] = tokens;
     argv[k++] = "--log-level"; argv[k++] = "debug";
     argv[k++] = "--threads-per-worker"; argv[k++] = "1";
+    const char *user = run_as(d, tokens);
+    if (user) {
+        argv[k++] = "--user";  argv[k++] = user;
+    }
     for (int i = 0; args && args[i] && k < 62; i++)
         argv[k++] = args[i];
     argv[k] = NULL;
@@ -129,6 +164,7 @@ void testdaemon_write_tokens(const char *path, const char *text)
     size_t n = strlen(text);
     if (fd < 0 || fchmod(fd, 0600) != 0 || write(fd, text, n) != (ssize_t)n || close(fd) != 0)
         FAILF("cannot write %s: %s", tmp, strerror(errno));
+    testdaemon_give(tmp);                  /* the daemon reads it again, as its user, on SIGHUP */
     if (rename(tmp, path) != 0)
         FAILF("rename %s: %s", path, strerror(errno));
 }
@@ -196,6 +232,38 @@ void testdaemon_kill(testdaemon *d)
     if (!WIFSIGNALED(st) || WTERMSIG(st) != SIGKILL)
         FAILF("meshcorrd ended with %s, not by the test's SIGKILL; log %s", status_text(st, what, sizeof what),
               d->log);
+}
+
+int testdaemon_prlimit(const testdaemon *d, int resource, const struct rlimit *new_limit, struct rlimit *old_limit)
+{
+    if (prlimit(d->pid, resource, new_limit, old_limit) == 0)
+        return 0;
+    if (errno != EPERM || geteuid() != 0)
+        return -1;
+    struct passwd *pw = getpwnam(TESTDAEMON_USER);
+    int fd[2];
+    if (!pw || pipe(fd) != 0)
+        return -1;
+    pid_t pid = fork();
+    if (pid == 0) {
+        struct { int rc, err; struct rlimit old; } r = {0, 0, {0, 0}};
+        if (setgid(pw->pw_gid) != 0 || setuid(pw->pw_uid) != 0 ||
+            prlimit(d->pid, resource, new_limit, &r.old) != 0)
+            r.rc = -1, r.err = errno;
+        _exit(write(fd[1], &r, sizeof r) == (ssize_t)sizeof r ? 0 : 1);
+    }
+    close(fd[1]);
+    struct { int rc, err; struct rlimit old; } r = {-1, EIO, {0, 0}};
+    ssize_t n = pid > 0 ? read(fd[0], &r, sizeof r) : -1;
+    close(fd[0]);
+    if (pid > 0)
+        waitpid(pid, NULL, 0);
+    if (n != (ssize_t)sizeof r)
+        r.rc = -1, r.err = EIO;
+    if (r.rc == 0 && old_limit)
+        *old_limit = r.old;
+    errno = r.err;
+    return r.rc;
 }
 
 mc_client *testdaemon_client(const testdaemon *d, const char *token)

@@ -6,7 +6,10 @@
  *   TESTDAEMON_ALICE (user alice), TESTDAEMON_BOB (user bob),
  *   TESTDAEMON_ADMIN (user boss, admin).
  * The daemon dies with the test process (PR_SET_PDEATHSIG). Jobs it runs:
- * icosphere pairs, quick or long. Test code only. */
+ * icosphere pairs, quick or long. A test run as root starts it with
+ * --user TESTDAEMON_USER (meshcorrd refuses root without --user), the
+ * test's directories given to that user (deploy/install-deps.sh creates
+ * it). Test code only. */
 #ifndef TESTDAEMON_H
 #define TESTDAEMON_H
 #include <sys/types.h>
@@ -17,6 +20,7 @@
 #define TESTDAEMON_ALICE "tok-alice-0123456789"
 #define TESTDAEMON_BOB   "tok-bob-0123456789"
 #define TESTDAEMON_ADMIN "tok-boss-0123456789"
+#define TESTDAEMON_USER  "meshcorr"
 
 typedef struct testdaemon {
     pid_t pid;
@@ -47,6 +51,18 @@ void testdaemon_stop(testdaemon *d, int sig);
 /* A crash: SIGKILLs the daemon and reaps it. Fails the test when it had
  * already died (by a signal or an exit) before the SIGKILL. */
 void testdaemon_kill(testdaemon *d);
+/* TESTDAEMON_USER when the test runs as root (the --user a meshcorrd the
+ * test starts by hand must be given), else NULL. */
+const char *testdaemon_user(void);
+/* When the test runs as root: path (a file or folder the daemon reads, or
+ * a folder on the way to one) becomes TESTDAEMON_USER's; else nothing. */
+void testdaemon_give(const char *path);
+/* prlimit(2) on the daemon (a test's way to shrink its descriptors). The
+ * daemon runs as TESTDAEMON_USER when the test is root, and root may lack
+ * CAP_SYS_RESOURCE (a container): then a child of the test that takes the
+ * daemon's user does it. 0, or -1 with errno set. */
+struct rlimit;
+int testdaemon_prlimit(const testdaemon *d, int resource, const struct rlimit *new_limit, struct rlimit *old_limit);
 /* A connected client: token NULL = the Unix socket (peer credentials), else
  * TCP with that token. Fails the test when it cannot connect. */
 mc_client *testdaemon_client(const testdaemon *d, const char *token);

@@ -20,6 +20,19 @@ static int listed(const char *line, const char *const *names, size_t n)
     return 0;
 }
 
+/* 1 when line starts with one of the blank-separated prefixes of also. */
+static int also_has(const char *also, const char *line)
+{
+    for (const char *p = also; p && *p;) {
+        size_t n = strcspn(p, " ");
+        if (n && strncmp(line, p, n) == 0)
+            return 1;
+        p += n;
+        p += strspn(p, " ");
+    }
+    return 0;
+}
+
 static void check(const char *path, const char *also, int with_tls)
 {
     static char out[1 << 14];
@@ -32,8 +45,7 @@ static void check(const char *path, const char *also, int with_tls)
         if (strstr(line, "not found"))
             FAILF("ldd %s: %s", path, line);
         if (!listed(line, allowed, sizeof allowed / sizeof *allowed) &&
-            !(with_tls && listed(line, tls, sizeof tls / sizeof *tls)) &&
-            !(also && !strncmp(line, also, strlen(also))))
+            !(with_tls && listed(line, tls, sizeof tls / sizeof *tls)) && !also_has(also, line))
             FAILF("ldd %s lists %s: only libc, libm, libdraco and the C++ runtime%s%s%s may be linked", path,
                   line, with_tls ? ", GnuTLS and its libraries" : "", also ? " and " : "", also ? also : "");
         n++;

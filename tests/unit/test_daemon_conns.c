@@ -160,7 +160,7 @@ TEST_T(idle_connections_at_the_descriptor_limit_never_fail_a_queued_job, 180)
     testdaemon d;
     testdaemon_start(&d, "fds", args);
     struct rlimit low = {256, 256};
-    if (prlimit(d.pid, RLIMIT_NOFILE, &low, NULL) != 0)
+    if (testdaemon_prlimit(&d, RLIMIT_NOFILE, &low, NULL) != 0)
         FAILF("prlimit: %s", strerror(errno));
     mc_client *c = testdaemon_client(&d, NULL);
     int rc;

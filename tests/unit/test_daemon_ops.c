@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -207,6 +208,7 @@ TEST_T(sd_notify_says_ready_status_reloading_and_stopping, 60)
     strcpy(a.sun_path, path);
     unlink(path);
     CHECK_INT(bind(fd, (struct sockaddr *)&a, sizeof a), 0);
+    CHECK_INT(chmod(path, 0666), 0);    /* as systemd's: the daemon may run as TESTDAEMON_USER */
     CHECK_INT(setenv("NOTIFY_SOCKET", path, 1), 0);
     testdaemon d;
     testdaemon_start(&d, "notify", NULL);

@@ -20,6 +20,7 @@
 #include "proto.h"
 #include "spool.h"        /* file names and exit statuses: SPOOL_* */
 #include "corr/corr.h"
+#include "sandbox/sandbox.h"
 
 typedef struct wrk_limits {
     int max_vertices, max_faces;   /* per mesh, checked while decoding */
@@ -108,6 +109,15 @@ void wrk_result_close(wrk_result *r);
  * the message naming the blob or field) on out_fd and SPOOL_EXIT_JOB. */
 int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim);
 
+/* The limits the worker sets whatever the daemon passes (WORKER.md,
+ * "Sandbox"): its largest file is one frame (result.frame), it needs few
+ * descriptors; --max-cpu-s is at most WRK_MAX_CPU_S, and a run that uses it
+ * up gets SIGXCPU, then SIGKILL WRK_CPU_GRACE_S CPU seconds later. */
+#define WRK_MAX_FILE_BYTES ((rlim_t)PROTO_MAX_FRAME)
+#define WRK_MAX_FILES 1024
+#define WRK_MAX_CPU_S (1ull << 40)
+#define WRK_CPU_GRACE_S 10
+
 /* worker_cli.c — shared by both programs' mains. wrk_parse_num: the decimal
  * s of option --opt in [lo, hi], or -1 with a message naming prog and the
  * option. wrk_setlimit: resource limit res to v (soft and hard), or -1 with
@@ -122,6 +132,16 @@ int wrk_setlimit(const char *prog, int res, const char *what, rlim_t v);
 int wrk_limit_option(const char *prog, int opt, const char *arg, wrk_limits *lim,
                      unsigned long long *memory_mb);
 void wrk_error_msg(proto_msg *m, int code, const char *msg, char text[PROTO_MAX_STRING + 1]);
+/* RLIMIT_CPU: soft cpu_s (SIGXCPU), hard WRK_CPU_GRACE_S later (SIGKILL). */
+int wrk_setlimit_cpu(const char *prog, rlim_t cpu_s);
+/* What both programs set before they read their input: no core file, files
+ * of at most max_file bytes, max_files descriptors, and RLIMIT_NPROC at half
+ * the system's task ids (the limit counts every process and thread of the
+ * user, the daemon's included: it keeps a runaway from taking them all). */
+int wrk_base_limits(const char *prog, rlim_t max_file, rlim_t max_files);
+/* The worker's sandbox profile (sandbox.h) for a job: the OpenCL one when
+ * its backend is opencl or auto (both set PoCL up), else the CPU one. */
+sbx_profile wrk_sandbox_profile(const proto_submit *s);
 
 /* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with
  * fp64, one per line on stdout; 0 when printed. */

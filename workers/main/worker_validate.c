@@ -142,7 +142,8 @@ int main(int argc, char **argv)
         return SPOOL_EXIT_USAGE;
     }
     /* the sandbox: bounded memory and CPU time, no files written, no core
-     * dumped, few descriptors; set before any input is read */
+     * dumped, few descriptors, then the seccomp allow-list (sandbox.h);
+     * all before any input is read */
     signal(SIGPIPE, SIG_IGN);
     /* the two meshes' buffers come and go: keep freed memory for reuse
      * instead of an mmap and its page faults per large buffer */
@@ -150,8 +151,12 @@ int main(int argc, char **argv)
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
     if ((max_memory_mb && wrk_setlimit(PROG, RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20)) ||
         (max_cpu_s && wrk_setlimit(PROG, RLIMIT_CPU, "--max-cpu-s", (rlim_t)max_cpu_s)) ||
-        wrk_setlimit(PROG, RLIMIT_FSIZE, "file size", 0) || wrk_setlimit(PROG, RLIMIT_CORE, "core size", 0) ||
-        wrk_setlimit(PROG, RLIMIT_NOFILE, "descriptors", 16))
+        wrk_base_limits(PROG, 0, 16))
         return SPOOL_EXIT_USAGE;
+    char err[256];
+    if (sbx_enter(SBX_VALIDATOR, PROG, err, sizeof err)) {
+        fprintf(stderr, PROG ": %s\n", err);
+        return SPOOL_EXIT_USAGE;
+    }
     return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim);
 }
