@@ -3,13 +3,15 @@
  * the reverse map. Reads files and prints; computes nothing itself. Maps
  * are meshcorr-map 1 files or vertex maps (map/vmap.h, base --map-base).
  *
- * Ground-truth formats:
+ * Ground-truth formats (files read by workers/lmk, the reader and base
+ * rule of match's landmarks: 0-based unless --gt-base 1, a BIM .vts file's
+ * positions checked against its mesh):
  *   vts-pair     --gt A --gt-target B: line k of A (source vertex) <-> line
- *                k of B (target vertex); first column read (BCICP/FAUST .vts,
- *                BIM .vts "id x y z"); 1-based unless --gt-base 0
+ *                k of B (target vertex); one id a line (BCICP/FAUST .vts:
+ *                1-based, --gt-base 1) or BIM .vts "id x y z" / .pid lines
  *   vertex-list  --gt G: line i = the target vertex of source vertex i, one
  *                line per source vertex (cartoon gt_*.txt written as floats,
- *                pyFM lion2cat); 0-based unless --gt-base 1 */
+ *                pyFM lion2cat) */
 #include "cli/cli.h"
 #include "geod/geod.h"
 #include "lmk/lmk.h"
@@ -55,13 +57,21 @@ static void usage(FILE *fp)
         "of every map (with a ground truth).\n");
 }
 
-/* lmk_read_ids with the message on stderr. */
-static int read_indices(const char *path, int base, int nv, int **out, int *n)
+/* lmk_read_ids_on with the message on stderr, and what to do about it. */
+static int read_indices(const char *path, int base, const mesh *m, int **out, int *n)
 {
     char err[512];
-    if (lmk_read_ids(path, base, nv, EVAL_MAX_GT_LINES, out, n, err, sizeof err) == LMK_OK)
+    int rc = lmk_read_ids_on(path, base, m, EVAL_MAX_GT_LINES, out, n, err, sizeof err);
+    if (rc == LMK_OK)
         return 0;
-    fprintf(stderr, "meshcorr eval: %s\n", err);
+    const char *hint = "";
+    if (rc == LMK_ELAYOUT)
+        hint = " (--gt, --gt-target)";
+    else if (rc == LMK_ERANGE && base == LMK_BASE_DEFAULT && strstr(err, "looks 1-based"))
+        hint = ": give --gt-base 1";
+    else if (rc == LMK_EBASE)
+        hint = ": leave --gt-base out";
+    fprintf(stderr, "meshcorr eval: %s%s\n", err, hint);
     return -1;
 }
 
@@ -178,7 +188,7 @@ int cli_eval(int argc, char **argv)
         {0, 0, 0, 0}};
     const char *rev = NULL, *gt = NULL, *gt2 = NULL, *fmt = NULL;
     const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL, *out_png = NULL;
-    int base = -1, json = 0, folds = 0, c, bad = 0, map_base = VMAP_BASE_AUTO;
+    int base = LMK_BASE_DEFAULT, json = 0, folds = 0, c, bad = 0, map_base = VMAP_BASE_AUTO;
     optind = 1;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
@@ -240,8 +250,6 @@ int cli_eval(int argc, char **argv)
         usage(stderr);
         return 2;
     }
-    if (base < 0)
-        base = pair ? 1 : 0;
     const char *spath = argv[optind], *tpath = argv[optind + 1];
     char *const *ppaths = argv + optind + 2;
     char err[1024];
@@ -262,7 +270,7 @@ int cli_eval(int argc, char **argv)
             goto done;
         }
     if (gt && pair) {
-        if (read_indices(gt, base, S->nv, &gsrc, &ngt) || read_indices(gt2, base, T->nv, &gtgt, &n2))
+        if (read_indices(gt, base, S, &gsrc, &ngt) || read_indices(gt2, base, T, &gtgt, &n2))
             goto done;
         if (ngt != n2 || ngt == 0) {
             fprintf(stderr, "meshcorr eval: %s has %d lines but %s has %d: line k of one must "
@@ -270,7 +278,7 @@ int cli_eval(int argc, char **argv)
             goto done;
         }
     } else if (gt) {
-        if (read_indices(gt, base, T->nv, &gtgt, &ngt))
+        if (read_indices(gt, base, T, &gtgt, &ngt))
             goto done;
         if (ngt != S->nv) {
             fprintf(stderr, "meshcorr eval: %s has %d lines, but the source %s has %d vertices "
