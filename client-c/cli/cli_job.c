@@ -1,6 +1,7 @@
 /* cli_job.c — see cli_job.h. Parsing and loading only; running a job is the
  * command's business. The job parameters are the rows of PROTO_PARAMS:
- * parsed by proto_param_parse, checked by proto_params_check. */
+ * parsed by proto_param_parse, checked by proto_params_check_as, which
+ * names each by its option (--iterations) and its whole range. */
 #include "cli/cli_job.h"
 #include "corr/corr.h"
 
@@ -164,7 +165,7 @@ int cli_job_check(cli_job *j, const char *cmd)
         j->w.backend = j->backend;
         j->device = NULL;
     }
-    if (proto_params_check(&j->w, err, sizeof err)) {
+    if (proto_params_check_as(&j->w, PROTO_NAME_CLI, err, sizeof err)) {
         fprintf(stderr, "meshcorr %s: %s\n", cmd, err);
         return -1;
     }

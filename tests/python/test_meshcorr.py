@@ -155,7 +155,7 @@ def case_bad_input_refused():
     expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, inner_iterations=500000,
                  has="inner_iterations")
     expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, iterations=0,
-                 has="params.iterations = 0 < 1")
+                 has="iterations = 0: out of range [1, 1000000]")
     expect_error(-100, "MC_EARG", c.submit, SRC, TGT, landmarks=LANDMARKS, model="sideways", has="sideways")
     expect_error(-100, "MC_EARG", c.submit, SRC, TGT, landmarks=LANDMARKS, no_such_option=1, has="no_such_option")
     expect_error(-100, "MC_EARG", c.submit, (V, np.array([[0, 1, nv + 5]])), TGT, landmarks=LANDMARKS)
