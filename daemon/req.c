@@ -380,14 +380,33 @@ static int list_add(void *ctx, const store_job *j)
     return 0;
 }
 
+/* s with control bytes as \xNN: a client's string fit for a log line. */
+static void list_printable(const char *s, char *out, size_t sz)
+{
+    size_t o = 0;
+    for (const unsigned char *p = (const unsigned char *)s; *p && o + 5 < sz; p++)
+        o += (size_t)(*p < 0x20 || *p == 0x7f || *p == '\\' ? snprintf(out + o, sz - o, "\\x%02x", *p)
+                                                             : snprintf(out + o, sz - o, "%c", *p));
+    out[o] = '\0';
+}
+
 static void on_list(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
     conn_auth *a = srv_conn_auth(c);
     const proto_list *q = &m->u.list;
-    const char *user = q->user[0] ? q->user : a->user;
-    if (strcmp(user, a->user) != 0 && !a->admin) {
-        srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", user);
+    /* "" the caller's jobs; PROTO_LIST_ALL_USERS every user's (admin) */
+    int all = strcmp(q->user, PROTO_LIST_ALL_USERS) == 0;
+    const char *user = all ? NULL : q->user[0] ? q->user : a->user;
+    if ((all || strcmp(user, a->user) != 0) && !a->admin) {
+        char esc[4 * PROTO_MAX_STRING + 1];
+        list_printable(all ? "(every user)" : user, esc, sizeof esc);
+        dlog(DLOG_WARN, "%s: LIST of %s refused: not an admin", a->user, esc);
+        if (all)
+            srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list every user's jobs (user \"%s\")",
+                           PROTO_LIST_ALL_USERS);
+        else
+            srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", esc);
         return;
     }
     uint32_t max = q->max_count ? q->max_count : REQ_LIST_PAGE;

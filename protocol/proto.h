@@ -355,9 +355,10 @@ typedef struct proto_status_ok {
     uint8_t has_progress; proto_progress progress;
     proto_quality quality;
 } proto_status_ok;
+#define PROTO_LIST_ALL_USERS "*"       /* LIST's user for every user's jobs (admin only) */
 typedef struct proto_list {
     uint32_t state_mask;              /* bit s = state s; 0 = every state */
-    const char *user;                 /* "" = me; another user: admin only */
+    const char *user;                 /* "" = me; another user or "*" (all): admin only */
     uint32_t max_count;               /* 0 = server's page size */
     uint64_t after_id;                /* ids greater than this (paging) */
 } proto_list;
