@@ -99,7 +99,8 @@ void conf_init(mcd_conf *c)
 
 void conf_usage(FILE *fp)
 {
-    fprintf(fp, "usage: meshcorrd --state-dir DIR --listen ADDR [options]\n\noptions (also `key = value` in --config):\n");
+    fprintf(fp, "usage: meshcorrd --state-dir DIR --listen ADDR [options]\n"
+                "       meshcorrd --version\n\noptions (also `key = value` in --config):\n");
     for (size_t i = 0; i < NOPTIONS; i++)
         fprintf(fp, "  --%-20s %s\n", options[i].name, options[i].help);
 }

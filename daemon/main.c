@@ -11,6 +11,7 @@
 #include "util/ompenv.h"
 
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -34,6 +35,10 @@ int main(int argc, char **argv)
 {
     static mcd d;
     char err[1024];
+    if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+        printf("meshcorrd %s\n", MC_VERSION);
+        return 0;
+    }
     conf_init(&d.conf);
     int rc = conf_parse_args(&d.conf, argc, argv, err, sizeof err);
     if (rc == 1) {

@@ -22,7 +22,7 @@ def _default_server():
     env = os.environ.get("MESHCORR_SERVER")
     if env:
         return env
-    return "unix:%s/meshcorr.sock" % (os.environ.get("XDG_RUNTIME_DIR") or "/tmp")
+    return "unix:/run/meshcorr/meshcorrd.sock"      # MC_DEFAULT_SERVER: the shipped config's socket
 
 
 def _text(value):
@@ -128,7 +128,7 @@ class Result:
 
 class Client:
     """One connection to meshcorrd. server: "unix:PATH" or "tcp:HOST:PORT"
-    (default $MESHCORR_SERVER, else unix:$XDG_RUNTIME_DIR/meshcorr.sock);
+    (default $MESHCORR_SERVER, else unix:/run/meshcorr/meshcorrd.sock);
     token: the user's token for TCP (default $MESHCORR_TOKEN; a Unix socket
     needs none); timeout: seconds a request waits (None: libmeshcorr's 30 s;
     0: forever). Use it from one thread at a time; close() or `with`."""
