@@ -4,7 +4,8 @@
 #   make test       unit tests + gradient checks + integration (tests/run-tests.sh)
 #   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
 #   make demo       install deps, build, run the demo job on Debian's CGAL meshes
-#   make install    PREFIX=/usr/local DESTDIR= SYSCONFDIR= (install-lib install-python: the client part)
+#   make install    PREFIX=/usr/local DESTDIR= SYSCONFDIR= (install-lib install-python: the client part;
+#                   install-doc: README and the specs into $(PREFIX)/share/doc/meshcorr)
 #   make doc-params PROTOCOL.md's parameter table and meshcorr(1)'s list from
 #                   protocol/proto_params.h
 PREFIX  ?= /usr/local
@@ -17,10 +18,12 @@ PKGS     = draco
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
 CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(BUILD)/gen
-# The project's version, kept in one place: the VERSION file (mc_version(),
-# the Python package's metadata, meshcorr.pc).
+# The project's one version (the file VERSION): every program's --version,
+# mc_version(), the Python package's metadata and meshcorr.pc; objects are
+# rebuilt when it changes.
 MC_VERSION := $(shell cat VERSION)
 CPPFLAGS += -DMC_VERSION='"$(MC_VERSION)"'
+
 # -fPIC everywhere so libmeshcorr.so can take engine objects from the same
 # archives; Debian's gcc builds PIE by default, so with
 # -fno-semantic-interposition the code is the same as before.
@@ -100,17 +103,17 @@ WORKER_OBJ   := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorr-validate $(BUILD)/meshcorrd
 
-.PHONY: all test bench demo install install-lib install-man install-python clean doc-params
+.PHONY: all test bench demo install install-lib install-man install-python install-doc clean doc-params
 # Objects built through pattern chains are kept (make would otherwise delete
 # them after the run and print that as the last line of `make test`).
 .SECONDARY:
 all: $(PROGRAMS)
 
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c VERSION
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 
-$(BUILD)/obj/%.o: %.cpp
+$(BUILD)/obj/%.o: %.cpp VERSION
 	@mkdir -p $(dir $@)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
@@ -149,8 +152,6 @@ $(ENGINE_SO): $(LOCAL_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) client-c/loc
 	  $(PROTO_LIB) $(LDLIBS)
 	ln -sf libmeshcorr-engine.so.1 $(BUILD)/libmeshcorr-engine.so
 
-# mc_version() is rebuilt when the version changes.
-$(BUILD)/obj/client-c/mc_version.o: VERSION
 
 $(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
 	@mkdir -p $(dir $@)
@@ -214,6 +215,7 @@ install: $(PROGRAMS)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/systemd/system $(DESTDIR)$(SYSCONFDIR)/meshcorr
 	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
 	sed -e 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' -e 's|/etc/meshcorr/|$(SYSCONFDIR)/meshcorr/|' \
+	  -e 's|/usr/share/doc/meshcorr/|$(DOCDIR)/|g' \
 	  deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	test -e $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf || \
@@ -227,13 +229,25 @@ install-man:
 	set -e; for p in $(MAN_PAGES); do d=$(DESTDIR)$(PREFIX)/share/man/man$${p##*.}; \
 	  install -d $$d; install -m 644 $$p $$d/; done
 
-# libmeshcorr: header, static and shared libraries, pkg-config file (the
-# engine and codec archives too: static users link them, see Libs.private).
+# The documentation, where the unit's Documentation= points, in the
+# repository's own layout so that the pages' links to each other work.
+DOCDIR ?= $(PREFIX)/share/doc/meshcorr
+DOCS   := README.md $(wildcard docs/*.md) protocol/PROTOCOL.md daemon/README.md daemon/MODBUS.md
+install: install-doc
+install-doc:
+	set -e; for f in $(DOCS); do d=$(DESTDIR)$(DOCDIR)/$$(dirname $$f); \
+	  install -d $$d; install -m 644 $$f $$d/; done
+
+# libmeshcorr: headers in include/meshcorr/ (meshcorr.h and the parameter
+# list it includes; pkg-config's Cflags name the folder, so both
+# <meshcorr.h> and <meshcorr/meshcorr.h> work), static and shared
+# libraries, pkg-config file (the engine and codec archives too: static
+# users link them, see Libs.private).
 all: $(CLIENT_SO) $(ENGINE_SO)
 install: install-lib
 install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_SO) $(ENGINE_LIB) $(PROTO_LIB)
-	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
-	install -m 644 client-c/meshcorr.h protocol/proto_params.h $(DESTDIR)$(PREFIX)/include/
+	install -d $(DESTDIR)$(PREFIX)/include/meshcorr $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 client-c/meshcorr.h protocol/proto_params.h $(DESTDIR)$(PREFIX)/include/meshcorr/
 	install -m 644 $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DESTDIR)$(PREFIX)/lib/
 	install -m 755 $(CLIENT_SO) $(ENGINE_SO) $(DESTDIR)$(PREFIX)/lib/
 	ln -sf libmeshcorr.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr.so

@@ -216,6 +216,10 @@ typedef struct mc_server_stats {
 } mc_server_stats;
 void mc_stats_free(mc_server_stats *s);
 
+/* The address clients use when none is given ($MESHCORR_SERVER first): the
+ * socket the shipped meshcorrd.conf and unit (RuntimeDirectory=meshcorr)
+ * listen on. */
+#define MC_DEFAULT_SERVER "unix:/run/meshcorr/meshcorrd.sock"
 /* address: "unix:PATH", "tls:HOST:PORT" or "tcp:HOST:PORT" (HOST a name or
  * numeric address). token: NULL or "" on a Unix socket (the server asks the
  * kernel who you are); the user's token on TCP. Sends HELLO; a refused token
@@ -237,8 +241,10 @@ int mc_is_admin(const mc_client *c);
 
 int mc_submit(mc_client *c, const mc_job_spec *spec, uint64_t *job_id);
 int mc_status(mc_client *c, uint64_t job_id, mc_job_status *out);
-/* Own jobs (user NULL) or another user's (admin); state_mask: bit s = state
- * s, 0 = all. Every page is fetched; *jobs is free()d by the caller. */
+/* Own jobs (user NULL), another user's (admin), or every user's (user
+ * MC_LIST_ALL_USERS, admin); state_mask: bit s = state s, 0 = all. Every
+ * page is fetched; *jobs is free()d by the caller. */
+#define MC_LIST_ALL_USERS "*"       /* PROTO_LIST_ALL_USERS */
 int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **jobs, uint32_t *n);
 /* Replays progress from outer iteration from_outer, then follows the job
  * live, calling cb (may be NULL) for each record until the job ends; then

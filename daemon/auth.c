@@ -83,6 +83,8 @@ int auth_user_ok(const char *user, char *err, size_t errsz)
             return errbuf_set(err, errsz, -1, "a user name is printable ASCII without blanks or '#' (byte %zu is "
                               "0x%02x)", i, c);
     }
+    if (strcmp(user, PROTO_LIST_ALL_USERS) == 0)
+        return errbuf_set(err, errsz, -1, "the user name %s means every user in LIST", PROTO_LIST_ALL_USERS);
     return 0;
 }
 

@@ -110,7 +110,7 @@ void conf_usage(FILE *fp)
 {
     fprintf(fp, "usage: meshcorrd --state-dir DIR --listen ADDR [options]\n"
                 "       meshcorrd token new USER [--admin] | token hash [USER [--admin]] < TOKEN\n"
-                "\noptions (also `key = value` in --config):\n");
+                "       meshcorrd --version\n\noptions (also `key = value` in --config):\n");
     for (size_t i = 0; i < NOPTIONS; i++)
         fprintf(fp, "  --%-20s %s\n", options[i].name, options[i].help);
 }

@@ -13,6 +13,7 @@
 #include "util/ompenv.h"
 
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -36,6 +37,10 @@ int main(int argc, char **argv)
 {
     static mcd d;
     char err[1024];
+    if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+        printf("meshcorrd %s\n", MC_VERSION);
+        return 0;
+    }
     if (argc > 1 && strcmp(argv[1], "token") == 0)
         return token_main(argc - 1, argv + 1);
     conf_init(&d.conf);

@@ -431,9 +431,16 @@ static void on_list(conn *c, const proto_msg *m)
     mcd *d = srv_conn_daemon(c);
     conn_auth *a = srv_conn_auth(c);
     const proto_list *q = &m->u.list;
-    const char *user = q->user[0] ? q->user : a->user;
-    if (strcmp(user, a->user) != 0 && !a->admin) {
-        srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", user);
+    /* "" the caller's jobs; PROTO_LIST_ALL_USERS every user's (admin) */
+    int all = strcmp(q->user, PROTO_LIST_ALL_USERS) == 0;
+    const char *user = all ? NULL : q->user[0] ? q->user : a->user;
+    if ((all || strcmp(user, a->user) != 0) && !a->admin) {
+        dlog(DLOG_WARN, "%s: LIST of %s refused: not an admin", a->user, all ? "(every user)" : user);
+        if (all)
+            srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list every user's jobs (user \"%s\")",
+                           PROTO_LIST_ALL_USERS);
+        else
+            srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", user);
         return;
     }
     uint32_t max = q->max_count ? q->max_count : REQ_LIST_PAGE;

@@ -167,7 +167,7 @@ def case_bad_input_refused():
     expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, inner_iterations=500000,
                  has="inner_iterations")
     expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, iterations=0,
-                 has="params.iterations = 0 < 1")
+                 has="iterations = 0: out of range [1, 1000000]")
     expect_error(-100, "MC_EARG", c.submit, SRC, TGT, landmarks=LANDMARKS, model="sideways", has="sideways")
     expect_error(-100, "MC_EARG", c.submit, SRC, TGT, landmarks=LANDMARKS, no_such_option=1, has="no_such_option")
     expect_error(-100, "MC_EARG", c.submit, (V, np.array([[0, 1, nv + 5]])), TGT, landmarks=LANDMARKS)
@@ -265,7 +265,7 @@ def case_errors_are_builtin_subclasses():
     assert (e.code, e.name) == (-13, "UNAUTHORIZED"), e
     e = expect(ValueError, c.submit, SRC, TGT, landmarks=LANDMARKS, iterations=0)
     assert isinstance(e, meshcorr.BadParamsError) and (e.code, e.field) == (-21, "iterations"), e
-    assert str(e) == "BAD_PARAMS (-21): params.iterations = 0 < 1", str(e)   # the name once
+    assert str(e) == "BAD_PARAMS (-21): iterations = 0: out of range [1, 1000000]", str(e)   # the name once
     e = expect(ValueError, c.submit, SRC, TGT, landmarks=LANDMARKS, model="sideways")
     assert isinstance(e, meshcorr.BadParamsError) and e.field == "model", e
     e = expect(ValueError, c.submit, SRC, TGT, landmarks=[[0, 0], [1, 1], [2, 500]])

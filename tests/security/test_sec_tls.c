@@ -142,7 +142,7 @@ static int tls_dial(dial *t, int port, const char *prio, const char *ca, const c
 {
     CHECK(gnutls_certificate_allocate_credentials(&t->cred) == 0);
     CHECK(gnutls_certificate_set_x509_trust_file(t->cred, ca, GNUTLS_X509_FMT_PEM) > 0);
-    CHECK(gnutls_init(&t->s, GNUTLS_CLIENT) == 0);
+    CHECK(gnutls_init(&t->s, GNUTLS_CLIENT | GNUTLS_NO_SIGNAL) == 0);   /* a closed peer is an error, not SIGPIPE */
     const char *errpos = NULL;
     if (gnutls_priority_set_direct(t->s, prio, &errpos) != 0)
         FAILF("priority %s refused at '%s'", prio, errpos ? errpos : "?");

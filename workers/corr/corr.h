@@ -191,7 +191,7 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report r
                 char *err, size_t errsz);
 
 /* A job's parameters (the wire form of the one list, proto_params.h) as the
- * engine's: checked with proto_params_check (CORR_EINPUT, "params.NAME ..."
+ * engine's: checked with proto_params_check (CORR_EINPUT, "NAME = V: ..."
  * in err), a 0 that means the default left at the default, backend
  * "NAME[:DEVICE]" split into p->backend and p->device, threads into both.
  * p and r start from their _init defaults (log_eps stays ECTM's). */

@@ -40,6 +40,7 @@ static void usage(void)
         "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N] [--max-cpu-s N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
         "       meshcorr-worker --list-devices [--threads N]\n"
+        "       meshcorr-worker --version\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage; 4: neither could be written.\n"
         "See workers/WORKER.md.\n");
@@ -88,6 +89,7 @@ int main(int argc, char **argv)
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"list-devices", no_argument, 0, 'L'},
         {"max-cpu-s", required_argument, 0, 'C'},    {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
@@ -124,6 +126,7 @@ int main(int argc, char **argv)
         case 's': secret_file = optarg; break;
         case 'L': list_devices = 1; break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
+        case 'V': printf(PROG " %s\n", MC_VERSION); return 0;
         default: bad = 1;
         }
     }

@@ -111,6 +111,7 @@ static void usage(void)
 {
     fprintf(stderr,
         "usage: " PROG " [--max-vertices N] [--max-faces N] [--max-memory-mb N] [--max-cpu-s N]\n"
+        "       " PROG " --version\n"
         "Reads one SUBMIT frame on stdin and checks it as a run would, running nothing:\n"
         "exit 0 when the job would run; else one ERROR frame on stdout and exit 1.\n"
         "Exit 2: bad usage. See workers/WORKER.md.\n");
@@ -121,7 +122,8 @@ int main(int argc, char **argv)
     static const struct option opts[] = {
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"max-cpu-s", required_argument, 0, 'C'},
-        {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
+        {"help", no_argument, 0, 'h'},               {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
     unsigned long long max_memory_mb = 0, max_cpu_s = 0;
     int c, bad = 0;
@@ -132,6 +134,7 @@ int main(int argc, char **argv)
             break;
         case 'C': bad |= wrk_parse_num(PROG, "max-cpu-s", optarg, 1, 1ull << 20, &max_cpu_s) != 0; break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
+        case 'V': printf(PROG " %s\n", MC_VERSION); return 0;
         default: bad = 1;
         }
     }

@@ -23,7 +23,7 @@ def _default_server() -> str:
     env = os.environ.get("MESHCORR_SERVER")
     if env:
         return env
-    return "unix:%s/meshcorr.sock" % (os.environ.get("XDG_RUNTIME_DIR") or "/tmp")
+    return "unix:/run/meshcorr/meshcorrd.sock"      # MC_DEFAULT_SERVER: the shipped config's socket
 
 
 def _quality(q: Any) -> Optional[Dict[str, Any]]:
@@ -40,7 +40,7 @@ def _state_name(state: int) -> str:
 class Client:
     """One connection to meshcorrd. server: "unix:PATH", "tls:HOST:PORT" or
     "tcp:HOST:PORT" (default $MESHCORR_SERVER, else
-    unix:$XDG_RUNTIME_DIR/meshcorr.sock); token: the user's token for TCP
+    unix:/run/meshcorr/meshcorrd.sock; a bare path is a Unix socket); token: the user's token for TCP
     (default $MESHCORR_TOKEN; a Unix socket needs none); ca: for tls:, the
     PEM file of the CA the server's certificate must chain to (default
     $MESHCORR_CA, else the system's trust store); timeout: seconds
@@ -57,8 +57,9 @@ class Client:
                  timeout: Optional[float] = None, ca: Optional[str] = None) -> None:
         self._c: Optional[int] = None
         self.server = server or _default_server()
-        if not self.server.startswith(("unix:", "tcp:", "tls:")):
-            raise _lib.error(MC_EADDRESS, "server %r: expected unix:PATH, tls:HOST:PORT or tcp:HOST:PORT" % self.server,
+        bare_path = self.server.startswith(("/", ".")) or ":" not in self.server
+        if not self.server.startswith(("unix:", "tcp:", "tls:")) and not bare_path:
+            raise _lib.error(MC_EADDRESS, "server %r: expected unix:PATH (or a path), tls:HOST:PORT or tcp:HOST:PORT" % self.server,
                              InvalidInputError, "server")
         self.token = token if token is not None else os.environ.get("MESHCORR_TOKEN")
         self.timeout = timeout

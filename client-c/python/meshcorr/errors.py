@@ -143,7 +143,8 @@ _CLASSES = {
 
 # The argument a server message names by its first words (PROTOCOL.md's
 # field names), as submit()'s keyword.
-_FIELDS = ((re.compile(r"params\.(\w+)"), None), (re.compile(r"landmarks\b"), "landmarks"),
+_FIELDS = ((re.compile(r"params\.(\w+)"), None), (re.compile(r"(\w+) = "), None),
+           (re.compile(r"landmarks\b"), "landmarks"),
            (re.compile(r"(source|target) mesh\b"), None), (re.compile(r"initial map p\b"), "init"),
            (re.compile(r"initial map q\b"), "init_reverse"), (re.compile(r"threads\b"), "threads"))
 
