@@ -450,6 +450,7 @@ typedef struct val_conf {         /* a copy taken on the loop, for the thread po
     unsigned max_vertices;
     unsigned long long max_faces;
     unsigned max_memory_mb, max_cpu_s;
+    unsigned worker_memory_mb;    /* the worker's limit: a job estimated over it is refused; 0 none */
 } val_conf;
 void val_conf_of(const mcd *d, val_conf *vc);
 /* Runs meshcorr-validate on the SUBMIT frame[len] and waits for

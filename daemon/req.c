@@ -74,7 +74,7 @@ static void prune(mcd *d)
     }
 }
 
-static void results_of_closed(mcd *d, conn *c);
+static void results_end(mcd *d, conn *c, int closing);
 
 void req_conn_closed(mcd *d, conn *c)
 {
@@ -82,7 +82,7 @@ void req_conn_closed(mcd *d, conn *c)
         if (w->c == c)
             w->c = NULL;
     prune(d);
-    results_of_closed(d, c);
+    results_end(d, c, 1);
 }
 
 int req_conn_watching(const mcd *d, const conn *c)
@@ -845,15 +845,15 @@ static void on_result(conn *c, const proto_msg *m)
     results_start(d);
 }
 
-/* c is closing: its waiting RESULTs are dropped (and their holds
- * released), its RESULTs being sent end; one being read ends in
- * result_done. */
-static void results_of_closed(mcd *d, conn *c)
+/* c's RESULTs end: those being sent, and with closing (c is going) those
+ * waiting too, their holds released; one being read ends in result_done.
+ * Then the waiting ones that fit start. */
+static void results_end(mcd *d, conn *c, int closing)
 {
     int ended = 0;
     for (req_result **p = &results; *p;) {
         req_result *r = *p;
-        if (r->c == c && r->phase != RESULT_READING) {
+        if (r->c == c && (r->phase == RESULT_SENDING || (closing && r->phase == RESULT_WAITING))) {
             *p = r->next;
             if (r->phase == RESULT_WAITING)
                 srv_conn_release(c);
@@ -869,19 +869,7 @@ static void results_of_closed(mcd *d, conn *c)
 
 void req_conn_sent(mcd *d, conn *c)
 {
-    int ended = 0;
-    for (req_result **p = &results; *p;) {
-        req_result *r = *p;
-        if (r->c == c && r->phase == RESULT_SENDING) {
-            *p = r->next;
-            free(r);
-            ended = 1;
-        } else {
-            p = &r->next;
-        }
-    }
-    if (ended)
-        results_start(d);
+    results_end(d, c, 0);
 }
 
 static void on_delete(conn *c, const proto_msg *m)

@@ -11,23 +11,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static void sphere_pair(int level, mesh **S, mesh **T)
-{
-    *S = testmesh_icosphere(level);
-    *T = testmesh_icosphere(level);
-    if (!*S || !*T)
-        FAILF("testmesh_icosphere(%d) failed", level);
-    for (int i = 0; i < (*T)->nv; i++) {        /* an ellipsoid, a little bent */
-        double *x = &(*T)->v[3 * i];
-        x[0] *= 1.3;
-        x[2] += 0.15 * x[0] * x[0];
-    }
-}
-
 uint64_t testsec_submit_sphere(mc_client *c, int level, int stages, int iterations, int *rc)
 {
     mesh *S, *T;
-    sphere_pair(level, &S, &T);
+    testdaemon_sphere_pair(level, &S, &T);
     size_t sl, tl;
     unsigned char *sb = testdaemon_encode(S, &sl), *tb = testdaemon_encode(T, &tl);
     static const uint32_t lm[] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5};
