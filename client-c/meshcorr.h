@@ -52,6 +52,7 @@ enum mc_error {
     MC_ECANCELLED = -25,       /* mc_match: stopped by its progress callback */
     MC_EBUSY = -26,            /* a connection limit: retry later (at connect) */
     MC_ETIMED_OUT = -27,       /* the server cut a silent, slow or idle connection */
+    MC_EOVER_QUOTA = -28,      /* SUBMIT: the user's stored bytes, or the spool's, would pass its quota */
 #define MC_ENUM(name, val, msg) name = val,
     MC_ERRORS(MC_ENUM)
 #undef MC_ENUM

@@ -44,6 +44,12 @@ static const struct option_def {
     {"result-ttl", K_U32, OFF(result_ttl_s), 1, 100000000, "SECONDS a finished job is kept"},
     {"max-output", K_U32, OFF(max_output), 4096, 1u << 31, "BYTES queued to one client before a watcher is dropped"},
     {"max-request-memory", K_U32, OFF(max_request_memory), 65536, 0xFFFFFFFFu, "BYTES of request frames being received from all clients at once (default 1 GiB)"},
+    {"max-request-memory-per-user", K_U32, OFF(max_request_memory_per_user), 0, 0xFFFFFFFFu, "BYTES of request frames being received from one user (default 0: a quarter of max-request-memory)"},
+    {"max-bytes-per-user", K_LONG, OFF(max_bytes_per_user), 1, LONG_MAX, "BYTES of spool one user's jobs and results may take (default 2 GiB)"},
+    {"max-spool-bytes", K_LONG, OFF(max_spool_bytes), 0, LONG_MAX, "BYTES of spool all jobs may take (default 0: 80 % of the state file system)"},
+    {"max-watches-per-session", K_U32, OFF(max_watches_per_session), 1, 1000000, "N live WATCHes of one connection (default 64)"},
+    {"max-result-sends", K_U32, OFF(max_result_sends), 1, 1000000, "N RESULT replies read or sent at once, all clients (default 16)"},
+    {"max-result-sends-per-user", K_U32, OFF(max_result_sends_per_user), 1, 1000000, "N RESULT replies read or sent at once to one user (default 4)"},
     {"max-connections", K_U32, OFF(max_connections), 1, 1000000, "N sessions of non-admin users in all (default 512)"},
     {"max-connections-per-user", K_U32, OFF(max_connections_per_user), 1, 1000000, "N sessions of one user, admins exempt (default 64)"},
     {"max-unauthenticated", K_U32, OFF(max_unauthenticated), 1, 1000000, "N TCP connections before HELLO (default 64)"},
@@ -88,6 +94,10 @@ void conf_init(mcd_conf *c)
     c->result_ttl_s = CONF_DEFAULT_RESULT_TTL_S;
     c->max_output = CONF_DEFAULT_MAX_OUTPUT;
     c->max_request_memory = CONF_DEFAULT_MAX_REQUEST_MEMORY;
+    c->max_bytes_per_user = CONF_DEFAULT_MAX_BYTES_PER_USER;
+    c->max_watches_per_session = CONF_DEFAULT_MAX_WATCHES_PER_SESSION;
+    c->max_result_sends = CONF_DEFAULT_MAX_RESULT_SENDS;
+    c->max_result_sends_per_user = CONF_DEFAULT_MAX_RESULT_SENDS_PER_USER;
     c->max_connections = CONF_DEFAULT_MAX_CONNECTIONS;
     c->max_connections_per_user = CONF_DEFAULT_MAX_CONNECTIONS_PER_USER;
     c->max_unauthenticated = CONF_DEFAULT_MAX_UNAUTHENTICATED;

@@ -77,6 +77,12 @@
 #define CONF_DEFAULT_REQUEST_TIMEOUT_S 300        /* first byte of a frame -> its last */
 #define CONF_DEFAULT_IDLE_TIMEOUT_S 600           /* a session with nothing going on */
 #define CONF_DEFAULT_MAX_REQUEST_MEMORY (1u << 30) /* bytes of request frames being received, all clients */
+/* Fair limits per user (req.c, srv.c admit): stored bytes, the spool, watches, RESULTs. */
+#define CONF_DEFAULT_MAX_BYTES_PER_USER (2ll << 30)  /* spool bytes of one user's jobs and results */
+#define CONF_SPOOL_SHARE_PERCENT 80               /* --max-spool-bytes 0: this much of the state file system */
+#define CONF_DEFAULT_MAX_WATCHES_PER_SESSION 64   /* live WATCHes of one connection */
+#define CONF_DEFAULT_MAX_RESULT_SENDS 16          /* RESULT replies being read or sent, all clients */
+#define CONF_DEFAULT_MAX_RESULT_SENDS_PER_USER 4  /* ... of one user */
 #define CONF_FD_RESERVE_BASE 32                   /* --fd-reserve 0: this many ... */
 #define CONF_FD_RESERVE_PER_SLOT 4                /* ... plus this many per backend slot */
 
@@ -108,6 +114,11 @@ typedef struct mcd_conf {
     uint32_t job_timeout_s, result_ttl_s;
     uint32_t max_output;          /* output bytes queued per connection */
     uint32_t max_request_memory;  /* bytes of frames being received, all connections */
+    uint32_t max_request_memory_per_user; /* ... of one user's connections; 0 = a quarter of the above */
+    long max_bytes_per_user;      /* spool bytes of one user's jobs (their rows' bytes summed) */
+    long max_spool_bytes;         /* spool bytes of all jobs; 0 = CONF_SPOOL_SHARE_PERCENT of the file system */
+    uint32_t max_watches_per_session; /* live WATCHes of one connection */
+    uint32_t max_result_sends, max_result_sends_per_user; /* RESULTs read or sent at once */
     uint32_t max_connections, max_connections_per_user, max_unauthenticated;
     uint32_t max_unauth_per_address, admin_reserve;
     uint32_t hello_timeout_s, request_timeout_s, idle_timeout_s;   /* 0 = none */
@@ -275,7 +286,8 @@ void store_close(store *s);
  * (found by its job's worker lock, wlock_), an unfinished local job whose
  * worker had written a valid result.frame is COMPLETED with it (adopted, not
  * run again), other RUNNING jobs go back to PENDING, spool dirs without a
- * row are removed, unfinished rows without job.frame become FAILED.
+ * row are removed, unfinished rows without job.frame become FAILED, and
+ * ended jobs that did not complete lose a job.frame left behind.
  * Unfinished jobs with a Slurm job id are left as they are with keep_slurm
  * (the Slurm backend re-attaches), else they go back to PENDING too. */
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
@@ -287,7 +299,9 @@ int store_submit(store *s, const char *user, const char *label, int32_t priority
                  uint64_t *id, char *err, size_t errsz);
 int store_get(store *s, uint64_t id, store_job *out);  /* 0, PROTO_ENOT_FOUND, or error */
 int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid);
-/* PENDING clears the run's times; a terminal state sets end_ms and counts it. */
+/* PENDING clears the run's times; a terminal state sets end_ms and counts
+ * it, and, for any end but COMPLETED, removes job.frame once committed (the
+ * row and its reason stay until expiry; such a job has no RESULT). */
 int store_set_state(store *s, uint64_t id, int state, const char *reason);
 int store_add_progress(store *s, uint64_t id, const proto_progress *p);
 /* The Slurm job running it ("" none) and how much of progress.frames is read. */
@@ -322,6 +336,11 @@ int store_each_slurm(store *s, store_job_fn fn, void *ctx);
 /* Terminal jobs that ended before before_ms. */
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx);
 int store_delete(store *s, uint64_t id);
+/* Bytes the spool holds for user's jobs (NULL: everyone's): the sum of the
+ * rows' byte counts, which store_ keeps as each job's counted files
+ * (job.frame, result.frame, error.frame, progress files) change: the
+ * frame at submit, the run's files at its end or re-run. 0 or error. */
+int store_bytes(store *s, const char *user, int64_t *bytes);
 void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *cancelled);
 /* <dir>/spool/<id>[/file] into buf. */
 const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz);
@@ -583,6 +602,7 @@ typedef struct val_conf {         /* a copy taken on the loop, for the thread po
     unsigned max_vertices;
     unsigned long long max_faces;
     unsigned max_memory_mb, max_cpu_s;
+    unsigned worker_memory_mb;    /* the worker's limit: a job estimated over it is refused; 0 none */
 } val_conf;
 void val_conf_of(const mcd *d, val_conf *vc);
 /* Runs meshcorr-validate on the SUBMIT frame[len] and waits for
@@ -655,7 +675,8 @@ void req_init(mcd *d);                                /* listens to job.c for th
 /* A drain: idle(d) is called each time one of the requests in the thread
  * pool (d->work_inflight) finishes from now on. */
 void req_quiesce(mcd *d, mcd_idle_fn idle);
-void req_conn_closed(mcd *d, conn *c);                /* forget its watches */
+void req_conn_closed(mcd *d, conn *c);                /* forget its watches and RESULTs */
+void req_conn_sent(mcd *d, conn *c);                  /* c's output is written whole: its RESULTs end */
 int req_conn_watching(const mcd *d, const conn *c);   /* 1: a WATCH of c is live */
 
 #endif

@@ -7,8 +7,15 @@
  * DESIGN: visibility — a non-admin session sees only its user's jobs, and
  * any other job is NOT_FOUND, exactly like a job that never existed, so ids
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
- * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
- * anything is stored, counting the SUBMITs still being checked or stored.
+ * (row committed, spool fsynced); QUEUE_FULL, USER_LIMIT and OVER_QUOTA
+ * refuse before anything is stored, counting the SUBMITs still being
+ * checked or stored, and so does FORBIDDEN for a user's priority above 0.
+ *
+ * DESIGN: fair limits per user (README, Quotas): stored bytes per user and
+ * in all (check_quota, from the store's per-job byte counts), live WATCHes
+ * per connection, RESULT replies in flight in all and per user (the
+ * RESULT section below); each refusal names the user, the figures and the
+ * option, and is logged.
  * Before the store, val_submit has a short-lived meshcorr-validate child
  * decode and check the meshes, the landmarks against
  * them, the maps and the parameters, so a job that can never run is refused
@@ -32,11 +39,14 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #define REQ_LIST_PAGE 1000
+#define REQ_REFUSAL_LOG_MS 1000   /* a flood of one kind of refusal logs one line per this */
 
 struct req_watch {
     conn *c;                      /* NULL once the connection is gone */
@@ -64,12 +74,15 @@ static void prune(mcd *d)
     }
 }
 
+static void results_end(mcd *d, conn *c, int closing);
+
 void req_conn_closed(mcd *d, conn *c)
 {
     for (req_watch *w = d->watches; w; w = w->next)
         if (w->c == c)
             w->c = NULL;
     prune(d);
+    results_end(d, c, 1);
 }
 
 int req_conn_watching(const mcd *d, const conn *c)
@@ -249,6 +262,56 @@ static uint32_t submits_in_flight(const mcd *d, const char *user)
     return n;
 }
 
+/* Frame bytes of the SUBMITs of user (NULL: of everyone) still being stored. */
+static int64_t submit_bytes_in_flight(const mcd *d, const char *user)
+{
+    int64_t n = 0;
+    for (const req_submit *s = d->submits; s; s = s->next)
+        if (!user || strcmp(s->user, user) == 0)
+            n += (int64_t)s->len;
+    return n;
+}
+
+/* The spool's cap: --max-spool-bytes, or CONF_SPOOL_SHARE_PERCENT of the
+ * state file system's size (what stands there besides the spool is the
+ * operator's); 0 when neither can be had. how (for the message) says which. */
+static int64_t spool_cap(const mcd *d, char *how, size_t hsz)
+{
+    struct statvfs v;
+    how[0] = '\0';
+    if (d->conf.max_spool_bytes)
+        return d->conf.max_spool_bytes;
+    if (statvfs(d->conf.state_dir, &v) != 0)
+        return 0;
+    snprintf(how, hsz, " (%d %% of the state file system)", CONF_SPOOL_SHARE_PERCENT);
+    return (int64_t)((double)v.f_blocks * (double)v.f_frsize * CONF_SPOOL_SHARE_PERCENT / 100);
+}
+
+/* The byte quotas of a SUBMIT of len bytes by user: the user's stored bytes
+ * (jobs and results in the spool, and SUBMITs being stored) under
+ * --max-bytes-per-user, and everyone's under the spool's cap. 0, or
+ * PROTO_EOVER_QUOTA (PROTO_ESTORAGE when the store cannot count) with the
+ * message in msg. */
+static int check_quota(const mcd *d, const char *user, size_t len, char *msg, size_t msz)
+{
+    int64_t mine, all;
+    if (store_bytes(d->store, user, &mine) || store_bytes(d->store, NULL, &all))
+        return snprintf(msg, msz, "job store failure counting the spool's bytes; nothing stored"), PROTO_ESTORAGE;
+    mine += submit_bytes_in_flight(d, user);
+    all += submit_bytes_in_flight(d, NULL);
+    if (mine + (int64_t)len > d->conf.max_bytes_per_user)
+        return snprintf(msg, msz, "over quota: user %s stores %lld bytes of jobs and results, and this %zu-byte"
+                        " SUBMIT would pass --max-bytes-per-user %ld; delete finished jobs to make room",
+                        user, (long long)mine, len, d->conf.max_bytes_per_user), PROTO_EOVER_QUOTA;
+    char how[64];
+    int64_t cap = spool_cap(d, how, sizeof how);
+    if (cap && all + (int64_t)len > cap)
+        return snprintf(msg, msz, "over quota: the spool holds %lld bytes of jobs and results, and this %zu-byte"
+                        " SUBMIT would pass --max-spool-bytes %lld%s; retry once jobs are deleted or expire",
+                        (long long)all, len, (long long)cap, how), PROTO_EOVER_QUOTA;
+    return 0;
+}
+
 static void submit_run(uv_work_t *w)      /* thread pool */
 {
     req_submit *s = w->data;
@@ -338,6 +401,15 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
         srv_send_error(c, m->request_id, rc, "%s", msg);
         return;
     }
+    /* users may lower their priority, never raise it over others': the
+     * fair share holds among equal priorities (a stated priority is kept
+     * as stated or refused, never changed quietly) */
+    if (s->priority > 0 && !a->admin) {
+        dlog(DLOG_WARN, "SUBMIT from %s refused (FORBIDDEN): priority %d", a->user, s->priority);
+        srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "priority = %d: user %s may only lower a job's priority"
+                       " (priority <= 0); only an admin may raise it above 0", s->priority, a->user);
+        return;
+    }
     /* jobs still being stored count as pending: they will be */
     uint32_t mine = sched_user_pending(d->sched, a->user) + sched_user_running(d->sched, a->user) +
                     submits_in_flight(d, a->user);
@@ -350,6 +422,12 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     if (pending >= d->conf.max_queue) {
         srv_send_error(c, m->request_id, PROTO_EQUEUE_FULL, "queue full: %u jobs pending (limit %u); nothing stored",
                        pending, d->conf.max_queue);
+        return;
+    }
+    if ((rc = check_quota(d, a->user, len, msg, sizeof msg))) {
+        dlog(rc == PROTO_EOVER_QUOTA ? DLOG_WARN : DLOG_ERROR, "SUBMIT from %s refused (%s): %s", a->user,
+             proto_err_name(rc), msg);
+        srv_send_error(c, m->request_id, rc, "%s", msg);
         return;
     }
     req_submit *w = calloc(1, sizeof *w);
@@ -508,6 +586,40 @@ static int send_end(conn *c, uint32_t rid, const store_job *j)
     return srv_send(c, &r, 1);
 }
 
+/* Live WATCHes of connection c. */
+static uint32_t watches_of(const mcd *d, const conn *c)
+{
+    uint32_t n = 0;
+    for (const req_watch *w = d->watches; w; w = w->next)
+        n += w->c == c;
+    return n;
+}
+
+/* A refusal's log line, at most one per REQ_REFUSAL_LOG_MS for each kind
+ * (a client looping on a refused request costs one line a second, with
+ * how many it stands for). */
+static void log_refusal(mcd *d, uint64_t *last_ms, unsigned long *held_back, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void log_refusal(mcd *d, uint64_t *last_ms, unsigned long *held_back, const char *fmt, ...)
+{
+    uint64_t now = uv_now(d->loop);
+    if (*last_ms && now - *last_ms < REQ_REFUSAL_LOG_MS) {
+        ++*held_back;
+        return;
+    }
+    char line[PROTO_MAX_STRING + 128];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (*held_back)
+        dlog(DLOG_WARN, "%s (and %lu more like it since the last line)", line, *held_back);
+    else
+        dlog(DLOG_WARN, "%s", line);
+    *last_ms = now;
+    *held_back = 0;
+}
+
 static void on_watch(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -515,6 +627,21 @@ static void on_watch(conn *c, const proto_msg *m)
     store_job j;
     if (visible_job(c, m->request_id, w->job_id, &j))
         return;
+    /* each live WATCH costs the loop a visit per progress record of its
+     * job: a session holds a bounded number (a finished job's WATCH ends
+     * at once and is not counted) */
+    uint32_t live = store_is_terminal(j.state) ? 0 : watches_of(d, c);
+    if (live >= d->conf.max_watches_per_session) {
+        static uint64_t last_ms;
+        static unsigned long held_back;
+        log_refusal(d, &last_ms, &held_back, "WATCH from %s refused (OVER_LIMIT): %u live WATCHes on its"
+                    " connection (--max-watches-per-session %u)", srv_conn_auth(c)->user, live,
+                    d->conf.max_watches_per_session);
+        srv_send_error(c, m->request_id, PROTO_EOVER_LIMIT, "this connection has %u live WATCHes, the limit"
+                       " (--max-watches-per-session %u): watch fewer jobs per connection", live,
+                       d->conf.max_watches_per_session);
+        return;
+    }
     replay_ctx rc = {c, m->request_id, 0};
     if (store_history(d->store, j.id, w->from_outer, replay_one, &rc)) {
         srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure reading the history of job %llu",
@@ -592,11 +719,28 @@ static void on_cancel(conn *c, const proto_msg *m)
     reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
 }
 
-/* A RESULT being read: result.frame is read and decoded in the thread pool. */
-typedef struct req_result {
+/* A RESULT: result.frame is read and decoded in the thread pool, the reply
+ * encoded onto the connection, and then it is written out.
+ *
+ * DESIGN: what RESULTs hold is bounded in all and per user, not per
+ * connection. A RESULT counts from the start of its read until its
+ * connection's output has been written whole (req_conn_sent) or the
+ * connection is gone; at most --max-result-sends count at once, and at
+ * most --max-result-sends-per-user of one user's. One that does not fit
+ * waits, in order of arrival, with its connection held (not read: its
+ * replies keep their order), and starts when a RESULT of a user with room
+ * ends; so clients that never read their replies hold at most those
+ * RESULTs' bytes, and other users' RESULTs go on. The decoded result is
+ * freed once the reply is encoded. */
+enum { RESULT_WAITING, RESULT_READING, RESULT_SENDING };
+typedef struct req_result req_result;
+struct req_result {
     uv_work_t work;
     mcd *d;                       /* loop side only */
-    conn *c;                      /* loop side only; held */
+    conn *c;                      /* loop side only; held until the read is done */
+    req_result *next;             /* results, in arrival order */
+    int phase;                    /* RESULT_* */
+    char user[AUTH_MAX_USER];     /* whose share it counts in */
     uint32_t request_id;
     uint64_t job_id;
     uint32_t what;                /* PROTO_WANT_* */
@@ -605,7 +749,27 @@ typedef struct req_result {
     proto_msg res;                /* the decoded RESULT_OK when rc is 0 */
     int rc;
     char err[256];
-} req_result;
+};
+
+static req_result *results;       /* every RESULT waiting, being read or being sent */
+
+static void result_unlink(req_result *r)
+{
+    for (req_result **p = &results; *p; p = &(*p)->next)
+        if (*p == r) {
+            *p = r->next;
+            return;
+        }
+}
+
+/* RESULTs being read or sent: of user, or of everyone (NULL). */
+static uint32_t results_active(const char *user)
+{
+    uint32_t n = 0;
+    for (const req_result *r = results; r; r = r->next)
+        n += r->phase != RESULT_WAITING && (!user || strcmp(r->user, user) == 0);
+    return n;
+}
 
 static void result_run(uv_work_t *w)      /* thread pool */
 {
@@ -613,9 +777,39 @@ static void result_run(uv_work_t *w)      /* thread pool */
     r->rc = store_result_read(r->store, r->job_id, &r->res, &r->buf, r->err, sizeof r->err);
 }
 
+static void result_done(uv_work_t *w, int status);
+
+/* Starts the waiting RESULTs that fit now, oldest first. The list is
+ * walked again from its head after each start: a start that fails
+ * answers, and that may close connections (req_conn_closed edits it). */
+static void results_start(mcd *d)
+{
+    for (;;) {
+        req_result *r = results;
+        while (r && (r->phase != RESULT_WAITING || results_active(r->user) >= d->conf.max_result_sends_per_user))
+            r = r->next;
+        if (!r || results_active(NULL) >= d->conf.max_result_sends)
+            return;
+        r->phase = RESULT_READING;
+        int rc = uv_queue_work(d->loop, &r->work, result_run, result_done);
+        if (rc == 0) {
+            d->work_inflight++;
+            continue;
+        }
+        dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)r->job_id,
+             uv_strerror(rc));
+        result_unlink(r);
+        srv_send_error(r->c, r->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
+                       (unsigned long long)r->job_id);
+        srv_conn_release(r->c);
+        free(r);
+    }
+}
+
 static void result_done(uv_work_t *w, int status)    /* loop */
 {
     req_result *r = w->data;
+    mcd *d = r->d;
     conn *c = r->c;
     unsigned long long id = (unsigned long long)r->job_id;
     if (status < 0) {                       /* never ran: res was never filled */
@@ -623,7 +817,7 @@ static void result_done(uv_work_t *w, int status)    /* loop */
         snprintf(r->err, sizeof r->err, "the read was not run: %s", uv_strerror(status));
     }
     store_job j;
-    if (r->rc && store_get(r->d->store, r->job_id, &j) == PROTO_ENOT_FOUND) {
+    if (r->rc && store_get(d->store, r->job_id, &j) == PROTO_ENOT_FOUND) {
         /* deleted (DELETE, expiry) while it was read */
         srv_send_error(c, r->request_id, PROTO_ENOT_FOUND, "no job %llu", id);
     } else if (r->rc) {
@@ -651,8 +845,18 @@ static void result_done(uv_work_t *w, int status)    /* loop */
     if (r->rc == 0)
         proto_msg_free(&r->res);
     free(r->buf);
-    work_end(r->d, c);
-    free(r);
+    r->buf = NULL;
+    /* the reply (or the error) is queued on c: it counts until it is
+     * written, unless c is gone already (req_conn_closed has passed) */
+    int sending = srv_conn_open(c);
+    if (sending) {
+        r->phase = RESULT_SENDING;
+    } else {
+        result_unlink(r);
+        free(r);
+    }
+    work_end(d, c);
+    results_start(d);
 }
 
 static void on_result(conn *c, const proto_msg *m)
@@ -675,18 +879,50 @@ static void on_result(conn *c, const proto_msg *m)
     r->work.data = r;
     r->d = d;
     r->c = c;
+    r->phase = RESULT_WAITING;
+    snprintf(r->user, sizeof r->user, "%s", srv_conn_auth(c)->user);
     r->request_id = m->request_id;
     r->job_id = j.id;
     r->what = q->what;
     r->store = d->store;
-    int rc = work_start(d, c, &r->work, result_run, result_done);
-    if (rc) {
-        dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)j.id,
-             uv_strerror(rc));
-        srv_send_error(c, m->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
-                       (unsigned long long)j.id);
-        free(r);
+    req_result **tail = &results;
+    while (*tail)
+        tail = &(*tail)->next;
+    *tail = r;
+    srv_conn_hold(c);                  /* nothing more is read from c until its read is done */
+    uint32_t mine = results_active(r->user), all = results_active(NULL);
+    if (mine >= d->conf.max_result_sends_per_user || all >= d->conf.max_result_sends)
+        dlog(DLOG_INFO, "job %llu: RESULT for %s waits: %u RESULT(s) of %s and %u in all being sent"
+             " (--max-result-sends-per-user %u, --max-result-sends %u)", (unsigned long long)j.id, r->user,
+             mine, r->user, all, d->conf.max_result_sends_per_user, d->conf.max_result_sends);
+    results_start(d);
+}
+
+/* c's RESULTs end: those being sent, and with closing (c is going) those
+ * waiting too, their holds released; one being read ends in result_done.
+ * Then the waiting ones that fit start. */
+static void results_end(mcd *d, conn *c, int closing)
+{
+    int ended = 0;
+    for (req_result **p = &results; *p;) {
+        req_result *r = *p;
+        if (r->c == c && (r->phase == RESULT_SENDING || (closing && r->phase == RESULT_WAITING))) {
+            *p = r->next;
+            if (r->phase == RESULT_WAITING)
+                srv_conn_release(c);
+            free(r);
+            ended = 1;
+        } else {
+            p = &r->next;
+        }
     }
+    if (ended)
+        results_start(d);
+}
+
+void req_conn_sent(mcd *d, conn *c)
+{
+    results_end(d, c, 0);
 }
 
 static void on_delete(conn *c, const proto_msg *m)

@@ -46,9 +46,11 @@
  * on (no request in flight, no live WATCH, nothing unread, no byte from
  * the client) for --idle-timeout; each gets ERROR TIMED_OUT and a log line.
  * What clients have half sent is bounded in all: a frame counts against
- * --max-request-memory from its header to its end (admit), one that does
- * not fit is refused BUSY the same way, and a buffer grown for a large
- * frame is freed once it is done.
+ * --max-request-memory from its header to its end (admit), and against its
+ * user's share of it, one that does not fit is refused BUSY the same way,
+ * and a buffer grown for a large frame is freed once it is done. A
+ * connection whose output has been written whole tells req.c
+ * (req_conn_sent): its RESULTs end there.
  *
  * DESIGN: a tls: listener's connections carry the same frames inside a
  * GnuTLS session (tls.c). What libuv reads is fed to the session and the
@@ -223,6 +225,10 @@ static void on_write(uv_write_t *w, int status)
     flush(c);
     if (c->closing)
         return;
+    if (!c->writing)
+        req_conn_sent(c->d, c);        /* all written: the RESULTs it was sending end */
+    if (c->closing)
+        return;
     if (!c->writing && c->close_after_write) {
         if (!tls_goodbye(c))
             srv_close(c);
@@ -382,19 +388,50 @@ static void fatal_error(conn *c, uint32_t request_id, int code, const char *msg)
     srv_close_soon(c);
 }
 
+/* Bytes admitted for user's connections (an incomplete frame each). */
+static size_t admitted_of(const mcd *d, const char *user)
+{
+    size_t n = 0;
+    for (const conn *o = d->conns; o; o = o->next)
+        if (o->auth.authed && strcmp(o->auth.user, user) == 0)
+            n += o->admitted;
+    return n;
+}
+
+/* One user's share of --max-request-memory (--max-request-memory-per-user,
+ * 0: a quarter of the total). */
+static size_t user_share(const mcd_conf *k)
+{
+    return k->max_request_memory_per_user ? k->max_request_memory_per_user : k->max_request_memory / 4;
+}
+
 /* A frame's header is in and the rest is coming: its length counts
- * against max-request-memory from now until it is consumed; a frame that
- * does not fit is refused BUSY (the client may send it again later) and
- * the connection closed, so what the daemon buffers stays bounded
- * whatever the number of clients. */
+ * against max-request-memory from now until it is consumed, and, after
+ * HELLO, against its user's share; a frame that does not fit is refused
+ * BUSY (the client may send it again later) and the connection closed, so
+ * what the daemon buffers stays bounded whatever the number of clients.
+ * One user's declarations never take more than a share, and admins and
+ * the Unix socket may use the last share of the total, which the others'
+ * declarations cannot take: nobody's stalled uploads lock out everyone
+ * else (an unauthenticated connection can only declare
+ * CONF_HELLO_MAX_FRAME). */
 static void admit(conn *c, const proto_hdr *hdr)
 {
-    size_t flen = PROTO_HDR_SIZE + (size_t)hdr->payload_len, cap = c->d->conf.max_request_memory;
-    if (admitted_total + flen > cap) {
-        char msg[256];
+    const mcd_conf *k = &c->d->conf;
+    size_t flen = PROTO_HDR_SIZE + (size_t)hdr->payload_len, cap = k->max_request_memory;
+    size_t share = user_share(k), mine = c->auth.authed ? admitted_of(c->d, c->auth.user) : 0;
+    int reserved = c->auth.authed && (c->auth.admin || c->auth.is_unix);
+    size_t open_to_all = cap > share ? cap - share : 0;
+    char msg[512] = "";
+    if (admitted_total + flen > (reserved ? cap : open_to_all))
         snprintf(msg, sizeof msg, "the server is receiving %zu bytes of requests already; this %zu-byte %s does"
-                 " not fit under max-request-memory %zu: send it again later", admitted_total, flen,
-                 proto_type_name(hdr->type), cap);
+                 " not fit under max-request-memory %zu%s: send it again later", admitted_total, flen,
+                 proto_type_name(hdr->type), cap, reserved ? "" : " less the admins' reserve (one user's share)");
+    else if (c->auth.authed && mine + flen > share)
+        snprintf(msg, sizeof msg, "user %s is sending %zu bytes of requests already; this %zu-byte %s does not fit"
+                 " under max-request-memory-per-user %zu: send it again once those are in", c->auth.user, mine,
+                 flen, proto_type_name(hdr->type), share);
+    if (msg[0]) {
         dlog(DLOG_WARN, "conn %lu (%s): BUSY: %s: closing", c->id, c->auth.authed ? c->auth.user : "-", msg);
         srv_send_error(c, hdr->request_id, PROTO_EBUSY, "%s", msg);
         /* like a refusal at accept: what else it sends is dropped until its

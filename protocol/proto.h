@@ -71,7 +71,8 @@
     X(PROTO_ESHUTTING_DOWN,-24,"SHUTTING_DOWN", "server shutting down")              \
     X(PROTO_ECANCELLED,   -25, "CANCELLED",     "job cancelled")                      \
     X(PROTO_EBUSY,        -26, "BUSY",          "server at a connection limit; retry later") \
-    X(PROTO_ETIMED_OUT,   -27, "TIMED_OUT",     "connection idle, or a request too slow, past its timeout")
+    X(PROTO_ETIMED_OUT,   -27, "TIMED_OUT",     "connection idle, or a request too slow, past its timeout") \
+    X(PROTO_EOVER_QUOTA,  -28, "OVER_QUOTA",    "the user's stored bytes, or the spool's, would pass its quota")
 
 enum proto_error {
 #define PROTO_ENUM(sym, val, name, msg) sym = val,

@@ -424,10 +424,15 @@ unsigned char *testdaemon_encode(const mesh *m, size_t *len)
 
 void testdaemon_pair(int long_job, mesh **S, mesh **T)
 {
-    *S = testmesh_icosphere(long_job ? 3 : 2);
-    *T = testmesh_icosphere(long_job ? 3 : 2);
+    testdaemon_sphere_pair(long_job ? 3 : 2, S, T);
+}
+
+void testdaemon_sphere_pair(int level, mesh **S, mesh **T)
+{
+    *S = testmesh_icosphere(level);
+    *T = testmesh_icosphere(level);
     if (!*S || !*T)
-        FAILF("testmesh_icosphere failed");
+        FAILF("testmesh_icosphere(%d) failed", level);
     for (int i = 0; i < (*T)->nv; i++) {        /* an ellipsoid, a little bent */
         double *x = &(*T)->v[3 * i];
         x[0] *= 1.3;

@@ -89,6 +89,8 @@ int testdaemon_wait_state(mc_client *c, uint64_t id, int state, int timeout_s);
 /* The pair of those jobs, as meshes (mesh_free both): level 2 (162
  * vertices), long_job level 3; fails the test on error. */
 void testdaemon_pair(int long_job, mesh **S, mesh **T);
+/* The same pair at any icosphere level (6: 40962 vertices). */
+void testdaemon_sphere_pair(int level, mesh **S, mesh **T);
 /* m as Draco bytes (mc_encode_mesh, malloc'd; fails the test on error). */
 unsigned char *testdaemon_encode(const mesh *m, size_t *len);
 uint64_t testdaemon_submit(mc_client *c, int iterations, int long_job, int32_t priority, int *rc);

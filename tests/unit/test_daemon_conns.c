@@ -383,7 +383,9 @@ static void raw_partial_submit(int fd, uint32_t rid, uint32_t payload, size_t se
  * bytes of a client that leaves half-way are counted no more. */
 TEST_T(request_frames_being_received_are_capped_in_all, 60)
 {
-    static const char *const args[] = {"--max-request-memory", "1000000", NULL};
+    /* the total alone: one user's share (test_sec_upload) set to all of it */
+    static const char *const args[] = {"--max-request-memory", "1000000", "--max-request-memory-per-user",
+                                       "1000000", NULL};
     testdaemon d;
     testdaemon_start(&d, "reqmem", args);
     int a = raw_unix(&d), b = raw_unix(&d), e = raw_unix(&d);

@@ -14,7 +14,8 @@ built-in exception it means, so callers catch it either way:
     ├── JobNotFoundError (LookupError)     NOT_FOUND
     ├── JobStateError (RuntimeError)       BAD_STATE (no maps of a failed job)
     ├── JobCancelledError                  CANCELLED (match() stopped by its progress callback)
-    ├── ServerBusyError                    QUEUE_FULL, USER_LIMIT, BUSY: retry later
+    ├── ServerBusyError                    QUEUE_FULL, USER_LIMIT, BUSY, OVER_QUOTA: retry later
+    │                                      (OVER_QUOTA: once jobs of yours are deleted)
     ├── ServerConnectionError (ConnectionError)  cannot connect, connection lost,
     │                                      SHUTTING_DOWN, TIMED_OUT (cut by the server)
     ├── MeshcorrTimeoutError (TimeoutError)  no answer in time, wait()/watch() timeout
@@ -136,6 +137,7 @@ _CLASSES = {
     -16: JobStateError, -17: ServerBusyError, -18: ServerBusyError, -19: BadMeshError,
     -20: BadLandmarksError, -21: BadParamsError, -22: ServerError, -23: ServerError,
     -24: ServerConnectionError, -25: JobCancelledError, -26: ServerBusyError, -27: ServerConnectionError,
+    -28: ServerBusyError,
     MC_EARG: InvalidInputError, MC_EADDRESS: ServerConnectionError, MC_ECONNECT: ServerConnectionError,
     MC_EIO: ServerConnectionError, MC_ETIMEOUT: MeshcorrTimeoutError, MC_EPROTO: ProtocolError,
     MC_ENOMEM: MeshcorrMemoryError, MC_EFILE: BadMeshError, MC_ETLS: ServerConnectionError,
