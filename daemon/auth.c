@@ -110,32 +110,20 @@ int auth_token_new(char tok[AUTH_NEW_TOKEN_LEN + 1], char *err, size_t errsz)
     return 0;
 }
 
-/* Where the tokens file is: the configured path, with a leading
- * ${CREDENTIALS_DIRECTORY} replaced by that variable (systemd's
- * LoadCredential=); without a configured path, $CREDENTIALS_DIRECTORY/tokens
- * when that file exists. "" when there is none. */
+/* Where the tokens file is: the configured path (conf_credential_path);
+ * without one, $CREDENTIALS_DIRECTORY/tokens when that file exists. ""
+ * when there is none. */
 static int resolve_path(const char *conf, char *out, size_t sz, char *err, size_t errsz)
 {
-    static const char var[] = "${CREDENTIALS_DIRECTORY}";
-    const char *creds = getenv("CREDENTIALS_DIRECTORY");
     out[0] = '\0';
-    if (!conf || !*conf) {
-        if (creds && *creds) {
-            snprintf(out, sz, "%s/tokens", creds);
-            if (access(out, F_OK) != 0)
-                out[0] = '\0';
-        }
-        return 0;
+    if (conf && *conf)
+        return conf_credential_path("tokens", conf, out, sz, err, errsz);
+    const char *creds = getenv("CREDENTIALS_DIRECTORY");
+    if (creds && *creds) {
+        snprintf(out, sz, "%s/tokens", creds);
+        if (access(out, F_OK) != 0)
+            out[0] = '\0';
     }
-    if (strncmp(conf, var, sizeof var - 1) != 0) {
-        snprintf(out, sz, "%s", conf);
-        return 0;
-    }
-    if (!creds || !*creds)
-        return errbuf_set(err, errsz, -1, "tokens %s: $CREDENTIALS_DIRECTORY is not set (systemd sets it for a "
-                          "unit with LoadCredential=)", conf);
-    if ((size_t)snprintf(out, sz, "%s%s", creds, conf + sizeof var - 1) >= sz)
-        return errbuf_set(err, errsz, -1, "tokens %s: the path is too long", conf);
     return 0;
 }
 

@@ -340,6 +340,23 @@ uint32_t conf_worker_memory_mb(const mcd_conf *c, int nslots)
     return mb > (1u << 24) ? 1u << 24 : (uint32_t)mb;
 }
 
+int conf_credential_path(const char *what, const char *path, char *out, size_t sz, char *err, size_t errsz)
+{
+    static const char var[] = "${CREDENTIALS_DIRECTORY}";
+    if (strncmp(path, var, sizeof var - 1) != 0) {
+        if ((size_t)snprintf(out, sz, "%s", path) >= sz)
+            return errbuf_set(err, errsz, -1, "%s %s: the path is too long", what, path);
+        return 0;
+    }
+    const char *creds = getenv("CREDENTIALS_DIRECTORY");
+    if (!creds || !*creds)
+        return errbuf_set(err, errsz, -1, "%s %s: $CREDENTIALS_DIRECTORY is not set (systemd sets it for a "
+                          "unit with LoadCredential=)", what, path);
+    if ((size_t)snprintf(out, sz, "%s%s", creds, path + sizeof var - 1) >= sz)
+        return errbuf_set(err, errsz, -1, "%s %s: the path is too long", what, path);
+    return 0;
+}
+
 void conf_note_change(int differs, const char *name, char *changed, size_t sz)
 {
     size_t len = strlen(changed);

@@ -164,6 +164,10 @@ uint32_t conf_worker_memory_mb(const mcd_conf *c, int nslots);
 /* SIGHUP: appends ", name" (or "name" first) to changed when the option
  * differs (a subsystem naming what it applies only at start). */
 void conf_note_change(int differs, const char *name, char *changed, size_t sz);
+/* A file option's path with a leading ${CREDENTIALS_DIRECTORY} replaced by
+ * that variable (systemd's LoadCredential=), into out: 0, or -1 with err
+ * naming the option (what) when the variable is unset or the path too long. */
+int conf_credential_path(const char *what, const char *path, char *out, size_t sz, char *err, size_t errsz);
 
 /* ---- priv_ ---------------------------------------------------------------- */
 /* The --user meshcorrd drops to when started as root (priv.c). */

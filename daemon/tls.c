@@ -148,9 +148,13 @@ static char *chain_pem(gnutls_x509_crt_t *crt, unsigned n)
 
 /* Reads and checks the pair; *out holds one reference. 0, or -1 with err
  * naming the option and file at fault. */
-static int creds_load(const char *cert, const char *key, tls_creds **out, char *err, size_t errsz)
+static int creds_load(const char *cert_opt, const char *key_opt, tls_creds **out, char *err, size_t errsz)
 {
     *out = NULL;
+    char cert[CONF_PATH], key[CONF_PATH];
+    if (conf_credential_path("--tls-cert", cert_opt, cert, sizeof cert, err, errsz) ||
+        conf_credential_path("--tls-key", key_opt, key, sizeof key, err, errsz))
+        return -1;
     gnutls_datum_t cd = {NULL, 0}, kd = {NULL, 0};
     gnutls_x509_crt_t *crt = NULL;
     unsigned ncrt = 0;

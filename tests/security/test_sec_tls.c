@@ -785,3 +785,32 @@ TEST(the_cli_and_python_take_the_ca_and_refuse_an_untrusted_server)
     CHECK_STR_HAS(out, "refused MC_ETLS the server's certificate is not trusted");
     testdaemon_stop(&d, SIGTERM);
 }
+
+/* Under systemd the key reaches the service as a credential
+ * (LoadCredential=): --tls-cert and --tls-key may start with
+ * ${CREDENTIALS_DIRECTORY}, as --tokens may. */
+TEST(the_certificate_and_key_are_found_as_systemd_credentials)
+{
+    testtls t;
+    testtls_make(&t, "certs");
+    testdaemon_give(t.dir);
+    testdaemon_give(t.cert);
+    testdaemon_give(t.key);
+    CHECK_INT(setenv("CREDENTIALS_DIRECTORY", t.dir, 1), 0);
+    const char *args[] = {"--listen", "tls:127.0.0.1:0", "--tls-cert", "${CREDENTIALS_DIRECTORY}/server.pem",
+                          "--tls-key", "${CREDENTIALS_DIRECTORY}/server.key", NULL};
+    testdaemon d;
+    testdaemon_start(&d, "tls-credential", args);
+    char addr[128];
+    mc_client *c = tls_client(tls_at(&d, "localhost", addr, sizeof addr), t.ca);
+    CHECK_INT(mc_ping(c), 0);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+    /* without the variable the start names it */
+    unsetenv("CREDENTIALS_DIRECTORY");
+    static char out[8192];
+    const char *bad[] = {"--listen", "tls:127.0.0.1:0", "--tls-cert", "${CREDENTIALS_DIRECTORY}/server.pem",
+                         "--tls-key", "${CREDENTIALS_DIRECTORY}/server.key", NULL};
+    CHECK(run_daemon("tls-no-credentials", bad, out, sizeof out) > 0);
+    CHECK_STR_HAS(out, "--tls-cert ${CREDENTIALS_DIRECTORY}/server.pem: $CREDENTIALS_DIRECTORY is not set");
+}
