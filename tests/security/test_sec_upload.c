@@ -10,7 +10,7 @@
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testsec.h"
-#include "support/testwire.h"
+#include "support/testraw.h"
 #include "meshcorr.h"
 
 #include <signal.h>
@@ -27,8 +27,8 @@
  * in *fd. */
 static int declare_huge(const testdaemon *d, int *fd, uint32_t rid)
 {
-    *fd = testwire_session(d, TESTDAEMON_ALICE);
-    testwire_send_header(*fd, PROTO_MSG_SUBMIT, rid, HUGE_FRAME - PROTO_HDR_SIZE);
+    *fd = testraw_session(d->tcp_addr, TESTDAEMON_ALICE);
+    testraw_send_header(*fd, PROTO_MSG_SUBMIT, rid, HUGE_FRAME - PROTO_HDR_SIZE);
     /* a refusal comes at once; an admitted header gets no answer */
     struct timespec ts = {0, 300 * 1000000L};
     nanosleep(&ts, NULL);
@@ -36,7 +36,7 @@ static int declare_huge(const testdaemon *d, int *fd, uint32_t rid)
     ssize_t n = recv(*fd, &b, 1, MSG_PEEK | MSG_DONTWAIT);
     if (n <= 0)
         return 0;
-    testwire_expect_error(*fd, rid, PROTO_EBUSY, "max-request-memory-per-user", 5);
+    testraw_expect_error(*fd, rid, PROTO_EBUSY, "max-request-memory-per-user", 5);
     return 1;
 }
 
@@ -80,16 +80,16 @@ TEST_T(the_admins_reserve_holds_when_ordinary_users_fill_the_rest, 120)
                                        "1572864", NULL};
     testdaemon d;
     testdaemon_start(&d, "reserve", args);
-    int a1 = testwire_session(&d, TESTDAEMON_ALICE), b1 = testwire_session(&d, TESTDAEMON_BOB);
-    int b2 = testwire_session(&d, TESTDAEMON_BOB), a2 = testwire_session(&d, TESTDAEMON_ALICE);
-    testwire_send_header(b1, PROTO_MSG_SUBMIT, 7, 1310720 - PROTO_HDR_SIZE);
+    int a1 = testraw_session(d.tcp_addr, TESTDAEMON_ALICE), b1 = testraw_session(d.tcp_addr, TESTDAEMON_BOB);
+    int b2 = testraw_session(d.tcp_addr, TESTDAEMON_BOB), a2 = testraw_session(d.tcp_addr, TESTDAEMON_ALICE);
+    testraw_send_header(b1, PROTO_MSG_SUBMIT, 7, 1310720 - PROTO_HDR_SIZE);
     /* bob's next half MiB would pass his share */
-    testwire_send_header(b2, PROTO_MSG_SUBMIT, 8, 524288 - PROTO_HDR_SIZE);
-    testwire_expect_error(b2, 8, PROTO_EBUSY, "max-request-memory-per-user 1572864", 10);
-    testwire_send_header(a1, PROTO_MSG_SUBMIT, 7, 1310720 - PROTO_HDR_SIZE);
+    testraw_send_header(b2, PROTO_MSG_SUBMIT, 8, 524288 - PROTO_HDR_SIZE);
+    testraw_expect_error(b2, 8, PROTO_EBUSY, "max-request-memory-per-user 1572864", 10);
+    testraw_send_header(a1, PROTO_MSG_SUBMIT, 7, 1310720 - PROTO_HDR_SIZE);
     /* alice has room in her share, but the ordinary room is full */
-    testwire_send_header(a2, PROTO_MSG_SUBMIT, 9, 262144 - PROTO_HDR_SIZE);
-    testwire_expect_error(a2, 9, PROTO_EBUSY, "less the admins' reserve", 10);
+    testraw_send_header(a2, PROTO_MSG_SUBMIT, 9, 262144 - PROTO_HDR_SIZE);
+    testraw_expect_error(a2, 9, PROTO_EBUSY, "less the admins' reserve", 10);
     CHECK(testdaemon_log_has(&d, "this 262144-byte SUBMIT does not fit under max-request-memory 4194304 less the"
                                  " admins' reserve"));
     /* the admin (TCP) and the Unix socket still get in, with frames of

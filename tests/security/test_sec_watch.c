@@ -10,7 +10,7 @@
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testsec.h"
-#include "support/testwire.h"
+#include "support/testraw.h"
 #include "meshcorr.h"
 
 #include <poll.h>
@@ -25,7 +25,7 @@ static void send_watch(int fd, uint32_t rid, uint64_t job, uint32_t from_outer)
 {
     proto_msg m = {.type = PROTO_MSG_WATCH, .request_id = rid};
     m.u.watch = (proto_watch){job, from_outer};
-    testwire_send_msg(fd, &m);
+    testraw_send_msg(fd, &m);
 }
 
 TEST_T(the_watches_of_one_session_are_capped_and_the_session_stays_usable, 120)
@@ -38,35 +38,35 @@ TEST_T(the_watches_of_one_session_are_capped_and_the_session_stays_usable, 120)
     testdaemon_wait_state(c, job, MC_RUNNING, 30);
     /* WATCHes that want no history and no record (from_outer past every
      * one) cost the session nothing to read, only the daemon its fan-out */
-    int fd = testwire_session(&d, TESTDAEMON_ALICE);
+    int fd = testraw_session(d.tcp_addr, TESTDAEMON_ALICE);
     for (uint32_t i = 0; i < NWATCH + 5; i++)
         send_watch(fd, 10 + i, job, UINT32_MAX);
     for (uint32_t i = NWATCH; i < NWATCH + 5; i++)
-        testwire_expect_error(fd, 10 + i, PROTO_EOVER_LIMIT, "--max-watches-per-session 64", 10);
+        testraw_expect_error(fd, 10 + i, PROTO_EOVER_LIMIT, "--max-watches-per-session 64", 10);
     CHECK(testdaemon_log_has(&d, "WATCH from alice refused (OVER_LIMIT): 64 live WATCHes on its connection"));
     /* still usable, and another session may watch */
     proto_msg m = {.type = PROTO_MSG_PING, .request_id = 99};
-    testwire_send_msg(fd, &m);
+    testraw_send_msg(fd, &m);
     uint8_t *buf;
-    testwire_read_msg(fd, &m, &buf, 1 << 20, 10);
+    CHECK_INT(testraw_read_msg(fd, &m, &buf, 10), 0);
     CHECK_INT(m.type, PROTO_MSG_PONG);
     CHECK_INT(m.request_id, 99);
     proto_msg_free(&m);
     free(buf);
-    int other = testwire_session(&d, TESTDAEMON_ALICE);
+    int other = testraw_session(d.tcp_addr, TESTDAEMON_ALICE);
     send_watch(other, 5, job, UINT32_MAX);
     /* the job's end reaches every live WATCH: 64 ENDs, then the other's */
     CHECK_INT(mc_cancel(c, job), 0);
     int ends = 0;
     while (ends < NWATCH) {
-        testwire_read_msg(fd, &m, &buf, 1 << 20, 30);
+        CHECK_INT(testraw_read_msg(fd, &m, &buf, 30), 0);
         CHECK_INT(m.type, PROTO_MSG_END);
         CHECK(m.request_id >= 10 && m.request_id < 10 + NWATCH);
         ends++;
         proto_msg_free(&m);
         free(buf);
     }
-    testwire_read_msg(other, &m, &buf, 1 << 20, 30);
+    CHECK_INT(testraw_read_msg(other, &m, &buf, 30), 0);
     CHECK_INT(m.type, PROTO_MSG_END);
     CHECK_INT(m.request_id, 5);
     proto_msg_free(&m);
@@ -108,10 +108,10 @@ TEST_T(unread_results_of_one_user_hold_at_most_her_share_and_others_go_on, 300)
      * reply of megabytes in the daemon until it is read */
     static int fds[NRESULT];
     for (int i = 0; i < NRESULT; i++) {
-        fds[i] = testwire_session(&d, NULL);
+        fds[i] = testraw_session(d.unix_addr, NULL);
         proto_msg m = {.type = PROTO_MSG_RESULT, .request_id = 1000 + (uint32_t)i};
         m.u.result = (proto_result){job, PROTO_WANT_P | PROTO_WANT_Q | PROTO_WANT_DEFORMED | PROTO_WANT_METRICS};
-        testwire_send_msg(fds[i], &m);
+        testraw_send_msg(fds[i], &m);
     }
     testdaemon_sleep_ms(3000);
     int answered = 0;
@@ -151,7 +151,7 @@ TEST_T(unread_results_of_one_user_hold_at_most_her_share_and_others_go_on, 300)
             if (p[k].revents) {
                 proto_msg m;
                 uint8_t *buf;
-                testwire_read_msg(fds[idx[k]], &m, &buf, 1u << 30, 60);
+                CHECK_INT(testraw_read_msg(fds[idx[k]], &m, &buf, 60), 0);
                 CHECK_INT(m.type, PROTO_MSG_RESULT_OK);
                 CHECK_INT(m.request_id, 1000 + idx[k]);
                 CHECK_INT(m.u.result_ok.p.n, 40962);

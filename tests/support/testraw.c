@@ -97,7 +97,7 @@ int testraw_read_msg(int fd, proto_msg *m, uint8_t **buf, double timeout_s)
         return rc;
     proto_hdr h;
     char err[512];
-    if (proto_frame_scan(hdr, sizeof hdr, 1 << 24, &h, err, sizeof err) < 0)
+    if (proto_frame_scan(hdr, sizeof hdr, PROTO_MAX_FRAME, &h, err, sizeof err) < 0)
         FAILF("reply header: %s", err);
     *buf = malloc(h.payload_len + 1);
     CHECK(*buf);
@@ -127,6 +127,43 @@ int testraw_hello(int fd, const char *token, const char *client, int *code, char
     proto_msg_free(&m);
     free(buf);
     return type;
+}
+
+int testraw_session(const char *addr, const char *token)
+{
+    int fd = strncmp(addr, "unix:", 5) == 0 ? testraw_unix(addr) : testraw_tcp(addr, NULL);
+    int code = 0;
+    char msg[1024];
+    int type = testraw_hello(fd, token, "testraw", &code, msg, sizeof msg, 10);
+    if (type != PROTO_MSG_HELLO_OK)
+        FAILF("HELLO on %s: %s%s%s", addr, type < 0 ? "no answer" : proto_type_name(type), *msg ? ": " : "", msg);
+    return fd;
+}
+
+void testraw_send_header(int fd, int type, uint32_t request_id, uint32_t payload_len)
+{
+    uint8_t h[PROTO_HDR_SIZE];
+    proto_hdr hdr = {PROTO_VERSION, (uint8_t)type, 0, request_id, payload_len};
+    proto_frame_put_header(h, &hdr);
+    testraw_send(fd, h, sizeof h);
+}
+
+void testraw_expect_error(int fd, uint32_t rid, int code, const char *what, double timeout_s)
+{
+    proto_msg m;
+    uint8_t *buf;
+    int rc = testraw_read_msg(fd, &m, &buf, timeout_s);
+    if (rc)
+        FAILF("no ERROR %s within %.1f s (%s)", proto_err_name(code), timeout_s, rc > 0 ? "EOF" : "nothing came");
+    if (m.type != PROTO_MSG_ERROR)
+        FAILF("got %s, expected ERROR %s", proto_type_name(m.type), proto_err_name(code));
+    if (m.u.error.code != code)
+        FAILF("got ERROR %s (%s), expected %s", proto_err_name(m.u.error.code), m.u.error.message,
+              proto_err_name(code));
+    CHECK_STR_HAS(m.u.error.message, what);
+    CHECK_INT(m.request_id, rid);
+    proto_msg_free(&m);
+    free(buf);
 }
 
 int testraw_ask(int fd, int type, uint32_t request_id, double timeout_s)

@@ -1,7 +1,7 @@
 /* testraw.h — the wire protocol over plain sockets, for tests that do what
  * libmeshcorr never would: connect from a chosen loopback address
  * (127.0.0.2, ...), stay silent, send half a frame or a forged header, or
- * read exactly what the server answers. Every helper fails the test on a
+ * read exactly what the server answers, declare a frame and stop. Every helper fails the test on a
  * local error (a socket call that should not fail). Test code only. */
 #ifndef TESTRAW_H
 #define TESTRAW_H
@@ -31,6 +31,15 @@ int testraw_read_msg(int fd, proto_msg *m, uint8_t **buf, double timeout_s);
  * after timeout_s. */
 int testraw_hello(int fd, const char *token, const char *client, int *code, char *msg, size_t msgsz,
                   double timeout_s);
+/* A connection to addr ("unix:PATH" or "tcp:HOST:PORT") that has done its
+ * HELLO (token NULL: peer credentials); fails the test unless HELLO_OK. */
+int testraw_session(const char *addr, const char *token);
+/* Only the header of a frame of this type declaring payload_len bytes:
+ * the rest never comes. */
+void testraw_send_header(int fd, int type, uint32_t request_id, uint32_t payload_len);
+/* The next frame is ERROR code (request id rid) whose message has what;
+ * fails the test otherwise. */
+void testraw_expect_error(int fd, uint32_t rid, int code, const char *what, double timeout_s);
 /* A request with an empty payload (STATS, PING, LIST with defaults...)
  * answered: the reply's type, or -1 (EOF or no answer in timeout_s). */
 int testraw_ask(int fd, int type, uint32_t request_id, double timeout_s);
