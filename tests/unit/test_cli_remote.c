@@ -89,6 +89,9 @@ TEST_T(submit_prints_the_id_watch_prints_energies_and_exits_0_and_result_writes_
                 if (k == 4)
                     e4 = e;
             }
+        } else if (sscanf(l, "job %llu repair iter %u/%u (", &jid, &k, &total) == 3) {
+            CHECK_INT(jid, id);          /* a fold repair: no energies, its maps done of total */
+            CHECK(total == 2 && (k == 0 || k == 2));
         } else if (strcmp(l, last) != 0) {
             FAILF("watch line is not in the documented format: %.*s", (int)strcspn(l, "\n"), l);
         }
@@ -191,6 +194,8 @@ TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
     CHECK_STR_HAS(out, want);
     CHECK_STR_HAS(out, "\"outer\":4,\"total\":4");
     CHECK_STR_HAS(out, "\"label\":\"a \\\"quoted\\\" label\"");
+    /* and the whole job's progress: done, nothing ahead */
+    CHECK_STR_HAS(out, ",\"fraction\":1,\"eta\":0.000,\"ahead\":0}");
     /* the map's quality: this small pair maps cleanly */
     CHECK_STR_HAS(out, ",\"quality\":\"ok\",\"quality_verdict\":0,\"flipped\":");
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr status %llu --server %s", (unsigned long long)id,
@@ -199,6 +204,8 @@ TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s", d.unix_addr), 0);
     CHECK_STR_HAS(out, " QUALITY ");
     CHECK_STR_HAS(out, " ok ");
+    CHECK_STR_HAS(out, " PROGRESS ");
+    CHECK_STR_HAS(out, " 100 % ");
 
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr stats --json --server %s", d.unix_addr), 0);
     if (!testjson_valid(out))

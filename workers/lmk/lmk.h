@@ -18,16 +18,16 @@
 #include "proto_params.h"   /* PROTO_MIN_LANDMARKS, PROTO_MAX_LANDMARKS: the one rule */
 
 #define LMK_ERRORS(X)                                                     \
-    X(LMK_OK,        0, "ok")                                             \
-    X(LMK_EIO,      -1, "cannot read the landmark file")                  \
-    X(LMK_EPARSE,   -2, "malformed landmark file")                        \
-    X(LMK_ERANGE,   -3, "landmark index out of range")                    \
-    X(LMK_EDUP,     -4, "duplicate source landmark")                      \
-    X(LMK_ECOUNT,   -5, "wrong number of landmarks")                      \
-    X(LMK_ENOMEM,   -6, "out of memory")
+    X(LMK_OK,        0, "ok", NONE)                                           \
+    X(LMK_EIO,      -1, "cannot read the landmark file", IO)                  \
+    X(LMK_EPARSE,   -2, "malformed landmark file", LANDMARKS)                 \
+    X(LMK_ERANGE,   -3, "landmark index out of range", LANDMARKS)             \
+    X(LMK_EDUP,     -4, "duplicate source landmark", LANDMARKS)               \
+    X(LMK_ECOUNT,   -5, "wrong number of landmarks", LANDMARKS)               \
+    X(LMK_ENOMEM,   -6, "out of memory", NOMEM)
 
 enum lmk_error {
-#define LMK_ENUM(name, val, msg) name = val,
+#define LMK_ENUM(name, val, msg, kind) name = val,
     LMK_ERRORS(LMK_ENUM)
 #undef LMK_ENUM
 };

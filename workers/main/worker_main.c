@@ -60,18 +60,6 @@ static int on_progress(void *ctx, const corr_progress *cp)
     return cancel_requested != 0;
 }
 
-static int proto_code_of(int corr_rc)
-{
-    switch (corr_rc) {
-    case CORR_EMESH: return PROTO_EBAD_MESH;
-    case CORR_EINPUT: return PROTO_EBAD_PARAMS;
-    case CORR_EINIT: return PROTO_EBAD_LANDMARKS;
-    case CORR_ENOMEM: return PROTO_ENOMEM;
-    case CORR_ECANCELED: return PROTO_ECANCELLED;
-    default: return PROTO_EINTERNAL;
-    }
-}
-
 /* Writes error.frame; returns the exit status for code. */
 static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
 {
@@ -196,7 +184,6 @@ int main(int argc, char **argv)
     }
     ctx.pg.fd = progress_fd;
     ctx.pg.job_id = job_id;
-    ctx.pg.total = job.params.iterations;
     ctx.t0 = t0;
     if (progress_tcp) {
         snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, SPOOL_PROGRESS_FILE);
@@ -205,16 +192,16 @@ int main(int argc, char **argv)
     corr_input in;
     wrk_job_input(&job, &in);
     if (cancel_requested)
-        rc = CORR_ECANCELED;
+        rc = CORR_ECANCELLED;
     else
         rc = corr_run(&in, &job.params, on_progress, &ctx, &res, err, sizeof err);
     if (rc == CORR_OK && cancel_requested)
-        rc = CORR_ECANCELED;                 /* SIGTERM during the last iteration */
-    if (rc == CORR_ECANCELED)
+        rc = CORR_ECANCELLED;                 /* SIGTERM during the last iteration */
+    if (rc == CORR_ECANCELLED)
         snprintf(err, sizeof err, "cancelled by SIGTERM after %d of %d outer iterations",
                  ctx.last_outer, job.params.iterations);
     if (rc) {
-        status = fail(dir, job_id, proto_code_of(rc), err);
+        status = fail(dir, job_id, corr_wire_code(rc), err);
         goto done;
     }
     if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err))) {

@@ -11,9 +11,10 @@ import numpy as np
 
 from . import _lib
 from ._lib import lib, check, errbuf
+from .errors import MeshcorrError
 from .map import Map, is_map_file, read_map, read_vertex_map, vertex_map
 
-STAGES = ("start", "rhm", "ectm", "init", "ddm")
+STAGES = ("start", "rhm", "ectm", "init", "ddm", "repair", "queued")
 _WANT_P, _WANT_Q, _WANT_DEFORMED, _WANT_METRICS = 1, 2, 4, 8
 _PARAM_NAMES = {p.name: p for p in _lib.PARAMS}
 
@@ -107,9 +108,16 @@ def _map_of(rows, n, n_target):
     return Map(rec["face"].astype(np.int32), rec["w"].copy(), n_target)
 
 
+def _number(v):
+    """A C double as JSON has it: None for NaN."""
+    return None if v != v else v
+
+
 def _progress(p):
+    """A progress record with the names `meshcorr watch --progress json` prints."""
     d = {"job": p.job_id, "stage": STAGES[p.stage] if p.stage < len(STAGES) else str(p.stage),
-         "outer": p.outer, "total": p.total, "beta": p.beta, "gamma": p.gamma, "elapsed": p.elapsed_s}
+         "outer": p.outer, "total": p.total, "fraction": _number(p.fraction), "eta": _number(p.eta_s),
+         "elapsed": p.elapsed_s, "ahead": p.ahead, "beta": _number(p.beta), "gamma": _number(p.gamma)}
     for side, name in enumerate(("source", "target")):
         d[name] = {t: getattr(p, t)[side] for t in ("membrane", "bending", "mismatch", "reverse", "energy")}
         d[name]["inner"] = p.inner[side]
@@ -236,7 +244,8 @@ class Client:
         try:
             return [{"id": j.job_id, "state": lib.mc_state_name(j.state).decode(), "user": j.user.decode(),
                      "priority": j.priority, "submit_ms": j.submit_ms, "outer": j.outer, "total": j.total,
-                     "label": j.label.decode(), "quality": _quality(j.quality)} for j in jobs[:n.value]]
+                     "label": j.label.decode(), "quality": _quality(j.quality), "fraction": _number(j.fraction),
+                     "eta": _number(j.eta_s), "ahead": j.ahead} for j in jobs[:n.value]]
         finally:
             _lib.free(jobs)
 
@@ -267,11 +276,13 @@ def _quality(q):
 
 class Job:
     """A job on the server. id: its number. After watch() or wait() ends:
-    state (the final state's name) and reason."""
+    state (the final state's name), reason, and error: a MeshcorrError of
+    the kind the job failed with (code and name: NUMERIC, BAD_MESH, ...),
+    None when it did not fail in its worker."""
 
     def __init__(self, client, job_id, n_target):
         self.client, self.id, self._n_target = client, job_id, n_target
-        self.state, self.reason = None, ""
+        self.state, self.reason, self.error = None, "", None
 
     def __repr__(self):
         return "Job(%d)" % self.id
@@ -293,8 +304,10 @@ class Job:
     def watch(self, from_outer=0):
         """Yields a progress dict per record (replayed from outer iteration
         from_outer, then live) until the job ends; then self.state and
-        self.reason tell how it ended. A dict: job, stage (start, rhm, ectm,
-        init, ddm), outer, total, beta, gamma, elapsed (s), membrane, bending,
+        self.reason tell how it ended. A dict: job, stage (queued, start,
+        rhm, ddm, repair, ectm), outer, total, fraction (the whole job's
+        share done), eta (seconds left; None not known), elapsed (s), ahead
+        (queued: jobs before it), beta, gamma, membrane, bending,
         mismatch, reverse, energy (both directions summed), and source,
         target: each direction's terms and inner iterations. It follows the
         job on a connection of its own."""
@@ -328,6 +341,9 @@ class Job:
         check(rc, err)
         self.state = lib.mc_state_name(state).decode() if lib.mc_state_name(state) else str(state)
         self.reason = reason
+        code = lib.mc_reason_error(reason.encode())     # the kind the job failed with, if any
+        self.error = (MeshcorrError(code, lib.mc_err_name(code).decode(), lib.mc_strerror(code).decode(),
+                                    reason) if code else None)
 
     def wait(self):
         """Follows the job to its end; returns its final state's name
