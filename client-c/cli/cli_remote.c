@@ -193,9 +193,10 @@ static int on_progress(void *ctx, const mc_progress *m)
 }
 
 /* Follows job id on c to its end (c is closed); exit status 0 when it
- * COMPLETED; else the state and reason on stderr and the status of the
- * reason's error kind (proto_kind.h: 3 numeric, 4 out of memory, 5
- * cancelled in the worker), 1 for any other end. */
+ * COMPLETED; else the state and reason on stderr and the status of its
+ * error kind (proto_kind.h): the one its reason names, else CANCELLED's
+ * for a cancelled job and NOMEM's for one out of memory; 1 for any other
+ * end (a timeout, a crash). */
 static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
 {
     int state = -1;
@@ -214,6 +215,10 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     fprintf(stderr, "meshcorr %s: job %llu %s%s%s\n", cmd, (unsigned long long)id,
             mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", reason);
     int kind = proto_kind_of_code(mc_reason_error(reason));
+    if (!kind && state == MC_CANCELLED)
+        kind = PROTO_KIND_CANCELLED;
+    if (!kind && state == MC_OUT_OF_MEMORY)
+        kind = PROTO_KIND_NOMEM;
     return kind ? proto_kind_exit(kind) : 1;
 }
 
@@ -482,7 +487,7 @@ int cli_watch(int argc, char **argv)
                                 "its place in the queue while it waits, then one record per iteration:\n"
                                 "the whole job's share done and time left, each term summed over both\n"
                                 "directions (a bar on a terminal); exit 0 when the job COMPLETED, else\n"
-                                "the status of its error kind (1 input, 3 numeric, 4 memory, 5 cancelled)\n";
+                                "the status of its error kind (3 numeric, 4 memory, 5 cancelled; else 1)\n";
     int u = one_id("watch", usage, argc, argv, &r, &id, extra, watch_opt, &w);
     if (u > 0)
         return 0;

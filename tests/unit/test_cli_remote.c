@@ -147,7 +147,7 @@ TEST_T(submit_prints_the_id_watch_prints_energies_and_exits_0_and_result_writes_
     testdaemon_stop(&d, SIGTERM);
 }
 
-TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_1_saying_why, 90)
+TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_5_saying_why, 90)
 {
     testdaemon_need_worker();
     write_inputs();
@@ -170,7 +170,7 @@ TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_1_sayi
                        d.unix_addr), 0);
     rc = testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s 2>&1 >/dev/null",
                   (unsigned long long)long_id, d.unix_addr);
-    CHECK_INT(rc, 1);
+    CHECK_INT(rc, 5);                   /* the kind CANCELLED's status (proto_kind.h) */
     CHECK_STR_HAS(out, "CANCELLED");
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);

@@ -5,8 +5,9 @@
  * a kind, and each kind a real input can provoke is provoked through the
  * real programs: a numerical failure of a landmark job and of a DDM job
  * without landmarks reaches the client as NUMERIC (meshcorr watch exits 3),
- * bad meshes, landmarks, parameters and maps are refused with their own
- * codes, and meshcorr match exits with the kind's status. */
+ * a worker out of memory as NOMEM (exit 4), bad meshes, landmarks,
+ * parameters and maps are refused with their own codes, and meshcorr
+ * match exits with the kind's status. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testfile.h"
@@ -211,6 +212,31 @@ TEST_T(a_numeric_failure_reaches_the_client_as_numeric_with_or_without_landmarks
     free(p);
     free(sb);
     free(tb);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* A worker out of address space (--worker-memory-mb 72, as
+ * test_daemon_ops: the SUBMIT check fits, the run does not): the job ends
+ * OUT_OF_MEMORY with the NOMEM kind in its reason, and `meshcorr watch`
+ * exits 4. */
+TEST_T(a_job_out_of_memory_reaches_the_client_as_nomem, 90)
+{
+    testdaemon_need_worker();
+    testdaemon d;
+    const char *args[] = {"--worker-memory-mb", "72", NULL};
+    testdaemon_start(&d, "nomem", args);
+    mc_client *c = testdaemon_client(&d, NULL);
+    uint64_t id = testdaemon_submit_ok(c, 2, 1, 0);
+    char reason[1100];
+    int end = watch_end(c, id, reason, sizeof reason);
+    if (end != MC_OUT_OF_MEMORY)
+        FAILF("job ended %s: %s", mc_state_name(end), reason);
+    CHECK_INT(mc_reason_error(reason), PROTO_ENOMEM);
+    int rc = testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s 2>&1 >/dev/null",
+                      (unsigned long long)id, d.unix_addr);
+    CHECK_INT(rc, 4);
+    CHECK_STR_HAS(out, "OUT_OF_MEMORY: NOMEM: ");
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
 }
