@@ -230,8 +230,10 @@ class Client:
 
     def list(self, user=None, states=None):
         """Jobs as dicts (id, state, user, priority, submit_ms, outer, total,
-        label, quality: see Job.status): own ones, or user's (admin);
-        states: names to keep."""
+        label, quality: see Job.status; fraction, eta: the latest progress
+        record's share of the whole job done and seconds left, None when not
+        known; ahead: a pending job's place in the queue): own ones, or
+        user's (admin); states: names to keep."""
         mask = 0
         for s in states or ():
             v = lib.mc_state_parse(s.encode())
