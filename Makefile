@@ -4,7 +4,8 @@
 #   make test       unit tests + gradient checks + integration (tests/run-tests.sh)
 #   make bench      benchmarks under tests/bench/ (print ratios, never fail on time)
 #   make demo       install deps, build, run the demo job on Debian's CGAL meshes
-#   make install    PREFIX=/usr/local DESTDIR= SYSCONFDIR= (install-lib install-python: the client part)
+#   make install    PREFIX=/usr/local DESTDIR= SYSCONFDIR= (install-lib install-python: the client part;
+#                   install-doc: README and the specs into $(PREFIX)/share/doc/meshcorr)
 #   make doc-params PROTOCOL.md's parameter table and meshcorr(1)'s list from
 #                   protocol/proto_params.h
 PREFIX  ?= /usr/local
@@ -17,6 +18,12 @@ PKGS     = draco
 WARN     = -Wall -Wextra -Werror
 OPT     ?= -O2 -g
 CPPFLAGS += -D_GNU_SOURCE -Iworkers -Iprotocol -Iclient-c -Idaemon -Itests -I$(BUILD)/gen
+# The project's one version (the file VERSION): every program's --version,
+# mc_version(), the Python package's metadata and meshcorr.pc; objects are
+# rebuilt when it changes.
+MC_VERSION := $(shell cat VERSION)
+CPPFLAGS += -DMC_VERSION='"$(MC_VERSION)"'
+
 # -fPIC everywhere so libmeshcorr.so can take engine objects from the same
 # archives; Debian's gcc builds PIE by default, so with
 # -fno-semantic-interposition the code is the same as before.
@@ -45,6 +52,14 @@ CLIENT_LIB := $(BUILD)/libmeshcorr.a
 # members they need (the linker takes only those from the archives); it
 # exports mc_* only (client-c/meshcorr.map).
 CLIENT_SO  := $(BUILD)/libmeshcorr.so.1
+# libmeshcorr-engine.so.1: mc_match, a job run in the caller's process
+# (client-c/local/) the way a worker runs it: the worker's job mapping, the
+# engine and the codec linked in; exports mc_match only. The Python
+# package loads it for meshcorr.match(), so libmeshcorr.so stays slim.
+LOCAL_C    := $(wildcard client-c/local/*.c)
+LOCAL_OBJ  := $(LOCAL_C:%.c=$(BUILD)/obj/%.o) \
+  $(addprefix $(BUILD)/obj/workers/main/,worker_job.o worker_result.o worker_progress.o)
+ENGINE_SO  := $(BUILD)/libmeshcorr-engine.so.1
 
 # meshcorrd: daemon/*.c; every file but main.c also goes into libmcdaemon.a
 # so tests can drive a module (the scheduler) directly.
@@ -88,17 +103,17 @@ WORKER_OBJ   := $(WORKER_C:%.c=$(BUILD)/obj/%.o)
 
 PROGRAMS := $(BUILD)/meshcorr $(BUILD)/meshcorr-worker $(BUILD)/meshcorr-validate $(BUILD)/meshcorrd
 
-.PHONY: all test bench demo install install-lib install-man install-python clean doc-params
+.PHONY: all test bench demo install install-lib install-man install-python install-doc clean doc-params
 # Objects built through pattern chains are kept (make would otherwise delete
 # them after the run and print that as the last line of `make test`).
 .SECONDARY:
 all: $(PROGRAMS)
 
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c VERSION
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 
-$(BUILD)/obj/%.o: %.cpp
+$(BUILD)/obj/%.o: %.cpp VERSION
 	@mkdir -p $(dir $@)
 	$(CXX) $(CPPFLAGS) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
@@ -130,6 +145,13 @@ $(CLIENT_SO): $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) client-c/meshcorr.map
 	$(CC) $(CFLAGS) -shared -Wl,-soname,libmeshcorr.so.1 -Wl,--no-undefined \
 	  -Wl,--version-script=client-c/meshcorr.map -o $@ $(CLIENT_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 	ln -sf libmeshcorr.so.1 $(BUILD)/libmeshcorr.so
+
+$(ENGINE_SO): $(LOCAL_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) client-c/local/meshcorr-engine.map
+	$(CC) $(CFLAGS) -shared -Wl,-soname,libmeshcorr-engine.so.1 -Wl,--no-undefined \
+	  -Wl,--version-script=client-c/local/meshcorr-engine.map -o $@ $(LOCAL_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) \
+	  $(PROTO_LIB) $(LDLIBS)
+	ln -sf libmeshcorr-engine.so.1 $(BUILD)/libmeshcorr-engine.so
+
 
 $(DAEMON_LIB): $(filter-out $(BUILD)/obj/daemon/main.o,$(DAEMON_OBJ))
 	@mkdir -p $(dir $@)
@@ -163,7 +185,7 @@ $(BUILD)/fuzz/%: tests/fuzz/%.c $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) 
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Itests $(CFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
 
-test: $(PROGRAMS) $(CLIENT_SO) $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
+test: $(PROGRAMS) $(CLIENT_SO) $(ENGINE_SO) $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
 	@sh tests/run-tests.sh $(TEST_BIN) $(SEC_BIN) $(FUZZ_BIN)
 
 bench: $(PROGRAMS) $(BENCH_BIN)
@@ -193,10 +215,12 @@ install: $(PROGRAMS)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/systemd/system $(DESTDIR)$(SYSCONFDIR)/meshcorr
 	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
 	sed -e 's|/usr/bin/meshcorrd|$(PREFIX)/bin/meshcorrd|' -e 's|/etc/meshcorr/|$(SYSCONFDIR)/meshcorr/|' \
+	  -e 's|/usr/share/doc/meshcorr/|$(DOCDIR)/|g' \
 	  deploy/meshcorrd.service > $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	chmod 644 $(DESTDIR)$(PREFIX)/lib/systemd/system/meshcorrd.service
 	test -e $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf || \
 	  install -m 644 deploy/meshcorrd.conf $(DESTDIR)$(SYSCONFDIR)/meshcorr/meshcorrd.conf
+	test -e $(DESTDIR)$(SYSCONFDIR)/meshcorr/tokens || install -m 600 /dev/null $(DESTDIR)$(SYSCONFDIR)/meshcorr/tokens
 
 # The man pages (deploy/man/NAME.SECTION), each into its section's folder.
 MAN_PAGES := $(wildcard deploy/man/*.[1-8])
@@ -205,18 +229,31 @@ install-man:
 	set -e; for p in $(MAN_PAGES); do d=$(DESTDIR)$(PREFIX)/share/man/man$${p##*.}; \
 	  install -d $$d; install -m 644 $$p $$d/; done
 
-# libmeshcorr: header, static and shared libraries, pkg-config file (the
-# engine and codec archives too: static users link them, see Libs.private).
-all: $(CLIENT_SO)
+# The documentation, where the unit's Documentation= points, in the
+# repository's own layout so that the pages' links to each other work.
+DOCDIR ?= $(PREFIX)/share/doc/meshcorr
+DOCS   := README.md $(wildcard docs/*.md) protocol/PROTOCOL.md daemon/README.md daemon/MODBUS.md
+install: install-doc
+install-doc:
+	set -e; for f in $(DOCS); do d=$(DESTDIR)$(DOCDIR)/$$(dirname $$f); \
+	  install -d $$d; install -m 644 $$f $$d/; done
+
+# libmeshcorr: headers in include/meshcorr/ (meshcorr.h and the parameter
+# list it includes; pkg-config's Cflags name the folder, so both
+# <meshcorr.h> and <meshcorr/meshcorr.h> work), static and shared
+# libraries, pkg-config file (the engine and codec archives too: static
+# users link them, see Libs.private).
+all: $(CLIENT_SO) $(ENGINE_SO)
 install: install-lib
-install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_LIB) $(PROTO_LIB)
-	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
-	install -m 644 client-c/meshcorr.h protocol/proto_params.h $(DESTDIR)$(PREFIX)/include/
+install-lib: $(CLIENT_LIB) $(CLIENT_SO) $(ENGINE_SO) $(ENGINE_LIB) $(PROTO_LIB)
+	install -d $(DESTDIR)$(PREFIX)/include/meshcorr $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 client-c/meshcorr.h protocol/proto_params.h $(DESTDIR)$(PREFIX)/include/meshcorr/
 	install -m 644 $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DESTDIR)$(PREFIX)/lib/
-	install -m 755 $(CLIENT_SO) $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(CLIENT_SO) $(ENGINE_SO) $(DESTDIR)$(PREFIX)/lib/
 	ln -sf libmeshcorr.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr.so
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(strip $(LDLIBS))|' client-c/meshcorr.pc.in \
-	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/meshcorr.pc
+	ln -sf libmeshcorr-engine.so.1 $(DESTDIR)$(PREFIX)/lib/libmeshcorr-engine.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(MC_VERSION)|' -e 's|@LIBS@|$(strip $(LDLIBS))|' \
+	  client-c/meshcorr.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/meshcorr.pc
 
 # The Python package (client-c/python/meshcorr) where Debian's python3 finds
 # it: /usr/lib/python3/dist-packages for PREFIX=/usr, else
@@ -227,7 +264,7 @@ PYTHON_SITE ?= $(if $(filter /usr,$(PREFIX)),$(PREFIX)/lib/python3/dist-packages
 install: install-python
 install-python: install-lib
 	install -d $(DESTDIR)$(PYTHON_SITE)/meshcorr
-	install -m 644 client-c/python/meshcorr/*.py $(DESTDIR)$(PYTHON_SITE)/meshcorr/
+	install -m 644 client-c/python/meshcorr/*.py client-c/python/meshcorr/py.typed $(DESTDIR)$(PYTHON_SITE)/meshcorr/
 	printf '"""_libpath.py — written by make install: the installed libmeshcorr."""\nLIBMESHCORR = "%s"\n' \
 	  '$(PREFIX)/lib/libmeshcorr.so.1' > $(DESTDIR)$(PYTHON_SITE)/meshcorr/_libpath.py
 

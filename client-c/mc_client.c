@@ -1,11 +1,22 @@
-/* mc_client.c — libmeshcorr's connection and requests: connect, HELLO, one
- * request at a time with blocking I/O under a timeout, replies decoded by
- * the protocol codec and copied into the public structs of meshcorr.h. Holds
- * no mesh code (mc_mesh.c) and no command-line code (cli/). */
-#include "meshcorr.h"
-#include "proto.h"
+/* mc_client.c — libmeshcorr's connection and requests: connect (Unix
+ * socket, TCP, or TCP with TLS), HELLO, one request at a time with blocking
+ * I/O under a timeout, replies decoded by the protocol codec and copied into
+ * the public structs of meshcorr.h. Holds no mesh code (mc_mesh.c) and no
+ * command-line code (cli/).
+ *
+ * TLS (GnuTLS): the server's certificate is verified against the CA file
+ * given (mc_connect_ca, else $MESHCORR_CA) or else the system's trust store,
+ * and must name the host of the address; TLS 1.2 at least. The session runs
+ * over the same non-blocking send/recv and poll as a plain connection, so
+ * every wait keeps the client's timeout. */
+#include "mc__wire.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <gnutls/gnutls.h>
+#include <gnutls/x509.h>
 #include <netdb.h>
 #include <poll.h>
 #include <stdarg.h>
@@ -19,9 +30,13 @@
 
 #define MC_DEFAULT_TIMEOUT_MS 30000
 #define MC_MAX_REPLY PROTO_MAX_FRAME
+/* The versions the daemon accepts (TLS_PRIORITY in daemon/mcd.h). */
+#define MC_TLS_PRIORITY "NORMAL:-VERS-ALL:+VERS-TLS1.3:+VERS-TLS1.2"
 
 struct mc_client {
     int fd;
+    gnutls_session_t tls;      /* NULL: a plain connection */
+    gnutls_certificate_credentials_t cred;
     int timeout_ms;
     uint32_t next_rid;
     char user[256];
@@ -66,6 +81,8 @@ const char *mc_state_name(int state) { return proto_state_name(state); }
 
 int mc_state_parse(const char *name)
 {
+    if (!name)
+        return -1;
     for (int i = 0; i <= PROTO_STATE_LAST; i++)
         if (strcasecmp(name, proto_state_name(i)) == 0)
             return i;
@@ -81,13 +98,24 @@ static int fail(mc_client *c, int code, const char *fmt, ...)
     return code;
 }
 
-void mc_set_timeout(mc_client *c, int ms) { c->timeout_ms = ms; }
-const char *mc_errmsg(const mc_client *c) { return c->errmsg; }
-const char *mc_user(const mc_client *c) { return c->user; }
-int mc_is_admin(const mc_client *c) { return c->admin; }
+/* Every call refuses a NULL client (never connected, or one a binding has
+ * closed) with MC_EARG instead of dereferencing it; the getters answer as
+ * for no user. */
+#define MC_NEED_CLIENT(c) do { if (!(c)) return MC_EARG; } while (0)
+
+void mc_set_timeout(mc_client *c, int ms)
+{
+    if (c)
+        c->timeout_ms = ms;
+}
+const char *mc_errmsg(const mc_client *c) { return c ? c->errmsg : "no client (NULL)"; }
+const char *mc_user(const mc_client *c) { return c ? c->user : ""; }
+int mc_is_admin(const mc_client *c) { return c ? c->admin : 0; }
 
 void mc_job_spec_init(mc_job_spec *s)
 {
+    if (!s)
+        return;
     memset(s, 0, sizeof *s);
 #define MC_DEFAULT_STR(name, dflt) s->name = NULL;
 #define MC_DEFAULT_NUM(name, dflt) s->name = dflt;
@@ -132,10 +160,53 @@ static int64_t deadline_of(const mc_client *c)
     return c->timeout_ms > 0 ? now_ms() + c->timeout_ms : -1;
 }
 
+/* TLS: which way the session waits after GNUTLS_E_AGAIN. */
+static short tls_wants(const mc_client *c)
+{
+    return gnutls_record_get_direction(c->tls) ? POLLOUT : POLLIN;
+}
+
+/* A TLS error in the middle of the session: MC_EIO with its reason (an
+ * end without close_notify is the server closing). */
+static int tls_broken(mc_client *c, const char *what, ssize_t g)
+{
+    if (g == GNUTLS_E_PREMATURE_TERMINATION || g == GNUTLS_E_PUSH_ERROR || g == GNUTLS_E_PULL_ERROR) {
+        if (errno == 0)
+            errno = EPIPE;
+        return fail(c, MC_EIO, "%s: %s", what, errno == EPIPE || errno == ECONNRESET || g ==
+                    GNUTLS_E_PREMATURE_TERMINATION ? "the server closed the connection" : strerror(errno));
+    }
+    return fail(c, MC_EIO, "%s: TLS: %s", what, gnutls_strerror((int)g));
+}
+
+static int send_tls(mc_client *c, const char *p, size_t len, int64_t deadline)
+{
+    while (len) {
+        errno = 0;
+        ssize_t w = gnutls_record_send(c->tls, p, len);
+        if (w > 0) {
+            p += w;
+            len -= (size_t)w;
+        } else if (w == GNUTLS_E_AGAIN || w == GNUTLS_E_INTERRUPTED) {
+            int rc = wait_fd(c, tls_wants(c), deadline);
+            if (rc)
+                return rc;
+        } else {
+            int e = errno;
+            int rc = tls_broken(c, "send", w);
+            errno = e ? e : EPIPE;    /* request() asks the server why (closed_reason) */
+            return rc;
+        }
+    }
+    return 0;
+}
+
 static int send_all(mc_client *c, const void *data, size_t len)
 {
     int64_t deadline = deadline_of(c);
     const char *p = data;
+    if (c->tls)
+        return send_tls(c, p, len, deadline);
     while (len) {
         ssize_t w = send(c->fd, p, len, MSG_NOSIGNAL | MSG_DONTWAIT);
         if (w > 0) {
@@ -159,9 +230,40 @@ static int send_all(mc_client *c, const void *data, size_t len)
     return 0;
 }
 
+static int recv_tls(mc_client *c, char *p, size_t len, int64_t deadline)
+{
+    short want = POLLIN;
+    while (len) {
+        /* records GnuTLS has already read are not on the socket any more */
+        if (!gnutls_record_check_pending(c->tls)) {
+            int rc = wait_fd(c, want, deadline);
+            if (rc)
+                return rc;
+        }
+        errno = 0;
+        ssize_t r = gnutls_record_recv(c->tls, p, len);
+        if (r > 0) {
+            p += r;
+            len -= (size_t)r;
+            want = POLLIN;
+        } else if (r == 0) {
+            return fail(c, MC_EIO, "the server closed the connection");
+        } else if (r == GNUTLS_E_AGAIN || r == GNUTLS_E_INTERRUPTED) {
+            want = tls_wants(c);
+        } else if (!gnutls_error_is_fatal((int)r)) {
+            want = POLLIN;                 /* a warning alert */
+        } else {
+            return tls_broken(c, "recv", r);
+        }
+    }
+    return 0;
+}
+
 static int recv_all(mc_client *c, void *data, size_t len, int64_t deadline)
 {
     char *p = data;
+    if (c->tls)
+        return recv_tls(c, p, len, deadline);
     while (len) {
         int rc = wait_fd(c, POLLIN, deadline);
         if (rc)
@@ -183,8 +285,10 @@ static int recv_all(mc_client *c, void *data, size_t len, int64_t deadline)
  * frame is returned as its code, with its message in errmsg. */
 static int read_frame(mc_client *c, proto_msg *m, int64_t deadline)
 {
-    uint8_t hdrb[PROTO_HDR_SIZE];
+    uint8_t hdrb[PROTO_HDR_SIZE] = {0};
     int rc = recv_all(c, hdrb, sizeof hdrb, deadline);
+    if (rc && !c->tls && hdrb[0] == 0x15 && hdrb[1] == 0x03)   /* a TLS alert record */
+        return fail(c, MC_ETLS, "the server speaks TLS on this port: connect to tls:HOST:PORT");
     if (rc)
         return rc;
     proto_hdr hdr;
@@ -281,12 +385,12 @@ static int connect_unix(mc_client *c, const char *path)
     return 0;
 }
 
-static int connect_tcp(mc_client *c, const char *hostport)
+/* scheme:HOST:PORT (tcp or tls); host receives HOST without brackets. */
+static int connect_tcp(mc_client *c, const char *scheme, const char *hostport, char host[256])
 {
-    char host[256];
     const char *colon = strrchr(hostport, ':');
-    if (!colon || colon == hostport || (size_t)(colon - hostport) >= sizeof host)
-        return fail(c, MC_EADDRESS, "tcp:%s: expected tcp:HOST:PORT", hostport);
+    if (!colon || colon == hostport || (size_t)(colon - hostport) >= 256)
+        return fail(c, MC_EADDRESS, "%s:%s: expected %s:HOST:PORT", scheme, hostport, scheme);
     memcpy(host, hostport, (size_t)(colon - hostport));
     host[colon - hostport] = '\0';
     if (host[0] == '[' && host[strlen(host) - 1] == ']') {
@@ -298,15 +402,20 @@ static int connect_tcp(mc_client *c, const char *hostport)
     hints.ai_socktype = SOCK_STREAM;
     int g = getaddrinfo(host, colon + 1, &hints, &res);
     if (g)
-        return fail(c, MC_EADDRESS, "tcp:%s: %s", hostport, gai_strerror(g));
-    int rc = fail(c, MC_ECONNECT, "tcp:%s: no address", hostport);
+        return fail(c, MC_EADDRESS, "%s:%s: %s", scheme, hostport, gai_strerror(g));
+    int rc = fail(c, MC_ECONNECT, "%s:%s: no address", scheme, hostport);
     for (struct addrinfo *ai = res; ai; ai = ai->ai_next) {
         c->fd = socket(ai->ai_family, ai->ai_socktype | SOCK_CLOEXEC, ai->ai_protocol);
         if (c->fd >= 0 && connect(c->fd, ai->ai_addr, ai->ai_addrlen) == 0) {
+            /* a request goes out in one send, but TLS's Finished and the
+             * HELLO after it are two: Nagle would hold the second until
+             * the server's delayed ACK */
+            int one = 1;
+            setsockopt(c->fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
             rc = 0;
             break;
         }
-        rc = fail(c, MC_ECONNECT, "tcp:%s: %s", hostport, strerror(errno));
+        rc = fail(c, MC_ECONNECT, "%s:%s: %s", scheme, hostport, strerror(errno));
         if (c->fd >= 0)
             close(c->fd);
         c->fd = -1;
@@ -315,8 +424,111 @@ static int connect_tcp(mc_client *c, const char *hostport)
     return rc;
 }
 
+static ssize_t tls_pull(gnutls_transport_ptr_t p, void *buf, size_t n)
+{
+    return recv(((mc_client *)p)->fd, buf, n, MSG_DONTWAIT);
+}
+
+static ssize_t tls_push(gnutls_transport_ptr_t p, const void *data, size_t n)
+{
+    return send(((mc_client *)p)->fd, data, n, MSG_NOSIGNAL | MSG_DONTWAIT);
+}
+
+static int is_ip(const char *host)
+{
+    unsigned char a[sizeof(struct in6_addr)];
+    return inet_pton(AF_INET, host, a) == 1 || inet_pton(AF_INET6, host, a) == 1;
+}
+
+/* The TLS handshake on the connected c->fd: the server's certificate must
+ * chain to ca (a PEM file; NULL: $MESHCORR_CA, else the system's trust
+ * store) and name host. */
+static int start_tls(mc_client *c, const char *hostport, const char *host, const char *ca)
+{
+    if (!ca || !*ca)
+        ca = getenv("MESHCORR_CA");
+    int g = gnutls_certificate_allocate_credentials(&c->cred);
+    if (g < 0)
+        return fail(c, MC_ENOMEM, "TLS: %s", gnutls_strerror(g));
+    if (ca && *ca) {
+        FILE *fp = fopen(ca, "r");
+        if (!fp)
+            return fail(c, MC_ETLS, "CA file %s: %s", ca, strerror(errno));
+        fclose(fp);
+        g = gnutls_certificate_set_x509_trust_file(c->cred, ca, GNUTLS_X509_FMT_PEM);
+        if (g <= 0)
+            return fail(c, MC_ETLS, "CA file %s: no PEM certificate in it%s%s", ca, g < 0 ? ": " : "",
+                        g < 0 ? gnutls_strerror(g) : "");
+    } else if (gnutls_certificate_set_x509_system_trust(c->cred) <= 0) {
+        /* nothing trusted: the handshake below fails, naming the remedy */
+    }
+    if ((g = gnutls_init(&c->tls, GNUTLS_CLIENT | GNUTLS_NONBLOCK | GNUTLS_NO_SIGNAL)) < 0) {
+        c->tls = NULL;
+        return fail(c, MC_ENOMEM, "TLS: %s", gnutls_strerror(g));
+    }
+    const char *errpos = NULL;
+    if ((g = gnutls_priority_set_direct(c->tls, MC_TLS_PRIORITY, &errpos)) < 0 ||
+        (g = gnutls_credentials_set(c->tls, GNUTLS_CRD_CERTIFICATE, c->cred)) < 0 ||
+        (!is_ip(host) && (g = gnutls_server_name_set(c->tls, GNUTLS_NAME_DNS, host, strlen(host))) < 0))
+        return fail(c, MC_ETLS, "TLS: %s", gnutls_strerror(g));
+    gnutls_session_set_verify_cert(c->tls, host, 0);
+    gnutls_handshake_set_timeout(c->tls, 0);       /* the deadline below rules */
+    gnutls_transport_set_ptr(c->tls, c);
+    gnutls_transport_set_pull_function(c->tls, tls_pull);
+    gnutls_transport_set_push_function(c->tls, tls_push);
+    int64_t deadline = deadline_of(c);
+    for (;;) {
+        errno = 0;
+        g = gnutls_handshake(c->tls);
+        if (g == 0)
+            return 0;
+        if (g == GNUTLS_E_AGAIN || g == GNUTLS_E_INTERRUPTED) {
+            int rc = wait_fd(c, tls_wants(c), deadline);
+            if (rc)
+                return rc == MC_ETIMEOUT ? fail(c, MC_ETIMEOUT, "no TLS handshake within %d ms", c->timeout_ms) : rc;
+        } else if (gnutls_error_is_fatal(g)) {
+            break;
+        }
+    }
+    if (g == GNUTLS_E_CERTIFICATE_VERIFICATION_ERROR) {
+        unsigned st = gnutls_session_get_verify_cert_status(c->tls);
+        gnutls_datum_t why = {NULL, 0};
+        gnutls_certificate_verification_status_print(st, GNUTLS_CRT_X509, &why, 0);
+        char w[512];
+        snprintf(w, sizeof w, "%s", why.data ? (const char *)why.data : "verification failed");
+        for (size_t n = strlen(w); n > 0 && w[n - 1] == ' '; n--)
+            w[n - 1] = '\0';
+        if ((st & GNUTLS_CERT_UNEXPECTED_OWNER) && !(st & GNUTLS_CERT_SIGNER_NOT_FOUND))
+            fail(c, MC_ETLS, "the server's certificate does not name the host %s: %s (connect to a name the "
+                 "certificate holds)", host, w);
+        else
+            fail(c, MC_ETLS, "the server's certificate is not trusted: %s (give its CA with --ca or MESHCORR_CA)",
+                 w);
+        gnutls_free(why.data);
+        return MC_ETLS;
+    }
+    if (g == GNUTLS_E_FATAL_ALERT_RECEIVED) {
+        const char *a = gnutls_alert_get_name(gnutls_alert_get(c->tls));
+        return fail(c, MC_ETLS, "the server refused the TLS handshake: %s", a ? a : "alert");
+    }
+    if (g == GNUTLS_E_PREMATURE_TERMINATION || g == GNUTLS_E_PULL_ERROR || g == GNUTLS_E_PUSH_ERROR)
+        return fail(c, MC_ETLS, "the server closed the connection during the TLS handshake%s%s",
+                    errno && errno != EAGAIN ? ": " : "", errno && errno != EAGAIN ? strerror(errno) : "");
+    return fail(c, MC_ETLS, "TLS handshake failed: %s (is %s a tls: listener?)", gnutls_strerror(g), hostport);
+}
+
 int mc_connect(const char *address, const char *token, mc_client **out, char *err, size_t errsz)
 {
+    return mc_connect_ca(address, token, NULL, out, err, errsz);
+}
+
+int mc_connect_ca(const char *address, const char *token, const char *ca_file, mc_client **out, char *err,
+                  size_t errsz)
+{
+    if (!out) {
+        snprintf(err, errsz, "mc_connect: out is NULL");
+        return MC_EARG;
+    }
     *out = NULL;
     mc_client *c = calloc(1, sizeof *c);
     if (!c) {
@@ -325,15 +537,21 @@ int mc_connect(const char *address, const char *token, mc_client **out, char *er
     }
     c->fd = -1;
     c->timeout_ms = MC_DEFAULT_TIMEOUT_MS;
-    int rc;
+    char host[256];
+    int rc = 0;
     if (!address)
         rc = fail(c, MC_EADDRESS, "no server address");
     else if (strncmp(address, "unix:", 5) == 0)
         rc = connect_unix(c, address + 5);
     else if (strncmp(address, "tcp:", 4) == 0)
-        rc = connect_tcp(c, address + 4);
-    else
-        rc = fail(c, MC_EADDRESS, "'%s' is not unix:PATH or tcp:HOST:PORT", address);
+        rc = connect_tcp(c, "tcp", address + 4, host);
+    else if (strncmp(address, "tls:", 4) == 0) {
+        rc = connect_tcp(c, "tls", address + 4, host);
+        if (!rc)
+            rc = start_tls(c, address + 4, host, ca_file);
+    } else {
+        rc = fail(c, MC_EADDRESS, "'%s' is not unix:PATH, tls:HOST:PORT or tcp:HOST:PORT", address);
+    }
     if (!rc) {
         proto_msg req, rep;
         memset(&req, 0, sizeof req);
@@ -356,72 +574,48 @@ int mc_connect(const char *address, const char *token, mc_client **out, char *er
     return 0;
 }
 
+/* The connection ends here (the client object stays). */
+static void hang_up(mc_client *c)
+{
+    if (c->tls) {
+        gnutls_bye(c->tls, GNUTLS_SHUT_WR);   /* close_notify if the socket takes it now */
+        gnutls_deinit(c->tls);
+        c->tls = NULL;
+    }
+    if (c->cred)
+        gnutls_certificate_free_credentials(c->cred);
+    c->cred = NULL;
+    if (c->fd >= 0)
+        close(c->fd);
+    c->fd = -1;
+}
+
 void mc_close(mc_client *c)
 {
     if (!c)
         return;
-    if (c->fd >= 0)
-        close(c->fd);
+    hang_up(c);
     free(c->rbuf);
     free(c);
 }
 
 int mc_submit(mc_client *c, const mc_job_spec *s, uint64_t *job_id)
 {
-    if (!s || !s->source || !s->target || s->source_len > UINT32_MAX || s->target_len > UINT32_MAX)
-        return fail(c, MC_EARG, "the job needs source and target Draco bytes");
+    MC_NEED_CLIENT(c);
+    if (!job_id)
+        return fail(c, MC_EARG, "mc_submit: job_id is NULL");
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
     req.type = PROTO_MSG_SUBMIT;
-    proto_submit *m = &req.u.submit;
-    m->source = (proto_blob){s->source, (uint32_t)s->source_len};
-    m->target = (proto_blob){s->target, (uint32_t)s->target_len};
-    m->landmarks = (proto_landmark *)s->landmarks;   /* (src, tgt) u32 pairs: the same layout */
-    m->nlandmarks = s->nlandmarks;
-    m->p = (proto_map){(proto_map_row *)s->p, s->np};
-    m->q = (proto_map){(proto_map_row *)s->q, s->nq};
-    proto_params *p = &m->params;
-    /* one assignment per row of the list; an int that does not fit a u8
-     * becomes 255, which the server refuses naming the field */
-#define MC_WIRE_U8(v) (uint8_t)((v) < 0 || (v) > 255 ? 255 : (v))
-#define MC_WIRE_ENUM(name) p->name = MC_WIRE_U8(s->name);
-#define MC_WIRE_BOOL(name) p->name = MC_WIRE_U8(s->name);
-#define MC_WIRE_U32(name)  p->name = s->name;
-#define MC_WIRE_F64(name)  p->name = s->name;
-#define MC_WIRE_STR(name)  p->name = s->name ? s->name : "";
-#define MC_WIRE(name, cli, type, ...) MC_WIRE_##type(name)
-    PROTO_PARAMS(MC_WIRE)
-#undef MC_WIRE
-    m->priority = s->priority;
-    m->label = s->label ? s->label : "";
-    int rc = request(c, &req, PROTO_MSG_SUBMIT_OK, &rep);
+    int rc = mc__submit_of(s, &req.u.submit, c->errmsg, sizeof c->errmsg);
+    if (rc)
+        return rc;
+    rc = request(c, &req, PROTO_MSG_SUBMIT_OK, &rep);
     if (!rc) {
         *job_id = rep.u.submit_ok.job_id;
         proto_msg_free(&rep);
     }
     return rc;
-}
-
-static void copy_progress(mc_progress *o, const proto_progress *p)
-{
-    o->job_id = p->job_id;
-    o->stage = p->stage;
-    o->outer = p->outer;
-    o->total = p->total;
-    for (int d = 0; d < 2; d++) {
-        o->inner[d] = p->inner[d];
-        o->membrane[d] = p->terms[d][PROTO_TERM_MEMBRANE];
-        o->bending[d] = p->terms[d][PROTO_TERM_BENDING];
-        o->mismatch[d] = p->terms[d][PROTO_TERM_MISMATCH];
-        o->reverse[d] = p->terms[d][PROTO_TERM_REVERSE];
-        o->energy[d] = p->terms[d][PROTO_TERM_ENERGY];
-    }
-    o->beta = p->beta;
-    o->gamma = p->gamma;
-    o->elapsed_s = p->elapsed_s;
-    o->fraction = p->fraction;
-    o->eta_s = p->eta_s;
-    o->ahead = p->ahead;
 }
 
 static int job_request(mc_client *c, int type, int want, uint64_t id, proto_msg *rep)
@@ -441,6 +635,9 @@ const char *mc_quality_name(int verdict)
 
 int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
 {
+    MC_NEED_CLIENT(c);
+    if (!o)
+        return fail(c, MC_EARG, "mc_status: out is NULL");
     proto_msg rep;
     int rc = job_request(c, PROTO_MSG_STATUS, PROTO_MSG_STATUS_OK, id, &rep);
     if (rc)
@@ -458,7 +655,7 @@ int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
     o->end_ms = s->end_ms;
     o->has_progress = s->has_progress;
     if (s->has_progress)
-        copy_progress(&o->progress, &s->progress);
+        mc__progress_of(&o->progress, &s->progress);
     o->quality = (mc_quality){s->quality.verdict, s->quality.flipped, s->quality.collapsed};
     proto_msg_free(&rep);
     return 0;
@@ -466,6 +663,7 @@ int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
 
 int mc_cancel(mc_client *c, uint64_t id)
 {
+    MC_NEED_CLIENT(c);
     proto_msg rep;
     int rc = job_request(c, PROTO_MSG_CANCEL, PROTO_MSG_OK, id, &rep);
     if (!rc)
@@ -475,6 +673,7 @@ int mc_cancel(mc_client *c, uint64_t id)
 
 int mc_delete(mc_client *c, uint64_t id)
 {
+    MC_NEED_CLIENT(c);
     proto_msg rep;
     int rc = job_request(c, PROTO_MSG_DELETE, PROTO_MSG_OK, id, &rep);
     if (!rc)
@@ -484,6 +683,7 @@ int mc_delete(mc_client *c, uint64_t id)
 
 int mc_ping(mc_client *c)
 {
+    MC_NEED_CLIENT(c);
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
     req.type = PROTO_MSG_PING;
@@ -495,6 +695,9 @@ int mc_ping(mc_client *c)
 
 int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **jobs, uint32_t *n)
 {
+    MC_NEED_CLIENT(c);
+    if (!jobs || !n)
+        return fail(c, MC_EARG, "mc_list: jobs or n is NULL");
     *jobs = NULL;
     *n = 0;
     uint64_t after = 0;
@@ -549,6 +752,7 @@ int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **j
 int mc_watch(mc_client *c, uint64_t id, uint32_t from_outer, mc_progress_fn cb, void *ctx,
              int *end_state, char *reason, size_t reasonsz)
 {
+    MC_NEED_CLIENT(c);
     proto_msg req;
     memset(&req, 0, sizeof req);
     req.type = PROTO_MSG_WATCH;
@@ -583,47 +787,20 @@ int mc_watch(mc_client *c, uint64_t id, uint32_t from_outer, mc_progress_fn cb, 
             return 0;
         }
         mc_progress p;
-        copy_progress(&p, &m.u.progress);
+        mc__progress_of(&p, &m.u.progress);
         proto_msg_free(&m);
         if (cb && (rc = cb(ctx, &p)) != 0) {
-            close(c->fd);
-            c->fd = -1;
+            hang_up(c);
             return rc;
         }
     }
 }
 
-static int copy_map(const proto_map *m, mc_map_row **out, uint32_t *n)
-{
-    *n = m->n;
-    *out = NULL;
-    if (!m->n)
-        return 0;
-    if (!(*out = malloc((size_t)m->n * sizeof **out)))
-        return -1;
-    for (uint32_t i = 0; i < m->n; i++) {
-        (*out)[i].face = m->rows[i].face;
-        memcpy((*out)[i].w, m->rows[i].w, sizeof (*out)[i].w);
-    }
-    return 0;
-}
-
-void mc_result_free(mc_job_result *r)
-{
-    if (!r)
-        return;
-    free(r->p);
-    free(r->q);
-    free(r->deformed);
-    for (uint32_t i = 0; r->metric_keys && i < r->nmetrics; i++)
-        free(r->metric_keys[i]);
-    free(r->metric_keys);
-    free(r->metric_values);
-    memset(r, 0, sizeof *r);
-}
-
 int mc_result(mc_client *c, uint64_t id, unsigned what, mc_job_result *out)
 {
+    MC_NEED_CLIENT(c);
+    if (!out)
+        return fail(c, MC_EARG, "mc_result: out is NULL");
     memset(out, 0, sizeof *out);
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
@@ -632,30 +809,9 @@ int mc_result(mc_client *c, uint64_t id, unsigned what, mc_job_result *out)
     int rc = request(c, &req, PROTO_MSG_RESULT_OK, &rep);
     if (rc)
         return rc;
-    const proto_result_ok *r = &rep.u.result_ok;
-    int bad = copy_map(&r->p, &out->p, &out->np) || copy_map(&r->q, &out->q, &out->nq);
-    if (!bad && r->deformed.len) {
-        out->deformed_len = r->deformed.len;
-        bad = !(out->deformed = malloc(r->deformed.len));
-        if (!bad)
-            memcpy(out->deformed, r->deformed.data, r->deformed.len);
-    }
-    if (!bad && r->nmetrics) {
-        out->metric_keys = calloc(r->nmetrics, sizeof *out->metric_keys);
-        out->metric_values = calloc(r->nmetrics, sizeof *out->metric_values);
-        bad = !out->metric_keys || !out->metric_values;
-        for (uint32_t i = 0; !bad && i < r->nmetrics; i++) {
-            bad = !(out->metric_keys[i] = strdup(r->metrics[i].key));
-            out->metric_values[i] = r->metrics[i].value;
-            out->nmetrics = i + 1;
-        }
-    }
+    rc = mc__result_of(&rep.u.result_ok, ~0u, out);     /* every part the server sent */
     proto_msg_free(&rep);
-    if (bad) {
-        mc_result_free(out);
-        return fail(c, MC_ENOMEM, "out of memory for the result");
-    }
-    return 0;
+    return rc ? fail(c, rc, "out of memory for the result") : 0;
 }
 
 void mc_stats_free(mc_server_stats *s)
@@ -669,6 +825,9 @@ void mc_stats_free(mc_server_stats *s)
 
 int mc_stats(mc_client *c, mc_server_stats *out)
 {
+    MC_NEED_CLIENT(c);
+    if (!out)
+        return fail(c, MC_EARG, "mc_stats: out is NULL");
     memset(out, 0, sizeof *out);
     proto_msg req, rep;
     memset(&req, 0, sizeof req);
@@ -707,6 +866,9 @@ int mc_stats(mc_client *c, mc_server_stats *out)
 
 int mc_send_raw(mc_client *c, const void *bytes, size_t len)
 {
+    MC_NEED_CLIENT(c);
+    if (!bytes && len)
+        return fail(c, MC_EARG, "mc_send_raw: bytes is NULL");
     c->errmsg[0] = '\0';
     int rc = send_all(c, bytes, len);
     if (rc)
@@ -716,4 +878,10 @@ int mc_send_raw(mc_client *c, const void *bytes, size_t len)
     if (!rc)
         proto_msg_free(&m);
     return rc;
+}
+
+void mc_interrupt(mc_client *c)
+{
+    if (c && c->fd >= 0)
+        shutdown(c->fd, SHUT_RDWR);     /* poll() wakes, recv() sees the end */
 }

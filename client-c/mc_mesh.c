@@ -110,6 +110,33 @@ int mc_encode_mesh_file(const char *path, unsigned char **bytes, size_t *len, ch
     return mc_encode_mesh_file_quantized(path, MC_QUANTIZATION_LOSSLESS, bytes, len, err, errsz);
 }
 
+int mc_read_mesh(const char *path, double **v, int *nv, int **f, int *nf, char *err, size_t errsz)
+{
+    if (!v || !nv || !f || !nf) {
+        snprintf(err, errsz, "mc_read_mesh: an output pointer is NULL");
+        return MC_EARG;
+    }
+    *v = NULL;
+    *f = NULL;
+    *nv = *nf = 0;
+    if (!path) {
+        snprintf(err, errsz, "mc_read_mesh: no path");
+        return MC_EARG;
+    }
+    mesh *m = NULL;
+    int rc = mesh_read(path, &m, err, errsz);
+    if (rc)
+        return rc == MESH_ENOMEM ? MC_ENOMEM : MC_EFILE;
+    *v = m->v;                  /* the arrays change owner: malloc()ed by the reader */
+    *f = m->f;
+    *nv = m->nv;
+    *nf = m->nf;
+    m->v = NULL;
+    m->f = NULL;
+    mesh_free(m);
+    return 0;
+}
+
 int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, int **f, int *nf, char *err,
                    size_t errsz)
 {

@@ -40,20 +40,29 @@ extern "C" {
     X(MC_ETIMEOUT, -104, "timed out waiting for the server")                \
     X(MC_EPROTO,   -105, "the server's reply does not follow the protocol") \
     X(MC_ENOMEM,   -106, "out of memory")                                   \
-    X(MC_EFILE,    -107, "cannot read or encode the file")
+    X(MC_EFILE,    -107, "cannot read or encode the file")                  \
+    X(MC_ETLS,     -108, "TLS failed: the server's certificate is not trusted, or no TLS session")
 
 enum mc_error {
     MC_OK = 0,
     /* the server's codes, the same numbers as the protocol's */
     MC_EUNAUTHORIZED = -13, MC_EFORBIDDEN = -14, MC_ENOT_FOUND = -15,
     MC_EBAD_STATE = -16, MC_EQUEUE_FULL = -17, MC_EUSER_LIMIT = -18,
+    MC_EBAD_MESH = -19, MC_EBAD_LANDMARKS = -20, MC_EBAD_PARAMS = -21,
+    MC_ECANCELLED = -25,       /* mc_match: stopped by its progress callback */
     MC_EBUSY = -26,            /* a connection limit: retry later (at connect) */
     MC_ETIMED_OUT = -27,       /* the server cut a silent, slow or idle connection */
+    MC_EOVER_QUOTA = -28,      /* SUBMIT: the user's stored bytes, or the spool's, would pass its quota */
+    MC_EBAD_MAP = -29,         /* an initial map that does not fit the meshes */
+    MC_ENUMERIC = -30,         /* a stage of the job failed numerically (mc_match; a job's reason) */
 #define MC_ENUM(name, val, msg) name = val,
     MC_ERRORS(MC_ENUM)
 #undef MC_ENUM
 };
 const char *mc_strerror(int code);
+/* The project's version, "MAJOR.MINOR.PATCH" (the VERSION file of the
+ * source tree the library was built from). */
+const char *mc_version(void);
 /* The code's name: "BAD_PARAMS" (the protocol's name of a server code), "MC_EARG"
  * (this library's); "UNKNOWN" for others. */
 const char *mc_err_name(int code);
@@ -227,11 +236,23 @@ typedef struct mc_server_stats {
 } mc_server_stats;
 void mc_stats_free(mc_server_stats *s);
 
-/* address: "unix:PATH" or "tcp:HOST:PORT" (HOST a name or numeric address).
- * token: NULL or "" on a Unix socket (the server asks the kernel who you
- * are); the user's token on TCP. Sends HELLO; a refused token is
- * MC_EUNAUTHORIZED. Detail in err. */
+/* The address clients use when none is given ($MESHCORR_SERVER first): the
+ * socket the shipped meshcorrd.conf and unit (RuntimeDirectory=meshcorr)
+ * listen on. */
+#define MC_DEFAULT_SERVER "unix:/run/meshcorr/meshcorrd.sock"
+/* address: "unix:PATH", "tls:HOST:PORT" or "tcp:HOST:PORT" (HOST a name or
+ * numeric address). token: NULL or "" on a Unix socket (the server asks the
+ * kernel who you are); the user's token on TCP. Sends HELLO; a refused token
+ * is MC_EUNAUTHORIZED. Detail in err.
+ * tls: the server's certificate must chain to a CA of $MESHCORR_CA (a PEM
+ * file) when set, else of the system's trust store, and must name HOST (a
+ * DNS name, or an IP address the certificate lists); TLS 1.2 at least. A
+ * certificate that fails, or a server that speaks no TLS, is MC_ETLS. */
 int mc_connect(const char *address, const char *token, mc_client **out, char *err, size_t errsz);
+/* mc_connect trusting the CAs of ca_file (PEM) for a tls: address instead
+ * of $MESHCORR_CA and the system's store (NULL or "": as mc_connect). */
+int mc_connect_ca(const char *address, const char *token, const char *ca_file, mc_client **out, char *err,
+                  size_t errsz);
 void mc_close(mc_client *c);
 void mc_set_timeout(mc_client *c, int ms);     /* <= 0: wait forever */
 const char *mc_errmsg(const mc_client *c);     /* detail of the last failure; "" after success */
@@ -240,8 +261,10 @@ int mc_is_admin(const mc_client *c);
 
 int mc_submit(mc_client *c, const mc_job_spec *spec, uint64_t *job_id);
 int mc_status(mc_client *c, uint64_t job_id, mc_job_status *out);
-/* Own jobs (user NULL) or another user's (admin); state_mask: bit s = state
- * s, 0 = all. Every page is fetched; *jobs is free()d by the caller. */
+/* Own jobs (user NULL), another user's (admin), or every user's (user
+ * MC_LIST_ALL_USERS, admin); state_mask: bit s = state s, 0 = all. Every
+ * page is fetched; *jobs is free()d by the caller. */
+#define MC_LIST_ALL_USERS "*"       /* PROTO_LIST_ALL_USERS */
 int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **jobs, uint32_t *n);
 /* Replays progress from outer iteration from_outer, then follows the job
  * live, calling cb (may be NULL) for each record until the job ends; then
@@ -256,6 +279,12 @@ int mc_cancel(mc_client *c, uint64_t job_id);
 int mc_delete(mc_client *c, uint64_t job_id);
 int mc_stats(mc_client *c, mc_server_stats *out);
 int mc_ping(mc_client *c);
+
+/* The one call another thread may make on a client while a call on it
+ * blocks (mc_watch waiting for progress): shuts the connection down, so
+ * that call returns MC_EIO at once. The client is then unusable: close it
+ * once that call has returned. NULL ok. */
+void mc_interrupt(mc_client *c);
 
 /* Sends raw bytes as they are (testing and tools): one request, and waits
  * for one reply frame of any kind; returns its error code if it is ERROR. */
@@ -282,6 +311,13 @@ int mc_encode_mesh(const double *v, int nv, const int *f, int nf, unsigned char 
 int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, int **f, int *nf, char *err,
                    size_t errsz);
 
+/* A mesh file (.off .obj .ply .drc, by extension) as arrays, read by the
+ * engine's readers as mc_encode_mesh_file reads it (vertex order kept,
+ * triangles only): *v nv by 3 doubles, *f nf by 3 0-based indices, both
+ * malloc()ed, free() them. A file that cannot be opened or read: MC_EFILE,
+ * the file named in err. */
+int mc_read_mesh(const char *path, double **v, int *nv, int **f, int *nf, char *err, size_t errsz);
+
 /* Position coding of the two calls below: MC_QUANTIZATION_LOSSLESS (what
  * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate
  * over the bounding box. Quantizing trades the server's exact view of the
@@ -300,6 +336,20 @@ int mc_encode_mesh_file_quantized(const char *path, int quantization_bits, unsig
 /* mc_encode_mesh with quantization_bits. */
 int mc_encode_mesh_quantized(const double *v, int nv, const int *f, int nf, int quantization_bits,
                              unsigned char **bytes, size_t *len, char *err, size_t errsz);
+
+/* In-process jobs: libmeshcorr-engine.so.1 (link -lmeshcorr-engine; it
+ * holds the engine, libmeshcorr.so holds none). Runs the job of spec in
+ * this process as a meshcorrd worker runs it: the same SUBMIT checks
+ * (meshes decoded and validated, landmarks, parameters: the server's codes
+ * and messages, MC_EBAD_PARAMS ...), the same engine, and the same answer
+ * in out as mc_result gives for that job (the parts `what` names: MC_WANT_*;
+ * mc_result_free). threads: OpenMP threads, 0 = by the pair's size as the
+ * worker does. cb (may be NULL) gets each progress record as mc_watch
+ * delivers it (job_id 0); a non-zero return stops the job: MC_ECANCELLED. Detail of a failure in err. Blocks
+ * until the job ends; one job per call, calls from several threads at once
+ * share OpenMP's thread count. */
+int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn cb, void *ctx,
+             mc_job_result *out, char *err, size_t errsz);
 
 #ifdef __cplusplus
 }

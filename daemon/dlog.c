@@ -2,8 +2,15 @@
  * configured level dropped. Each line starts with its syslog priority in the
  * sd-daemon convention (`<3>` error, `<4>` warning, `<6>` info, `<7>` debug)
  * that journald reads; the UTC time follows unless stderr is the journal's
- * stream ($JOURNAL_STREAM), which stamps lines itself. No other output. */
+ * stream ($JOURNAL_STREAM), which stamps lines itself. No other output.
+ *
+ * DESIGN: one event is one line. Messages carry what clients sent (names,
+ * labels, users, their messages), so the whole formatted message goes
+ * through stresc (workers/util/stresc.h): a newline, an ESC or a `<3>` after
+ * a line break can never forge a line or a priority, whichever call site
+ * forgot to think of it. */
 #include "mcd.h"
+#include "util/stresc.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -26,11 +33,12 @@ void dlog(int level, const char *fmt, ...)
     static const int prio[] = {3, 4, 6, 7};
     if (level > __atomic_load_n(&level_max, __ATOMIC_RELAXED))
         return;
-    char line[2048];
+    char raw[2048], line[STRESC_SIZE(sizeof raw)];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
+    vsnprintf(raw, sizeof raw, fmt, ap);
     va_end(ap);
+    stresc(raw, line, sizeof line);
     if (getenv("JOURNAL_STREAM")) {
         fprintf(stderr, "<%d>%s: %s\n", prio[level], names[level], line);
         return;

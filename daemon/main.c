@@ -1,8 +1,10 @@
 /* main.c — meshcorrd's main(): options, store recovery, the scheduler's
  * queue rebuilt from the store, the job bookkeeping (job.c, its expiry
- * sweep included), the backend (backend.h), listeners, the signal handlers
+ * sweep included), the backend (backend.h), listeners, the drop from root
+ * to --user (priv.c: the store and the backend are set up as that user,
+ * the listeners bound as root, then root is gone), the signal handlers
  * (SIGTERM/SIGINT: drain.c; SIGHUP: reload.c), READY=1 to the service
- * manager, then the loop. The loop ends once the drain has closed every
+ * manager, then the loop; or `meshcorrd token ...` (token.c) alone. The loop ends once the drain has closed every
  * handle; only then the store closes (no store_submit can be running) and
  * the dashboard threads (--modbus, --metrics) stop. Holds no request, job or
  * shutdown logic. */
@@ -11,6 +13,7 @@
 #include "util/ompenv.h"
 
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -34,6 +37,12 @@ int main(int argc, char **argv)
 {
     static mcd d;
     char err[1024];
+    if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+        printf("meshcorrd %s\n", MC_VERSION);
+        return 0;
+    }
+    if (argc > 1 && strcmp(argv[1], "token") == 0)
+        return token_main(argc - 1, argv + 1);
     conf_init(&d.conf);
     int rc = conf_parse_args(&d.conf, argc, argv, err, sizeof err);
     if (rc == 1) {
@@ -46,6 +55,11 @@ int main(int argc, char **argv)
         return 2;
     }
     dlog_set_level(d.conf.log_level);
+    priv_user priv;
+    if (priv_init(&d.conf, &priv, err, sizeof err)) {
+        dlog(DLOG_ERROR, "%s", err);
+        return 2;
+    }
     signal(SIGPIPE, SIG_IGN);
     /* The workers we spawn inherit it and skip their re-exec: one program
      * load less per job (bench_daemon's 162-vertex job: overhead 63-66 ->
@@ -58,7 +72,9 @@ int main(int argc, char **argv)
              validator);
     int status = 1;
     d.loop = uv_default_loop();
-    if (auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
+    /* the tokens file is read as the user the daemon runs as: SIGHUP reads it again as that user */
+    if (priv_become(&priv, d.conf.state_dir, err, sizeof err) ||
+        auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
         store_open(d.conf.state_dir, &d.store, err, sizeof err) ||
         store_recover(d.store, strcmp(d.conf.backend, "slurm") == 0, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
@@ -70,12 +86,16 @@ int main(int argc, char **argv)
     }
     job_init(&d);
     req_init(&d);
-    if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
+    /* the TLS key is read while root is still at hand, with the binds */
+    if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
+        priv_bind_begin(&priv, err, sizeof err) || tls_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
-        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.snap, &d.metrics, err, sizeof err))) {
+        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.tls, d.snap, &d.metrics, err, sizeof err)) ||
+        priv_drop(&priv, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }
+    srv_note_tokens(&d);
     job_sweep_start(&d);
     uv_signal_init(d.loop, &d.sigterm);
     uv_signal_init(d.loop, &d.sigint);
@@ -102,6 +122,7 @@ done:
     }
     mbus_stop(d.mbus);
     metrics_stop(d.metrics);
+    tls_close(&d);
     snap_free(d.snap);
     uv_loop_close(d.loop);
     store_close(d.store);

@@ -3,7 +3,10 @@
  *
  *   conf.c   conf_   options from the command line and a `key = value` file
  *   dlog.c   dlog_   leveled log lines on stderr
- *   auth.c   auth_   tokens file (TCP) and peer credentials (Unix socket)
+ *   auth.c   auth_   tokens file (TCP, hashed) and peer credentials (Unix socket)
+ *   throttle.c throttle_ failed logins per address: growing waits
+ *   fds.c    fds_    the descriptor budget: free, reserved, the TCP floor
+ *   token.c  token_  `meshcorrd token new|hash`
  *   store.c  store_  SQLite job rows (WAL) and spool directories: durability
  *   wlock.c  wlock_  a job's worker lock: two workers of one job never run
  *   sched.c  sched_  which pending job runs next (priority, fairness, age)
@@ -14,6 +17,7 @@
  *   bk_prog.c        progress connections from workers on Slurm nodes
  *   bk_cmd.c         external commands run without blocking the loop
  *   srv.c    srv_    libuv loop, listeners, connections, bounded buffers
+ *   tls.c    tls_    GnuTLS credentials and one session per tls: connection
  *   req.c    req_    one handler per request type, WATCH fan-out
  *   snap.c   snap_   the status snapshot: STATS and the dashboards read it
  *   dash.c   dash_   listening sockets of the dashboard servers
@@ -22,6 +26,7 @@
  *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
  *   drain.c  drain_  SIGTERM/SIGINT: the graceful shutdown
  *   reload.c reload_ SIGHUP: options and tokens read again
+ *   priv.c   priv_   started as root: bind, then run as --user for good
  *   main.c          main(): wires the above together
  *
  * The DESIGN rule every module keeps: an acknowledged job is never lost.
@@ -56,14 +61,28 @@
 #define CONF_KILL_GRACE_S 5                  /* SIGTERM -> SIGKILL */
 #define CONF_DEFAULT_SLURM_MAX_JOBS 100
 #define CONF_DEFAULT_SLURM_POLL_MS 5000
+/* --worker-memory-mb not given: CONF_WORKER_MEMORY_SHARE of the physical
+ * memory split between the slots, at least CONF_WORKER_MEMORY_MIN_MB
+ * (conf_worker_memory_mb); 0 given: no limit */
+#define CONF_WORKER_MEMORY_AUTO 0xFFFFFFFFu
+#define CONF_WORKER_MEMORY_SHARE 0.75
+#define CONF_WORKER_MEMORY_MIN_MB 1024
 /* Connections (srv.c): caps, timeouts, and the descriptors kept free. */
 #define CONF_DEFAULT_MAX_CONNECTIONS 512          /* client connections in all */
 #define CONF_DEFAULT_MAX_CONNECTIONS_PER_USER 64  /* sessions of one user (admins exempt) */
-#define CONF_DEFAULT_MAX_UNAUTHENTICATED 64       /* connections that have not done HELLO */
+#define CONF_DEFAULT_MAX_UNAUTHENTICATED 64       /* TCP connections that have not done HELLO */
+#define CONF_DEFAULT_MAX_UNAUTH_PER_ADDRESS 8     /* of them from one address (IPv6: one /64) or local uid */
+#define CONF_DEFAULT_ADMIN_RESERVE 32             /* descriptors beyond fd-reserve for Unix and admins */
 #define CONF_DEFAULT_HELLO_TIMEOUT_S 10           /* accept -> HELLO done */
 #define CONF_DEFAULT_REQUEST_TIMEOUT_S 300        /* first byte of a frame -> its last */
 #define CONF_DEFAULT_IDLE_TIMEOUT_S 600           /* a session with nothing going on */
 #define CONF_DEFAULT_MAX_REQUEST_MEMORY (1u << 30) /* bytes of request frames being received, all clients */
+/* Fair limits per user (req.c, srv.c admit): stored bytes, the spool, watches, RESULTs. */
+#define CONF_DEFAULT_MAX_BYTES_PER_USER (2ll << 30)  /* spool bytes of one user's jobs and results */
+#define CONF_SPOOL_SHARE_PERCENT 80               /* --max-spool-bytes 0: this much of the state file system */
+#define CONF_DEFAULT_MAX_WATCHES_PER_SESSION 64   /* live WATCHes of one connection */
+#define CONF_DEFAULT_MAX_RESULT_SENDS 16          /* RESULT replies being read or sent, all clients */
+#define CONF_DEFAULT_MAX_RESULT_SENDS_PER_USER 4  /* ... of one user */
 #define CONF_FD_RESERVE_BASE 32                   /* --fd-reserve 0: this many ... */
 #define CONF_FD_RESERVE_PER_SLOT 4                /* ... plus this many per backend slot */
 
@@ -75,8 +94,11 @@ typedef struct conf_endpoint {
 } conf_endpoint;
 
 typedef struct mcd_conf {
-    char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH" or "tcp:HOST:PORT" */
+    char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH", "tcp:HOST:PORT" or "tls:HOST:PORT" */
     int nlisten;
+    char tls_cert[CONF_PATH];     /* PEM certificate chain of tls: listeners and --metrics; "" = none */
+    char tls_key[CONF_PATH];      /* its private key */
+    int insecure_tcp;             /* a tcp: listener may bind a non-loopback address */
     char state_dir[CONF_PATH];
     char tokens[CONF_PATH];       /* "" = no TCP users */
     char worker[CONF_PATH];       /* "" = meshcorr-worker next to meshcorrd */
@@ -84,13 +106,21 @@ typedef struct mcd_conf {
     char port_file[CONF_PATH];    /* "" = none; else bound TCP addresses, one a line */
     int workers;                  /* worker slots (>= 1) */
     int threads_per_worker;       /* 0 = the worker's default */
-    uint32_t worker_memory_mb;    /* address-space limit per worker; 0 = none */
+    uint32_t worker_memory_mb;    /* address-space limit per worker; 0 = none;
+                                     CONF_WORKER_MEMORY_AUTO = not given */
+    char user[CONF_PATH];         /* --user: run as this user once bound ("" = as started) */
     uint32_t max_frame, max_vertices, max_landmarks;
     uint32_t max_jobs_per_user, max_queue;
     uint32_t job_timeout_s, result_ttl_s;
     uint32_t max_output;          /* output bytes queued per connection */
     uint32_t max_request_memory;  /* bytes of frames being received, all connections */
+    uint32_t max_request_memory_per_user; /* ... of one user's connections; 0 = a quarter of the above */
+    long max_bytes_per_user;      /* spool bytes of one user's jobs (their rows' bytes summed) */
+    long max_spool_bytes;         /* spool bytes of all jobs; 0 = CONF_SPOOL_SHARE_PERCENT of the file system */
+    uint32_t max_watches_per_session; /* live WATCHes of one connection */
+    uint32_t max_result_sends, max_result_sends_per_user; /* RESULTs read or sent at once */
     uint32_t max_connections, max_connections_per_user, max_unauthenticated;
+    uint32_t max_unauth_per_address, admin_reserve;
     uint32_t hello_timeout_s, request_timeout_s, idle_timeout_s;   /* 0 = none */
     uint32_t fd_reserve;          /* descriptors kept free under RLIMIT_NOFILE; 0 = automatic */
     long admin_uid;               /* Unix-socket uid treated as admin; -1 none (root always) */
@@ -127,9 +157,38 @@ const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz);
 const char *conf_validator_path(const mcd_conf *c, char *buf, size_t sz);
 /* The worker's --max-faces for the configured --max-vertices. */
 unsigned long long conf_max_faces(const mcd_conf *c);
+/* The workers' address-space limit in MB, 0 = none: --worker-memory-mb, or
+ * when not given CONF_WORKER_MEMORY_SHARE of the physical memory over
+ * nslots, at least CONF_WORKER_MEMORY_MIN_MB. */
+uint32_t conf_worker_memory_mb(const mcd_conf *c, int nslots);
 /* SIGHUP: appends ", name" (or "name" first) to changed when the option
  * differs (a subsystem naming what it applies only at start). */
 void conf_note_change(int differs, const char *name, char *changed, size_t sz);
+/* A file option's path with a leading ${CREDENTIALS_DIRECTORY} replaced by
+ * that variable (systemd's LoadCredential=), into out: 0, or -1 with err
+ * naming the option (what) when the variable is unset or the path too long. */
+int conf_credential_path(const char *what, const char *path, char *out, size_t sz, char *err, size_t errsz);
+
+/* ---- priv_ ---------------------------------------------------------------- */
+/* The --user meshcorrd drops to when started as root (priv.c). */
+typedef struct priv_user {
+    int active;                   /* 0: not root, nothing to drop */
+    uid_t uid;
+    gid_t gid;
+    char name[256];
+} priv_user;
+/* Resolves --user; refuses root without it, root as --user, and another
+ * user's name when not started as root. 0 or -1 with the reason in err. */
+int priv_init(const mcd_conf *c, priv_user *u, char *err, size_t errsz);
+/* Makes state_dir USER's (created, or an empty one taken over; a used one
+ * of another owner is refused) and USER the effective user, root staying
+ * the real one: the store is opened and the backend set up as USER. */
+int priv_become(const priv_user *u, const char *state_dir, char *err, size_t errsz);
+/* Root effective again, to bind the listeners. */
+int priv_bind_begin(const priv_user *u, char *err, size_t errsz);
+/* USER for good (groups, gid, uid; root cannot be regained, checked). */
+int priv_drop(const priv_user *u, char *err, size_t errsz);
+void priv_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 
 /* ---- dlog_ ---------------------------------------------------------------- */
 enum { DLOG_ERROR, DLOG_WARN, DLOG_INFO, DLOG_DEBUG };
@@ -138,15 +197,65 @@ void dlog(int level, const char *fmt, ...) __attribute__((format(printf, 2, 3)))
 
 /* ---- auth_ ---------------------------------------------------------------- */
 #define AUTH_MAX_USER 256
+#define AUTH_MAX_LINE 1023            /* bytes of one tokens-file line, newline excluded */
+#define AUTH_HASH_LEN 32              /* SHA-256 */
+#define AUTH_TOKEN_PREFIX "mc_"       /* the tokens `meshcorrd token new` makes */
+#define AUTH_NEW_TOKEN_BYTES 24       /* their randomness (getrandom): 192 bits */
+#define AUTH_NEW_TOKEN_LEN (3 + 4 * AUTH_NEW_TOKEN_BYTES / 3)   /* prefix and base64url */
 typedef struct auth_tokens auth_tokens;
-/* Lines `token user [admin]`; '#' comments. A missing path gives an empty table. */
+/* Lines `sha256:HEX user [admin]`; '#' comments. The path may start with
+ * ${CREDENTIALS_DIRECTORY}; without one, $CREDENTIALS_DIRECTORY/tokens if it
+ * exists, else an empty table. Refuses a file not owned by the daemon's
+ * user or root, writable by group or others, readable by others, and any
+ * line that is not exactly that form (over AUTH_MAX_LINE, a NUL, a
+ * plaintext token, a token twice), naming the file and line. */
 int auth_tokens_load(const char *path, auth_tokens **out, char *err, size_t errsz);
 void auth_tokens_free(auth_tokens *t);
-/* 0 and the user for a known token, -1 otherwise. */
-int auth_token_user(const auth_tokens *t, const char *token, char user[AUTH_MAX_USER], int *admin);
+int auth_tokens_count(const auth_tokens *t);
+const char *auth_tokens_path(const auth_tokens *t);   /* the file read, "" none */
+/* SHA-256 of a token: 0, or -1. */
+int auth_token_hash(const char *token, uint8_t out[AUTH_HASH_LEN]);
+void auth_hash_hex(const uint8_t h[AUTH_HASH_LEN], char hex[2 * AUTH_HASH_LEN + 1]);
+/* 0 and the user for a known token's hash, -1 otherwise. */
+int auth_token_user(const auth_tokens *t, const uint8_t hash[AUTH_HASH_LEN], char user[AUTH_MAX_USER],
+                    int *admin);
+/* A user name the tokens file may hold: 0, or -1 with why. */
+int auth_user_ok(const char *user, char *err, size_t errsz);
+/* A new random token (AUTH_TOKEN_PREFIX, AUTH_NEW_TOKEN_BYTES from getrandom). */
+int auth_token_new(char tok[AUTH_NEW_TOKEN_LEN + 1], char *err, size_t errsz);
+/* The Unix-socket peer's uid from SO_PEERCRED; root and admin_uid are admin. 0 or -1. */
+int auth_peer_uid(int fd, long admin_uid, unsigned long *uid, int *admin);
 /* The Unix-socket peer's user from SO_PEERCRED; root and admin_uid are admin. */
 int auth_peer_user(int fd, long admin_uid, char user[AUTH_MAX_USER], int *admin,
                    char *err, size_t errsz);
+
+/* ---- throttle_: failed logins per address (throttle.c) ---------------------- */
+#define THROTTLE_FREE_FAILS 5         /* failed HELLOs an address may make in a row, */
+#define THROTTLE_REFILL_S 12          /* one more for every this many quiet seconds; */
+#define THROTTLE_BASE_BLOCK_S 2       /* then its HELLOs are refused this long, doubling */
+#define THROTTLE_MAX_BLOCK_S 600      /* with each further failure up to this */
+#define THROTTLE_LOG_PERIOD_S 10      /* at most one line per address in this time */
+#define THROTTLE_MAX_ADDRS 4096       /* addresses followed at once; the quietest go first */
+/* Loop thread, now_ms: the loop's clock. 0 when peer may try a token now;
+ * else the seconds it must wait (the HELLO is refused unchecked, counted). */
+uint32_t throttle_check(const char *peer, uint64_t now_ms);
+/* A HELLO from peer failed (why: "unknown token"): counted, and logged
+ * with the address at once for the first of a burst, then summed up. */
+void throttle_fail(const char *peer, const char *client, const char *why, uint64_t now_ms);
+/* Writes the sums of bursts due and forgets addresses gone quiet. */
+void throttle_sweep(uint64_t now_ms);
+
+/* ---- fds_: the descriptor budget (fds.c) ------------------------------------ */
+/* Descriptors still free under the soft RLIMIT_NOFILE (INT32_MAX when that
+ * cannot be told, 0 when none). */
+long fds_free(void);
+/* Kept for the workers, the database and the spool (--fd-reserve, or 32 +
+ * 4 per slot of the backend's nslots). */
+long fds_reserve(const mcd_conf *c, int nslots);
+/* Below this many free descriptors no TCP client (nor Slurm progress
+ * connection) is taken: the reserve plus --admin-reserve, kept for the Unix
+ * socket and admin sessions. */
+long fds_tcp_floor(const mcd_conf *c, int nslots);
 
 /* ---- store_ --------------------------------------------------------------- */
 typedef struct store store;
@@ -182,7 +291,8 @@ void store_close(store *s);
  * (found by its job's worker lock, wlock_), an unfinished local job whose
  * worker had written a valid result.frame is COMPLETED with it (adopted, not
  * run again), other RUNNING jobs go back to PENDING, spool dirs without a
- * row are removed, unfinished rows without job.frame become FAILED.
+ * row are removed, unfinished rows without job.frame become FAILED, and
+ * ended jobs that did not complete lose a job.frame left behind.
  * Unfinished jobs with a Slurm job id are left as they are with keep_slurm
  * (the Slurm backend re-attaches), else they go back to PENDING too. */
 int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
@@ -194,7 +304,9 @@ int store_submit(store *s, const char *user, const char *label, int32_t priority
                  uint64_t *id, char *err, size_t errsz);
 int store_get(store *s, uint64_t id, store_job *out);  /* 0, PROTO_ENOT_FOUND, or error */
 int store_set_running(store *s, uint64_t id, int64_t start_ms, long pid);
-/* PENDING clears the run's times; a terminal state sets end_ms and counts it. */
+/* PENDING clears the run's times; a terminal state sets end_ms and counts
+ * it, and, for any end but COMPLETED, removes job.frame once committed (the
+ * row and its reason stay until expiry; such a job has no RESULT). */
 int store_set_state(store *s, uint64_t id, int state, const char *reason);
 int store_add_progress(store *s, uint64_t id, const proto_progress *p);
 /* The Slurm job running it ("" none) and how much of progress.frames is read. */
@@ -229,6 +341,11 @@ int store_each_slurm(store *s, store_job_fn fn, void *ctx);
 /* Terminal jobs that ended before before_ms. */
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx);
 int store_delete(store *s, uint64_t id);
+/* Bytes the spool holds for user's jobs (NULL: everyone's): the sum of the
+ * rows' byte counts, which store_ keeps as each job's counted files
+ * (job.frame, result.frame, error.frame, progress files) change: the
+ * frame at submit, the run's files at its end or re-run. 0 or error. */
+int store_bytes(store *s, const char *user, int64_t *bytes);
 void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *cancelled);
 /* <dir>/spool/<id>[/file] into buf. */
 const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz);
@@ -335,9 +452,62 @@ void mbus_fill(const mcd_snapshot *s, uint16_t *regs);
 int mbus_start(const conf_endpoint *e, snap *s, mbus **out, char *err, size_t errsz);
 void mbus_stop(mbus *m);          /* joins the thread; NULL ok */
 
+/* ---- tls_ ----------------------------------------------------------------- */
+/* TLS 1.2 at least, 1.3 preferred; no renegotiation (tls.c). */
+#define TLS_PRIORITY "NORMAL:-VERS-ALL:+VERS-TLS1.3:+VERS-TLS1.2"
+#define TLS_MAX_FILE (1u << 20)   /* bytes of a --tls-cert or --tls-key file */
+#define TLS_MAX_INPUT (1u << 20)  /* ciphertext fed to a session and not yet taken */
+typedef struct tls_creds tls_creds;
+typedef struct tls_conn tls_conn;
+/* Start: checks that every tls: listener has --tls-cert and --tls-key and
+ * reads them into d->tls (NULL without them). 0, or -1 with err naming the
+ * option and the file. */
+int tls_init(mcd *d, char *err, size_t errsz);
+/* SIGHUP: the files read again; a pair that loads serves the connections
+ * accepted from now on (1), one that does not keeps the running pair and
+ * is logged (0, as when TLS is off). */
+int tls_reload(mcd *d);
+void tls_close(mcd *d);           /* drops d->tls; live sessions keep theirs */
+/* SIGHUP: turning TLS on or off and --insecure-tcp wait for the next start. */
+void tls_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
+/* The certificate chain and key as PEM text (libmicrohttpd takes them so),
+ * owned by t. */
+const char *tls_creds_cert_pem(const tls_creds *t);
+const char *tls_creds_key_pem(const tls_creds *t);
+/* A session's records go out through push(ctx, bytes, len): 0, or -1 when
+ * they cannot be queued. */
+typedef int (*tls_push_fn)(void *ctx, const void *data, size_t len);
+/* A server session on creds (a reference is held until tls_conn_free);
+ * peer names the client in log lines. 0 or -1. */
+int tls_conn_new(tls_creds *creds, const char *peer, tls_push_fn push, void *ctx, tls_conn **out);
+void tls_conn_free(tls_conn *t);  /* NULL ok */
+const char *tls_conn_peer(const tls_conn *t);
+int tls_conn_ready(const tls_conn *t);    /* 1 once the handshake is done */
+/* Ciphertext from the peer, kept until the calls below take it; more than
+ * TLS_MAX_INPUT waiting is an error. 0 or -1 with msg. */
+int tls_conn_feed(tls_conn *t, const void *data, size_t len, char *msg, size_t msgsz);
+/* Runs the handshake on what was fed: 1 done, 0 waiting for the peer, -1
+ * failed (the reason in msg; an alert is pushed for the peer). */
+int tls_conn_handshake(tls_conn *t, char *msg, size_t msgsz);
+/* Appends the plaintext of every whole record fed to out: 0, 1 when the
+ * peer closed the session (close_notify), -1 on an error (msg; a
+ * renegotiation request is one). */
+int tls_conn_read(tls_conn *t, proto_buf *out, char *msg, size_t msgsz);
+/* Seals len bytes into records pushed out: 0 or -1 with msg. */
+int tls_conn_write(tls_conn *t, const void *data, size_t len, char *msg, size_t msgsz);
+/* Pushes close_notify once; 1 when it did, 0 when not (before the
+ * handshake, or already sent). */
+int tls_conn_bye(tls_conn *t);
+/* "TLS1.3 AES-256-GCM" of a ready session into buf. */
+const char *tls_conn_desc(const tls_conn *t, char *buf, size_t sz);
+
 /* ---- metrics_ ------------------------------------------------------------- */
 typedef struct metrics metrics;
-int metrics_start(const conf_endpoint *e, snap *s, metrics **out, char *err, size_t errsz);
+/* Serves HTTPS with tls's certificate and key when tls is not NULL. */
+int metrics_start(const conf_endpoint *e, const tls_creds *tls, snap *s, metrics **out, char *err, size_t errsz);
+/* SIGHUP: new connections get tls's certificate (the listening socket
+ * stays); 0, or -1 with err (the running one goes on). */
+int metrics_set_tls(metrics *m, const tls_creds *tls, char *err, size_t errsz);
 void metrics_stop(metrics *m);    /* NULL ok */
 
 /* ---- the daemon ------------------------------------------------------------ */
@@ -368,6 +538,7 @@ struct mcd {
     snap *snap;                   /* the status snapshot */
     mbus *mbus;                   /* NULL unless --modbus */
     metrics *metrics;             /* NULL unless --metrics */
+    tls_creds *tls;               /* NULL unless --tls-cert and --tls-key */
     const bk_ops *bk;             /* the backend (backend.h) */
     int argc;                     /* the command line, parsed again on SIGHUP */
     char **argv;
@@ -427,6 +598,10 @@ void notify_reloaded(void);
 void notify_stopping(mcd *d);
 void notify_close(mcd *d);        /* stops the STATUS= timer */
 
+/* ---- token_: `meshcorrd token new|hash` (token.c) ------------------------- */
+/* argv[0] is "token"; the exit status. */
+int token_main(int argc, char **argv);
+
 /* ---- reload_ -------------------------------------------------------------- */
 void reload_init(mcd *d, int argc, char **argv);  /* SIGHUP handler */
 void reload_close(mcd *d);
@@ -439,6 +614,7 @@ typedef struct val_conf {         /* a copy taken on the loop, for the thread po
     unsigned max_vertices;
     unsigned long long max_faces;
     unsigned max_memory_mb, max_cpu_s;
+    unsigned worker_memory_mb;    /* the worker's limit: a job estimated over it is refused; 0 none */
 } val_conf;
 void val_conf_of(const mcd *d, val_conf *vc);
 /* Runs meshcorr-validate on the SUBMIT frame[len] and waits for
@@ -467,9 +643,14 @@ void srv_close(conn *c);
 void srv_close_soon(conn *c);
 
 /* What req_ needs to know about a connection. */
+#define SRV_MAX_PEER 64
 typedef struct conn_auth {
     int authed, admin, is_unix;
     char user[AUTH_MAX_USER];
+    char peer[SRV_MAX_PEER];      /* who connects, for logs and the per-address caps: "127.0.0.1",
+                                   * "2001:db8:1:2::/64" (IPv6 by /64), "uid 1000" (Unix socket) */
+    int by_token;                 /* logged in with a token: its hash follows (SIGHUP checks it) */
+    uint8_t token_hash[AUTH_HASH_LEN];
 } conn_auth;
 conn_auth *srv_conn_auth(conn *c);
 mcd *srv_conn_daemon(conn *c);
@@ -482,9 +663,17 @@ void srv_conn_hold(conn *c);
 void srv_conn_release(conn *c);
 int srv_conn_open(const conn *c);     /* not closed or closing: replies can go out */
 /* HELLO, once the user is known and before HELLO_OK: 0 when the session
- * may go on, else PROTO_EBUSY with the reason in msg (logged here): the
- * user already has --max-connections-per-user sessions (admins never do). */
+ * may go on, else PROTO_EBUSY with the reason in msg (logged here): non-admin
+ * sessions are at --max-connections, or the user already has
+ * --max-connections-per-user (admins are never refused either way). */
 int srv_conn_admit_user(conn *c, char *msg, size_t msgsz);
+/* fn(c, ctx) for every open session (after HELLO); fn may end it. */
+void srv_each_session(mcd *d, void (*fn)(conn *c, void *ctx), void *ctx);
+/* Ends a session from the server's side: ERROR code (request id 0) with
+ * why, a warning naming the connection and user, and a close. */
+void srv_end_session(conn *c, int code, const char *why);
+/* With a TCP listener and no token, a warning: no TCP user can log in. */
+void srv_note_tokens(mcd *d);
 /* Closed, or the client has hung up (EOF or an error waits on the socket). */
 int srv_conn_hung_up(conn *c);
 
@@ -498,7 +687,8 @@ void req_init(mcd *d);                                /* listens to job.c for th
 /* A drain: idle(d) is called each time one of the requests in the thread
  * pool (d->work_inflight) finishes from now on. */
 void req_quiesce(mcd *d, mcd_idle_fn idle);
-void req_conn_closed(mcd *d, conn *c);                /* forget its watches */
+void req_conn_closed(mcd *d, conn *c);                /* forget its watches and RESULTs */
+void req_conn_sent(mcd *d, conn *c);                  /* c's output is written whole: its RESULTs end */
 int req_conn_watching(const mcd *d, const conn *c);   /* 1: a WATCH of c is live */
 
 #endif

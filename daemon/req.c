@@ -7,8 +7,15 @@
  * DESIGN: visibility — a non-admin session sees only its user's jobs, and
  * any other job is NOT_FOUND, exactly like a job that never existed, so ids
  * do not leak. SUBMIT answers SUBMIT_OK only after store_submit returned 0
- * (row committed, spool fsynced); QUEUE_FULL and USER_LIMIT refuse before
- * anything is stored, counting the SUBMITs still being checked or stored.
+ * (row committed, spool fsynced); QUEUE_FULL, USER_LIMIT and OVER_QUOTA
+ * refuse before anything is stored, counting the SUBMITs still being
+ * checked or stored, and so does FORBIDDEN for a user's priority above 0.
+ *
+ * DESIGN: fair limits per user (README, Quotas): stored bytes per user and
+ * in all (check_quota, from the store's per-job byte counts), live WATCHes
+ * per connection, RESULT replies in flight in all and per user (the
+ * RESULT section below); each refusal names the user, the figures and the
+ * option, and is logged.
  * Before the store, val_submit has a short-lived meshcorr-validate child
  * decode and check the meshes, the landmarks against
  * them, the maps and the parameters, so a job that can never run is refused
@@ -32,11 +39,14 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #define REQ_LIST_PAGE 1000
+#define REQ_REFUSAL_LOG_MS 1000   /* a flood of one kind of refusal logs one line per this */
 
 struct req_watch {
     conn *c;                      /* NULL once the connection is gone */
@@ -66,12 +76,15 @@ static void prune(mcd *d)
     }
 }
 
+static void results_end(mcd *d, conn *c, int closing);
+
 void req_conn_closed(mcd *d, conn *c)
 {
     for (req_watch *w = d->watches; w; w = w->next)
         if (w->c == c)
             w->c = NULL;
     prune(d);
+    results_end(d, c, 1);
 }
 
 int req_conn_watching(const mcd *d, const conn *c)
@@ -111,6 +124,11 @@ static int visible_job(conn *c, uint32_t rid, uint64_t id, store_job *j)
     return -1;
 }
 
+/* HELLO: the Unix socket's peer credentials, or a token, whose SHA-256 is
+ * looked up (the plaintext is wiped from the request at once). An address
+ * that failed too often is refused without a look at its token
+ * (throttle.c); every failure is counted there and logged with the
+ * address. */
 static void on_hello(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -122,12 +140,31 @@ static void on_hello(conn *c, const proto_msg *m)
         return;
     }
     int rc;
-    if (a->is_unix && h->token[0] == '\0')
+    uint64_t now = uv_now(d->loop);
+    if (a->is_unix && h->token[0] == '\0') {
         rc = auth_peer_user(srv_conn_fd(c), d->conf.admin_uid, a->user, &a->admin, err, sizeof err);
-    else if ((rc = auth_token_user(d->tokens, h->token, a->user, &a->admin)) != 0)
-        snprintf(err, sizeof err, "unknown token");
+        if (rc)
+            dlog(DLOG_WARN, "HELLO from %s refused: %s (client '%s')", a->peer, err, h->client);
+    } else {
+        uint32_t wait = throttle_check(a->peer, now);
+        if (wait) {
+            explicit_bzero((char *)h->token, strlen(h->token));
+            srv_send_error(c, m->request_id, PROTO_EBUSY, "too many failed logins from %s: retry in %u s",
+                           a->peer, wait);
+            srv_close_soon(c);
+            return;
+        }
+        int given = h->token[0] != '\0';
+        rc = auth_token_hash(h->token, a->token_hash);
+        explicit_bzero((char *)h->token, strlen(h->token));
+        if (rc == 0 && (rc = auth_token_user(d->tokens, a->token_hash, a->user, &a->admin)) == 0) {
+            a->by_token = 1;
+        } else {
+            snprintf(err, sizeof err, "%s", given ? "unknown token" : "no token");
+            throttle_fail(a->peer, h->client, err, now);
+        }
+    }
     if (rc) {
-        dlog(DLOG_WARN, "HELLO from client '%s' refused: %s", h->client, err);
         srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "authentication failed: %s", err);
         srv_close_soon(c);
         return;
@@ -138,8 +175,8 @@ static void on_hello(conn *c, const proto_msg *m)
         return;
     }
     a->authed = 1;
-    dlog(DLOG_INFO, "session: user %s%s, client '%s' (protocol %u)", a->user, a->admin ? " (admin)" : "",
-         h->client, h->version);
+    dlog(DLOG_INFO, "session: user %s%s from %s, client '%s' (protocol %u)", a->user, a->admin ? " (admin)" : "",
+         a->peer, h->client, h->version);
     proto_msg r;
     memset(&r, 0, sizeof r);
     r.type = PROTO_MSG_HELLO_OK;
@@ -227,6 +264,56 @@ static uint32_t submits_in_flight(const mcd *d, const char *user)
     return n;
 }
 
+/* Frame bytes of the SUBMITs of user (NULL: of everyone) still being stored. */
+static int64_t submit_bytes_in_flight(const mcd *d, const char *user)
+{
+    int64_t n = 0;
+    for (const req_submit *s = d->submits; s; s = s->next)
+        if (!user || strcmp(s->user, user) == 0)
+            n += (int64_t)s->len;
+    return n;
+}
+
+/* The spool's cap: --max-spool-bytes, or CONF_SPOOL_SHARE_PERCENT of the
+ * state file system's size (what stands there besides the spool is the
+ * operator's); 0 when neither can be had. how (for the message) says which. */
+static int64_t spool_cap(const mcd *d, char *how, size_t hsz)
+{
+    struct statvfs v;
+    how[0] = '\0';
+    if (d->conf.max_spool_bytes)
+        return d->conf.max_spool_bytes;
+    if (statvfs(d->conf.state_dir, &v) != 0)
+        return 0;
+    snprintf(how, hsz, " (%d %% of the state file system)", CONF_SPOOL_SHARE_PERCENT);
+    return (int64_t)((double)v.f_blocks * (double)v.f_frsize * CONF_SPOOL_SHARE_PERCENT / 100);
+}
+
+/* The byte quotas of a SUBMIT of len bytes by user: the user's stored bytes
+ * (jobs and results in the spool, and SUBMITs being stored) under
+ * --max-bytes-per-user, and everyone's under the spool's cap. 0, or
+ * PROTO_EOVER_QUOTA (PROTO_ESTORAGE when the store cannot count) with the
+ * message in msg. */
+static int check_quota(const mcd *d, const char *user, size_t len, char *msg, size_t msz)
+{
+    int64_t mine, all;
+    if (store_bytes(d->store, user, &mine) || store_bytes(d->store, NULL, &all))
+        return snprintf(msg, msz, "job store failure counting the spool's bytes; nothing stored"), PROTO_ESTORAGE;
+    mine += submit_bytes_in_flight(d, user);
+    all += submit_bytes_in_flight(d, NULL);
+    if (mine + (int64_t)len > d->conf.max_bytes_per_user)
+        return snprintf(msg, msz, "over quota: user %s stores %lld bytes of jobs and results, and this %zu-byte"
+                        " SUBMIT would pass --max-bytes-per-user %ld; delete finished jobs to make room",
+                        user, (long long)mine, len, d->conf.max_bytes_per_user), PROTO_EOVER_QUOTA;
+    char how[64];
+    int64_t cap = spool_cap(d, how, sizeof how);
+    if (cap && all + (int64_t)len > cap)
+        return snprintf(msg, msz, "over quota: the spool holds %lld bytes of jobs and results, and this %zu-byte"
+                        " SUBMIT would pass --max-spool-bytes %lld%s; retry once jobs are deleted or expire",
+                        (long long)all, len, (long long)cap, how), PROTO_EOVER_QUOTA;
+    return 0;
+}
+
 static void submit_run(uv_work_t *w)      /* thread pool */
 {
     req_submit *s = w->data;
@@ -236,6 +323,27 @@ static void submit_run(uv_work_t *w)      /* thread pool */
     }
     s->rc = store_submit(s->store, s->user, s->label, s->priority, s->total, s->params, s->frame, s->len,
                          &s->id, s->msg, sizeof s->msg);
+}
+
+/* msg for a client: the server's own paths (a word that starts with '/'
+ * or with the state directory, up to a ':' or blank) become "<path>".
+ * The log keeps the whole message. */
+static const char *without_paths(const mcd *d, const char *msg, char *out, size_t sz)
+{
+    const char *dir = d->conf.state_dir;
+    size_t dl = strlen(dir), o = 0;
+    for (const char *p = msg; *p && o + 8 < sz;) {
+        int word_start = p == msg || p[-1] == ' ' || p[-1] == '(' || p[-1] == '\'';
+        if (word_start && (*p == '/' || (dl && strncmp(p, dir, dl) == 0))) {
+            p += strcspn(p, ": ),'");
+            memcpy(out + o, "<path>", 6);
+            o += 6;
+        } else {
+            out[o++] = *p++;
+        }
+    }
+    out[o] = '\0';
+    return out;
 }
 
 static void submit_done(uv_work_t *w, int status)    /* loop */
@@ -252,13 +360,14 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
         s->rc = PROTO_EINTERNAL;
         snprintf(s->msg, sizeof s->msg, "the store's work was not run: %s", uv_strerror(status));
     }
+    char shown[sizeof s->msg];           /* a STORAGE message without the server's paths */
     if (s->refused) {
         dlog(s->rc == PROTO_EINTERNAL ? DLOG_ERROR : DLOG_INFO, "SUBMIT from %s refused (%s, checked in %.1f ms, %.1f ms CPU): %s",
              s->user, proto_err_name(s->rc), s->val_ms, s->val_cpu_ms, s->msg);
         srv_send_error(c, s->request_id, s->rc, "%s", s->msg);
     } else if (s->rc) {
         dlog(DLOG_ERROR, "SUBMIT from %s: %s", s->user, s->msg);
-        srv_send_error(c, s->request_id, s->rc, "job not stored: %s", s->msg);
+        srv_send_error(c, s->request_id, s->rc, "job not stored: %s", without_paths(d, s->msg, shown, sizeof shown));
     } else {
         unsigned long long id = (unsigned long long)s->id;
         store_job j;
@@ -295,6 +404,15 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
         srv_send_error(c, m->request_id, rc, "%s", msg);
         return;
     }
+    /* users may lower their priority, never raise it over others': the
+     * fair share holds among equal priorities (a stated priority is kept
+     * as stated or refused, never changed quietly) */
+    if (s->priority > 0 && !a->admin) {
+        dlog(DLOG_WARN, "SUBMIT from %s refused (FORBIDDEN): priority %d", a->user, s->priority);
+        srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "priority = %d: user %s may only lower a job's priority"
+                       " (priority <= 0); only an admin may raise it above 0", s->priority, a->user);
+        return;
+    }
     /* jobs still being stored count as pending: they will be */
     uint32_t mine = sched_user_pending(d->sched, a->user) + sched_user_running(d->sched, a->user) +
                     submits_in_flight(d, a->user);
@@ -307,6 +425,12 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     if (pending >= d->conf.max_queue) {
         srv_send_error(c, m->request_id, PROTO_EQUEUE_FULL, "queue full: %u jobs pending (limit %u); nothing stored",
                        pending, d->conf.max_queue);
+        return;
+    }
+    if ((rc = check_quota(d, a->user, len, msg, sizeof msg))) {
+        dlog(rc == PROTO_EOVER_QUOTA ? DLOG_WARN : DLOG_ERROR, "SUBMIT from %s refused (%s): %s", a->user,
+             proto_err_name(rc), msg);
+        srv_send_error(c, m->request_id, rc, "%s", msg);
         return;
     }
     req_submit *w = calloc(1, sizeof *w);
@@ -406,9 +530,16 @@ static void on_list(conn *c, const proto_msg *m)
     mcd *d = srv_conn_daemon(c);
     conn_auth *a = srv_conn_auth(c);
     const proto_list *q = &m->u.list;
-    const char *user = q->user[0] ? q->user : a->user;
-    if (strcmp(user, a->user) != 0 && !a->admin) {
-        srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", user);
+    /* "" the caller's jobs; PROTO_LIST_ALL_USERS every user's (admin) */
+    int all = strcmp(q->user, PROTO_LIST_ALL_USERS) == 0;
+    const char *user = all ? NULL : q->user[0] ? q->user : a->user;
+    if ((all || strcmp(user, a->user) != 0) && !a->admin) {
+        dlog(DLOG_WARN, "%s: LIST of %s refused: not an admin", a->user, all ? "(every user)" : user);
+        if (all)
+            srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list every user's jobs (user \"%s\")",
+                           PROTO_LIST_ALL_USERS);
+        else
+            srv_send_error(c, m->request_id, PROTO_EFORBIDDEN, "only an admin may list the jobs of user %s", user);
         return;
     }
     uint32_t max = q->max_count ? q->max_count : REQ_LIST_PAGE;
@@ -481,6 +612,40 @@ static int send_end(conn *c, uint32_t rid, const store_job *j)
     return srv_send(c, &r, 1);
 }
 
+/* Live WATCHes of connection c. */
+static uint32_t watches_of(const mcd *d, const conn *c)
+{
+    uint32_t n = 0;
+    for (const req_watch *w = d->watches; w; w = w->next)
+        n += w->c == c;
+    return n;
+}
+
+/* A refusal's log line, at most one per REQ_REFUSAL_LOG_MS for each kind
+ * (a client looping on a refused request costs one line a second, with
+ * how many it stands for). */
+static void log_refusal(mcd *d, uint64_t *last_ms, unsigned long *held_back, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void log_refusal(mcd *d, uint64_t *last_ms, unsigned long *held_back, const char *fmt, ...)
+{
+    uint64_t now = uv_now(d->loop);
+    if (*last_ms && now - *last_ms < REQ_REFUSAL_LOG_MS) {
+        ++*held_back;
+        return;
+    }
+    char line[PROTO_MAX_STRING + 128];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (*held_back)
+        dlog(DLOG_WARN, "%s (and %lu more like it since the last line)", line, *held_back);
+    else
+        dlog(DLOG_WARN, "%s", line);
+    *last_ms = now;
+    *held_back = 0;
+}
+
 static void on_watch(conn *c, const proto_msg *m)
 {
     mcd *d = srv_conn_daemon(c);
@@ -488,6 +653,21 @@ static void on_watch(conn *c, const proto_msg *m)
     store_job j;
     if (visible_job(c, m->request_id, w->job_id, &j))
         return;
+    /* each live WATCH costs the loop a visit per progress record of its
+     * job: a session holds a bounded number (a finished job's WATCH ends
+     * at once and is not counted) */
+    uint32_t live = store_is_terminal(j.state) ? 0 : watches_of(d, c);
+    if (live >= d->conf.max_watches_per_session) {
+        static uint64_t last_ms;
+        static unsigned long held_back;
+        log_refusal(d, &last_ms, &held_back, "WATCH from %s refused (OVER_LIMIT): %u live WATCHes on its"
+                    " connection (--max-watches-per-session %u)", srv_conn_auth(c)->user, live,
+                    d->conf.max_watches_per_session);
+        srv_send_error(c, m->request_id, PROTO_EOVER_LIMIT, "this connection has %u live WATCHes, the limit"
+                       " (--max-watches-per-session %u): watch fewer jobs per connection", live,
+                       d->conf.max_watches_per_session);
+        return;
+    }
     replay_ctx rc = {c, m->request_id, 0};
     if (store_history(d->store, j.id, w->from_outer, replay_one, &rc)) {
         srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure reading the history of job %llu",
@@ -585,11 +765,28 @@ static void on_cancel(conn *c, const proto_msg *m)
     reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
 }
 
-/* A RESULT being read: result.frame is read and decoded in the thread pool. */
-typedef struct req_result {
+/* A RESULT: result.frame is read and decoded in the thread pool, the reply
+ * encoded onto the connection, and then it is written out.
+ *
+ * DESIGN: what RESULTs hold is bounded in all and per user, not per
+ * connection. A RESULT counts from the start of its read until its
+ * connection's output has been written whole (req_conn_sent) or the
+ * connection is gone; at most --max-result-sends count at once, and at
+ * most --max-result-sends-per-user of one user's. One that does not fit
+ * waits, in order of arrival, with its connection held (not read: its
+ * replies keep their order), and starts when a RESULT of a user with room
+ * ends; so clients that never read their replies hold at most those
+ * RESULTs' bytes, and other users' RESULTs go on. The decoded result is
+ * freed once the reply is encoded. */
+enum { RESULT_WAITING, RESULT_READING, RESULT_SENDING };
+typedef struct req_result req_result;
+struct req_result {
     uv_work_t work;
     mcd *d;                       /* loop side only */
-    conn *c;                      /* loop side only; held */
+    conn *c;                      /* loop side only; held until the read is done */
+    req_result *next;             /* results, in arrival order */
+    int phase;                    /* RESULT_* */
+    char user[AUTH_MAX_USER];     /* whose share it counts in */
     uint32_t request_id;
     uint64_t job_id;
     uint32_t what;                /* PROTO_WANT_* */
@@ -598,7 +795,27 @@ typedef struct req_result {
     proto_msg res;                /* the decoded RESULT_OK when rc is 0 */
     int rc;
     char err[256];
-} req_result;
+};
+
+static req_result *results;       /* every RESULT waiting, being read or being sent */
+
+static void result_unlink(req_result *r)
+{
+    for (req_result **p = &results; *p; p = &(*p)->next)
+        if (*p == r) {
+            *p = r->next;
+            return;
+        }
+}
+
+/* RESULTs being read or sent: of user, or of everyone (NULL). */
+static uint32_t results_active(const char *user)
+{
+    uint32_t n = 0;
+    for (const req_result *r = results; r; r = r->next)
+        n += r->phase != RESULT_WAITING && (!user || strcmp(r->user, user) == 0);
+    return n;
+}
 
 static void result_run(uv_work_t *w)      /* thread pool */
 {
@@ -606,9 +823,39 @@ static void result_run(uv_work_t *w)      /* thread pool */
     r->rc = store_result_read(r->store, r->job_id, &r->res, &r->buf, r->err, sizeof r->err);
 }
 
+static void result_done(uv_work_t *w, int status);
+
+/* Starts the waiting RESULTs that fit now, oldest first. The list is
+ * walked again from its head after each start: a start that fails
+ * answers, and that may close connections (req_conn_closed edits it). */
+static void results_start(mcd *d)
+{
+    for (;;) {
+        req_result *r = results;
+        while (r && (r->phase != RESULT_WAITING || results_active(r->user) >= d->conf.max_result_sends_per_user))
+            r = r->next;
+        if (!r || results_active(NULL) >= d->conf.max_result_sends)
+            return;
+        r->phase = RESULT_READING;
+        int rc = uv_queue_work(d->loop, &r->work, result_run, result_done);
+        if (rc == 0) {
+            d->work_inflight++;
+            continue;
+        }
+        dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)r->job_id,
+             uv_strerror(rc));
+        result_unlink(r);
+        srv_send_error(r->c, r->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
+                       (unsigned long long)r->job_id);
+        srv_conn_release(r->c);
+        free(r);
+    }
+}
+
 static void result_done(uv_work_t *w, int status)    /* loop */
 {
     req_result *r = w->data;
+    mcd *d = r->d;
     conn *c = r->c;
     unsigned long long id = (unsigned long long)r->job_id;
     if (status < 0) {                       /* never ran: res was never filled */
@@ -616,7 +863,7 @@ static void result_done(uv_work_t *w, int status)    /* loop */
         snprintf(r->err, sizeof r->err, "the read was not run: %s", uv_strerror(status));
     }
     store_job j;
-    if (r->rc && store_get(r->d->store, r->job_id, &j) == PROTO_ENOT_FOUND) {
+    if (r->rc && store_get(d->store, r->job_id, &j) == PROTO_ENOT_FOUND) {
         /* deleted (DELETE, expiry) while it was read */
         srv_send_error(c, r->request_id, PROTO_ENOT_FOUND, "no job %llu", id);
     } else if (r->rc) {
@@ -644,8 +891,18 @@ static void result_done(uv_work_t *w, int status)    /* loop */
     if (r->rc == 0)
         proto_msg_free(&r->res);
     free(r->buf);
-    work_end(r->d, c);
-    free(r);
+    r->buf = NULL;
+    /* the reply (or the error) is queued on c: it counts until it is
+     * written, unless c is gone already (req_conn_closed has passed) */
+    int sending = srv_conn_open(c);
+    if (sending) {
+        r->phase = RESULT_SENDING;
+    } else {
+        result_unlink(r);
+        free(r);
+    }
+    work_end(d, c);
+    results_start(d);
 }
 
 static void on_result(conn *c, const proto_msg *m)
@@ -668,18 +925,50 @@ static void on_result(conn *c, const proto_msg *m)
     r->work.data = r;
     r->d = d;
     r->c = c;
+    r->phase = RESULT_WAITING;
+    snprintf(r->user, sizeof r->user, "%s", srv_conn_auth(c)->user);
     r->request_id = m->request_id;
     r->job_id = j.id;
     r->what = q->what;
     r->store = d->store;
-    int rc = work_start(d, c, &r->work, result_run, result_done);
-    if (rc) {
-        dlog(DLOG_ERROR, "job %llu: cannot queue the read of its result: %s", (unsigned long long)j.id,
-             uv_strerror(rc));
-        srv_send_error(c, m->request_id, PROTO_EINTERNAL, "the result of job %llu cannot be read",
-                       (unsigned long long)j.id);
-        free(r);
+    req_result **tail = &results;
+    while (*tail)
+        tail = &(*tail)->next;
+    *tail = r;
+    srv_conn_hold(c);                  /* nothing more is read from c until its read is done */
+    uint32_t mine = results_active(r->user), all = results_active(NULL);
+    if (mine >= d->conf.max_result_sends_per_user || all >= d->conf.max_result_sends)
+        dlog(DLOG_INFO, "job %llu: RESULT for %s waits: %u RESULT(s) of %s and %u in all being sent"
+             " (--max-result-sends-per-user %u, --max-result-sends %u)", (unsigned long long)j.id, r->user,
+             mine, r->user, all, d->conf.max_result_sends_per_user, d->conf.max_result_sends);
+    results_start(d);
+}
+
+/* c's RESULTs end: those being sent, and with closing (c is going) those
+ * waiting too, their holds released; one being read ends in result_done.
+ * Then the waiting ones that fit start. */
+static void results_end(mcd *d, conn *c, int closing)
+{
+    int ended = 0;
+    for (req_result **p = &results; *p;) {
+        req_result *r = *p;
+        if (r->c == c && (r->phase == RESULT_SENDING || (closing && r->phase == RESULT_WAITING))) {
+            *p = r->next;
+            if (r->phase == RESULT_WAITING)
+                srv_conn_release(c);
+            free(r);
+            ended = 1;
+        } else {
+            p = &r->next;
+        }
     }
+    if (ended)
+        results_start(d);
+}
+
+void req_conn_sent(mcd *d, conn *c)
+{
+    results_end(d, c, 0);
 }
 
 static void on_delete(conn *c, const proto_msg *m)
@@ -700,6 +989,20 @@ static void on_delete(conn *c, const proto_msg *m)
     }
     dlog(DLOG_INFO, "job %llu: deleted by %s", (unsigned long long)j.id, srv_conn_auth(c)->user);
     reply_id(c, PROTO_MSG_OK, m->request_id, j.id);
+}
+
+/* A non-admin's STATS counts that user's ended jobs still in the store, not
+ * everyone's since the store was created. */
+static int count_ended(void *ctx, const store_job *j)
+{
+    proto_stats_ok *s = ctx;
+    if (j->state == PROTO_STATE_COMPLETED)
+        s->completed++;
+    else if (j->state == PROTO_STATE_CANCELLED)
+        s->cancelled++;
+    else if (store_is_terminal(j->state))
+        s->failed++;
+    return 0;
 }
 
 static void on_stats(conn *c, const proto_msg *m)
@@ -730,9 +1033,14 @@ static void on_stats(conn *c, const proto_msg *m)
     s->queued = a->admin ? now->queued : sched_user_pending(d->sched, a->user);
     s->running = a->admin ? now->running : running;
     s->workers = now->workers;
-    s->completed = now->completed;
-    s->failed = now->failed;
-    s->cancelled = now->cancelled;
+    if (a->admin) {
+        s->completed = now->completed;
+        s->failed = now->failed;
+        s->cancelled = now->cancelled;
+    } else if (store_list(d->store, a->user, 0, 0, UINT32_MAX, count_ended, s)) {
+        srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure counting your jobs");
+        goto done;
+    }
     s->slots = slots;
     s->nslots = nslots;
     char dev[64];
@@ -760,7 +1068,7 @@ void req_handle(conn *c, const proto_msg *m, const void *frame, size_t len)
 {
     conn_auth *a = srv_conn_auth(c);
     if (!a->authed && m->type != PROTO_MSG_HELLO) {
-        dlog(DLOG_WARN, "%s before HELLO: closing", proto_type_name(m->type));
+        dlog(DLOG_WARN, "%s before HELLO from %s: closing", proto_type_name(m->type), a->peer);
         srv_send_error(c, m->request_id, PROTO_EUNAUTHORIZED, "%s before HELLO", proto_type_name(m->type));
         srv_close_soon(c);
         return;

@@ -22,26 +22,52 @@
  * released, so an after-work callback may always look at it (srv_send to a
  * closed connection is a no-op).
  *
- * DESIGN: idle clients never cost an acknowledged job. A connection is
- * accepted only while more than the descriptor reserve (--fd-reserve) is
- * left under RLIMIT_NOFILE, so starting a worker (its pipes) always finds
- * descriptors, and only under --max-connections in all and
- * --max-unauthenticated before HELLO; HELLO adds --max-connections-per-user.
- * A refused client is told why (ERROR BUSY, request id 0), the refusal is
- * logged, and the connection lingers a moment (reading and dropping what
- * the client sends) so the ERROR is read rather than lost to a reset. A
- * timer cuts connections that hold resources for nothing: no HELLO within
- * --hello-timeout, a frame still incomplete --request-timeout after its
- * first byte, or a session with nothing going on (no request in flight, no
- * live WATCH, nothing unread, no byte from the client) for --idle-timeout;
- * each gets ERROR TIMED_OUT and a log line. What clients have half sent is
- * bounded in all: a frame counts against --max-request-memory from its
- * header to its end (admit), one that does not fit is refused BUSY the
- * same way, and a buffer grown for a large frame is freed once it is done. */
+ * DESIGN: idle clients never cost an acknowledged job, and nobody who has
+ * not logged in can keep anyone else out. Budgets are separate: TCP
+ * connections that have not done HELLO are at most --max-unauthenticated
+ * in all and --max-unauthenticated-per-address from one address (an IPv4
+ * address or IPv6 /64; on the Unix socket a local uid, root and
+ * --admin-uid exempt), and
+ * when a new one arrives over either cap the OLDEST such connection (of
+ * that address, or of all) is closed in its place, so a client that does
+ * its HELLO at once always gets in; sessions (after HELLO) count against
+ * --max-connections and --max-connections-per-user, admins against
+ * neither. Descriptors are budgeted in tiers (fds.c): the Unix socket is
+ * served while more than --fd-reserve are free (kept for the workers: their
+ * pipes, the database, the spool), a TCP client only while more than
+ * --admin-reserve beyond that are free, or in the place of the oldest TCP
+ * connection without HELLO. A refused or displaced client is told why
+ * (ERROR BUSY, request id 0), the refusal is logged with the address, and
+ * the connection lingers a moment (reading and dropping what the client
+ * sends) so the ERROR is read rather than lost to a reset; TCP ones linger
+ * only while few do. A timer cuts connections that hold resources for
+ * nothing: no HELLO within --hello-timeout, a frame still incomplete
+ * --request-timeout after its first byte, or a session with nothing going
+ * on (no request in flight, no live WATCH, nothing unread, no byte from
+ * the client) for --idle-timeout; each gets ERROR TIMED_OUT and a log line.
+ * What clients have half sent is bounded in all: a frame counts against
+ * --max-request-memory from its header to its end (admit), and against its
+ * user's share of it, one that does not fit is refused BUSY the same way,
+ * and a buffer grown for a large frame is freed once it is done. A
+ * connection whose output has been written whole tells req.c
+ * (req_conn_sent): its RESULTs end there.
+ *
+ * DESIGN: a tls: listener's connections carry the same frames inside a
+ * GnuTLS session (tls.c). What libuv reads is fed to the session and the
+ * plaintext it yields goes to the framing code as a plain connection's
+ * bytes would; what the framing code queues in `out` is sealed into records
+ * (tls_out) once the handshake is done, and those are what uv_write sends.
+ * Every bound above holds over TLS: queued output counts the records, the
+ * read stops as for a plain connection, a half-done handshake is an
+ * unauthenticated connection (cut by --hello-timeout, counted under
+ * --max-unauthenticated), and a refused client completes its handshake to
+ * read its ERROR. A failed handshake is logged with the peer's address and
+ * GnuTLS's reason, and the connection closes after the alert. A plain tcp:
+ * listener binds loopback only unless --insecure-tcp says otherwise. */
 #include "mcd.h"
 #include "backend.h"
 
-#include <dirent.h>
+#include <arpa/inet.h>
 #include <errno.h>
 #include <poll.h>
 #include <stdarg.h>
@@ -53,6 +79,7 @@
 
 #define SRV_SWEEP_MS 250           /* how often the connection timeouts are checked */
 #define SRV_REFUSE_LINGER_MS 2000  /* a refused connection waits this long for the client's EOF */
+#define SRV_MAX_LINGER 64          /* displaced or TCP refused connections lingering at once; more close at once */
 
 struct conn {
     union { uv_handle_t h; uv_stream_t s; uv_tcp_t tcp; uv_pipe_t pipe; } u;
@@ -71,11 +98,14 @@ struct conn {
     size_t held_len;          /* bytes of in.data the held request's frame takes */
     int handle_closed;        /* uv_close finished: free once holds is 0 */
     int refused;              /* told BUSY: input dropped, closed soon */
+    int unix_admin;           /* Unix socket, root or --admin-uid: no per-uid cap */
     uint64_t refused_ms;      /* loop time of the refusal */
     uint64_t accepted_ms;     /* loop time of the accept */
     uint64_t frame_ms;        /* when the incomplete frame in `in` began; 0: none */
     uint64_t active_ms;       /* last byte read, write done or request finished */
     size_t admitted;          /* the incomplete frame's length, counted in admitted_total */
+    tls_conn *tls;            /* a tls: listener's session; in and out hold plaintext */
+    proto_buf tls_out;        /* records sealed, not yet handed to uv_write */
 };
 
 /* Bytes of the frames being received (admitted, not yet consumed), all
@@ -84,6 +114,10 @@ static size_t admitted_total;
 
 static uv_timer_t sweep_timer;     /* the connection timeouts (one loop) */
 static int sweep_on;
+
+/* The tls: listeners (one loop). */
+static const uv_handle_t *tls_listeners[CONF_MAX_LISTEN];
+static int ntls_listeners;
 
 conn_auth *srv_conn_auth(conn *c) { return &c->auth; }
 mcd *srv_conn_daemon(conn *c) { return c->d; }
@@ -96,7 +130,7 @@ int srv_conn_fd(conn *c)
 
 static size_t queued(const conn *c)
 {
-    return c->inflight + c->out.len;
+    return c->inflight + c->out.len + c->tls_out.len;
 }
 
 /* The frame at the front of c->in is consumed (or c is gone): its bytes
@@ -118,6 +152,8 @@ static void conn_free(conn *c)
     c->admitted = 0;
     proto_buf_free(&c->in);
     proto_buf_free(&c->out);
+    proto_buf_free(&c->tls_out);
+    tls_conn_free(c->tls);
     free(c->wdata);
     free(c);
 }
@@ -150,6 +186,7 @@ static void process_input(conn *c);
 static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf);
 static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf);
 static void flush(conn *c);
+static int tls_goodbye(conn *c);
 
 /* Reads while nothing stops it: a close under way, output over the limit
  * (paused), or a request whose work is in flight (holds). */
@@ -188,8 +225,13 @@ static void on_write(uv_write_t *w, int status)
     flush(c);
     if (c->closing)
         return;
+    if (!c->writing)
+        req_conn_sent(c->d, c);        /* all written: the RESULTs it was sending end */
+    if (c->closing)
+        return;
     if (!c->writing && c->close_after_write) {
-        srv_close(c);
+        if (!tls_goodbye(c))
+            srv_close(c);
         return;
     }
     if (c->paused && queued(c) <= c->d->conf.max_output / 2) {
@@ -201,13 +243,44 @@ static void on_write(uv_write_t *w, int status)
     }
 }
 
+/* TLS: the plaintext queued in c->out becomes records in c->tls_out once
+ * the handshake is done (before, it waits). 0 when that failed and c is
+ * closed. */
+static int seal(conn *c)
+{
+    if (!tls_conn_ready(c->tls) || c->out.len == 0)
+        return 1;
+    char msg[256];
+    int rc = tls_conn_write(c->tls, c->out.data, c->out.len, msg, sizeof msg);
+    proto_buf_free(&c->out);
+    if (rc || c->tls_out.err) {
+        dlog(DLOG_WARN, "conn %lu (tls %s): TLS: %s: closing", c->id, tls_conn_peer(c->tls),
+             rc ? msg : "out of memory for the output");
+        srv_close(c);
+        return 0;
+    }
+    return 1;
+}
+
+static int tls_push(void *ctx, const void *data, size_t len)
+{
+    conn *c = ctx;
+    proto_buf_put(&c->tls_out, data, len);
+    return c->tls_out.err ? -1 : 0;
+}
+
 static void flush(conn *c)
 {
-    if (c->writing || c->closing || c->out.len == 0)
+    /* while a write is in flight frames gather in out (over TLS: sealed
+     * together into fewer records once it is done) */
+    if (c->writing || c->closing || (c->tls && !seal(c)))
         return;
-    c->wdata = c->out.data;
-    c->inflight = c->out.len;
-    proto_buf_init(&c->out);           /* the bytes now belong to the write */
+    proto_buf *src = c->tls ? &c->tls_out : &c->out;
+    if (src->len == 0)
+        return;
+    c->wdata = src->data;
+    c->inflight = src->len;
+    proto_buf_init(src);               /* the bytes now belong to the write */
     uv_buf_t b = uv_buf_init((char *)c->wdata, (unsigned)c->inflight);
     c->wreq.data = c;
     c->writing = 1;
@@ -286,8 +359,24 @@ void srv_close_soon(conn *c)
         return;
     c->close_after_write = 1;
     update_reading(c);
-    if (!c->writing)
+    if (!c->writing && !tls_goodbye(c))
         srv_close(c);
+}
+
+/* A closing TLS connection says close_notify after its last record: 1
+ * when the caller has nothing more to do (it is being written, and
+ * on_write closes after it; or c is closed already), 0 when the caller
+ * closes c now. */
+static int tls_goodbye(conn *c)
+{
+    if (!c->tls || c->closing || !tls_conn_ready(c->tls))
+        return 0;
+    if (!seal(c))
+        return 1;                      /* closed on the failure */
+    if (!tls_conn_bye(c->tls))
+        return 0;                      /* said before */
+    flush(c);
+    return c->writing || c->closing;
 }
 
 /* Byte-stream errors: ERROR, then close once it is written. */
@@ -299,19 +388,50 @@ static void fatal_error(conn *c, uint32_t request_id, int code, const char *msg)
     srv_close_soon(c);
 }
 
+/* Bytes admitted for user's connections (an incomplete frame each). */
+static size_t admitted_of(const mcd *d, const char *user)
+{
+    size_t n = 0;
+    for (const conn *o = d->conns; o; o = o->next)
+        if (o->auth.authed && strcmp(o->auth.user, user) == 0)
+            n += o->admitted;
+    return n;
+}
+
+/* One user's share of --max-request-memory (--max-request-memory-per-user,
+ * 0: a quarter of the total). */
+static size_t user_share(const mcd_conf *k)
+{
+    return k->max_request_memory_per_user ? k->max_request_memory_per_user : k->max_request_memory / 4;
+}
+
 /* A frame's header is in and the rest is coming: its length counts
- * against max-request-memory from now until it is consumed; a frame that
- * does not fit is refused BUSY (the client may send it again later) and
- * the connection closed, so what the daemon buffers stays bounded
- * whatever the number of clients. */
+ * against max-request-memory from now until it is consumed, and, after
+ * HELLO, against its user's share; a frame that does not fit is refused
+ * BUSY (the client may send it again later) and the connection closed, so
+ * what the daemon buffers stays bounded whatever the number of clients.
+ * One user's declarations never take more than a share, and admins and
+ * the Unix socket may use the last share of the total, which the others'
+ * declarations cannot take: nobody's stalled uploads lock out everyone
+ * else (an unauthenticated connection can only declare
+ * CONF_HELLO_MAX_FRAME). */
 static void admit(conn *c, const proto_hdr *hdr)
 {
-    size_t flen = PROTO_HDR_SIZE + (size_t)hdr->payload_len, cap = c->d->conf.max_request_memory;
-    if (admitted_total + flen > cap) {
-        char msg[256];
+    const mcd_conf *k = &c->d->conf;
+    size_t flen = PROTO_HDR_SIZE + (size_t)hdr->payload_len, cap = k->max_request_memory;
+    size_t share = user_share(k), mine = c->auth.authed ? admitted_of(c->d, c->auth.user) : 0;
+    int reserved = c->auth.authed && (c->auth.admin || c->auth.is_unix);
+    size_t open_to_all = cap > share ? cap - share : 0;
+    char msg[512] = "";
+    if (admitted_total + flen > (reserved ? cap : open_to_all))
         snprintf(msg, sizeof msg, "the server is receiving %zu bytes of requests already; this %zu-byte %s does"
-                 " not fit under max-request-memory %zu: send it again later", admitted_total, flen,
-                 proto_type_name(hdr->type), cap);
+                 " not fit under max-request-memory %zu%s: send it again later", admitted_total, flen,
+                 proto_type_name(hdr->type), cap, reserved ? "" : " less the admins' reserve (one user's share)");
+    else if (c->auth.authed && mine + flen > share)
+        snprintf(msg, sizeof msg, "user %s is sending %zu bytes of requests already; this %zu-byte %s does not fit"
+                 " under max-request-memory-per-user %zu: send it again once those are in", c->auth.user, mine,
+                 flen, proto_type_name(hdr->type), share);
+    if (msg[0]) {
         dlog(DLOG_WARN, "conn %lu (%s): BUSY: %s: closing", c->id, c->auth.authed ? c->auth.user : "-", msg);
         srv_send_error(c, hdr->request_id, PROTO_EBUSY, "%s", msg);
         /* like a refusal at accept: what else it sends is dropped until its
@@ -331,7 +451,7 @@ static void process_input(conn *c)
 {
     while (!c->closing && !c->close_after_write && !c->paused && !c->holds && c->in.len) {
         size_t limit = c->auth.authed ? c->d->conf.max_frame : CONF_HELLO_MAX_FRAME;
-        proto_hdr hdr;
+        proto_hdr hdr = {0};           /* a bad magic or header CRC leaves it unread: request id 0 */
         char err[512];
         int rc = proto_frame_scan(c->in.data, c->in.len, limit, &hdr, err, sizeof err);
         if (rc == PROTO_NEED_MORE) {
@@ -340,7 +460,7 @@ static void process_input(conn *c)
             return;
         }
         if (rc < 0) {
-            fatal_error(c, c->in.len >= PROTO_HDR_SIZE ? hdr.request_id : 0, rc, err);
+            fatal_error(c, hdr.request_id, rc, err);
             return;
         }
         size_t flen = PROTO_HDR_SIZE + (size_t)hdr.payload_len;
@@ -415,16 +535,77 @@ static void on_alloc(uv_handle_t *h, size_t suggested, uv_buf_t *buf)
     *buf = uv_buf_init(chunk, sizeof chunk);
 }
 
+/* TLS: ciphertext read from the client goes to its session (the handshake,
+ * then records); the plaintext is appended to c->in for the framing. */
+static void tls_input(conn *c, const void *data, size_t n)
+{
+    char msg[512];
+    const char *peer = tls_conn_peer(c->tls);
+    if (c->refused && tls_conn_ready(c->tls))
+        return;                        /* a refused client's requests are dropped */
+    if (tls_conn_feed(c->tls, data, n, msg, sizeof msg) != 0) {
+        dlog(DLOG_WARN, "conn %lu (tls %s): %s: closing", c->id, peer, msg);
+        srv_close(c);
+        return;
+    }
+    if (!tls_conn_ready(c->tls)) {
+        int rc = tls_conn_handshake(c->tls, msg, sizeof msg);
+        flush(c);                      /* the handshake's records; a refusal's ERROR once sealed */
+        if (c->closing)
+            return;
+        if (rc < 0) {
+            dlog(DLOG_WARN, "conn %lu (tls %s): TLS handshake failed: %s: closing", c->id, peer, msg);
+            srv_close_soon(c);         /* after the alert */
+            return;
+        }
+        if (rc == 0)
+            return;
+        char desc[64];
+        dlog(DLOG_DEBUG, "conn %lu (tls %s): TLS handshake done: %s", c->id, peer,
+             tls_conn_desc(c->tls, desc, sizeof desc));
+        if (c->refused)
+            return;
+    }
+    size_t before = c->in.len;
+    int rc = tls_conn_read(c->tls, &c->in, msg, sizeof msg);
+    if (c->in.len > before) {
+        c->active_ms = uv_now(c->d->loop);
+        if (before == 0)
+            c->frame_ms = c->active_ms;
+    }
+    if (rc < 0) {
+        dlog(DLOG_WARN, "conn %lu (tls %s): TLS: %s: closing", c->id, peer, msg);
+        flush(c);                      /* an alert */
+        srv_close_soon(c);
+        return;
+    }
+    flush(c);                          /* records the session answers with itself (a key update) */
+    if (c->closing)
+        return;
+    process_input(c);
+    if (rc == 1 && !c->closing)        /* close_notify: the client is done, as at EOF */
+        srv_close(c);
+}
+
 static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf)
 {
     conn *c = s->data;
     if (n < 0) {
         if (n != UV_EOF)
             dlog(DLOG_INFO, "conn %lu: read: %s", c->id, uv_strerror((int)n));
+        else if (c->tls && !tls_conn_ready(c->tls) && !c->refused)
+            dlog(DLOG_INFO, "conn %lu (tls %s): the client left during the TLS handshake", c->id,
+                 tls_conn_peer(c->tls));
         srv_close(c);
         return;
     }
-    if (n == 0 || c->closing || c->close_after_write || c->refused)
+    if (n == 0 || c->closing || c->close_after_write)
+        return;
+    if (c->tls) {
+        tls_input(c, buf->base, (size_t)n);
+        return;
+    }
+    if (c->refused)
         return;                        /* a refused client's bytes are dropped */
     c->active_ms = uv_now(c->d->loop);
     if (c->in.len == 0)
@@ -437,48 +618,113 @@ static void on_read(uv_stream_t *s, ssize_t n, const uv_buf_t *buf)
     process_input(c);
 }
 
-/* Descriptors still free under the soft RLIMIT_NOFILE: the limit less
- * those open (counted in /proc/self/fd, exact; the count's own descriptor
- * is not left out, a margin of one). 0 when not even that can be opened;
- * INT32_MAX when it cannot be counted. */
-static long fds_free(void)
+/* sa's address as text into ip (64 bytes); its port. */
+static int addr_name(const struct sockaddr_storage *sa, char ip[64])
 {
-    struct rlimit rl;
-    if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
-        return INT32_MAX;
-    DIR *dir = opendir("/proc/self/fd");
-    if (!dir)
-        return errno == EMFILE || errno == ENFILE ? 0 : INT32_MAX;
-    long open = 0;
-    while (readdir(dir))
-        open++;
-    closedir(dir);
-    open -= 2;                         /* "." and ".." */
-    return (long)rl.rlim_cur - open;
+    if (sa->ss_family == AF_INET6) {
+        uv_ip6_name((const struct sockaddr_in6 *)sa, ip, 64);
+        return ntohs(((const struct sockaddr_in6 *)sa)->sin6_port);
+    }
+    uv_ip4_name((const struct sockaddr_in *)sa, ip, 64);
+    return ntohs(((const struct sockaddr_in *)sa)->sin_port);
 }
 
-static long fd_reserve(const mcd *d)
+/* A connection accepted on a tls: listener gets its session: 0, or -1
+ * (logged) when it cannot. */
+static int conn_tls_start(conn *c)
 {
-    if (d->conf.fd_reserve)
-        return d->conf.fd_reserve;
-    return CONF_FD_RESERVE_BASE + (long)CONF_FD_RESERVE_PER_SLOT * bk_nslots(d);
+    struct sockaddr_storage sa;
+    int len = sizeof sa, port = 0;
+    char ip[64] = "?", peer[80];
+    if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) == 0)
+        port = addr_name(&sa, ip);
+    snprintf(peer, sizeof peer, strchr(ip, ':') ? "[%s]:%d" : "%s:%d", ip, port);
+    if (!c->d->tls || tls_conn_new(c->d->tls, peer, tls_push, c, &c->tls) != 0) {
+        dlog(DLOG_ERROR, "conn %lu (tls %s): cannot start a TLS session: closing", c->id, peer);
+        return -1;
+    }
+    dlog(DLOG_DEBUG, "conn %lu (tls %s): TLS session started", c->id, peer);
+    return 0;
 }
 
-/* Client connections (refused ones not counted): all, and before HELLO. */
-static void count_conns(const mcd *d, uint32_t *all, uint32_t *unauth)
+static int is_tls_listener(const uv_stream_t *server)
 {
-    *all = *unauth = 0;
-    for (const conn *c = d->conns; c; c = c->next)
-        if (!c->closing && !c->refused) {
-            ++*all;
-            *unauth += !c->auth.authed;
+    for (int i = 0; i < ntls_listeners; i++)
+        if (tls_listeners[i] == (const uv_handle_t *)server)
+            return 1;
+    return 0;
+}
+
+/* Who connects, into c->auth.peer: the IPv4 address, an IPv6 address's
+ * /64 (one host has a whole /64 to pick from), or "uid N" on the Unix
+ * socket (and whether that uid is root or --admin-uid). */
+static void peer_of(conn *c)
+{
+    char *out = c->auth.peer;
+    snprintf(out, SRV_MAX_PEER, "?");
+    if (c->auth.is_unix) {
+        unsigned long uid;
+        if (auth_peer_uid(srv_conn_fd(c), c->d->conf.admin_uid, &uid, &c->unix_admin) == 0)
+            snprintf(out, SRV_MAX_PEER, "uid %lu", uid);
+        return;
+    }
+    struct sockaddr_storage sa;
+    int len = sizeof sa;
+    if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) != 0)
+        return;
+    if (sa.ss_family == AF_INET) {
+        inet_ntop(AF_INET, &((struct sockaddr_in *)&sa)->sin_addr, out, SRV_MAX_PEER);
+    } else if (sa.ss_family == AF_INET6) {
+        struct in6_addr a = ((struct sockaddr_in6 *)&sa)->sin6_addr;
+        if (IN6_IS_ADDR_V4MAPPED(&a)) {
+            inet_ntop(AF_INET, &a.s6_addr[12], out, SRV_MAX_PEER);
+            return;
         }
+        memset(&a.s6_addr[8], 0, 8);
+        char ip[INET6_ADDRSTRLEN];
+        inet_ntop(AF_INET6, &a, ip, sizeof ip);
+        snprintf(out, SRV_MAX_PEER, "%s/64", ip);
+    }
+}
+
+/* What the accept decides on, c itself not counted. */
+typedef struct census {
+    uint32_t unauth_tcp;      /* TCP connections before HELLO */
+    uint32_t unauth_here;     /* connections before HELLO from c's peer, on c's kind of socket */
+    uint32_t lingering;       /* refused connections not closed yet */
+    conn *oldest_here;        /* the oldest of unauth_here */
+    conn *oldest_tcp;         /* the oldest of unauth_tcp */
+} census;
+
+static void count_conns(const conn *c, census *k)
+{
+    memset(k, 0, sizeof *k);
+    for (conn *o = c->d->conns; o; o = o->next) {
+        if (o == c || o->closing || o->close_after_write)
+            continue;
+        if (o->refused) {
+            k->lingering++;
+            continue;
+        }
+        if (o->auth.authed)
+            continue;
+        if (!o->auth.is_unix) {
+            k->unauth_tcp++;
+            if (!k->oldest_tcp || o->accepted_ms <= k->oldest_tcp->accepted_ms)
+                k->oldest_tcp = o;
+        }
+        if (o->auth.is_unix == c->auth.is_unix && strcmp(o->auth.peer, c->auth.peer) == 0) {
+            k->unauth_here++;
+            if (!k->oldest_here || o->accepted_ms <= k->oldest_here->accepted_ms)
+                k->oldest_here = o;
+        }
+    }
 }
 
 /* Refusals, logged at most once a second per reason (a flood of clients
  * gives one line a second, with the number it stands for). */
-enum { REFUSE_FDS, REFUSE_TOTAL, REFUSE_UNAUTH, REFUSE_USER, REFUSE_KINDS };
-static void log_refusal(const mcd *d, int kind, const char *what, const char *why)
+enum { REFUSE_FDS, REFUSE_TOTAL, REFUSE_UNAUTH, REFUSE_ADDR, REFUSE_USER, REFUSE_KINDS };
+static void log_refusal(const mcd *d, int kind, const char *what, const char *verb, const char *why)
 {
     static uint64_t last_ms[REFUSE_KINDS];
     static unsigned long held_back[REFUSE_KINDS];
@@ -488,11 +734,47 @@ static void log_refusal(const mcd *d, int kind, const char *what, const char *wh
         return;
     }
     if (held_back[kind])
-        dlog(DLOG_WARN, "%s refused: %s (and %lu more like it in the last second)", what, why, held_back[kind]);
+        dlog(DLOG_WARN, "%s %s: %s (and %lu more like it in the last second)", what, verb, why, held_back[kind]);
     else
-        dlog(DLOG_WARN, "%s refused: %s", what, why);
+        dlog(DLOG_WARN, "%s %s: %s", what, verb, why);
     last_ms[kind] = now;
     held_back[kind] = 0;
+}
+
+/* c is told BUSY with why and closed: after a short linger (so it reads the
+ * ERROR), or at once when descriptors are short or too many TCP
+ * connections linger already. */
+static void refuse(conn *c, int kind, const char *verb, const char *why, int linger)
+{
+    char what[SRV_MAX_PEER + 64];
+    snprintf(what, sizeof what, "conn %lu (%s %s)", c->id, c->auth.is_unix ? "unix" : "tcp", c->auth.peer);
+    log_refusal(c->d, kind, what, verb, why);
+    c->refused = 1;
+    c->refused_ms = uv_now(c->d->loop);
+    c->frame_ms = 0;
+    admitted_total -= c->admitted;     /* half a HELLO it sent is dropped */
+    c->admitted = 0;
+    proto_buf_free(&c->in);
+    proto_buf_init(&c->in);
+    srv_send_error(c, 0, PROTO_EBUSY, "server busy: %s; retry later", why);
+    if (linger)
+        update_reading(c);             /* until the client's EOF, or the linger time */
+    else
+        srv_close(c);
+}
+
+/* The oldest TCP connection without HELLO makes room for c: 0, or -1 when
+ * there is none. */
+static int displace(conn *victim, int kind, const char *why, long left, long floor)
+{
+    if (!victim)
+        return -1;
+    census k;
+    count_conns(victim, &k);
+    char msg[320];
+    snprintf(msg, sizeof msg, "%s; the oldest connection without HELLO makes room for a newer one", why);
+    refuse(victim, kind, "closed", msg, k.lingering < SRV_MAX_LINGER && left > floor);
+    return 0;
 }
 
 static void on_connection(uv_stream_t *server, int status)
@@ -503,23 +785,9 @@ static void on_connection(uv_stream_t *server, int status)
         dlog(DLOG_WARN, "accept: %s", uv_strerror(status));
         return;
     }
-    /* the caps, before the accept takes a descriptor */
-    char why[256] = "";
-    int kind = -1;
-    uint32_t all, unauth;
-    count_conns(d, &all, &unauth);
-    long left = fds_free(), reserve = fd_reserve(d);
-    if (left <= reserve) {
-        kind = REFUSE_FDS;
-        snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
-                 "(--fd-reserve)", left, reserve);
-    } else if (all >= d->conf.max_connections) {
-        kind = REFUSE_TOTAL;
-        snprintf(why, sizeof why, "%u connections open, the limit (--max-connections)", all);
-    } else if (unauth >= d->conf.max_unauthenticated) {
-        kind = REFUSE_UNAUTH;
-        snprintf(why, sizeof why, "%u connections without HELLO, the limit (--max-unauthenticated)", unauth);
-    }
+    /* the descriptors, before the accept takes one */
+    long left = fds_free(), reserve = fds_reserve(&d->conf, bk_nslots(d));
+    long floor = fds_tcp_floor(&d->conf, bk_nslots(d));
     conn *c = calloc(1, sizeof *c);
     if (!c) {
         dlog(DLOG_ERROR, "accept: out of memory");
@@ -535,7 +803,7 @@ static void on_connection(uv_stream_t *server, int status)
     else
         uv_tcp_init(d->loop, &c->u.tcp);
     c->u.h.data = c;
-    if (uv_accept(server, &c->u.s) != 0) {
+    if (uv_accept(server, &c->u.s) != 0 || (is_tls_listener(server) && conn_tls_start(c) != 0)) {
         uv_close(&c->u.h, on_closed);
         return;
     }
@@ -544,21 +812,46 @@ static void on_connection(uv_stream_t *server, int status)
         d->conns->prev = c;
     d->conns = c;
     c->accepted_ms = c->active_ms = uv_now(d->loop);
-    if (kind < 0) {
-        dlog(DLOG_DEBUG, "conn %lu: accepted (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
-        update_reading(c);
-        return;
+    peer_of(c);
+    const mcd_conf *k = &d->conf;
+    census n;
+    count_conns(c, &n);
+    char why[256];
+    if (c->auth.is_unix) {
+        if (left <= reserve) {
+            snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
+                     "(--fd-reserve)", left, reserve);
+            refuse(c, REFUSE_FDS, "refused", why, left > reserve / 2);
+            return;
+        }
+        if (!c->unix_admin && n.unauth_here >= k->max_unauth_per_address) {
+            snprintf(why, sizeof why, "%u connections without HELLO from %s, the limit "
+                     "(--max-unauthenticated-per-address)", n.unauth_here, c->auth.peer);
+            displace(n.oldest_here, REFUSE_ADDR, why, left, reserve);
+        }
+    } else {
+        if (left <= floor) {
+            snprintf(why, sizeof why, "%ld file descriptor(s) left under RLIMIT_NOFILE, %ld kept for the workers "
+                     "(--fd-reserve) and %u more for the Unix socket and admins (--admin-reserve)", left, reserve,
+                     k->admin_reserve);
+            if (displace(n.oldest_tcp, REFUSE_FDS, why, left, floor)) {
+                refuse(c, REFUSE_FDS, "refused", why, left > reserve && n.lingering < SRV_MAX_LINGER);
+                return;
+            }
+            count_conns(c, &n);
+        }
+        if (n.unauth_here >= k->max_unauth_per_address) {
+            snprintf(why, sizeof why, "%u connections without HELLO from %s, the limit "
+                     "(--max-unauthenticated-per-address)", n.unauth_here, c->auth.peer);
+            displace(n.oldest_here, REFUSE_ADDR, why, left, floor);
+        } else if (n.unauth_tcp >= k->max_unauthenticated) {
+            snprintf(why, sizeof why, "%u TCP connections without HELLO, the limit (--max-unauthenticated)",
+                     n.unauth_tcp);
+            displace(n.oldest_tcp, REFUSE_UNAUTH, why, left, floor);
+        }
     }
-    char what[64];
-    snprintf(what, sizeof what, "conn %lu (%s)", c->id, c->auth.is_unix ? "unix" : "tcp");
-    log_refusal(d, kind, what, why);
-    c->refused = 1;
-    c->refused_ms = c->accepted_ms;
-    srv_send_error(c, 0, PROTO_EBUSY, "server busy: %s; retry later", why);
-    if (left <= reserve / 2)
-        srv_close(c);                  /* no descriptor to spare for lingering */
-    else
-        update_reading(c);             /* until the client's EOF, or the linger time */
+    dlog(DLOG_DEBUG, "conn %lu: accepted (%s %s)", c->id, c->auth.is_unix ? "unix" : "tcp", c->auth.peer);
+    update_reading(c);
 }
 
 int srv_conn_admit_user(conn *c, char *msg, size_t msgsz)
@@ -566,17 +859,61 @@ int srv_conn_admit_user(conn *c, char *msg, size_t msgsz)
     const mcd *d = c->d;
     if (c->auth.admin)
         return 0;
-    uint32_t n = 0;
+    uint32_t all = 0, mine = 0;
     for (const conn *o = d->conns; o; o = o->next)
-        n += o != c && !o->closing && !o->refused && o->auth.authed && strcmp(o->auth.user, c->auth.user) == 0;
-    if (n < d->conf.max_connections_per_user)
+        if (o != c && !o->closing && !o->refused && o->auth.authed && !o->auth.admin) {
+            all++;
+            mine += strcmp(o->auth.user, c->auth.user) == 0;
+        }
+    int kind;
+    if (all >= d->conf.max_connections) {
+        kind = REFUSE_TOTAL;
+        snprintf(msg, msgsz, "server busy: %u sessions open, the limit (--max-connections; admins exempt); "
+                 "retry later", all);
+    } else if (mine >= d->conf.max_connections_per_user) {
+        kind = REFUSE_USER;
+        snprintf(msg, msgsz, "server busy: user %s has %u sessions, the limit (--max-connections-per-user); "
+                 "retry later", c->auth.user, mine);
+    } else {
         return 0;
-    snprintf(msg, msgsz, "server busy: user %s has %u sessions, the limit (--max-connections-per-user); "
-             "retry later", c->auth.user, n);
-    char what[AUTH_MAX_USER + 64];
-    snprintf(what, sizeof what, "conn %lu (user %s)", c->id, c->auth.user);
-    log_refusal(d, REFUSE_USER, what, msg);
+    }
+    char what[AUTH_MAX_USER + SRV_MAX_PEER + 64];
+    snprintf(what, sizeof what, "conn %lu (user %s, %s)", c->id, c->auth.user, c->auth.peer);
+    log_refusal(d, kind, what, "refused", msg);
     return PROTO_EBUSY;
+}
+
+void srv_each_session(mcd *d, void (*fn)(conn *c, void *ctx), void *ctx)
+{
+    conn *next;
+    for (conn *c = d->conns; c; c = next) {
+        next = c->next;                /* fn may close c (srv_close unlinks it) */
+        if (c->auth.authed && !c->closing && !c->close_after_write)
+            fn(c, ctx);
+    }
+}
+
+void srv_end_session(conn *c, int code, const char *why)
+{
+    dlog(DLOG_WARN, "conn %lu (user %s%s, %s): session ended: %s", c->id, c->auth.user,
+         c->auth.admin ? ", admin" : "", c->auth.peer, why);
+    srv_send_error(c, 0, code, "%s", why);
+    srv_close_soon(c);
+}
+
+void srv_note_tokens(mcd *d)
+{
+    int tcp = 0;
+    for (int i = 0; i < d->conf.nlisten; i++)
+        tcp |= strncmp(d->conf.listen[i], "tcp:", 4) == 0;
+    const char *path = auth_tokens_path(d->tokens);
+    if (!tcp)
+        return;
+    if (auth_tokens_count(d->tokens) == 0)
+        dlog(DLOG_WARN, "TCP listener without a token (%s%s): no TCP user can log in; make one with "
+             "`meshcorrd token new USER`", path[0] ? "no line in " : "no --tokens file", path);
+    else
+        dlog(DLOG_INFO, "%d token(s) from %s", auth_tokens_count(d->tokens), path);
 }
 
 /* ERROR TIMED_OUT (request id 0), a log line, and a close once it is written. */
@@ -607,6 +944,7 @@ static void on_sweep(uv_timer_t *t)
     mcd *d = t->data;
     const mcd_conf *k = &d->conf;
     uint64_t now = uv_now(d->loop);
+    throttle_sweep(now);
     conn *next;
     for (conn *c = d->conns; c; c = next) {
         next = c->next;                /* srv_close unlinks c */
@@ -616,7 +954,11 @@ static void on_sweep(uv_timer_t *t)
             if (now - c->refused_ms >= SRV_REFUSE_LINGER_MS)
                 srv_close(c);
         } else if (!c->auth.authed && k->hello_timeout_s && now - c->accepted_ms >= 1000ull * k->hello_timeout_s) {
-            time_out(c, "no HELLO within %u s (--hello-timeout)", k->hello_timeout_s);
+            if (c->tls && !tls_conn_ready(c->tls))
+                time_out(c, "TLS handshake with %s not done within %u s (--hello-timeout)", tls_conn_peer(c->tls),
+                         k->hello_timeout_s);
+            else
+                time_out(c, "no HELLO within %u s (--hello-timeout)", k->hello_timeout_s);
         } else if (c->frame_ms && !c->holds && !c->paused &&
                    now - c->frame_ms >= 1000ull * k->request_timeout_s && k->request_timeout_s) {
             size_t want = frame_size(c);
@@ -662,13 +1004,24 @@ static int listen_unix(mcd *d, const char *path, uv_handle_t **out, char *err, s
     return 0;
 }
 
-static int listen_tcp(mcd *d, const char *hostport, uv_handle_t **out, FILE *portfp,
+/* 127.0.0.0/8, ::1, or 127.0.0.0/8 mapped into IPv6. */
+static int is_loopback(const struct sockaddr_storage *sa)
+{
+    if (sa->ss_family == AF_INET)
+        return (ntohl(((const struct sockaddr_in *)sa)->sin_addr.s_addr) >> 24) == 127;
+    const struct in6_addr *a = &((const struct sockaddr_in6 *)sa)->sin6_addr;
+    return IN6_IS_ADDR_LOOPBACK(a) || (IN6_IS_ADDR_V4MAPPED(a) && a->s6_addr[12] == 127);
+}
+
+/* A tcp: listener (tls 0) or a tls: one: scheme:HOST:PORT, HOST numeric. */
+static int listen_tcp(mcd *d, const char *hostport, int tls, uv_handle_t **out, FILE *portfp,
                       char *err, size_t errsz)
 {
     char host[256];
+    const char *scheme = tls ? "tls" : "tcp";
     const char *colon = strrchr(hostport, ':');
     if (!colon || colon == hostport || (size_t)(colon - hostport) >= sizeof host)
-        return snprintf(err, errsz, "tcp:%s: expected tcp:HOST:PORT", hostport), -1;
+        return snprintf(err, errsz, "%s:%s: expected %s:HOST:PORT", scheme, hostport, scheme), -1;
     memcpy(host, hostport, (size_t)(colon - hostport));
     host[colon - hostport] = '\0';
     if (host[0] == '[' && host[strlen(host) - 1] == ']') {
@@ -678,11 +1031,18 @@ static int listen_tcp(mcd *d, const char *hostport, uv_handle_t **out, FILE *por
     char *e;
     long port = strtol(colon + 1, &e, 10);
     if (*e || port < 0 || port > 65535)
-        return snprintf(err, errsz, "tcp:%s: bad port", hostport), -1;
+        return snprintf(err, errsz, "%s:%s: bad port", scheme, hostport), -1;
     struct sockaddr_storage sa;
     if (uv_ip4_addr(host, (int)port, (struct sockaddr_in *)&sa) != 0 &&
         uv_ip6_addr(host, (int)port, (struct sockaddr_in6 *)&sa) != 0)
-        return snprintf(err, errsz, "tcp:%s: '%s' is not a numeric IP address", hostport, host), -1;
+        return snprintf(err, errsz, "%s:%s: '%s' is not a numeric IP address", scheme, hostport, host), -1;
+    if (!tls && !is_loopback(&sa)) {
+        if (!d->conf.insecure_tcp)
+            return snprintf(err, errsz, "tcp:%s is not loopback: tokens would cross the network in clear; use "
+                            "tls:HOST:PORT with --tls-cert/--tls-key, or --insecure-tcp to allow it", hostport), -1;
+        dlog(DLOG_WARN, "tcp:%s is not loopback: tokens, meshes and maps cross the network in clear "
+             "(--insecure-tcp)", hostport);
+    }
     uv_tcp_t *t = calloc(1, sizeof *t);
     if (!t)
         return snprintf(err, errsz, "out of memory"), -1;
@@ -693,22 +1053,17 @@ static int listen_tcp(mcd *d, const char *hostport, uv_handle_t **out, FILE *por
     if (!rc)
         rc = uv_listen((uv_stream_t *)t, 128, on_connection);
     if (rc)
-        return snprintf(err, errsz, "tcp:%s: %s", hostport, uv_strerror(rc)), -1;
+        return snprintf(err, errsz, "%s:%s: %s", scheme, hostport, uv_strerror(rc)), -1;
+    if (tls)
+        tls_listeners[ntls_listeners++] = (uv_handle_t *)t;
     struct sockaddr_storage bound;
     int len = sizeof bound;
     uv_tcp_getsockname(t, (struct sockaddr *)&bound, &len);
     char ip[64];
-    int bport;
-    if (bound.ss_family == AF_INET6) {
-        uv_ip6_name((struct sockaddr_in6 *)&bound, ip, sizeof ip);
-        bport = ntohs(((struct sockaddr_in6 *)&bound)->sin6_port);
-    } else {
-        uv_ip4_name((struct sockaddr_in *)&bound, ip, sizeof ip);
-        bport = ntohs(((struct sockaddr_in *)&bound)->sin_port);
-    }
-    dlog(DLOG_INFO, "listening on tcp:%s:%d", ip, bport);
+    int bport = addr_name(&bound, ip);
+    dlog(DLOG_INFO, "listening on %s:%s:%d", scheme, ip, bport);
     if (portfp)
-        fprintf(portfp, "tcp:%s:%d\n", ip, bport);
+        fprintf(portfp, "%s:%s:%d\n", scheme, ip, bport);
     return 0;
 }
 
@@ -727,14 +1082,16 @@ int srv_listen(mcd *d, char *err, size_t errsz)
     int rc = 0;
     struct rlimit rl;
     if (getrlimit(RLIMIT_NOFILE, &rl) == 0)
-        dlog(DLOG_INFO, "file descriptors: soft limit %llu, %ld kept for the workers; at most %u connections "
-             "(%u per user, %u before HELLO)", (unsigned long long)rl.rlim_cur, fd_reserve(d),
-             d->conf.max_connections, d->conf.max_connections_per_user, d->conf.max_unauthenticated);
+        dlog(DLOG_INFO, "file descriptors: soft limit %llu, %ld kept for the workers, %u more for the Unix socket "
+             "and admins; at most %u non-admin sessions (%u per user), %u TCP connections before HELLO (%u per "
+             "address)", (unsigned long long)rl.rlim_cur, fds_reserve(&d->conf, bk_nslots(d)),
+             d->conf.admin_reserve, d->conf.max_connections, d->conf.max_connections_per_user,
+             d->conf.max_unauthenticated, d->conf.max_unauth_per_address);
     for (int i = 0; i < d->conf.nlisten && !rc; i++) {
         const char *a = d->conf.listen[i];
         uv_handle_t *h = NULL;
         rc = strncmp(a, "unix:", 5) == 0 ? listen_unix(d, a + 5, &h, err, errsz)
-                                         : listen_tcp(d, a + 4, &h, portfp, err, errsz);
+                                         : listen_tcp(d, a + 4, strncmp(a, "tls:", 4) == 0, &h, portfp, err, errsz);
         if (h)
             d->listeners[d->nlisteners++] = h;
     }
@@ -776,6 +1133,7 @@ void srv_stop_listening(mcd *d)
         uv_close(h, free_handle);
     }
     d->nlisteners = 0;
+    ntls_listeners = 0;
     if (!d->conns)
         sweep_stop();              /* else the timeouts go on until srv_close_all */
 }

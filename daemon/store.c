@@ -113,7 +113,8 @@ static const char schema[] =
     " crashes INTEGER NOT NULL DEFAULT 0," /* runs whose worker crashed */
     " verdict INTEGER NOT NULL DEFAULT -1," /* the map's quality_verdict; -1 not known */
     " flipped REAL, collapsed REAL,"      /* its flipped and collapsed fractions */
-    " fraction REAL, eta_s REAL);"        /* latest progress: the whole job's share done, time left */
+    " fraction REAL, eta_s REAL,"         /* latest progress: the whole job's share done, time left */
+    " bytes INTEGER NOT NULL DEFAULT 0);" /* its spool files' size (spool_bytes) */
     "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
     "CREATE TABLE IF NOT EXISTS history("
     " job INTEGER NOT NULL, stage INTEGER NOT NULL, outer_it INTEGER NOT NULL,"
@@ -216,6 +217,38 @@ static void remove_dir(const char *dir)
         dlog(DLOG_WARN, "store: cannot remove %s: %s", dir, strerror(errno));
 }
 
+/* The spool files a job's bytes count: its input, its answer and its
+ * progress (worker.lock and progress.secret are a few bytes and left out). */
+static const char *const counted_files[] = {SPOOL_JOB_FRAME, SPOOL_RESULT_FRAME, SPOOL_ERROR_FRAME,
+                                            SPOOL_PROGRESS_FILE, SPOOL_SLURM_OUT};
+
+/* Bytes of job id's counted spool files (a stat each, no directory walk);
+ * with_input 0 leaves job.frame out (it is about to go). */
+static int64_t spool_bytes(const store *s, uint64_t id, int with_input)
+{
+    char path[CONF_PATH + 96];
+    int64_t n = 0;
+    struct stat st;
+    for (size_t i = with_input ? 0 : 1; i < sizeof counted_files / sizeof counted_files[0]; i++)
+        if (stat(store_spool_path(s, id, counted_files[i], path, sizeof path), &st) == 0)
+            n += (int64_t)st.st_size;
+    return n;
+}
+
+/* Removes job id's job.frame (an ended job that did not complete). */
+static void drop_input(const store *s, uint64_t id)
+{
+    char path[CONF_PATH + 64];
+    if (unlink(store_spool_path(s, id, SPOOL_JOB_FRAME, path, sizeof path)) != 0 && errno != ENOENT)
+        dlog(DLOG_WARN, "store: cannot remove %s: %s", path, strerror(errno));
+}
+
+/* Counts job id's spool files again into its row's bytes. */
+static int recount_bytes(store *s, uint64_t id)
+{
+    return exec_v(s->db, "UPDATE jobs SET bytes = ? WHERE id = ?", "ii", spool_bytes(s, id, 1), (int64_t)id);
+}
+
 /* Removes spool/<id>/ and the files in it. */
 static void spool_remove(const store *s, uint64_t id)
 {
@@ -238,6 +271,19 @@ static int open_db(const char *path, sqlite3 **db, int (*busy)(void *, int), voi
         return PROTO_ESTORAGE;
     }
     return 0;
+}
+
+/* Every row's bytes from its spool files (a store from before the column). */
+static int count_all_bytes(store *s)
+{
+    sqlite3_stmt *st;
+    if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs", -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    int rc = 0;
+    while (!rc && sqlite3_step(st) == SQLITE_ROW)
+        rc = recount_bytes(s, (uint64_t)sqlite3_column_int64(st, 0));
+    sqlite3_finalize(st);
+    return rc;
 }
 
 int store_open(const char *dir, store **out, char *err, size_t errsz)
@@ -287,6 +333,13 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN eta_s REAL", NULL, NULL, NULL);
     sqlite3_exec(s->db, "ALTER TABLE history ADD COLUMN fraction REAL", NULL, NULL, NULL);
     sqlite3_exec(s->db, "ALTER TABLE history ADD COLUMN eta_s REAL", NULL, NULL, NULL);
+    /* a jobs.db from before the byte quota gains the column, counted once
+     * from the files (the ALTER succeeds only when the column is new) */
+    if (sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN bytes INTEGER NOT NULL DEFAULT 0", NULL, NULL, NULL)
+        == SQLITE_OK && count_all_bytes(s)) {
+        errbuf_set(err, errsz, rc, "%s: cannot count the jobs' spool bytes", path);
+        goto fail;
+    }
     /* a jobs.db from before the crash count gains the column */
     sqlite3_stmt *probe;
     if (sqlite3_prepare_v2(s->db, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, NULL) == SQLITE_OK) {
@@ -477,9 +530,43 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
         store_set_state(s, lost[i], PROTO_STATE_FAILED, "spool file job.frame missing after restart");
     }
     free(lost);
+    /* 4. ended jobs that did not complete hold no input (store_set_state
+     * removes it after its commit; a daemon killed in between left it):
+     * their missing job.frame is how it should be, not a loss */
+    if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs WHERE state NOT IN ('PENDING', 'RUNNING', 'COMPLETED')",
+                           -1, &st, NULL) != SQLITE_OK)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
+    int dropped = 0;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+        uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
+        char path[CONF_PATH + 64];
+        if (access(store_spool_path(s, id, SPOOL_JOB_FRAME, path, sizeof path), F_OK) == 0) {
+            drop_input(s, id);
+            recount_bytes(s, id);
+            dropped++;
+        }
+    }
+    sqlite3_finalize(st);
     dlog(DLOG_INFO, "store: recovered: %d result(s) adopted, %d running job(s) re-queued, %d orphan spool"
-         " dir(s) removed, %zu job(s) without spool failed", adopted, requeued, removed, nlost);
+         " dir(s) removed, %zu job(s) without spool failed, %d ended job(s)' input removed", adopted, requeued,
+         removed, nlost, dropped);
     return 0;
+}
+
+int store_bytes(store *s, const char *user, int64_t *bytes)
+{
+    sqlite3_stmt *st;
+    *bytes = 0;
+    if (sqlite3_prepare_v2(s->db, "SELECT COALESCE(SUM(bytes), 0) FROM jobs WHERE ?1 IS NULL OR user = ?1", -1,
+                           &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    if (user)
+        sqlite3_bind_text(st, 1, user, -1, SQLITE_TRANSIENT);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        *bytes = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return rc == SQLITE_ROW ? 0 : PROTO_ESTORAGE;
 }
 
 /* Writes len bytes of data to a new file path and fsyncs it. 0, or -1 with errno. */
@@ -534,9 +621,9 @@ int store_submit(store *s, const char *user, const char *label, int32_t priority
         remove_dir(tmpdir);
         return errbuf_set(err, errsz, PROTO_ESTORAGE, "job database busy or failing");
     }
-    if (exec_v(s->sdb, "INSERT INTO jobs(user, label, priority, state, submit_ms, params, total)"
-               " VALUES(?, ?, ?, 'PENDING', ?, ?, ?)", "ttiiti", user, label, (int64_t)priority,
-               store_now_ms(), params, (int64_t)total)) {
+    if (exec_v(s->sdb, "INSERT INTO jobs(user, label, priority, state, submit_ms, params, total, bytes)"
+               " VALUES(?, ?, ?, 'PENDING', ?, ?, ?, ?)", "ttiitii", user, label, (int64_t)priority,
+               store_now_ms(), params, (int64_t)total, (int64_t)len)) {
         errbuf_set(err, errsz, PROTO_ESTORAGE, "cannot insert the job row");
         goto fail;
     }
@@ -665,19 +752,27 @@ int store_set_state(store *s, uint64_t id, int state, const char *reason)
                       proto_state_name(state), reason ? reason : "", (int64_t)id);
     const char *counter = state == PROTO_STATE_COMPLETED ? "completed"
                         : state == PROTO_STATE_CANCELLED ? "cancelled" : "failed";
+    /* a job that did not complete keeps its row and reason until expiry,
+     * but not its input: nobody can ask for its result, so job.frame goes
+     * once the end is committed and its bytes stop counting now */
+    int keep_input = state == PROTO_STATE_COMPLETED;
     int rc = exec_v(s->db, "BEGIN", NULL);
     if (!rc)
-        rc = exec_v(s->db, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0, slurm_id = '' WHERE id = ?",
-                    "ttii",
-                    proto_state_name(state), reason ? reason : "", store_now_ms(), (int64_t)id);
+        rc = exec_v(s->db, "UPDATE jobs SET state = ?, reason = ?, end_ms = ?, pid = 0, slurm_id = '', bytes = ?"
+                    " WHERE id = ?", "ttiii", proto_state_name(state), reason ? reason : "", store_now_ms(),
+                    spool_bytes(s, id, keep_input), (int64_t)id);
     if (!rc)
         rc = exec_v(s->db, "INSERT INTO counters(name, value) VALUES(?, 1)"
                     " ON CONFLICT(name) DO UPDATE SET value = value + 1", "t", counter);
     if (!rc)
         rc = exec_v(s->db, "COMMIT", NULL);
-    if (rc)
+    if (rc) {
         exec_v(s->db, "ROLLBACK", NULL);
-    return rc;
+        return rc;
+    }
+    if (!keep_input)
+        drop_input(s, id);
+    return 0;
 }
 
 int store_add_progress(store *s, uint64_t id, const proto_progress *p)
@@ -737,7 +832,8 @@ int store_clear_run(store *s, uint64_t id)
                                   SPOOL_SLURM_OUT};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         unlink(store_spool_path(s, id, files[i], path, sizeof path));
-    return exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
+    int rc = recount_bytes(s, id);
+    return rc ? rc : exec_v(s->db, "DELETE FROM history WHERE job = ?", "i", (int64_t)id);
 }
 
 int store_result_read(const store *s, uint64_t id, proto_msg *m, uint8_t **bufp, char *why, size_t wsz)

@@ -38,11 +38,14 @@ void val_conf_of(const mcd *d, val_conf *vc)
     vc->max_vertices = d->conf.max_vertices;
     vc->max_faces = conf_max_faces(&d->conf);
     /* a decoded mesh is well under 256 bytes a vertex (Draco's buffers,
-     * positions, faces, the check's tables); the worker's limit when set */
-    vc->max_memory_mb = d->conf.worker_memory_mb
-                            ? d->conf.worker_memory_mb
+     * positions, faces, the check's tables); the worker's limit when one
+     * was given */
+    uint32_t wm = d->conf.worker_memory_mb;
+    vc->max_memory_mb = wm && wm != CONF_WORKER_MEMORY_AUTO
+                            ? wm
                             : VAL_BASE_MEMORY_MB + (unsigned)(2ull * d->conf.max_vertices * 256 >> 20);
     vc->max_cpu_s = VAL_MAX_CPU_S;
+    vc->worker_memory_mb = d->conf.worker_memory_mb;
 }
 
 static int write_all(int fd, const void *p, size_t n)
@@ -66,13 +69,14 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
     clock_gettime(CLOCK_MONOTONIC, &t0);
     if (cpu_ms)
         *cpu_ms = 0;
-    char maxv[24], maxf[24], mem[24], cpu[24];
+    char maxv[24], maxf[24], mem[24], cpu[24], wmem[24];
     snprintf(maxv, sizeof maxv, "%u", vc->max_vertices);
     snprintf(maxf, sizeof maxf, "%llu", vc->max_faces);
     snprintf(mem, sizeof mem, "%u", vc->max_memory_mb);
     snprintf(cpu, sizeof cpu, "%u", vc->max_cpu_s);
+    snprintf(wmem, sizeof wmem, "%u", vc->worker_memory_mb);
     char *argv[] = { (char *)vc->validator, "--max-vertices", maxv, "--max-faces", maxf,
-                     "--max-memory-mb", mem, "--max-cpu-s", cpu, NULL };
+                     "--max-memory-mb", mem, "--max-cpu-s", cpu, "--worker-memory-mb", wmem, NULL };
     int in[2] = {-1, -1}, out[2] = {-1, -1}, rc = PROTO_EINTERNAL;
     pid_t pid = -1;
     posix_spawn_file_actions_t fa;

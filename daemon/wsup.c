@@ -23,6 +23,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,6 +70,19 @@ static struct {
 static void slot_finish(wsup_slot *s);
 static void wsup_schedule(mcd *d);
 
+/* A worker's CPU seconds (its --max-cpu-s): the wall time it may run,
+ * SIGKILL's grace included, times the CPUs it may run on. CPU time counts
+ * every thread (OpenMP's, TBB's, PoCL's), and no mix of them gets more than
+ * that in that wall time, so the limit never ends a run the wall timer
+ * lets finish; it ends a worker that outlived its daemon (workers do, by
+ * design) after at most as much CPU as a run may take. */
+static unsigned long long wsup_cpu_limit_s(const mcd *d)
+{
+    cpu_set_t set;
+    long ncpu = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set) : sysconf(_SC_NPROCESSORS_ONLN);
+    return ((unsigned long long)d->conf.job_timeout_s + CONF_KILL_GRACE_S) * (unsigned long long)(ncpu > 0 ? ncpu : 1);
+}
+
 static int wsup_init(mcd *d, char *err, size_t errsz)
 {
     d->slots = calloc((size_t)d->conf.workers, sizeof *d->slots);
@@ -94,6 +108,13 @@ static int wsup_init(mcd *d, char *err, size_t errsz)
     const char *w = conf_worker_path(&d->conf, buf, sizeof buf);
     if (access(w, X_OK) != 0)
         dlog(DLOG_WARN, "worker program %s is not executable: jobs will fail until it is", w);
+    uint32_t mem_mb = conf_worker_memory_mb(&d->conf, d->conf.workers);
+    if (mem_mb)
+        dlog(DLOG_INFO, "workers run sandboxed (workers/WORKER.md): address space %u MB each (--worker-memory-mb),"
+             " CPU time %llu s each", mem_mb, wsup_cpu_limit_s(d));
+    else
+        dlog(DLOG_INFO, "workers run sandboxed (workers/WORKER.md): no address-space limit (--worker-memory-mb 0),"
+             " CPU time %llu s each", wsup_cpu_limit_s(d));
     return 0;
 }
 
@@ -366,7 +387,7 @@ static int slot_start(wsup_slot *s, uint64_t id, const char *user)
     proto_buf_reset(&s->in);
     store_clear_run(d->store, id);
 
-    char wbuf[PATH_MAX], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16];
+    char wbuf[PATH_MAX], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16], cpu[24];
     snprintf(sid, sizeof sid, "%llu", (unsigned long long)id);
     snprintf(fd, sizeof fd, "%d", SPOOL_PROGRESS_FD);
     snprintf(thr, sizeof thr, "%d", d->conf.threads_per_worker);
@@ -384,11 +405,15 @@ static int slot_start(wsup_slot *s, uint64_t id, const char *user)
         argv[k++] = "--threads";
         argv[k++] = thr;
     }
-    if (d->conf.worker_memory_mb > 0) {
-        snprintf(mem, sizeof mem, "%u", d->conf.worker_memory_mb);
+    uint32_t mem_mb = conf_worker_memory_mb(&d->conf, d->conf.workers);
+    if (mem_mb > 0) {
+        snprintf(mem, sizeof mem, "%u", mem_mb);
         argv[k++] = "--max-memory-mb";
         argv[k++] = mem;
     }
+    snprintf(cpu, sizeof cpu, "%llu", wsup_cpu_limit_s(d));
+    argv[k++] = "--max-cpu-s";
+    argv[k++] = cpu;
     argv[k] = NULL;
 
     uv_pipe_init(d->loop, &s->pipe, 0);

@@ -40,7 +40,14 @@ trap 'exit 130' INT TERM
 # stops the daemon, and not the daemon alone.
 rm -rf "$out/state" "$sock"
 mkdir -p "$out/state"
-setsid "$build/meshcorrd" --state-dir "$out/state" --listen "$server" --workers 1 2>"$out/meshcorrd.log" &
+# meshcorrd refuses to run as root: as root, it runs as the system user
+# meshcorr that deploy/install-deps.sh adds (the state directory becomes its).
+as_user=""
+if [ "$(id -u)" -eq 0 ]; then
+    as_user="--user meshcorr"
+fi
+# shellcheck disable=SC2086
+setsid "$build/meshcorrd" $as_user --state-dir "$out/state" --listen "$server" --workers 1 2>"$out/meshcorrd.log" &
 daemon=$!
 tries=0
 until "$build/meshcorr" stats --server "$server" >/dev/null 2>&1; do

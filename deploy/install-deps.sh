@@ -1,7 +1,9 @@
 #!/bin/sh
 # install-deps.sh — installs the Debian 12 packages meshcorr builds, tests and
-# demos with. Idempotent and non-interactive; fetches nothing but Debian
-# packages. Must not build or configure anything of the project itself.
+# demos with, and adds the system user the tests and the demo run meshcorrd
+# as (below).
+# Idempotent and non-interactive; fetches nothing but Debian packages. Must
+# not build or configure anything of the project itself.
 set -eu
 
 PACKAGES="
@@ -42,4 +44,12 @@ if [ -n "$missing" ]; then
     $SUDO apt-get install -y -qq --no-install-recommends $missing
 else
     echo "install-deps: all packages present"
+fi
+
+# Started as root, meshcorrd runs as --user meshcorr (it refuses root
+# without --user): the tests (tests/support/testdaemon.c) and make demo
+# (deploy/demo.sh) do so. A system user with no home and no login shell.
+if ! getent passwd meshcorr >/dev/null; then
+    echo "install-deps: adding the system user meshcorr"
+    $SUDO useradd --system --no-create-home --home-dir /nonexistent --shell /usr/sbin/nologin meshcorr
 fi

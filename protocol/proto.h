@@ -72,6 +72,7 @@
     X(PROTO_ECANCELLED,   -25, "CANCELLED",     "job cancelled")                      \
     X(PROTO_EBUSY,        -26, "BUSY",          "server at a connection limit; retry later") \
     X(PROTO_ETIMED_OUT,   -27, "TIMED_OUT",     "connection idle, or a request too slow, past its timeout") \
+    X(PROTO_EOVER_QUOTA,  -28, "OVER_QUOTA",    "the user's stored bytes, or the spool's, would pass its quota") \
     X(PROTO_EBAD_MAP,     -29, "BAD_MAP",       "initial map does not fit the meshes") \
     X(PROTO_ENUMERIC,     -30, "NUMERIC",       "a stage of the job failed numerically")
 
@@ -281,21 +282,30 @@ extern const proto_param_info proto_param_infos[PROTO_NPARAMS];
 
 /* Every member its default (backend ""). */
 void proto_params_init(proto_params *p);
+/* How a message names a parameter: as the wire, the C API and Python do
+ * ("inner_iterations = 500000"), or as the CLI's option
+ * ("--inner-iterations 500000"). */
+enum proto_param_naming { PROTO_NAME_WIRE, PROTO_NAME_CLI };
 /* THE validator: every field in its range (0 allowed where 0 means the
  * default), enumerations among their values, backend "" or cpu|opencl|auto
  * with an optional ":DEVICE" of at most PROTO_MAX_DEVICE bytes. 0, or
- * PROTO_EBAD_PARAMS with the field named in err, e.g.
- * "params.inner_iterations = 500000 > 100000". */
+ * PROTO_EBAD_PARAMS with the field by its wire name and its whole range in
+ * err: "inner_iterations = 500000: out of range [1, 100000]". */
 int proto_params_check(const proto_params *p, char *err, size_t errsz);
+/* The same naming the field as `naming` says (the CLI: "--iterations 0:
+ * out of range [1, 1000000]"). */
+int proto_params_check_as(const proto_params *p, int naming, char *err, size_t errsz);
 /* The range rule of row i for one numeric value v (no 0-means-default
- * rule): 0 or PROTO_EBAD_PARAMS with "params.NAME = V ..." in err. The
- * engine checks its own copies of the fields with it. */
+ * rule): 0 or PROTO_EBAD_PARAMS with "NAME = V: ..." (wire name) in err.
+ * The engine checks its own copies of the fields with it. */
 int proto_param_check(int i, double v, char *err, size_t errsz);
 /* Numeric member i as a double (STR: 0). */
 double proto_param_get(const proto_params *p, int i);
 /* Sets member i from text (a number, a value name of an ENUM, "0"/"1" for
  * BOOL; STR keeps the pointer: text must outlive p). Only parses: ranges
- * are proto_params_check's. 0, or PROTO_EBAD_PARAMS with "'x' is not ..." */
+ * are proto_params_check's. 0, or PROTO_EBAD_PARAMS with "'x' is not ..."
+ * (an integer row names its whole range: "'-1' is not an integer in [1,
+ * 1000000]"). */
 int proto_param_parse(proto_params *p, int i, const char *text, char *err, size_t errsz);
 /* Name of value v of ENUM row i ("injective"); NULL if none. */
 const char *proto_param_value_name(int i, unsigned v, char *buf, size_t sz);
@@ -360,9 +370,10 @@ typedef struct proto_status_ok {
     uint8_t has_progress; proto_progress progress;
     proto_quality quality;
 } proto_status_ok;
+#define PROTO_LIST_ALL_USERS "*"       /* LIST's user for every user's jobs (admin only) */
 typedef struct proto_list {
     uint32_t state_mask;              /* bit s = state s; 0 = every state */
-    const char *user;                 /* "" = me; another user: admin only */
+    const char *user;                 /* "" = me; another user or "*" (all): admin only */
     uint32_t max_count;               /* 0 = server's page size */
     uint64_t after_id;                /* ids greater than this (paging) */
 } proto_list;

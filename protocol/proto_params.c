@@ -73,66 +73,85 @@ static const char *words_of(const char *values, char *buf, size_t sz)
     return buf;
 }
 
-int proto_param_check(int i, double v, char *err, size_t errsz)
+/* The parameter as the message's reader knows it: "alpha =" or "--alpha". */
+static const char *named(const proto_param_info *f, int naming, char *buf, size_t sz)
+{
+    if (naming == PROTO_NAME_CLI)
+        snprintf(buf, sz, "--%s", f->cli);
+    else
+        snprintf(buf, sz, "%s =", f->name);
+    return buf;
+}
+
+static int check_as(int i, double v, int naming, char *err, size_t errsz)
 {
     const proto_param_info *f = &proto_param_infos[i];
-    char w[128];
+    char w[128], n[64], r[160];
+    named(f, naming, n, sizeof n);
     if (f->type == PROTO_PARAM_ENUM && (v < f->min || v > f->max || v != floor(v)))
-        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g: not %s", f->name, v,
+        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "%s %g: not %s", n, v,
                            words_of(f->values, w, sizeof w));
     if (!isfinite(v))
-        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g: not a finite number",
-                           f->name, v);
+        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "%s %g: not a finite number", n, v);
     if ((f->type == PROTO_PARAM_U32 || f->type == PROTO_PARAM_BOOL) && v != floor(v))
-        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g: not an integer", f->name, v);
+        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "%s %g: not an integer", n, v);
     if (v == 0 && (f->flags & PROTO_PARAM_ZERO_OFF))
         return PROTO_OK;
-    if (v < f->min || (v == f->min && (f->flags & PROTO_PARAM_OPEN_MIN)))
-        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g %s %g", f->name, v,
-                           v < f->min ? "<" : "<=", f->min);
-    if (v > f->max || (v == f->max && (f->flags & PROTO_PARAM_OPEN_MAX)))
-        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = %g %s %g", f->name, v,
-                           v > f->max ? ">" : ">=", f->max);
+    if (v < f->min || (v == f->min && (f->flags & PROTO_PARAM_OPEN_MIN)) ||
+        v > f->max || (v == f->max && (f->flags & PROTO_PARAM_OPEN_MAX)))
+        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "%s %g: out of range %s", n, v,
+                           proto_param_range(i, r, sizeof r));
     return PROTO_OK;
 }
 
-/* backend: "" or a word of the row's values, optionally ":DEVICE". */
-static int check_backend(const proto_param_info *f, const char *b, char *err, size_t errsz)
+int proto_param_check(int i, double v, char *err, size_t errsz)
 {
-    char w[128];
+    return check_as(i, v, PROTO_NAME_WIRE, err, errsz);
+}
+
+/* backend: "" or a word of the row's values, optionally ":DEVICE". */
+static int check_backend(const proto_param_info *f, const char *b, int naming, char *err, size_t errsz)
+{
+    char w[128], n[64];
     if (!b || !b[0])
         return PROTO_OK;
+    named(f, naming, n, sizeof n);
     size_t k = strcspn(b, ":");
     for (const char *s = f->values; *s;) {
-        size_t n = strcspn(s, "|");
-        if (n == k && strncmp(s, b, n) == 0) {
+        size_t len = strcspn(s, "|");
+        if (len == k && strncmp(s, b, len) == 0) {
             if (b[k] && strlen(b + k + 1) > PROTO_MAX_DEVICE)
                 return proto__errf(err, errsz, PROTO_EBAD_PARAMS,
-                                   "params.%s: device name of %zu bytes, over %d", f->name,
+                                   "%s '%s': device name of %zu bytes, over %d", n, b,
                                    strlen(b + k + 1), PROTO_MAX_DEVICE);
             return PROTO_OK;
         }
-        s += n + (s[n] == '|');
+        s += len + (s[len] == '|');
     }
-    return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "params.%s = '%s': not %s (optionally :DEVICE)",
-                       f->name, b, words_of(f->values, w, sizeof w));
+    return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "%s '%s': not %s (optionally :DEVICE)", n, b,
+                       words_of(f->values, w, sizeof w));
 }
 
-int proto_params_check(const proto_params *p, char *err, size_t errsz)
+int proto_params_check_as(const proto_params *p, int naming, char *err, size_t errsz)
 {
     for (int i = 0; i < PROTO_NPARAMS; i++) {
         const proto_param_info *f = &proto_param_infos[i];
         int rc;
         if (f->type == PROTO_PARAM_STR)
-            rc = check_backend(f, *(const char *const *)((const char *)p + f->offset), err, errsz);
+            rc = check_backend(f, *(const char *const *)((const char *)p + f->offset), naming, err, errsz);
         else if ((f->flags & PROTO_PARAM_ZERO_DEFAULT) && proto_param_get(p, i) == 0)
             rc = PROTO_OK;
         else
-            rc = proto_param_check(i, proto_param_get(p, i), err, errsz);
+            rc = check_as(i, proto_param_get(p, i), naming, err, errsz);
         if (rc)
             return rc;
     }
     return PROTO_OK;
+}
+
+int proto_params_check(const proto_params *p, char *err, size_t errsz)
+{
+    return proto_params_check_as(p, PROTO_NAME_WIRE, err, errsz);
 }
 
 int proto_param_parse(proto_params *p, int i, const char *text, char *err, size_t errsz)
@@ -161,8 +180,11 @@ int proto_param_parse(proto_params *p, int i, const char *text, char *err, size_
         return PROTO_OK;
     }
     uint32_t max = f->type == PROTO_PARAM_BOOL ? 1 : UINT32_MAX;
-    if (v != floor(v) || v < 0 || v > max)
-        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "'%s' is not an integer in [0, %u]", text, max);
+    if (v != floor(v) || v < 0 || v > max) {
+        char r[160];
+        return proto__errf(err, errsz, PROTO_EBAD_PARAMS, "'%s' is not an integer in %s", text,
+                           proto_param_range(i, r, sizeof r));
+    }
     if (f->type == PROTO_PARAM_BOOL)
         *(uint8_t *)at = (uint8_t)v;
     else

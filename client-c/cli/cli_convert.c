@@ -14,10 +14,13 @@ int cli_convert(int argc, char **argv)
         fputs("usage: meshcorr convert IN OUT\n", stdout);
         return 0;
     }
-    if (argc != 3) {
-        fputs("usage: meshcorr convert IN OUT\n", stderr);
-        return 2;
-    }
+    for (int i = 1; i < argc; i++)
+        if (argv[i][0] == '-' && argv[i][1])
+            return cli_usage_error("convert", "unknown option %s", argv[i]);
+    if (argc != 3)
+        return cli_usage_error("convert", "need IN and OUT mesh files (%d given)", argc - 1);
+    if (cli_output_check("convert", "OUT", argv[2]))
+        return CLI_EXIT_USAGE;
     char err[1024];
     mesh *m = NULL;
     if (mesh_read(argv[1], &m, err, sizeof err)) {

@@ -18,8 +18,8 @@ int cli_devices(int argc, char **argv)
                    "the first device with fp64 whose platform or device name contains NAME.\n");
             return 0;
         }
-        fprintf(stderr, "usage: meshcorr devices\n");
-        return 2;
+        return cli_usage_error("devices", "%s '%s'", argv[1][0] == '-' ? "unknown option" : "unexpected argument",
+                               argv[1]);
     }
     static ener_ocl_device dev[ENER_OCL_DEVICES_MAX];
     int n = 0;

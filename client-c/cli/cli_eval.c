@@ -3,13 +3,15 @@
  * the reverse map. Reads files and prints; computes nothing itself. Maps
  * are meshcorr-map 1 files or vertex maps (map/vmap.h, base --map-base).
  *
- * Ground-truth formats:
+ * Ground-truth formats (files read by workers/lmk, the reader and base
+ * rule of match's landmarks: 0-based unless --gt-base 1, a BIM .vts file's
+ * positions checked against its mesh):
  *   vts-pair     --gt A --gt-target B: line k of A (source vertex) <-> line
- *                k of B (target vertex); first column read (BCICP/FAUST .vts,
- *                BIM .vts "id x y z"); 1-based unless --gt-base 0
+ *                k of B (target vertex); one id a line (BCICP/FAUST .vts:
+ *                1-based, --gt-base 1) or BIM .vts "id x y z" / .pid lines
  *   vertex-list  --gt G: line i = the target vertex of source vertex i, one
  *                line per source vertex (cartoon gt_*.txt written as floats,
- *                pyFM lion2cat); 0-based unless --gt-base 1 */
+ *                pyFM lion2cat) */
 #include "cli/cli.h"
 #include "geod/geod.h"
 #include "lmk/lmk.h"
@@ -42,27 +44,41 @@ static void usage(FILE *fp)
         "         [--out-curve CURVES.svg] [--out-csv CURVES.csv]\n"
         "Maps: meshcorr-map 1 files, or vertex maps (one target vertex per source vertex a line,\n"
         "as BCICP and BIM write them; --map-base as match's --init-base, default auto).\n"
+        "Ground truth: vts-pair: line k of GT (a source vertex) <-> line k of GT2 (a target\n"
+        "vertex); vertex-list: line i of GT = the target vertex of source vertex i. One id a\n"
+        "line, or BIM .vts (`id x y z`) or .pid lines; ids 0-based as match's landmark files\n"
+        "(a .vts file's positions are checked against its mesh) unless --gt-base 1 (BCICP\n"
+        "and FAUST .vts lists are 1-based).\n"
         "Prints, for each map: conformal and area distortion, flipped and collapsed triangles,\n"
         "mean-curvature error, coverage of the target, the round trip with Q (one map only),\n"
         "and the geodesic error to a ground truth (divided by sqrt(target area); mean and\n"
         "cumulative curve to 0.25). Pictures: --out-colors writes PREFIX.target.ply (the\n"
         "target coloured by position) and PREFIX.source.ply (the source coloured through the\n"
         "first map: same colour, same place); --out-png writes the same colours as a picture,\n"
-        "800 by 800 pixels: left the source through the map, right the target; top row the\n"
+        "800 pixels wide: left the source through the map, right the target; top row the\n"
         "target's widest side (the world axes of its longest and middle extents across and\n"
         "up), bottom row from behind; the source turned to face as its images on the target\n"
         "do, each shape centred in its panel (--mark-folds hatches the source's flipped and\n"
-        "collapsed triangles). --out-curve and --out-csv write the cumulative error curves\n"
-        "of every map (with a ground truth).\n");
+        "collapsed triangles); captions say which side is which, the map, its flipped and\n"
+        "collapsed triangles and its geodesic error. --out-curve and --out-csv write the\n"
+        "cumulative error curves of every map (with a ground truth).\n");
 }
 
-/* lmk_read_ids with the message on stderr. */
-static int read_indices(const char *path, int base, int nv, int **out, int *n)
+/* lmk_read_ids_on with the message on stderr, and what to do about it. */
+static int read_indices(const char *path, int base, const mesh *m, int **out, int *n)
 {
     char err[512];
-    if (lmk_read_ids(path, base, nv, EVAL_MAX_GT_LINES, out, n, err, sizeof err) == LMK_OK)
+    int rc = lmk_read_ids_on(path, base, m, EVAL_MAX_GT_LINES, out, n, err, sizeof err);
+    if (rc == LMK_OK)
         return 0;
-    fprintf(stderr, "meshcorr eval: %s\n", err);
+    const char *hint = "";
+    if (rc == LMK_ELAYOUT)
+        hint = " (--gt, --gt-target)";
+    else if (rc == LMK_ERANGE && base == LMK_BASE_DEFAULT && strstr(err, "looks 1-based"))
+        hint = ": give --gt-base 1";
+    else if (rc == LMK_EBASE)
+        hint = ": leave --gt-base out";
+    fprintf(stderr, "meshcorr eval: %s%s\n", err, hint);
     return -1;
 }
 
@@ -94,23 +110,53 @@ out:
     return rc;
 }
 
+/* What the picture shows, for its captions: the files, the map's quality
+ * and (gt_points > 0) its mean geodesic error. */
+typedef struct png_words {
+    const char *spath, *tpath, *ppath;
+    double flipped, collapsed, gt_mean;
+    int gt_points, folds;
+} png_words;
+
+/* The last part of a path: captions name files, not folders. */
+static const char *base_name(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s && s[1] ? s + 1 : path;
+}
+
 /* FILE: the source coloured through P beside the target coloured by
  * position (render_map_picture), the source turned to face as its images
- * P·X̃ do; folds: hatch P's flipped and collapsed source faces. */
-static int write_png(const char *path, const mesh *S, const mesh *T, const bmap *P, int folds)
+ * P·X̃ do, with captions saying which side is which, which map and how
+ * good it is; folds: hatch P's flipped and collapsed source faces. */
+static int write_png(const char *path, const mesh *S, const mesh *T, const bmap *P, const png_words *w)
 {
     char err[1024];
     int rc = RENDER_ENOMEM;
     unsigned char *trgb = malloc(3 * (size_t)T->nv + 1), *srgb = malloc(3 * (size_t)S->nv + 1);
-    unsigned char *kind = folds ? malloc((size_t)S->nf + 1) : NULL;
+    unsigned char *kind = w->folds ? malloc((size_t)S->nf + 1) : NULL;
     double *img = malloc(sizeof(double) * 3 * (size_t)S->nv + 1);
-    render_image *im = NULL;
-    if (!trgb || !srgb || !img || (folds && (!kind || metric_fold_faces(S, T, P, kind) < 0)))
+    render_image *im = NULL, *pic = NULL;
+    if (!trgb || !srgb || !img || (w->folds && (!kind || metric_fold_faces(S, T, P, kind) < 0)))
         goto fail;
     viz_position_colors(T, trgb);
     viz_pull_colors(P, T->f, trgb, srgb);
     bmap_apply(P, T->f, T->v, 3, img);
-    if ((rc = render_map_picture(S, srgb, kind, img, T, trgb, EVAL_PNG_PANEL, &im)))
+    if ((rc = render_map_picture(S, srgb, kind, img, T, trgb, EVAL_PNG_PANEL, &pic)))
+        goto fail;
+    char src[600], tgt[600], map[600], quality[200], error[200] = "";
+    snprintf(src, sizeof src, "source: %s", base_name(w->spath));
+    snprintf(tgt, sizeof tgt, "target: %s", base_name(w->tpath));
+    snprintf(map, sizeof map, "map: %s", base_name(w->ppath));
+    snprintf(quality, sizeof quality, "source triangles flipped %.2f %%, collapsed %.2f %%%s", 100 * w->flipped,
+             100 * w->collapsed, w->folds ? " (hatched)" : "");
+    if (w->gt_points > 0)
+        snprintf(error, sizeof error, "geodesic error: mean %.4f of sqrt(area), %d points", w->gt_mean,
+                 w->gt_points);
+    render_caption cap = {{src, "coloured through the map"}, {tgt, "coloured by position"},
+                          {map, quality, w->gt_points > 0 ? error : "top: the target's widest side; bottom: from behind",
+                           w->gt_points > 0 ? "top: the target's widest side; bottom: from behind" : NULL}};
+    if ((rc = render_captioned(pic, &cap, &im)))
         goto fail;
     if ((rc = render_png_write(im, path, err, sizeof err)))
         fprintf(stderr, "meshcorr eval: %s\n", err);
@@ -118,6 +164,7 @@ static int write_png(const char *path, const mesh *S, const mesh *T, const bmap 
 fail:
     fprintf(stderr, "meshcorr eval: %s: %s\n", path, render_strerror(rc));
 out:
+    render_image_free(pic);
     render_image_free(im);
     free(img);
     free(kind);
@@ -179,26 +226,22 @@ int cli_eval(int argc, char **argv)
         {0, 0, 0, 0}};
     const char *rev = NULL, *gt = NULL, *gt2 = NULL, *fmt = NULL;
     const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL, *out_png = NULL;
-    int base = -1, json = 0, folds = 0, c, bad = 0, map_base = VMAP_BASE_AUTO;
+    int base = LMK_BASE_DEFAULT, json = 0, folds = 0, c, map_base = VMAP_BASE_AUTO;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    while ((c = cli_getopt("eval", argc, argv, opts)) != -1) {
         switch (c) {
         case 'r': rev = optarg; break;
         case 'g': gt = optarg; break;
         case 't': gt2 = optarg; break;
         case 'f': fmt = optarg; break;
         case 'b':
-            if (strcmp(optarg, "0") && strcmp(optarg, "1")) {
-                fprintf(stderr, "meshcorr eval: --gt-base: '%s' is not 0 or 1\n", optarg);
-                bad = 1;
-            }
+            if (strcmp(optarg, "0") && strcmp(optarg, "1"))
+                return cli_usage_error("eval", "--gt-base: '%s' is not 0 or 1", optarg);
             base = optarg[0] - '0';
             break;
         case 'B':
-            if (strcmp(optarg, "0") && strcmp(optarg, "1") && strcmp(optarg, "auto")) {
-                fprintf(stderr, "meshcorr eval: --map-base: '%s' is not 0, 1 or auto\n", optarg);
-                bad = 1;
-            }
+            if (strcmp(optarg, "0") && strcmp(optarg, "1") && strcmp(optarg, "auto"))
+                return cli_usage_error("eval", "--map-base: '%s' is not 0, 1 or auto", optarg);
             map_base = strcmp(optarg, "auto") ? optarg[0] - '0' : VMAP_BASE_AUTO;
             break;
         case 'j': json = 1; break;
@@ -208,41 +251,32 @@ int cli_eval(int argc, char **argv)
         case 'p': out_png = optarg; break;
         case 'm': folds = 1; break;
         case 'h': usage(stdout); return 0;
-        default: bad = 1;
+        default: return cli_usage_see("eval");
         }
     }
     int pair = fmt && strcmp(fmt, "vts-pair") == 0, list = fmt && strcmp(fmt, "vertex-list") == 0;
     int nmaps = argc - optind - 2;
-    if (!bad && (nmaps < 1 || nmaps > EVAL_MAX_MAPS)) {
-        fprintf(stderr, "meshcorr eval: need SOURCE TARGET and 1 to %d maps\n", EVAL_MAX_MAPS);
-        bad = 1;
-    }
-    if (!bad && rev && nmaps != 1) {
-        fprintf(stderr, "meshcorr eval: --reverse goes with a single map\n");
-        bad = 1;
-    }
-    if (!bad && (out_curve || out_csv) && !gt) {
-        fprintf(stderr, "meshcorr eval: --out-curve and --out-csv need a ground truth (--gt)\n");
-        bad = 1;
-    }
-    if (!bad && folds && !out_png) {
-        fprintf(stderr, "meshcorr eval: --mark-folds goes with --out-png\n");
-        bad = 1;
-    }
-    if (!bad && gt && !pair && !list) {
-        fprintf(stderr, "meshcorr eval: --gt needs --gt-format vts-pair or vertex-list\n");
-        bad = 1;
-    }
-    if (!bad && gt && pair != !!gt2) {
-        fprintf(stderr, "meshcorr eval: --gt-target goes with --gt-format vts-pair, and only with it\n");
-        bad = 1;
-    }
-    if (bad) {
-        usage(stderr);
-        return 2;
-    }
-    if (base < 0)
-        base = pair ? 1 : 0;
+    if (nmaps < 1 || nmaps > EVAL_MAX_MAPS)
+        return cli_usage_error("eval", "need SOURCE TARGET and 1 to %d maps (%d file%s given)", EVAL_MAX_MAPS,
+                               argc - optind, argc - optind == 1 ? "" : "s");
+    if (rev && nmaps != 1)
+        return cli_usage_error("eval", "--reverse goes with a single map");
+    if ((out_curve || out_csv) && !gt)
+        return cli_usage_error("eval", "--out-curve and --out-csv need a ground truth (--gt)");
+    if (folds && !out_png)
+        return cli_usage_error("eval", "--mark-folds goes with --out-png");
+    if (fmt && !pair && !list)
+        return cli_usage_error("eval", "--gt-format: '%s' is not vts-pair or vertex-list", fmt);
+    if (gt && !fmt)
+        return cli_usage_error("eval", "--gt needs --gt-format vts-pair or vertex-list");
+    if (gt && pair != !!gt2)
+        return cli_usage_error("eval", "--gt-target goes with --gt-format vts-pair, and only with it");
+    char colors[4200];
+    snprintf(colors, sizeof colors, "%s.target.ply", out_colors ? out_colors : "");
+    if (cli_output_check("eval", "--out-colors", out_colors ? colors : NULL) ||
+        cli_output_check("eval", "--out-png", out_png) || cli_output_check("eval", "--out-curve", out_curve) ||
+        cli_output_check("eval", "--out-csv", out_csv))
+        return CLI_EXIT_USAGE;
     const char *spath = argv[optind], *tpath = argv[optind + 1];
     char *const *ppaths = argv + optind + 2;
     char err[1024];
@@ -263,7 +297,7 @@ int cli_eval(int argc, char **argv)
             goto done;
         }
     if (gt && pair) {
-        if (read_indices(gt, base, S->nv, &gsrc, &ngt) || read_indices(gt2, base, T->nv, &gtgt, &n2))
+        if (read_indices(gt, base, S, &gsrc, &ngt) || read_indices(gt2, base, T, &gtgt, &n2))
             goto done;
         if (ngt != n2 || ngt == 0) {
             fprintf(stderr, "meshcorr eval: %s has %d lines but %s has %d: line k of one must "
@@ -271,7 +305,7 @@ int cli_eval(int argc, char **argv)
             goto done;
         }
     } else if (gt) {
-        if (read_indices(gt, base, T->nv, &gtgt, &ngt))
+        if (read_indices(gt, base, T, &gtgt, &ngt))
             goto done;
         if (ngt != S->nv) {
             fprintf(stderr, "meshcorr eval: %s has %d lines, but the source %s has %d vertices "
@@ -284,6 +318,7 @@ int cli_eval(int argc, char **argv)
             gsrc[k] = k;
     }
     double curves[EVAL_MAX_MAPS][EVAL_CURVE_STEPS], gmean[EVAL_MAX_MAPS];
+    png_words words = {spath, tpath, ppaths[0], NAN, NAN, NAN, 0, folds};
     if (gt) {
         if (geod_solver_new(T, 0, &gs, err, sizeof err)) {
             fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);
@@ -318,6 +353,10 @@ int cli_eval(int argc, char **argv)
             fprintf(stderr, "meshcorr eval: curvature error of %s: %s\n", ppath, err);
             status = crc == METRIC_ENOMEM ? proto_kind_exit(PROTO_KIND_NOMEM) : 1;
             goto done;
+        }
+        if (a == 0) {
+            words.flipped = ms.flipped_fraction;
+            words.collapsed = ms.collapsed_fraction;
         }
         if (json) {
             printf("{\"map\":\"%s\",\"conformal_median\":%.9g,\"conformal_mean\":%.9g,"
@@ -354,7 +393,9 @@ int cli_eval(int argc, char **argv)
     }
     if (out_colors && write_colors(out_colors, S, T, maps[0]))
         goto done;
-    if (out_png && write_png(out_png, S, T, maps[0], folds))
+    words.gt_points = gt ? ngt : 0;
+    words.gt_mean = gt ? gmean[0] : NAN;
+    if (out_png && write_png(out_png, S, T, maps[0], &words))
         goto done;
     if (out_curve || out_csv) {
         const double *cv[EVAL_MAX_MAPS];

@@ -14,10 +14,10 @@ int cli_info(int argc, char **argv)
         fputs("usage: meshcorr info MESH\n", stdout);
         return 0;
     }
-    if (argc != 2) {
-        fputs("usage: meshcorr info MESH\n", stderr);
-        return 2;
-    }
+    if (argc == 2 && argv[1][0] == '-' && argv[1][1])
+        return cli_usage_error("info", "unknown option %s", argv[1]);
+    if (argc != 2)
+        return cli_usage_error("info", "need one mesh file (%d given)", argc - 1);
     const char *path = argv[1];
     char err[1024];
     mesh *m = NULL;

@@ -1,6 +1,7 @@
 /* cli_job.c — see cli_job.h. Parsing and loading only; running a job is the
  * command's business. The job parameters are the rows of PROTO_PARAMS:
- * parsed by proto_param_parse, checked by proto_params_check. */
+ * parsed by proto_param_parse, checked by proto_params_check_as, which
+ * names each by its option (--iterations) and its whole range. */
 #include "cli/cli_job.h"
 #include "corr/corr.h"
 
@@ -15,6 +16,10 @@ void cli_job_usage(FILE *fp)
         "           | --init P.map [--init-reverse Q.map] [--init-base 0|1|auto] [landmarks]\n"
         "           (landmarks: at least %d pairs; without --init the initial maps come from\n"
         "           them: a start map (--start), then Reversible Harmonic Maps)\n"
+        "           PAIRS: `source_vertex target_vertex` a line; A, B: one vertex id a line,\n"
+        "           or BIM .vts (`id x y z`) or .pid (`id 0 0 0`) lines, line k of A <-> line k\n"
+        "           of B; ids 0-based (as BIM's files; a .vts file's positions are checked\n"
+        "           against the mesh) unless --one-based (BCICP and FAUST .vts lists)\n"
         "           --init files: meshcorr-map 1, or a vertex map (one target vertex per\n"
         "           source vertex a line, as BCICP and BIM write them); its base: --init-base,\n"
         "           else auto: a 0 among the indices -> 0-based, else the target's vertex\n"
@@ -160,7 +165,7 @@ int cli_job_check(cli_job *j, const char *cmd)
         j->w.backend = j->backend;
         j->device = NULL;
     }
-    if (proto_params_check(&j->w, err, sizeof err)) {
+    if (proto_params_check_as(&j->w, PROTO_NAME_CLI, err, sizeof err)) {
         fprintf(stderr, "meshcorr %s: %s\n", cmd, err);
         return -1;
     }
@@ -188,12 +193,23 @@ int cli_job_load(const cli_job *j, const char *cmd, const mesh *S, const mesh *T
         rc = vmap_read_any(j->init, j->init_base, S, T, P0, err, sizeof err);
     if (!rc && j->init_rev)
         rc = vmap_read_any(j->init_rev, j->init_base, T, S, Q0, err, sizeof err);
-    if (!rc && j->lmk_pairs)
-        rc = lmk_read_pairs(j->lmk_pairs, j->one_based, S, T, L, err, sizeof err);
-    else if (!rc && j->lmk_src && j->lmk_tgt)
-        rc = lmk_read_lists(j->lmk_src, j->lmk_tgt, j->one_based, S, T, L, err, sizeof err);
+    int base = j->one_based ? 1 : LMK_BASE_DEFAULT;
+    const char *hint = "";
+    if (!rc && j->lmk_pairs) {
+        rc = lmk_read_pairs(j->lmk_pairs, base, S, T, L, err, sizeof err);
+        if (rc == LMK_ELAYOUT)
+            hint = " (--landmarks), or give two lists: --source-landmarks A.vts --target-landmarks B.vts";
+    } else if (!rc && j->lmk_src && j->lmk_tgt) {
+        rc = lmk_read_lists(j->lmk_src, j->lmk_tgt, base, S, T, L, err, sizeof err);
+        if (rc == LMK_ELAYOUT)
+            hint = " (--source-landmarks, --target-landmarks); pairs go to --landmarks";
+    }
+    if (rc == LMK_ERANGE && !j->one_based && strstr(err, "looks 1-based"))
+        hint = ": give --one-based";
+    else if (rc == LMK_EBASE)
+        hint = ": leave --one-based out";
     if (rc) {
-        fprintf(stderr, "meshcorr %s: %s\n", cmd, err);
+        fprintf(stderr, "meshcorr %s: %s%s\n", cmd, err, hint);
         lmk_free(*L);
         bmap_free(*P0);
         bmap_free(*Q0);

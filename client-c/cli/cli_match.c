@@ -20,6 +20,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#define MATCH_MAX_THREADS 4096   /* --threads: more is a typo, not a machine */
+
 static void usage(FILE *fp)
 {
     fprintf(fp,
@@ -90,15 +92,15 @@ int cli_match(int argc, char **argv)
     double log_eps = pe.log_eps;
     int threads = 0;
     int progress = CLI_PROGRESS_AUTO;
-    int c, bad = 0;
+    int c;
     char *e;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    while ((c = cli_getopt("match", argc, argv, opts)) != -1) {
         int r = cli_job_option(&job, "match", c, optarg);
-        if (r) {
-            bad |= r < 0;
+        if (r < 0)
+            return cli_usage_see("match");
+        if (r)
             continue;
-        }
         switch (c) {
         case O_OUT: out = optarg; break;
         case O_OUT_REVERSE: out_rev = optarg; break;
@@ -106,49 +108,41 @@ int cli_match(int argc, char **argv)
         case O_OUT_REMESHED: out_rem = optarg; break;
         case O_LOG_EPS:
             log_eps = strtod(optarg, &e);
-            if (!*optarg || *e) {
-                fprintf(stderr, "meshcorr match: --log-eps: '%s' is not a number\n", optarg);
-                bad = 1;
-            }
+            if (!*optarg || *e || !(log_eps > 0) || !isfinite(log_eps))
+                return cli_usage_error("match", "--log-eps: '%s' is not a number > 0", optarg);
             break;
         case O_THREADS:
             threads = (int)strtol(optarg, &e, 10);
-            if (!*optarg || *e) {
-                fprintf(stderr, "meshcorr match: --threads: '%s' is not an integer\n", optarg);
-                bad = 1;
-            }
+            if (!*optarg || *e || threads < 0 || threads > MATCH_MAX_THREADS)
+                return cli_usage_error("match", "--threads: '%s' is not an integer in [0, %d] (0: by the "
+                                       "pair's size)", optarg, MATCH_MAX_THREADS);
             break;
         case O_PROGRESS:
-            if (cli_progress_parse(optarg, &progress)) {
-                fprintf(stderr, "meshcorr match: --progress: '%s' is not auto, bar, text, json or none\n",
-                        optarg);
-                bad = 1;
-            }
+            if (cli_progress_parse(optarg, &progress))
+                return cli_usage_error("match", "--progress: '%s' is not auto, bar, text, json or none",
+                                       optarg);
             break;
         case 'h': usage(stdout); return 0;
-        default: bad = 1;
+        default: return cli_usage_see("match");
         }
     }
-    if (!bad && (argc - optind != 2 || !out)) {
-        fprintf(stderr, "meshcorr match: need SOURCE TARGET and --out\n");
-        bad = 1;
-    }
-    if (bad || cli_job_check(&job, "match") || cli_job_engine(&job, "match", threads, &pe, &rp)) {
-        usage(stderr);
-        return 2;
-    }
+    if (argc - optind != 2)
+        return cli_usage_error("match", "need SOURCE and TARGET mesh files (%d given)", argc - optind);
+    if (!out)
+        return cli_usage_error("match", "need --out P.map");
+    if (cli_job_check(&job, "match") || cli_job_engine(&job, "match", threads, &pe, &rp))
+        return cli_usage_see("match");
     pe.log_eps = log_eps;
     corr_stages stages = (corr_stages)job.w.stages;
     int ectm_last = corr_stages_run(stages, !!job.init) & CORR_RUN_ECTM;
-    if (!ectm_last && out_def) {
-        fprintf(stderr, "meshcorr match: --out-deformed needs the ECTM stage (the deformation is "
-                "ECTM's)\n");
-        return 2;
-    }
-    if (pe.model == ECTM_INJECTIVE && out_rev) {
-        fprintf(stderr, "meshcorr match: --out-reverse needs the bijective model\n");
-        return 2;
-    }
+    if (!ectm_last && out_def)
+        return cli_usage_error("match", "--out-deformed needs the ECTM stage (the deformation is ECTM's)");
+    if (pe.model == ECTM_INJECTIVE && out_rev)
+        return cli_usage_error("match", "--out-reverse needs the bijective model");
+    if (cli_output_check("match", "--out", out) || cli_output_check("match", "--out-reverse", out_rev) ||
+        cli_output_check("match", "--out-deformed", out_def) ||
+        cli_output_check("match", "--out-remeshed", out_rem))
+        return CLI_EXIT_USAGE;
     char err[1024];
     progress = cli_progress_resolve(progress, stderr);
 

@@ -71,12 +71,18 @@ int cli_params(int argc, char **argv)
         free(t);
         return 0;
     }
+    if (argc == 2 && !strcmp(argv[1], "--help")) {
+        printf("usage: meshcorr params [--markdown | --mdoc]\n"
+               "the job options of meshcorr match and submit; --markdown: as PROTOCOL.md's table;\n"
+               "--mdoc: as meshcorr(1)'s list\n");
+        return 0;
+    }
     if (argc != 1) {
-        fprintf(argc == 2 && !strcmp(argv[1], "--help") ? stdout : stderr,
-                "usage: meshcorr params [--markdown | --mdoc]\n"
-                "the job options of meshcorr match and submit; --markdown: as PROTOCOL.md's table;\n"
-                "--mdoc: as meshcorr(1)'s list\n");
-        return argc == 2 && !strcmp(argv[1], "--help") ? 0 : 2;
+        static const char *const names[] = {"markdown", "mdoc", "help"};
+        char buf[128];
+        const char *a = argv[1], *sg = strncmp(a, "--", 2) ? NULL : cli_suggest(a + 2, names, 3, "--", buf, sizeof buf);
+        return cli_usage_error("params", "%s '%s'%s%s%s", a[0] == '-' ? "unknown option" : "unexpected argument", a,
+                               sg ? "; did you mean " : "", sg ? sg : "", sg ? "?" : "");
     }
     cli_job_usage(stdout);
     return 0;

@@ -1,9 +1,14 @@
 /* cli_remote.c — the `meshcorr` subcommands that talk to meshcorrd through
  * libmeshcorr: submit, status, watch, result, cancel, delete, list, stats.
- * They share the server options (--server ADDR, --token T, --token-file F;
- * defaults $MESHCORR_SERVER or unix:$XDG_RUNTIME_DIR/meshcorr.sock, and
- * $MESHCORR_TOKEN) and print one line per fact, or JSON where asked. No
- * numerics, no protocol details: meshcorr.h is the whole interface. */
+ * They share the server options (--server ADDR, --token T, --token-file F,
+ * --ca FILE; defaults $MESHCORR_SERVER or MC_DEFAULT_SERVER, the socket the
+ * shipped config listens on, $MESHCORR_TOKEN, and $MESHCORR_CA, read by
+ * libmeshcorr; a bare path is a Unix socket) and print one line per fact,
+ * or JSON where asked. A failed connect says what to do about it. No
+ * numerics, no protocol details: meshcorr.h is the whole interface. Every
+ * string the server sends (labels, user names, reasons, messages, device
+ * names) reaches the terminal through shown() or json_str, which escape
+ * control characters, escape sequences and bidi marks (stresc). */
 #include "cli/cli.h"
 #include "metric/metric.h"
 #include "cli/cli_job.h"
@@ -13,7 +18,9 @@
 #include "mesh/draco_bridge.h"
 #include "mesh/mesh.h"
 #include "meshcorr.h"
+#include "util/stresc.h"
 
+#include <ctype.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -22,10 +29,22 @@
 #include <strings.h>
 #include <time.h>
 
+/* s, a string from the server, as the terminal may show it (stresc). The
+ * result lives until the fourth call after this one (four buffers in
+ * turn: enough for the strings of one line). */
+static const char *shown(const char *s)
+{
+    static char bufs[4][STRESC_SIZE(2048)];
+    static unsigned next;
+    char *b = bufs[next++ % 4];
+    return stresc(s, b, sizeof bufs[0]);
+}
+
 typedef struct remote {
     const char *server, *token;
     const char *token_file;    /* when set, the token is this file's first line */
-    char def[4200];
+    const char *ca;            /* --ca: the CA file a tls: server's certificate must chain to */
+    char addr[4200];           /* server as an address mc_connect takes */
 } remote;
 
 static void remote_defaults(remote *r)
@@ -33,11 +52,19 @@ static void remote_defaults(remote *r)
     r->server = getenv("MESHCORR_SERVER");
     r->token = getenv("MESHCORR_TOKEN");
     r->token_file = NULL;
-    if (!r->server || !*r->server) {
-        const char *xdg = getenv("XDG_RUNTIME_DIR");
-        snprintf(r->def, sizeof r->def, "unix:%s/meshcorr.sock", xdg && *xdg ? xdg : "/tmp");
-        r->server = r->def;
-    }
+    r->ca = NULL;
+    if (!r->server || !*r->server)
+        r->server = MC_DEFAULT_SERVER;
+}
+
+/* The address of r->server: unix:PATH and tcp:HOST:PORT as they are; a
+ * bare path (one that starts with / or ., or holds no ':') as unix:PATH. */
+static const char *remote_address(remote *r)
+{
+    const char *s = r->server;
+    int path = s[0] == '/' || s[0] == '.' || !strchr(s, ':');
+    snprintf(r->addr, sizeof r->addr, "%s%s", path ? "unix:" : "", s);
+    return r->addr;
 }
 
 /* The token in a --token-file: its first line, without the line end. */
@@ -59,7 +86,38 @@ static int read_token_file(const char *cmd, const char *path, char *tok, size_t 
     return 0;
 }
 
-static mc_client *remote_connect(const char *cmd, const remote *r)
+/* The words of a failed connect: what failed, then what to do. */
+static void connect_failed(const char *cmd, const char *addr, int rc, const char *err, const remote *r,
+                           const char *token)
+{
+    size_t al = strlen(addr);
+    if (strncmp(err, addr, al) == 0 && strncmp(err + al, ": ", 2) == 0)
+        err += al + 2;                       /* libmeshcorr's detail starts with the address */
+    err = shown(err);                        /* the server's words may be part of it */
+    int has_token = token && *token;
+    if (rc == MC_ECONNECT)
+        fprintf(stderr, "meshcorr %s: cannot connect to %s: %s (is meshcorrd running there? set "
+                "MESHCORR_SERVER or --server)\n", cmd, addr, err);
+    else if (rc == MC_EADDRESS) {
+        const char *colon = strrchr(r->server, ':');
+        int hostport = colon && colon[1] && strspn(colon + 1, "0123456789") == strlen(colon + 1);
+        if (hostport)
+            fprintf(stderr, "meshcorr %s: %s; did you mean tls:%s (or tcp:%s on loopback)?\n", cmd, err,
+                    shown(r->server), shown(r->server));
+        else
+            fprintf(stderr, "meshcorr %s: %s\n", cmd, err);
+    } else if (rc == MC_EUNAUTHORIZED && !has_token && strncmp(addr, "unix:", 5) != 0)
+        fprintf(stderr, "meshcorr %s: %s needs a token: --token T, --token-file F or MESHCORR_TOKEN "
+                "(the server said: %s)\n", cmd, addr, err);
+    else if (rc == MC_EUNAUTHORIZED)
+        fprintf(stderr, "meshcorr %s: %s refused %s: %s\n", cmd, addr,
+                !has_token ? "this Unix user" : r->token_file ? "the token (from --token-file)"
+                                                             : "the token (from --token or $MESHCORR_TOKEN)", err);
+    else
+        fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, addr, err);
+}
+
+static mc_client *remote_connect(const char *cmd, remote *r)
 {
     mc_client *c = NULL;
     char err[1200], tok[1024];
@@ -69,12 +127,10 @@ static mc_client *remote_connect(const char *cmd, const remote *r)
             return NULL;
         token = tok;
     }
-    int rc = mc_connect(r->server, token, &c, err, sizeof err);
+    const char *addr = remote_address(r);
+    int rc = mc_connect_ca(addr, token, r->ca, &c, err, sizeof err);
     if (rc) {
-        fprintf(stderr, "meshcorr %s: %s: %s\n", cmd, r->server, err);
-        if (rc == MC_EUNAUTHORIZED)
-            fprintf(stderr, "meshcorr %s: the server refused the token (from %s)\n", cmd,
-                    r->token_file ? "--token-file" : token && *token ? "--token or $MESHCORR_TOKEN" : "nowhere: none given");
+        connect_failed(cmd, addr, rc, err, r, token);
         return NULL;
     }
     return c;
@@ -82,7 +138,7 @@ static mc_client *remote_connect(const char *cmd, const remote *r)
 
 static int fail(const char *cmd, mc_client *c, int rc)
 {
-    fprintf(stderr, "meshcorr %s: %s\n", cmd, mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc));
+    fprintf(stderr, "meshcorr %s: %s\n", cmd, shown(mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc)));
     mc_close(c);
     return 1;
 }
@@ -100,11 +156,11 @@ static int parse_id(const char *cmd, const char *s, uint64_t *id)
 }
 
 /* Options every remote subcommand takes; 1 when handled. */
-enum { O_SERVER = 1000, O_TOKEN, O_TOKEN_FILE };
+enum { O_SERVER = 1000, O_TOKEN, O_TOKEN_FILE, O_CA };
 #define REMOTE_OPTS {"server", required_argument, 0, O_SERVER}, {"token", required_argument, 0, O_TOKEN}, \
-                    {"token-file", required_argument, 0, O_TOKEN_FILE}
-#define REMOTE_NOPTS 3
-#define REMOTE_USAGE "         [--server ADDR] [--token T | --token-file F]\n"
+                    {"token-file", required_argument, 0, O_TOKEN_FILE}, {"ca", required_argument, 0, O_CA}
+#define REMOTE_NOPTS 4
+#define REMOTE_USAGE "         [--server ADDR] [--token T | --token-file F] [--ca FILE]\n"
 
 /* The last of --token and --token-file wins; either overrides $MESHCORR_TOKEN. */
 static int remote_opt(remote *r, int c)
@@ -112,21 +168,27 @@ static int remote_opt(remote *r, int c)
     if (c == O_SERVER) r->server = optarg;
     else if (c == O_TOKEN) r->token = optarg, r->token_file = NULL;
     else if (c == O_TOKEN_FILE) r->token_file = optarg;
+    else if (c == O_CA) r->ca = optarg;
     else return 0;
     return 1;
 }
 
-/* s as a JSON string, quotes included. */
+/* s as a JSON string, quotes included; what stresc would escape is written
+ * as \\uXXXX (a byte that is not UTF-8 as U+FFFD). */
 static void json_str(const char *s)
 {
     putchar('"');
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\')
-            printf("\\%c", *p);
-        else if (*p < 0x20)
-            printf("\\u%04x", *p);
+    for (size_t i = 0, n = strlen(s), len; i < n; i += len) {
+        uint32_t cp;
+        int ok = stresc_char(s + i, n - i, &len, &cp);
+        if (s[i] == '"' || s[i] == '\\')
+            printf("\\%c", s[i]);
+        else if (ok)
+            fwrite(s + i, 1, len, stdout);
+        else if (cp >= 0x80 && len == 1)
+            printf("\\ufffd");
         else
-            putchar(*p);
+            printf("\\u%04x", (unsigned)cp);
     }
     putchar('"');
 }
@@ -173,15 +235,24 @@ static mc_map_row *rows_of(const bmap *P)
     return r;
 }
 
-typedef struct watch_opts { long from; int mode; int bad; } watch_opts;
+typedef struct watch_opts { long from; int mode, progress_given; } watch_opts;
 
-static void watch_opt(int c, void *ctx)
+/* --from K and --progress auto|bar|text|json; -1 after the usage error. */
+static int watch_opt(const char *cmd, int c, void *ctx)
 {
     watch_opts *w = ctx;
-    if (c == 'f')
-        w->from = strtol(optarg, NULL, 10);
-    else if (c == 'p')
-        w->bad |= cli_progress_parse(optarg, &w->mode) != 0 || w->mode == CLI_PROGRESS_NONE;
+    char *e;
+    if (c == 'f') {
+        w->from = strtol(optarg, &e, 10);
+        if (!*optarg || *e || w->from < 0 || w->from > UINT32_MAX)
+            return cli_usage_error(cmd, "--from: '%s' is not an outer iteration in [0, %u]", optarg,
+                                   UINT32_MAX), -1;
+    } else if (c == 'p') {
+        if (cli_progress_parse(optarg, &w->mode) || w->mode == CLI_PROGRESS_NONE)
+            return cli_usage_error(cmd, "--progress: '%s' is not auto, bar, text or json", optarg), -1;
+        w->progress_given = 1;
+    }
+    return 0;
 }
 
 static int on_progress(void *ctx, const mc_progress *m)
@@ -213,7 +284,7 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     }
     fflush(stdout);
     fprintf(stderr, "meshcorr %s: job %llu %s%s%s\n", cmd, (unsigned long long)id,
-            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", reason);
+            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", shown(reason));
     int kind = proto_kind_of_code(mc_reason_error(reason));
     if (!kind && state == MC_CANCELLED)
         kind = PROTO_KIND_CANCELLED;
@@ -252,37 +323,36 @@ int cli_submit(int argc, char **argv)
     mc_job_spec_init(&spec);
     cli_job job;
     cli_job_init(&job, argc, argv);
-    int c, bad = 0, watch = 0, qbits = MC_QUANTIZATION_LOSSLESS;
+    int c, watch = 0, qbits = MC_QUANTIZATION_LOSSLESS;
     watch_opts w = {0, CLI_PROGRESS_AUTO, 0};
     char *e;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    while ((c = cli_getopt("submit", argc, argv, opts)) != -1) {
         if (remote_opt(&r, c))
             continue;
         int jr = cli_job_option(&job, "submit", c, optarg);
-        if (jr) {
-            bad |= jr < 0;
+        if (jr < 0)
+            return cli_usage_see("submit");
+        if (jr)
             continue;
-        }
         switch (c) {
         case O_PRIORITY:
             spec.priority = (int32_t)strtol(optarg, &e, 10);
-            if (!*optarg || *e) {
-                fprintf(stderr, "meshcorr submit: --priority: '%s' is not an integer\n", optarg);
-                bad = 1;
-            }
+            if (!*optarg || *e)
+                return cli_usage_error("submit", "--priority: '%s' is not an integer", optarg);
             break;
         case O_LABEL: spec.label = optarg; break;
         case O_QUANTIZATION:
             qbits = (int)strtol(optarg, &e, 10);
-            if (!*optarg || *e || qbits < 1 || qbits > MC_QUANTIZATION_MAX_BITS) {
-                fprintf(stderr, "meshcorr submit: --quantization: '%s' is not a number of bits from 1 to %d\n",
-                        optarg, MC_QUANTIZATION_MAX_BITS);
-                bad = 1;
-            }
+            if (!*optarg || *e || qbits < 1 || qbits > MC_QUANTIZATION_MAX_BITS)
+                return cli_usage_error("submit", "--quantization: '%s' is not a number of bits from 1 to %d",
+                                       optarg, MC_QUANTIZATION_MAX_BITS);
             break;
         case O_WATCH: watch = 1; break;
-        case O_PROGRESS: watch_opt('p', &w); break;
+        case O_PROGRESS:
+            if (watch_opt("submit", 'p', &w))
+                return CLI_EXIT_USAGE;
+            break;
         case 'h':
             printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
                    "         [--quantization BITS] [--watch [--progress auto|bar|text|json]]\n" REMOTE_USAGE
@@ -295,23 +365,17 @@ int cli_submit(int argc, char **argv)
                    "Job options:\n", MC_QUANTIZATION_MAX_BITS);
             cli_job_usage(stdout);
             return 0;
-        default: bad = 1;
+        default: return cli_usage_see("submit");
         }
     }
-    if (!bad && argc - optind != 2) {
-        fprintf(stderr, "meshcorr submit: need SOURCE TARGET (see --help)\n");
-        bad = 1;
-    }
-    if (!bad && qbits != MC_QUANTIZATION_LOSSLESS && (is_drc(argv[optind]) || is_drc(argv[optind + 1]))) {
-        fprintf(stderr, "meshcorr submit: --quantization: a .drc file is sent as it is, with its own coding\n");
-        bad = 1;
-    }
-    if (!watch && w.mode != CLI_PROGRESS_AUTO) {
-        fprintf(stderr, "meshcorr submit: --progress goes with --watch\n");
-        bad = 1;
-    }
-    if (bad || w.bad || cli_job_check(&job, "submit"))
-        return 2;
+    if (argc - optind != 2)
+        return cli_usage_error("submit", "need SOURCE and TARGET mesh files (%d given)", argc - optind);
+    if (qbits != MC_QUANTIZATION_LOSSLESS && (is_drc(argv[optind]) || is_drc(argv[optind + 1])))
+        return cli_usage_error("submit", "--quantization: a .drc file is sent as it is, with its own coding");
+    if (!watch && w.progress_given)
+        return cli_usage_error("submit", "--progress goes with --watch");
+    if (cli_job_check(&job, "submit"))
+        return cli_usage_see("submit");
     spec_of_job(&job, &spec);
     const char *src = argv[optind], *tgt = argv[optind + 1];
     char err[4096];
@@ -402,9 +466,10 @@ static void print_time(const char *what, int64_t ms)
 
 /* Parses [--server A] [--token T] [extra...] ID for the one-id commands:
  * 0 parsed; 1 --help (usage printed on stdout: exit 0); -1 bad usage
- * (usage printed on stderr after the message: exit 2). */
+ * (the one-line error printed: exit 2). on_extra handles the extra
+ * options, -1 after printing its own usage error. */
 static int one_id(const char *cmd, const char *usage, int argc, char **argv, remote *r, uint64_t *id,
-                  const struct option *extra, void (*on_extra)(int, void *), void *ctx)
+                  const struct option *extra, int (*on_extra)(const char *, int, void *), void *ctx)
 {
     struct option opts[16] = {REMOTE_OPTS, {"help", no_argument, 0, 'h'}};
     int n = REMOTE_NOPTS + 1;
@@ -414,7 +479,7 @@ static int one_id(const char *cmd, const char *usage, int argc, char **argv, rem
     remote_defaults(r);
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    while ((c = cli_getopt(cmd, argc, argv, opts)) != -1) {
         if (remote_opt(r, c))
             continue;
         if (c == 'h') {
@@ -422,27 +487,93 @@ static int one_id(const char *cmd, const char *usage, int argc, char **argv, rem
             return 1;
         }
         if (c == '?' || !on_extra)
-            goto bad;
-        on_extra(c, ctx);
+            return cli_usage_see(cmd), -1;
+        if (on_extra(cmd, c, ctx))
+            return -1;
     }
-    if (argc - optind != 1) {
-        fprintf(stderr, "meshcorr %s: need one job id\n", cmd);
-        goto bad;
+    if (argc - optind != 1)
+        return cli_usage_error(cmd, "need one job id (%d given)", argc - optind), -1;
+    if (parse_id(cmd, argv[optind], id))
+        return cli_usage_see(cmd), -1;
+    return 0;
+}
+
+/* v as a JSON number, null when it is not finite. */
+static void json_num(double v)
+{
+    if (isfinite(v))
+        printf("%.17g", v);
+    else
+        printf("null");
+}
+
+/* The quality as the Python package's dict: verdict name, fractions. */
+static void print_quality_object(const mc_quality *q)
+{
+    printf("{\"verdict\":\"%s\",\"flipped\":", mc_quality_name(q->verdict));
+    json_num(q->flipped);
+    printf(",\"collapsed\":");
+    json_num(q->collapsed);
+    printf("}");
+}
+
+/* A progress record as the Python package's dict: the keys of `meshcorr
+ * watch --progress json` and the sums `meshcorr watch` prints. */
+static void print_progress_object(const mc_progress *p)
+{
+    const char *stage = proto_stage_name(p->stage);
+    printf("{\"job\":%llu,\"stage\":\"%s\",\"outer\":%u,\"total\":%u,\"fraction\":",
+           (unsigned long long)p->job_id, stage ? stage : "?", p->outer, p->total);
+    json_num(p->fraction);
+    printf(",\"eta\":");
+    json_num(p->eta_s);
+    printf(",\"elapsed\":");
+    json_num(p->elapsed_s);
+    printf(",\"ahead\":%u,\"beta\":", p->ahead);
+    json_num(p->beta);
+    printf(",\"gamma\":");
+    json_num(p->gamma);
+    static const char *names[2] = {"source", "target"};
+    for (int d = 0; d < 2; d++) {
+        const double t[5] = {p->membrane[d], p->bending[d], p->mismatch[d], p->reverse[d], p->energy[d]};
+        static const char *terms[5] = {"membrane", "bending", "mismatch", "reverse", "energy"};
+        printf(",\"%s\":{", names[d]);
+        for (int k = 0; k < 5; k++) {
+            printf("%s\"%s\":", k ? "," : "", terms[k]);
+            json_num(t[k]);
+        }
+        printf(",\"inner\":%u}", p->inner[d]);
     }
-    if (parse_id(cmd, argv[optind], id) == 0)
-        return 0;
-bad:
-    fputs(usage, stderr);
-    return -1;
+    const double sum[5] = {p->membrane[0] + p->membrane[1], p->bending[0] + p->bending[1],
+                           p->mismatch[0] + p->mismatch[1], p->reverse[0] + p->reverse[1],
+                           p->energy[0] + p->energy[1]};
+    static const char *terms[5] = {"membrane", "bending", "mismatch", "reverse", "energy"};
+    for (int k = 0; k < 5; k++) {
+        printf(",\"%s\":", terms[k]);
+        json_num(sum[k]);
+    }
+    printf("}");
+}
+
+static int status_opt(const char *cmd, int c, void *ctx)
+{
+    (void)cmd;
+    if (c == 'j')
+        *(int *)ctx = 1;
+    return 0;
 }
 
 int cli_status(int argc, char **argv)
 {
+    static const struct option extra[] = {{"json", no_argument, 0, 'j'}, {0, 0, 0, 0}};
     remote r;
     uint64_t id;
-    int u = one_id("status", "usage: meshcorr status ID\n" REMOTE_USAGE, argc, argv, &r, &id, NULL, NULL, NULL);
+    int json = 0;
+    int u = one_id("status", "usage: meshcorr status ID [--json]\n" REMOTE_USAGE
+                   "--json: one object with the fields of the Python package's Job.status()\n",
+                   argc, argv, &r, &id, extra, status_opt, &json);
     if (u)
-        return u > 0 ? 0 : 2;
+        return u > 0 ? 0 : CLI_EXIT_USAGE;
     mc_client *c = remote_connect("status", &r);
     if (!c)
         return 1;
@@ -450,10 +581,30 @@ int cli_status(int argc, char **argv)
     int rc = mc_status(c, id, &s);
     if (rc)
         return fail("status", c, rc);
+    if (json) {
+        printf("{\"id\":%llu,\"state\":\"%s\",\"priority\":%d,\"user\":", (unsigned long long)s.job_id,
+               mc_state_name(s.state) ? mc_state_name(s.state) : "?", s.priority);
+        json_str(s.user);
+        printf(",\"label\":");
+        json_str(s.label);
+        printf(",\"reason\":");
+        json_str(s.reason);
+        printf(",\"submit_ms\":%lld,\"start_ms\":%lld,\"end_ms\":%lld,\"progress\":", (long long)s.submit_ms,
+               (long long)s.start_ms, (long long)s.end_ms);
+        if (s.has_progress)
+            print_progress_object(&s.progress);
+        else
+            printf("null");
+        printf(",\"quality\":");
+        print_quality_object(&s.quality);
+        printf("}\n");
+        mc_close(c);
+        return 0;
+    }
     printf("job       %llu\nstate     %s\nuser      %s\nlabel     %s\npriority  %d\n", (unsigned long long)s.job_id,
-           mc_state_name(s.state), s.user, s.label, s.priority);
+           mc_state_name(s.state), shown(s.user), shown(s.label), s.priority);
     if (s.reason[0])
-        printf("reason    %s\n", s.reason);
+        printf("reason    %s\n", shown(s.reason));
     print_time("submitted", s.submit_ms);
     print_time("started", s.start_ms);
     print_time("ended", s.end_ms);
@@ -489,28 +640,26 @@ int cli_watch(int argc, char **argv)
                                 "directions (a bar on a terminal); exit 0 when the job COMPLETED, else\n"
                                 "the status of its error kind (3 numeric, 4 memory, 5 cancelled; else 1)\n";
     int u = one_id("watch", usage, argc, argv, &r, &id, extra, watch_opt, &w);
-    if (u > 0)
-        return 0;
-    if (u < 0 || w.bad || w.from < 0) {
-        if (!u)
-            fputs(usage, stderr);
-        return 2;
-    }
+    if (u)
+        return u > 0 ? 0 : CLI_EXIT_USAGE;
     mc_client *c = remote_connect("watch", &r);
     if (!c)
         return 1;
     return watch_job("watch", c, id, &w);
 }
 
-typedef struct result_opts { const char *out, *out_rev, *out_def, *target; } result_opts;
+typedef struct result_opts { const char *out, *out_rev, *out_def, *target; int json; } result_opts;
 
-static void result_opt(int c, void *ctx)
+static int result_opt(const char *cmd, int c, void *ctx)
 {
+    (void)cmd;
     result_opts *o = ctx;
     if (c == 'o') o->out = optarg;
     else if (c == 'O') o->out_rev = optarg;
     else if (c == 'd') o->out_def = optarg;
     else if (c == 't') o->target = optarg;
+    else if (c == 'j') o->json = 1;
+    return 0;
 }
 
 static int write_map(const char *path, const mc_map_row *rows, uint32_t n, int nt, const char *comment)
@@ -536,26 +685,31 @@ int cli_result(int argc, char **argv)
 {
     static const struct option extra[] = {
         {"out", required_argument, 0, 'o'}, {"out-reverse", required_argument, 0, 'O'},
-        {"out-deformed", required_argument, 0, 'd'}, {"target", required_argument, 0, 't'}, {0, 0, 0, 0}};
+        {"out-deformed", required_argument, 0, 'd'}, {"target", required_argument, 0, 't'},
+        {"json", no_argument, 0, 'j'}, {0, 0, 0, 0}};
     remote r;
     uint64_t id;
     result_opts o = {0};
     static const char usage[] = "usage: meshcorr result ID --out P.map [--out-reverse Q.map] [--out-deformed Y.ply]\n"
                                 "         [--target MESH (injective jobs: the target's vertex count for P.map)]\n"
-                                REMOTE_USAGE;
+                                "         [--json]\n" REMOTE_USAGE
+                                "prints the job's metrics, one `name value` a line; --json: one object\n"
+                                "{\"id\", \"metrics\": {name: value}, \"p_rows\", \"q_rows\", the files written}\n"
+                                "(with --json the map files are optional)\n";
     int u = one_id("result", usage, argc, argv, &r, &id, extra, result_opt, &o);
-    if (u > 0)
-        return 0;
-    if (u < 0 || (!o.out && !o.out_rev && !o.out_def)) {
-        if (!u)
-            fputs(usage, stderr);
-        return 2;
-    }
+    if (u)
+        return u > 0 ? 0 : CLI_EXIT_USAGE;
+    if (!o.out && !o.out_rev && !o.out_def && !o.json)
+        return cli_usage_error("result", "need --out P.map (or --out-reverse, --out-deformed, --json)");
+    if (cli_output_check("result", "--out", o.out) || cli_output_check("result", "--out-reverse", o.out_rev) ||
+        cli_output_check("result", "--out-deformed", o.out_def))
+        return CLI_EXIT_USAGE;
     mc_client *c = remote_connect("result", &r);
     if (!c)
         return 1;
     mc_job_result res;
-    unsigned what = MC_WANT_P | MC_WANT_Q | MC_WANT_METRICS | (o.out_def ? MC_WANT_DEFORMED : 0);
+    unsigned what = MC_WANT_METRICS | (o.out || o.out_rev || o.json ? MC_WANT_P | MC_WANT_Q : 0) |
+                    (o.out_def ? MC_WANT_DEFORMED : 0);
     int rc = mc_result(c, id, what, &res), status = 1;
     if (rc)
         return fail("result", c, rc);
@@ -594,26 +748,47 @@ int cli_result(int argc, char **argv)
         free(Y.f);
     }
     double verdict = 0, fl[2] = {0, 0}, co[2] = {0, 0};
+    if (o.json)
+        printf("{\"id\":%llu,\"metrics\":{", (unsigned long long)id);
     for (uint32_t i = 0; i < res.nmetrics; i++) {
         const char *k = res.metric_keys[i];
         double v = res.metric_values[i];
-        printf("%s %.10g\n", k, v);
+        if (o.json) {
+            printf("%s", i ? "," : "");
+            json_str(k);
+            putchar(':');
+            json_num(v);
+        } else {
+            printf("%s %.10g\n", shown(k), v);
+        }
         if (!strcmp(k, "quality_verdict"))
             verdict = v;
-        for (int r = 0; r < 2; r++) {
-            if (!strcmp(k, r ? "reverse_flipped_fraction" : "flipped_fraction"))
-                fl[r] = v;
-            if (!strcmp(k, r ? "reverse_collapsed_fraction" : "collapsed_fraction"))
-                co[r] = v;
+        for (int d = 0; d < 2; d++) {
+            if (!strcmp(k, d ? "reverse_flipped_fraction" : "flipped_fraction"))
+                fl[d] = v;
+            if (!strcmp(k, d ? "reverse_collapsed_fraction" : "collapsed_fraction"))
+                co[d] = v;
         }
+    }
+    if (o.json) {
+        printf("},\"p_rows\":%u,\"q_rows\":%u", res.np, res.nq);
+        const char *const files[3][2] = {{"out", o.out}, {"out_reverse", o.out_rev}, {"out_deformed", o.out_def}};
+        for (int f = 0; f < 3; f++) {
+            printf(",\"%s\":", files[f][0]);
+            if (files[f][1])
+                json_str(files[f][1]);
+            else
+                printf("null");
+        }
+        printf("}\n");
     }
     if (verdict > 0) {
         /* the worse of the two maps, by the worker's rule */
-        int r = metric_verdict(fl[1], co[1]) > metric_verdict(fl[0], co[0]);
+        int d = metric_verdict(fl[1], co[1]) > metric_verdict(fl[0], co[0]);
         char text[256];
-        metric_verdict_text((int)verdict, fl[r], co[r], text, sizeof text);
+        metric_verdict_text((int)verdict, fl[d], co[d], text, sizeof text);
         fprintf(stderr, "meshcorr result: warning: job %llu: %s%s\n", (unsigned long long)id,
-                r ? "the reverse map: " : "", text);
+                d ? "the reverse map: " : "", text);
     }
     status = 0;
 done:
@@ -630,7 +805,7 @@ static int simple(const char *cmd, const char *usage, int argc, char **argv, int
     uint64_t id;
     int u = one_id(cmd, usage, argc, argv, &r, &id, NULL, NULL, NULL);
     if (u)
-        return u > 0 ? 0 : 2;
+        return u > 0 ? 0 : CLI_EXIT_USAGE;
     mc_client *c = remote_connect(cmd, &r);
     if (!c)
         return 1;
@@ -652,8 +827,8 @@ int cli_delete(int argc, char **argv)
     return simple("delete", "usage: meshcorr delete ID\n" REMOTE_USAGE, argc, argv, mc_delete, "deleted");
 }
 
-/* A LIST row's progress column: "3 ahead" while it waits, "42 %" and
- * "1:02 left" while it runs, "100 %" once COMPLETED, else "-". */
+/* A LIST row's progress column: "3 ahead" while it waits, "42 %" while it
+ * runs, "100 %" once COMPLETED, else "-". */
 static const char *list_progress(const mc_job_info *j, char *buf, size_t sz)
 {
     if (j->state == MC_PENDING)
@@ -667,12 +842,37 @@ static const char *list_progress(const mc_job_info *j, char *buf, size_t sz)
     return buf;
 }
 
+/* --state S: a state's bit, or -1 after the usage error naming the states. */
+static int state_bit(const char *arg)
+{
+    int s = mc_state_parse(arg);
+    if (s >= 0)
+        return s;
+    const char *names[16];
+    int n = 0;
+    for (; n < 16 && mc_state_name(n); n++)
+        names[n] = mc_state_name(n);
+    char up[64], buf[256], all[256] = "";
+    snprintf(up, sizeof up, "%s", arg);
+    for (char *p = up; *p; p++)
+        *p = (char)toupper((unsigned char)*p);
+    const char *sg = cli_suggest(up, names, n, "", buf, sizeof buf);
+    for (int i = 0, o = 0; i < n; i++)
+        o += snprintf(all + o, sizeof all - (size_t)o, "%s%s", i ? ", " : "", names[i]);
+    if (sg)
+        cli_usage_error("list", "--state: '%s' is not a job state; did you mean %s?", arg, sg);
+    else
+        cli_usage_error("list", "--state: '%s' is not a job state (%s)", arg, all);
+    return -1;
+}
+
 int cli_list(int argc, char **argv)
 {
     static const struct option opts[] = {REMOTE_OPTS, {"state", required_argument, 0, 's'},
                                          {"user", required_argument, 0, 'u'}, {"json", no_argument, 0, 'j'},
                                          {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
     static const char usage[] = "usage: meshcorr list [--state S]... [--user U] [--json]\n" REMOTE_USAGE
+                                "your jobs; an admin's: every user's (--user U: only U's)\n"
                                 "--json: one array of job objects\n";
     remote r;
     remote_defaults(&r);
@@ -681,28 +881,32 @@ int cli_list(int argc, char **argv)
     const char *user = NULL;
     int c;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    while ((c = cli_getopt("list", argc, argv, opts)) != -1) {
         if (remote_opt(&r, c))
             continue;
         if (c == 's') {
-            int s = mc_state_parse(optarg);
-            if (s < 0) {
-                fprintf(stderr, "meshcorr list: --state: '%s' is not a job state (PENDING, RUNNING, ...)\n", optarg);
-                return 2;
-            }
+            int s = state_bit(optarg);
+            if (s < 0)
+                return CLI_EXIT_USAGE;
             mask |= 1u << s;
         } else if (c == 'u') {
             user = optarg;
         } else if (c == 'j') {
             json = 1;
+        } else if (c == 'h') {
+            fputs(usage, stdout);
+            return 0;
         } else {
-            fputs(usage, c == 'h' ? stdout : stderr);
-            return c == 'h' ? 0 : 2;
+            return cli_usage_see("list");
         }
     }
+    if (optind != argc)
+        return cli_usage_error("list", "unexpected argument '%s'", argv[optind]);
     mc_client *cl = remote_connect("list", &r);
     if (!cl)
         return 1;
+    if (!user && mc_is_admin(cl))
+        user = MC_LIST_ALL_USERS;          /* an admin sees everyone's jobs */
     mc_job_info *jobs;
     uint32_t n;
     int rc = mc_list(cl, user, mask, &jobs, &n);
@@ -730,13 +934,13 @@ int cli_list(int argc, char **argv)
     printf("%-8s %-13s %-10s %4s %11s %-8s %-10s %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "QUALITY",
            "PROGRESS", "LABEL");
     for (uint32_t i = 0; i < n; i++) {
-        char it[32];
+        char it[32], pg[32];
         snprintf(it, sizeof it, "%u/%u", jobs[i].outer, jobs[i].total);
         int v = jobs[i].quality.verdict;
         printf("%-8llu %-13s %-10s %4d %11s %-8s %-10s %s\n", (unsigned long long)jobs[i].job_id,
-               mc_state_name(jobs[i].state), jobs[i].user, jobs[i].priority, it,
-               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), list_progress(&jobs[i], it, sizeof it),
-               jobs[i].label);
+               mc_state_name(jobs[i].state), shown(jobs[i].user), jobs[i].priority, it,
+               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), list_progress(&jobs[i], pg, sizeof pg),
+               shown(jobs[i].label));
     }
     free(jobs);
     mc_close(cl);
@@ -751,15 +955,19 @@ int cli_stats(int argc, char **argv)
     remote_defaults(&r);
     int c, json = 0;
     optind = 1;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    while ((c = cli_getopt("stats", argc, argv, opts)) != -1) {
         if (remote_opt(&r, c))
             continue;
-        if (c != 'j') {
-            fputs("usage: meshcorr stats [--json]\n" REMOTE_USAGE, c == 'h' ? stdout : stderr);
-            return c == 'h' ? 0 : 2;
+        if (c == 'h') {
+            fputs("usage: meshcorr stats [--json]\n" REMOTE_USAGE, stdout);
+            return 0;
         }
+        if (c != 'j')
+            return cli_usage_see("stats");
         json = 1;
     }
+    if (optind != argc)
+        return cli_usage_error("stats", "unexpected argument '%s'", argv[optind]);
     mc_client *cl = remote_connect("stats", &r);
     if (!cl)
         return 1;
@@ -792,7 +1000,7 @@ int cli_stats(int argc, char **argv)
         printf("slot %u    %s%s%.0llu\n", i, slot[s.slot_state[i] & 3], s.slot_job[i] ? " job " : "",
                (unsigned long long)s.slot_job[i]);
     for (uint32_t i = 0; i < s.ndevices; i++)
-        printf("device    %s\n", s.devices[i]);
+        printf("device    %s\n", shown(s.devices[i]));
     mc_stats_free(&s);
     mc_close(cl);
     return 0;

@@ -93,6 +93,37 @@ int render_map_picture(const mesh *S, const unsigned char *srgb, const unsigned 
                        const double *simg, const mesh *T, const unsigned char *trgb, int px,
                        render_image **out);
 
+/* Text in a 5 by 9 pixel font (printable ASCII; other bytes show as '?'),
+ * each font pixel a scale by scale block of rgb, the top-left of the first
+ * glyph at (x, y); what falls outside im is cut off. Returns the width
+ * drawn, as render_text_width. */
+#define RENDER_FONT_W 5           /* glyph pixels across */
+#define RENDER_FONT_H 9           /* glyph pixels down (2 below the baseline) */
+#define RENDER_FONT_ADVANCE 6     /* font pixels from a glyph to the next */
+#define RENDER_FONT_LINE 11       /* font pixels from a line of text to the next */
+int render_text(render_image *im, int x, int y, int scale, const unsigned char rgb[3], const char *text);
+/* Pixels across that text takes at scale (no blank after the last glyph). */
+int render_text_width(const char *text, int scale);
+
+/* The words around a map picture (render_map_picture): two lines above
+ * each column (what the mesh is, how it is coloured) and up to
+ * RENDER_CAPTION_LINES below (which map, its quality); NULL or "" lines
+ * stay blank. A line too long for its place ends in "...". */
+#define RENDER_CAPTION_LINES 4
+#define RENDER_CAPTION_MAX 256    /* characters of one line drawn at most */
+typedef struct render_caption {
+    const char *source[2];        /* above the left column */
+    const char *target[2];        /* above the right column */
+    const char *below[RENDER_CAPTION_LINES];
+} render_caption;
+/* pic with a band of render_caption_top(pic->w) pixels above it and one of
+ * render_caption_bottom(pic->w) below (text at 1 font pixel per pixel, 2
+ * from 800 pixels across), on white: a new image in *out. RENDER_ESIZE when
+ * the result would be over RENDER_MAX_SIDE, RENDER_ENOMEM. */
+int render_captioned(const render_image *pic, const render_caption *c, render_image **out);
+int render_caption_top(int w);
+int render_caption_bottom(int w);
+
 /* Writes im as an 8-bit RGB PNG. RENDER_EPNG with the file and libpng's
  * message in err. */
 int render_png_write(const render_image *im, const char *path, char *err, size_t errsz);

@@ -9,7 +9,9 @@
 set -eu
 DIR=$1
 mkdir -p "$DIR/munge" "$DIR/ctld" "$DIR/slurmd" "$DIR/log"
-chmod 755 "$DIR/munge"   # clients need search permission to reach the socket
+# clients need search permission to reach the socket, and read slurm.conf:
+# a root test runs meshcorrd (and so sbatch, squeue) as another user
+chmod 755 "$DIR" "$DIR/munge"
 : > "$DIR/pids"
 
 # munge: its own key and socket

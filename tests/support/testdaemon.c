@@ -8,10 +8,14 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <gnutls/crypto.h>
+#include <gnutls/gnutls.h>
+#include <pwd.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -32,6 +36,35 @@ void testdaemon_need_worker(void)
         SKIP("%s not built (the worker branch provides it)", WORKER);
 }
 
+const char *testdaemon_user(void)
+{
+    return geteuid() == 0 ? TESTDAEMON_USER : NULL;
+}
+
+void testdaemon_give(const char *path)
+{
+    if (geteuid() != 0)
+        return;
+    struct passwd *pw = getpwnam(TESTDAEMON_USER);
+    if (!pw)
+        FAILF("no user %s to run meshcorrd as (tests run as root): deploy/install-deps.sh creates it",
+              TESTDAEMON_USER);
+    if (chown(path, pw->pw_uid, pw->pw_gid) != 0)
+        FAILF("chown %s to %s: %s", path, TESTDAEMON_USER, strerror(errno));
+}
+
+/* Run as root: the daemon's --user is TESTDAEMON_USER, and the harness's
+ * directory and d's (its socket, port file and tokens) are that user's, so
+ * it can reach its state directory and read its files on SIGHUP after the
+ * drop. NULL when not root (the daemon runs as the test does). */
+static const char *run_as(const testdaemon *d, const char *tokens)
+{
+    const char *mine[] = {harness_tmpdir(), d->dir, tokens};
+    for (size_t i = 0; i < sizeof mine / sizeof mine[0]; i++)
+        testdaemon_give(mine[i]);
+    return testdaemon_user();
+}
+
 void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
 {
     snprintf(d->dir, sizeof d->dir, "%s/%s", harness_tmpdir(), name);
@@ -43,12 +76,13 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     snprintf(tokens, sizeof tokens, "%s/tokens", d->dir);
     snprintf(port, sizeof port, "%s/port", d->dir);
     snprintf(listen_unix, sizeof listen_unix, "%s", d->unix_addr);
-    FILE *fp = fopen(tokens, "w");
-    if (!fp)
-        FAILF("cannot write %s", tokens);
-    fprintf(fp, "# token user [admin]\n%s alice\n%s bob\n%s boss admin\n", TESTDAEMON_ALICE,
-            TESTDAEMON_BOB, TESTDAEMON_ADMIN);
-    fclose(fp);
+    char lines[3][256], text[1024];
+    testdaemon_token_line(TESTDAEMON_ALICE, "alice", 0, lines[0], sizeof lines[0]);
+    testdaemon_token_line(TESTDAEMON_BOB, "bob", 0, lines[1], sizeof lines[1]);
+    testdaemon_token_line(TESTDAEMON_ADMIN, "boss", 1, lines[2], sizeof lines[2]);
+    snprintf(text, sizeof text, "# sha256:HEX user [admin]\n%s\n%s\n%s\n", lines[0], lines[1], lines[2]);
+    testdaemon_write_tokens(tokens, text);
+    FILE *fp;
     unlink(port);
     const char *argv[64];
     int k = 0;
@@ -60,6 +94,10 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     argv[k++] = "--tokens";    argv[k++] = tokens;
     argv[k++] = "--log-level"; argv[k++] = "debug";
     argv[k++] = "--threads-per-worker"; argv[k++] = "1";
+    const char *user = run_as(d, tokens);
+    if (user) {
+        argv[k++] = "--user";  argv[k++] = user;
+    }
     for (int i = 0; args && args[i] && k < 62; i++)
         argv[k++] = args[i];
     argv[k] = NULL;
@@ -88,7 +126,13 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     for (int i = 0; i < 1000; i++) {      /* up to 10 s */
         fp = fopen(port, "r");
         if (fp) {
+            /* the tcp: listener's line first, then those of args */
             int ok = fscanf(fp, "%63s", d->tcp_addr) == 1;
+            char more[64];
+            d->tls_addr[0] = '\0';
+            while (ok && fscanf(fp, "%63s", more) == 1)
+                if (!d->tls_addr[0] && strncmp(more, "tls:", 4) == 0)
+                    snprintf(d->tls_addr, sizeof d->tls_addr, "%s", more);
             fclose(fp);
             if (ok)
                 return;
@@ -99,6 +143,30 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
         sleep_ms(10);
     }
     FAILF("meshcorrd did not write its port file; log %s", d->log);
+}
+
+void testdaemon_token_line(const char *token, const char *user, int admin, char *line, size_t sz)
+{
+    unsigned char h[32];
+    if (gnutls_hash_fast(GNUTLS_DIG_SHA256, token, strlen(token), h) != 0)
+        FAILF("gnutls_hash_fast failed");
+    int n = snprintf(line, sz, "sha256:");
+    for (int i = 0; i < 32; i++)
+        n += snprintf(line + n, sz - (size_t)n, "%02x", h[i]);
+    snprintf(line + n, sz - (size_t)n, " %s%s", user, admin ? " admin" : "");
+}
+
+void testdaemon_write_tokens(const char *path, const char *text)
+{
+    char tmp[1100];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    size_t n = strlen(text);
+    if (fd < 0 || fchmod(fd, 0600) != 0 || write(fd, text, n) != (ssize_t)n || close(fd) != 0)
+        FAILF("cannot write %s: %s", tmp, strerror(errno));
+    testdaemon_give(tmp);                  /* the daemon reads it again, as its user, on SIGHUP */
+    if (rename(tmp, path) != 0)
+        FAILF("rename %s: %s", path, strerror(errno));
 }
 
 /* "exit status N" / "killed by signal N (NAME)" for a wait status. */
@@ -164,6 +232,38 @@ void testdaemon_kill(testdaemon *d)
     if (!WIFSIGNALED(st) || WTERMSIG(st) != SIGKILL)
         FAILF("meshcorrd ended with %s, not by the test's SIGKILL; log %s", status_text(st, what, sizeof what),
               d->log);
+}
+
+int testdaemon_prlimit(const testdaemon *d, int resource, const struct rlimit *new_limit, struct rlimit *old_limit)
+{
+    if (prlimit(d->pid, resource, new_limit, old_limit) == 0)
+        return 0;
+    if (errno != EPERM || geteuid() != 0)
+        return -1;
+    struct passwd *pw = getpwnam(TESTDAEMON_USER);
+    int fd[2];
+    if (!pw || pipe(fd) != 0)
+        return -1;
+    pid_t pid = fork();
+    if (pid == 0) {
+        struct { int rc, err; struct rlimit old; } r = {0, 0, {0, 0}};
+        if (setgid(pw->pw_gid) != 0 || setuid(pw->pw_uid) != 0 ||
+            prlimit(d->pid, resource, new_limit, &r.old) != 0)
+            r.rc = -1, r.err = errno;
+        _exit(write(fd[1], &r, sizeof r) == (ssize_t)sizeof r ? 0 : 1);
+    }
+    close(fd[1]);
+    struct { int rc, err; struct rlimit old; } r = {-1, EIO, {0, 0}};
+    ssize_t n = pid > 0 ? read(fd[0], &r, sizeof r) : -1;
+    close(fd[0]);
+    if (pid > 0)
+        waitpid(pid, NULL, 0);
+    if (n != (ssize_t)sizeof r)
+        r.rc = -1, r.err = EIO;
+    if (r.rc == 0 && old_limit)
+        *old_limit = r.old;
+    errno = r.err;
+    return r.rc;
 }
 
 mc_client *testdaemon_client(const testdaemon *d, const char *token)
@@ -324,10 +424,15 @@ unsigned char *testdaemon_encode(const mesh *m, size_t *len)
 
 void testdaemon_pair(int long_job, mesh **S, mesh **T)
 {
-    *S = testmesh_icosphere(long_job ? 3 : 2);
-    *T = testmesh_icosphere(long_job ? 3 : 2);
+    testdaemon_sphere_pair(long_job ? 3 : 2, S, T);
+}
+
+void testdaemon_sphere_pair(int level, mesh **S, mesh **T)
+{
+    *S = testmesh_icosphere(level);
+    *T = testmesh_icosphere(level);
     if (!*S || !*T)
-        FAILF("testmesh_icosphere failed");
+        FAILF("testmesh_icosphere(%d) failed", level);
     for (int i = 0; i < (*T)->nv; i++) {        /* an ellipsoid, a little bent */
         double *x = &(*T)->v[3 * i];
         x[0] *= 1.3;

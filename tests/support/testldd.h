@@ -4,7 +4,10 @@
  * slim libmeshcorr a laptop installs: no engine library). Test code only. */
 #ifndef TESTLDD_H
 #define TESTLDD_H
+/* libmeshcorr: GnuTLS (its tls: addresses) and the libraries GnuTLS loads
+ * are allowed too. */
 void testldd_check_slim(const char *path);
-/* The same with one more library allowed (a name's prefix, "libgomp.so."). */
+/* The list above without GnuTLS, and more libraries allowed: their names'
+ * prefixes separated by blanks ("libgomp.so. libseccomp.so."). */
 void testldd_check_slim_and(const char *path, const char *also);
 #endif

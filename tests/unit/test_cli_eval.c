@@ -118,7 +118,7 @@ TEST(eval_geodesic_error_against_ground_truth_layouts)
     snprintf(a, sizeof a, "%s", testfile_text("a.vts", "1\n101\n2001\n4001\n"));
     const char *b = testfile_text("b.vts", "2\n102\n2002\n4002\n");
     snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-target %s "
-             "--gt-format vts-pair --json", w, w, map, a, b);
+             "--gt-format vts-pair --gt-base 1 --json", w, w, map, a, b);
     CHECK_INT(run(cmd, out, sizeof out), 0);
     CHECK_STR_HAS(out, "\"points\":4,");
     CHECK(field(out, "mean") > 1e-4 && field(out, "mean") < 0.05);   /* one edge away */
@@ -158,7 +158,8 @@ TEST(eval_refuses_wrong_ground_truth_and_map_naming_the_file)
 }
 
 /* Published vertex maps (TOSCA gorilla_01 -> man_01) are maps eval reads:
- * the BCICP map (1-based, holds 5000) with the base told by the rule, the
+ * the BCICP map (1-based, holds 5000) with the base told by the rule (its
+ * 1-based ground-truth lists with --gt-base 1), the
  * BIM map (0-based, neither 0 nor 5000) refused until --map-base 0. The
  * README's sanity figure for BCICP is a Euclidean 0.025 of the bounding
  * box; the geodesic mean over the 900 points is 0.0474 (test_ddm's). */
@@ -175,6 +176,12 @@ TEST(eval_reads_published_vertex_maps)
                                                           "WKSini_direct_BCICP/8_gorilla_01_8_man_01.map"));
     snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-target %s --gt-format vts-pair "
              "--json", s0, s1, bcicp, g0, g1);
+    CHECK_INT(run(cmd, out, sizeof out), 1);            /* BCICP's lists are 1-based: said, not guessed */
+    CHECK_STR_HAS(out, "8_man_01.vts:");
+    CHECK_STR_HAS(out, "vertex 5000 out of range [0, 4999]: 0-based ids end below the vertex count, so "
+                  "the file looks 1-based: give --gt-base 1");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-target %s --gt-format vts-pair "
+             "--gt-base 1 --json", s0, s1, bcicp, g0, g1);
     CHECK_INT(run(cmd, out, sizeof out), 0);
     const char *geo = strstr(out, "\"geodesic\":");
     CHECK(geo);
@@ -221,4 +228,60 @@ TEST(eval_names_a_non_manifold_mesh_instead_of_running_out_of_memory)
     mesh_free(N);
     mesh_free(S);
     mesh_free(T);
+}
+
+/* eval reads BIM landmark files as match does (workers/lmk: 0-based, the
+ * .vts positions checked): on SHREC'07 glasses 52 -> 58 a vertex map that
+ * sends every source landmark onto its target landmark scores 0 against
+ * the landmarks as ground truth; a map that misses them does not; and a
+ * base the files' positions contradict is refused. */
+TEST(eval_scores_a_map_exact_at_the_bim_landmarks_zero)
+{
+    char s52[512], s58[512], a[512], b[512], cmd[4096], out[16384], err[512];
+    snprintf(s52, sizeof s52, "%s", harness_data_path("shrec07_bim/Meshes/52.off"));
+    snprintf(s58, sizeof s58, "%s", harness_data_path("shrec07_bim/Meshes/58.off"));
+    snprintf(a, sizeof a, "%s", harness_data_path("shrec07_bim/Corrs/52.vts"));
+    snprintf(b, sizeof b, "%s", harness_data_path("shrec07_bim/Corrs/58.vts"));
+    mesh *S = NULL;
+    CHECK_INT(mesh_read(s52, &S, err, sizeof err), 0);
+    /* the vertex map: landmark k's source vertex -> its target vertex (the
+     * first column of each file, as BIM writes it), every other vertex -> 0 */
+    int *to = calloc((size_t)S->nv, sizeof *to);
+    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
+    CHECK(to && fa && fb);
+    int i, j, n = 0;
+    while (fscanf(fa, "%d %*f %*f %*f", &i) == 1 && fscanf(fb, "%d %*f %*f %*f", &j) == 1) {
+        to[i] = j;
+        n++;
+    }
+    fclose(fa);
+    fclose(fb);
+    CHECK_INT(n, 10);
+    char *text = malloc((size_t)S->nv * 12 + 1), *p = text, *q;
+    for (int v = 0; v < S->nv; v++)
+        p += sprintf(p, "%d\n", to[v]);
+    char exact[600], off[600];
+    snprintf(exact, sizeof exact, "%s", testfile_text("exact.vmap", text));
+    /* the same map one vertex off at every landmark */
+    p = text;
+    for (int v = 0; v < S->nv; v++)
+        p += sprintf(p, "%d\n", to[v] ? to[v] + 1 : 0);
+    snprintf(off, sizeof off, "%s", testfile_text("off.vmap", text));
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s %s --gt %s --gt-target %s --gt-format vts-pair "
+             "--json", s52, s58, exact, off, a, b);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    CHECK((q = strstr(out, "\"geodesic\":")) != NULL);
+    CHECK_STR_HAS(q, "\"points\":10,");
+    CHECK(field(q, "mean") == 0);
+    CHECK((q = strstr(q + 1, "\"geodesic\":")) != NULL);
+    CHECK(field(q, "mean") > 1e-3);
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --gt %s --gt-target %s --gt-format vts-pair "
+             "--gt-base 1", s52, s58, exact, a, b);
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "52.vts: read 1-based, but the position on each line is that of its vertex read "
+                  "0-based");
+    CHECK_STR_HAS(out, ": leave --gt-base out");
+    free(text);
+    free(to);
+    mesh_free(S);
 }

@@ -123,6 +123,36 @@ TEST(match_refuses_landmark_out_of_range_naming_it)
     CHECK_STR_HAS(out, "9239 out of range");
 }
 
+/* A BIM .pid file given as --landmarks is refused naming file, line and
+ * what it looks like, with what to give instead, by match and by submit
+ * (before any server is asked), instead of becoming pairs of its first two
+ * columns (21 landmarks on target vertex 0). */
+TEST(landmarks_option_refuses_a_bim_pid_file_saying_what_to_give)
+{
+    char w0[512], w1[512], pid[512], cmd[4096], out[8192];
+    snprintf(w0, sizeof w0, "%s", harness_data_path("tosca_hires/Meshes/wolf0.off"));
+    snprintf(w1, sizeof w1, "%s", harness_data_path("tosca_hires/Meshes/wolf1.off"));
+    snprintf(pid, sizeof pid, "%s", harness_data_path("tosca_hires/Corrs/wolf.pid"));
+    static const char want[] = "wolf.pid:1: 4 columns: this looks like a BIM .pid file (point ids with "
+                               "barycentric coordinates); landmark pairs are `source_vertex target_vertex` "
+                               "a line (--landmarks), or give two lists: --source-landmarks A.vts "
+                               "--target-landmarks B.vts";
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s --out %s/p.map", w0, w1, pid,
+             harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, want);
+    snprintf(cmd, sizeof cmd, "build/meshcorr submit %s %s --landmarks %s --server unix:%s/none.sock", w0, w1,
+             pid, harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, want);
+    CHECK(strstr(out, "connect") == NULL);
+    /* the same file as two lists (the same ids on both poses) is read */
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --source-landmarks %s --target-landmarks %s "
+             "--stages rhm --rhm-iterations 1 --progress none --out %s/p.map", w0, w1, pid, pid,
+             harness_tmpdir());
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+}
+
 TEST(match_refuses_bad_option_value)
 {
     paths();

@@ -2,8 +2,11 @@
  * real meshcorrd (tests/support/testdaemon): submit prints the id alone,
  * watch prints one line per iteration and exits 0 only for a COMPLETED job,
  * result writes the maps mc_result returns, list/stats --json are JSON,
- * --token-file works over TCP and a bad token is refused in words, and a
- * lossless upload gives the map `meshcorr match` gives, bit for bit. */
+ * --token-file works over TCP and a bad token is refused in words, a
+ * lossless upload gives the map `meshcorr match` gives, bit for bit, an
+ * admin's list shows every user's jobs, status and result --json are the
+ * Python package's fields, and the default server, bare socket paths and
+ * connect errors say what to do. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testfile.h"
@@ -18,7 +21,9 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 static char src[600], tgt[600], lmk[600], out[1 << 16];
 
@@ -176,15 +181,23 @@ TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_5_sayi
     testdaemon_stop(&d, SIGTERM);
 }
 
-TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
+/* A daemon started on d with one quick job submitted (extra: more submit
+ * options) and watched to its end; the job's id. */
+static uint64_t completed_job(testdaemon *d, const char *extra)
 {
     testdaemon_need_worker();
     write_inputs();
-    testdaemon d;
-    testdaemon_start(&d, "d", NULL);
-    uint64_t id = submit(&d, "--label 'a \"quoted\" label'");
+    testdaemon_start(d, "d", NULL);
+    uint64_t id = submit(d, extra);
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s", (unsigned long long)id,
-                       d.unix_addr), 0);
+                       d->unix_addr), 0);
+    return id;
+}
+
+TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
+{
+    testdaemon d;
+    uint64_t id = completed_job(&d, "--label 'a \"quoted\" label'");
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --json --server %s", d.unix_addr), 0);
     if (!testjson_valid(out))
         FAILF("list --json is not JSON:\n%s", out);
@@ -205,6 +218,7 @@ TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
     CHECK_STR_HAS(out, " QUALITY ");
     CHECK_STR_HAS(out, " ok ");
     CHECK_STR_HAS(out, " PROGRESS ");
+    CHECK_STR_HAS(out, " 4/4 ");                 /* ITER beside the PROGRESS column */
     CHECK_STR_HAS(out, " 100 % ");
 
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr stats --json --server %s", d.unix_addr), 0);
@@ -375,4 +389,167 @@ TEST_T(submit_returns_the_map_meshcorr_match_computes_bit_for_bit_and_quantizati
     bmap_free(Qq);
     mesh_free(S);
     mesh_free(T);
+}
+
+/* The rows of a `meshcorr list` table: count of lines naming user. */
+static int rows_of_user(const char *table, const char *user)
+{
+    int n = 0;
+    for (const char *l = table; *l; l = strchr(l, '\n') ? strchr(l, '\n') + 1 : l + strlen(l)) {
+        unsigned long long id;
+        char state[32], u[64];
+        if (sscanf(l, "%llu %31s %63s", &id, state, u) == 3 && strcmp(u, user) == 0)
+            n++;
+    }
+    return n;
+}
+
+/* alice and bob each submit; the admin's `meshcorr list` shows both with
+ * their USER, `--user bob` only bob's; alice sees only hers, and her
+ * `--user bob` and a LIST of every user ("*") are FORBIDDEN, logged. */
+TEST_T(admin_list_shows_every_users_jobs_and_user_filters, 120)
+{
+    testdaemon_need_worker();
+    write_inputs();
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    char extra[256];
+    snprintf(extra, sizeof extra, "--server %s --token %s", d.tcp_addr, TESTDAEMON_ALICE);
+    uint64_t a1 = submit(&d, extra), a2 = submit(&d, extra);
+    snprintf(extra, sizeof extra, "--server %s --token %s", d.tcp_addr, TESTDAEMON_BOB);
+    uint64_t b1 = submit(&d, extra);
+    CHECK(a1 && a2 && b1);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s --token %s 2>&1", d.tcp_addr,
+                       TESTDAEMON_ADMIN), 0);
+    CHECK_STR_HAS(out, " USER ");
+    if (rows_of_user(out, "alice") != 2 || rows_of_user(out, "bob") != 1)
+        FAILF("the admin's list does not show alice's 2 jobs and bob's 1:\n%s", out);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --json --server %s --token %s 2>&1", d.tcp_addr,
+                       TESTDAEMON_ADMIN), 0);
+    CHECK(testjson_valid(out));
+    CHECK_STR_HAS(out, "\"user\":\"alice\"");
+    CHECK_STR_HAS(out, "\"user\":\"bob\"");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --user bob --server %s --token %s 2>&1", d.tcp_addr,
+                       TESTDAEMON_ADMIN), 0);
+    if (rows_of_user(out, "alice") != 0 || rows_of_user(out, "bob") != 1)
+        FAILF("--user bob lists other jobs than bob's:\n%s", out);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s --token %s 2>&1", d.tcp_addr,
+                       TESTDAEMON_ALICE), 0);
+    if (rows_of_user(out, "alice") != 2 || rows_of_user(out, "bob") != 0)
+        FAILF("alice's list is not her 2 jobs:\n%s", out);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --user bob --server %s --token %s 2>&1", d.tcp_addr,
+                       TESTDAEMON_ALICE), 1);
+    CHECK_STR_HAS(out, "only an admin may list the jobs of user bob");
+    mc_client *c = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_job_info *jobs = NULL;
+    uint32_t n = 0;
+    CHECK_INT(mc_list(c, MC_LIST_ALL_USERS, 0, &jobs, &n), MC_EFORBIDDEN);
+    CHECK_STR_HAS(mc_errmsg(c), "only an admin may list every user's jobs");
+    CHECK(jobs == NULL);
+    CHECK_INT(mc_ping(c), 0);                    /* the session goes on */
+    mc_close(c);
+    CHECK(testdaemon_log_has(&d, "alice: LIST of (every user) refused: not an admin"));
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* `meshcorr status --json` and `meshcorr result --json` print one JSON
+ * object each, with the field names of the Python package's dicts. */
+TEST_T(status_and_result_json_are_one_object_with_the_python_fields, 90)
+{
+    testdaemon d;
+    uint64_t id = completed_job(&d, "--label lab");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr status %llu --json --server %s", (unsigned long long)id,
+                       d.unix_addr), 0);
+    if (!testjson_valid(out) || out[0] != '{' || strchr(out, '\n') != out + strlen(out) - 1)
+        FAILF("status --json is not one JSON object on one line:\n%s", out);
+    char want[64];
+    snprintf(want, sizeof want, "{\"id\":%llu,\"state\":\"COMPLETED\",", (unsigned long long)id);
+    CHECK_STR_HAS(out, want);
+    static const char *const fields[] = {"\"priority\":", "\"user\":", "\"label\":\"lab\"", "\"reason\":",
+                                         "\"submit_ms\":", "\"start_ms\":", "\"end_ms\":",
+                                         "\"progress\":{\"job\":", "\"stage\":\"repair\"",
+                                         "\"outer\":2,\"total\":2,\"fraction\":1,\"eta\":",
+                                         "\"ahead\":0,", "\"source\":{\"membrane\":", "\"inner\":",
+                                         "\"energy\":",
+                                         "\"quality\":{\"verdict\":\"ok\",\"flipped\":"};
+    for (size_t k = 0; k < sizeof fields / sizeof fields[0]; k++)
+        CHECK_STR_HAS(out, fields[k]);
+    char P[700];
+    snprintf(P, sizeof P, "%s/p.map", harness_tmpdir());
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr result %llu --json --out %s --server %s",
+                       (unsigned long long)id, P, d.unix_addr), 0);
+    if (!testjson_valid(out) || out[0] != '{')
+        FAILF("result --json is not one JSON object:\n%s", out);
+    snprintf(want, sizeof want, "{\"id\":%llu,\"metrics\":{", (unsigned long long)id);
+    CHECK_STR_HAS(out, want);
+    CHECK_STR_HAS(out, "\"flipped_fraction\":");
+    CHECK_STR_HAS(out, "\"p_rows\":162,\"q_rows\":162");
+    CHECK_STR_HAS(out, "\"out\":\"");
+    /* metrics alone, no file */
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr result %llu --json --server %s", (unsigned long long)id,
+                       d.unix_addr), 0);
+    CHECK(testjson_valid(out));
+    CHECK_STR_HAS(out, "\"out\":null");
+    testdaemon_stop(&d, SIGTERM);
+}
+
+/* The one default address is the socket the shipped config and unit use,
+ * in the CLI (MC_DEFAULT_SERVER), the Python package and deploy/; a bare
+ * path is a Unix socket; a failed connect names the address once, the
+ * reason and what to do; a TCP server without a token says how to give
+ * one. */
+TEST_T(default_server_bare_paths_and_connect_errors_say_what_to_do, 60)
+{
+    testdaemon_need_worker();
+    size_t len;
+    char *conf = (char *)testfile_read("deploy/meshcorrd.conf", &len);
+    conf = realloc(conf, len + 1);
+    conf[len] = '\0';
+    CHECK_STR_HAS(conf, "\nlisten = " MC_DEFAULT_SERVER "\n");
+    free(conf);
+    char *unit = (char *)testfile_read("deploy/meshcorrd.service", &len);
+    unit = realloc(unit, len + 1);
+    unit[len] = '\0';
+    CHECK_STR_HAS(unit, "\nRuntimeDirectory=meshcorr\n");          /* /run/meshcorr */
+    free(unit);
+    char *py = (char *)testfile_read("client-c/python/meshcorr/client.py", &len);
+    py = realloc(py, len + 1);
+    py[len] = '\0';
+    CHECK_STR_HAS(py, "return \"" MC_DEFAULT_SERVER "\"");
+    free(py);
+    CHECK_INT(strcmp(MC_DEFAULT_SERVER, "unix:/run/meshcorr/meshcorrd.sock"), 0);
+    struct stat st;
+    if (stat(MC_DEFAULT_SERVER + 5, &st) != 0) {    /* no daemon of the machine's own there */
+        CHECK_INT(testrunf(out, sizeof out, "env -u MESHCORR_SERVER build/meshcorr list 2>&1"), 1);
+        CHECK_STR_HAS(out, "meshcorr list: cannot connect to " MC_DEFAULT_SERVER ": No such file or directory "
+                      "(is meshcorrd running there? set MESHCORR_SERVER or --server)");
+    }
+    CHECK_INT(testrunf(out, sizeof out, "MESHCORR_SERVER=unix:%s/none.sock build/meshcorr stats 2>&1",
+                       harness_tmpdir()), 1);
+    CHECK_STR_HAS(out, "cannot connect to unix:");
+    char *first = strstr(out, "none.sock");
+    CHECK(first && !strstr(first + 1, "none.sock"));                 /* the address once */
+
+    testdaemon d;
+    testdaemon_start(&d, "d", NULL);
+    /* a bare path, absolute and relative */
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr stats --json --server %s 2>&1", d.unix_addr + 5), 0);
+    CHECK(testjson_valid(out));
+    char here[1024];
+    CHECK(getcwd(here, sizeof here));
+    CHECK_INT(testrunf(out, sizeof out, "cd %s && %s/build/meshcorr stats --json --server ./sock 2>&1", d.dir,
+                       here), 0);
+    CHECK(testjson_valid(out));
+    /* TCP without a token */
+    CHECK_INT(testrunf(out, sizeof out, "env -u MESHCORR_TOKEN build/meshcorr list --server %s 2>&1", d.tcp_addr),
+              1);
+    char want[2048];
+    snprintf(want, sizeof want, "meshcorr list: %s needs a token: --token T, --token-file F or MESHCORR_TOKEN",
+             d.tcp_addr);
+    CHECK_STR_HAS(out, want);
+    /* HOST:PORT without a scheme: TLS first, plain TCP for loopback */
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s 2>&1", d.tcp_addr + 4), 1);
+    snprintf(want, sizeof want, "did you mean tls:%s (or %s on loopback)?", d.tcp_addr + 4, d.tcp_addr);
+    CHECK_STR_HAS(out, want);
+    testdaemon_stop(&d, SIGTERM);
 }

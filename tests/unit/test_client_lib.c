@@ -247,7 +247,7 @@ TEST_T(installed_library_builds_a_program_with_pkg_config_that_talks_to_meshcorr
     snprintf(dest, sizeof dest, "%s/dest", harness_tmpdir());
     CHECK_INT(testrunf(out, sizeof out, "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s install-lib "
                        "DESTDIR=%s PREFIX=/opt/mc 2>&1", dest), 0);
-    static const char *const files[] = {"include/meshcorr.h", "lib/libmeshcorr.a", "lib/libmeshcorr.so.1",
+    static const char *const files[] = {"include/meshcorr/meshcorr.h", "lib/libmeshcorr.a", "lib/libmeshcorr.so.1",
                                         "lib/libmeshcorr.so", "lib/pkgconfig/meshcorr.pc"};
     struct stat st;
     for (int i = 0; i < 5; i++) {

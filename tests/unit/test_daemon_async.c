@@ -94,7 +94,9 @@ static void *ping_thread(void *arg)
     return NULL;
 }
 
-/* The jobs.db row of job id exists and spool/<id>/job.frame is there. */
+/* The jobs.db row of job id exists and spool/<id>/job.frame is there,
+ * unless the job has ended without completing (its input is removed then,
+ * its row kept). */
 static int stored(const testdaemon *d, uint64_t id)
 {
     char path[1024];
@@ -105,16 +107,18 @@ static int stored(const testdaemon *d, uint64_t id)
         return 0;
     }
     sqlite3_stmt *st;
-    int row = 0;
-    if (sqlite3_prepare_v2(db, "SELECT id FROM jobs WHERE id = ?", -1, &st, NULL) == SQLITE_OK) {
+    int row = 0, ended = 0;
+    if (sqlite3_prepare_v2(db, "SELECT state IN ('PENDING', 'RUNNING', 'COMPLETED') FROM jobs WHERE id = ?", -1,
+                           &st, NULL) == SQLITE_OK) {
         sqlite3_bind_int64(st, 1, (sqlite3_int64)id);
         row = sqlite3_step(st) == SQLITE_ROW;
+        ended = row && sqlite3_column_int(st, 0) == 0;
         sqlite3_finalize(st);
     }
     sqlite3_close(db);
     struct stat sb;
     snprintf(path, sizeof path, "%s/spool/%llu/job.frame", d->state, (unsigned long long)id);
-    return row && stat(path, &sb) == 0 && sb.st_size > 0;
+    return row && (ended || (stat(path, &sb) == 0 && sb.st_size > 0));
 }
 
 /* Six clients (Unix socket and TCP, three users) submit eight jobs each at

@@ -1,7 +1,8 @@
 /* test_daemon_conns.c — the real meshcorrd under idle and greedy
  * connections: with its descriptor limit taken by 1100 idle Unix clients a
  * queued job still starts and completes, and a new client is told why it is
- * refused; each connection cap refuses with BUSY and a log line; silent,
+ * refused; each connection cap refuses with BUSY and a log line (the
+ * oldest TCP connection without HELLO makes room for a newer one); silent,
  * half-sent and idle clients are cut after their timeouts with TIMED_OUT,
  * while a quiet WATCH is kept. Raw sockets speak the protocol where
  * libmeshcorr would not misbehave on purpose. */
@@ -10,7 +11,9 @@
 #include "proto.h"
 #include "meshcorr.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <string.h>
@@ -157,7 +160,7 @@ TEST_T(idle_connections_at_the_descriptor_limit_never_fail_a_queued_job, 180)
     testdaemon d;
     testdaemon_start(&d, "fds", args);
     struct rlimit low = {256, 256};
-    if (prlimit(d.pid, RLIMIT_NOFILE, &low, NULL) != 0)
+    if (testdaemon_prlimit(&d, RLIMIT_NOFILE, &low, NULL) != 0)
         FAILF("prlimit: %s", strerror(errno));
     mc_client *c = testdaemon_client(&d, NULL);
     int rc;
@@ -231,42 +234,61 @@ static mc_client *connect_soon(const testdaemon *d, const char *addr, const char
     return NULL;
 }
 
+/* A plain TCP connection to the daemon's listener; nothing sent. */
+static int raw_tcp(const testdaemon *d)
+{
+    struct sockaddr_in sa = {.sin_family = AF_INET};
+    int port = atoi(strrchr(d->tcp_addr, ':') + 1);
+    sa.sin_port = htons((uint16_t)port);
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0)
+        FAILF("connect %s: %s", d->tcp_addr, strerror(errno));
+    return fd;
+}
+
+/* The caps, each with its BUSY and log line: TCP connections without HELLO
+ * (the oldest makes room for a newer one; the Unix socket is not counted),
+ * sessions per user, non-admin sessions in all (admins exempt). */
 TEST_T(each_connection_cap_refuses_with_busy_and_a_log_line, 60)
 {
-    static const char *const args[] = {"--max-connections", "5", "--max-connections-per-user", "2",
+    static const char *const args[] = {"--max-connections", "3", "--max-connections-per-user", "2",
                                        "--max-unauthenticated", "2", "--hello-timeout", "0", NULL};
     testdaemon d;
     testdaemon_start(&d, "caps", args);
     char err[1024];
     mc_client *x = NULL;
-    /* two silent connections use up --max-unauthenticated */
-    int u1 = raw_unix(&d), u2 = raw_unix(&d);
-    CHECK_INT(mc_connect(d.unix_addr, NULL, &x, err, sizeof err), MC_EBUSY);
-    CHECK(x == NULL);
-    CHECK_STR_HAS(err, "BUSY: server busy: 2 connections without HELLO, the limit (--max-unauthenticated)");
-    /* the raw refusal: ERROR BUSY with request id 0, then the close */
-    int u3 = raw_unix(&d);
-    expect_error_then_eof(u3, PROTO_EBUSY, "--max-unauthenticated", 5);
-    close(u3);
-    close(u1);
-    close(u2);
+    /* two silent TCP connections use up --max-unauthenticated: a third
+     * closes the oldest, which reads ERROR BUSY (request id 0) and the close */
+    int t1 = raw_tcp(&d), t2 = raw_tcp(&d);
+    testdaemon_sleep_ms(100);
+    int t3 = raw_tcp(&d);
+    expect_error_then_eof(t1, PROTO_EBUSY, "2 TCP connections without HELLO, the limit (--max-unauthenticated)", 5);
+    expect_quiet(t2, 0.3);
+    mc_client *u = testdaemon_client(&d, NULL);          /* the Unix socket does not count */
+    CHECK_INT(mc_ping(u), 0);
+    mc_close(u);
+    close(t1);
+    close(t2);
+    close(t3);
 
-    /* two sessions per user; an admin is exempt */
+    /* two sessions per user */
     mc_client *a1 = connect_soon(&d, d.tcp_addr, TESTDAEMON_ALICE);
     mc_client *a2 = connect_soon(&d, d.tcp_addr, TESTDAEMON_ALICE);
     CHECK_INT(mc_connect(d.tcp_addr, TESTDAEMON_ALICE, &x, err, sizeof err), MC_EBUSY);
+    CHECK(x == NULL);
     CHECK_STR_HAS(err, "user alice has 2 sessions, the limit (--max-connections-per-user)");
+    /* three non-admin sessions in all: the next user is refused, admins are not */
     mc_client *b1 = connect_soon(&d, d.tcp_addr, TESTDAEMON_BOB);
-    mc_client *boss[2] = {connect_soon(&d, d.tcp_addr, TESTDAEMON_ADMIN), NULL};
-    /* five in all: the next is refused, whoever it is */
-    boss[1] = connect_soon(&d, d.tcp_addr, TESTDAEMON_ADMIN);
     CHECK_INT(mc_connect(d.tcp_addr, TESTDAEMON_BOB, &x, err, sizeof err), MC_EBUSY);
-    CHECK_STR_HAS(err, "5 connections open, the limit (--max-connections)");
+    CHECK_STR_HAS(err, "3 sessions open, the limit (--max-connections; admins exempt)");
+    mc_client *boss[2] = {connect_soon(&d, d.tcp_addr, TESTDAEMON_ADMIN), connect_soon(&d, d.tcp_addr, TESTDAEMON_ADMIN)};
+    CHECK_INT(mc_ping(boss[1]), 0);
     CHECK_INT(mc_ping(a1), 0);      /* those in are served */
     CHECK_INT(mc_ping(b1), 0);
-    CHECK(testdaemon_log_has(&d, "refused: 2 connections without HELLO, the limit (--max-unauthenticated)"));
-    CHECK(testdaemon_log_has(&d, "(user alice) refused: server busy: user alice has 2 sessions"));
-    CHECK(testdaemon_log_has(&d, "refused: 5 connections open, the limit (--max-connections)"));
+    CHECK(testdaemon_log_has(&d, "closed: 2 TCP connections without HELLO, the limit (--max-unauthenticated)"));
+    CHECK(testdaemon_log_has(&d, "(user alice, 127.0.0.1) refused: server busy: user alice has 2 sessions"));
+    CHECK(testdaemon_log_has(&d, "refused: server busy: 3 sessions open, the limit (--max-connections"));
     /* one leaves: the next one gets in */
     mc_close(a2);
     mc_client *b2 = connect_soon(&d, d.tcp_addr, TESTDAEMON_BOB);
@@ -368,7 +390,9 @@ static void raw_partial_submit(int fd, uint32_t rid, uint32_t payload, size_t se
  * bytes of a client that leaves half-way are counted no more. */
 TEST_T(request_frames_being_received_are_capped_in_all, 60)
 {
-    static const char *const args[] = {"--max-request-memory", "1000000", NULL};
+    /* the total alone: one user's share (test_sec_upload) set to all of it */
+    static const char *const args[] = {"--max-request-memory", "1000000", "--max-request-memory-per-user",
+                                       "1000000", NULL};
     testdaemon d;
     testdaemon_start(&d, "reqmem", args);
     int a = raw_unix(&d), b = raw_unix(&d), e = raw_unix(&d);

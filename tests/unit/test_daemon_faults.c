@@ -380,9 +380,9 @@ TEST_T(worker_start_without_descriptors_waits_and_the_job_completes_later, 90)
     int base = open_fds(d.pid);
     CHECK(base > 0);
     struct rlimit old, rl;
-    CHECK_INT(prlimit(d.pid, RLIMIT_NOFILE, NULL, &old), 0);
+    CHECK_INT(testdaemon_prlimit(&d, RLIMIT_NOFILE, NULL, &old), 0);
     rl = (struct rlimit){(rlim_t)base + 16, old.rlim_max};       /* the soft limit */
-    CHECK_INT(prlimit(d.pid, RLIMIT_NOFILE, &rl, NULL), 0);
+    CHECK_INT(testdaemon_prlimit(&d, RLIMIT_NOFILE, &rl, NULL), 0);
     int idle[IDLE_CONNS], nidle = 0;
     for (int i = 0; i < IDLE_CONNS; i++)
         if ((idle[nidle] = idle_connection(&d)) >= 0)
@@ -402,7 +402,7 @@ TEST_T(worker_start_without_descriptors_waits_and_the_job_completes_later, 90)
     int waited = testdaemon_log_has(&d, "waiting to start: cannot start worker");
     for (int i = 0; i < nidle; i++)
         close(idle[i]);
-    CHECK_INT(prlimit(d.pid, RLIMIT_NOFILE, &old, NULL), 0);
+    CHECK_INT(testdaemon_prlimit(&d, RLIMIT_NOFILE, &old, NULL), 0);
     int end = testdaemon_wait_state(c, queued, -1, 60);
     CHECK_INT(mc_status(c, queued, &s), 0);
     if (end != MC_COMPLETED)

@@ -171,16 +171,16 @@ TEST_T(parameters_out_of_range_are_refused_naming_the_field, 60)
     raw_init(&r);
     proto_params *p = &r.msg.u.submit.params, keep = *p;
     p->inner_iterations = 500000;
-    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "params.inner_iterations = 500000 > 100000", NULL);
+    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "inner_iterations = 500000: out of range [1, 100000]", NULL);
     *p = keep;
     p->rhm_alpha = 2;
-    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "params.rhm_alpha = 2 > 1", NULL);
+    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "rhm_alpha = 2: out of range (0, 1); 0 = the default", NULL);
     *p = keep;
     p->rhm_dim = 100000;
-    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "params.rhm_dim = 100000 > 64", NULL);
+    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "rhm_dim = 100000: out of range [3, 64]; 0 = the default", NULL);
     *p = keep;
     p->alpha = -1;
-    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "params.alpha = -1 < 0", NULL);
+    expect_refusal(c, &r, PROTO_EBAD_PARAMS, "alpha = -1: out of range (0, inf)", NULL);
     *p = keep;
     r.msg.u.submit.nlandmarks = 2;                       /* 3 pairs at least, everywhere */
     expect_refusal(c, &r, PROTO_EBAD_LANDMARKS, "2 landmark pairs, at least 3", NULL);

@@ -274,6 +274,7 @@ TEST_T(sigterm_of_a_slurm_daemon_under_systemd_exits_0_and_its_job_completes_aft
     strcpy(a.sun_path, path);
     unlink(path);
     CHECK_INT(bind(fd, (struct sockaddr *)&a, sizeof a), 0);
+    CHECK_INT(chmod(path, 0666), 0);    /* as systemd's: the daemon may run as TESTDAEMON_USER */
     CHECK_INT(setenv("NOTIFY_SOCKET", path, 1), 0);
     testdaemon d;
     const char *args[] = {"--slurm-max-jobs", "3", NULL};

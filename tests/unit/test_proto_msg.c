@@ -280,7 +280,7 @@ TEST(error_names_and_messages_come_from_one_list)
     CHECK(strcmp(proto_stage_name(PROTO_STAGE_INIT), "init") == 0);
     CHECK(proto_stage_name(PROTO_STAGE_LAST + 1) == NULL);
     CHECK(strcmp(proto_slot_name(PROTO_SLOT_BUSY), "busy") == 0);
-    for (int c = 0; c >= PROTO_ETIMED_OUT; c--)
+    for (int c = 0; c >= PROTO_EOVER_QUOTA; c--)
         CHECK(strcmp(proto_err_name(c), "UNKNOWN") != 0);
 }
 

@@ -95,16 +95,16 @@ static const char *refusal(int i, double v)
 
 TEST(validator_names_the_field_and_the_bound)
 {
-    CHECK_STR(refusal(PROTO_P_inner_iterations, 500000), "params.inner_iterations = 500000 > 100000");
-    CHECK_STR(refusal(PROTO_P_rhm_alpha, 2), "params.rhm_alpha = 2 > 1");
-    CHECK_STR(refusal(PROTO_P_rhm_alpha, 1), "params.rhm_alpha = 1 >= 1");
-    CHECK_STR(refusal(PROTO_P_rhm_dim, 100000), "params.rhm_dim = 100000 > 64");
-    CHECK_STR(refusal(PROTO_P_alpha, 0), "params.alpha = 0 <= 0");
-    CHECK_STR(refusal(PROTO_P_eta, -1), "params.eta = -1 < 0");
-    CHECK_STR(refusal(PROTO_P_gamma, NAN), "params.gamma = nan: not a finite number");
-    CHECK_STR(refusal(PROTO_P_tolerance, INFINITY), "params.tolerance = inf: not a finite number");
-    CHECK_STR(refusal(PROTO_P_model, 2), "params.model = 2: not bijective or injective");
-    CHECK_STR(refusal(PROTO_P_beta_ramp, 0), "params.beta_ramp = 0 < 1");
+    CHECK_STR(refusal(PROTO_P_inner_iterations, 500000), "inner_iterations = 500000: out of range [1, 100000]");
+    CHECK_STR(refusal(PROTO_P_rhm_alpha, 2), "rhm_alpha = 2: out of range (0, 1); 0 = the default");
+    CHECK_STR(refusal(PROTO_P_rhm_alpha, 1), "rhm_alpha = 1: out of range (0, 1); 0 = the default");
+    CHECK_STR(refusal(PROTO_P_rhm_dim, 100000), "rhm_dim = 100000: out of range [3, 64]; 0 = the default");
+    CHECK_STR(refusal(PROTO_P_alpha, 0), "alpha = 0: out of range (0, inf)");
+    CHECK_STR(refusal(PROTO_P_eta, -1), "eta = -1: out of range [0, inf)");
+    CHECK_STR(refusal(PROTO_P_gamma, NAN), "gamma = nan: not a finite number");
+    CHECK_STR(refusal(PROTO_P_tolerance, INFINITY), "tolerance = inf: not a finite number");
+    CHECK_STR(refusal(PROTO_P_model, 2), "model = 2: not bijective or injective");
+    CHECK_STR(refusal(PROTO_P_beta_ramp, 0), "beta_ramp = 0: out of range [1, 1000000]");
     CHECK(refusal(PROTO_P_rhm_dim, 0) == NULL);          /* 0 = the default */
     CHECK(refusal(PROTO_P_rhm_iterations, 0) == NULL);
     CHECK(refusal(PROTO_P_rhm_alpha, 0) == NULL);
@@ -119,7 +119,7 @@ TEST(validator_names_the_field_and_the_bound)
     }
     w.backend = "gpu-please";
     CHECK_INT(proto_params_check(&w, err, sizeof err), PROTO_EBAD_PARAMS);
-    CHECK_STR(err, "params.backend = 'gpu-please': not cpu, opencl or auto (optionally :DEVICE)");
+    CHECK_STR(err, "backend = 'gpu-please': not cpu, opencl or auto (optionally :DEVICE)");
     char longdev[200];
     snprintf(longdev, sizeof longdev, "opencl:%0*d", PROTO_MAX_DEVICE + 1, 0);
     w.backend = longdev;
@@ -191,6 +191,9 @@ TEST(values_parse_from_text_by_type)
     CHECK_INT(proto_param_parse(&w, PROTO_P_alpha, "abc", err, sizeof err), PROTO_EBAD_PARAMS);
     CHECK_STR(err, "'abc' is not a number");
     CHECK_INT(proto_param_parse(&w, PROTO_P_iterations, "1.5", err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_STR(err, "'1.5' is not an integer in [1, 1000000]");      /* the row's range, not u32's */
+    CHECK_INT(proto_param_parse(&w, PROTO_P_zoomout, "-1", err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_STR(err, "'-1' is not an integer in [51, 300]; or 0 = off");
     CHECK_INT(proto_param_parse(&w, PROTO_P_start, "cells", err, sizeof err), PROTO_EBAD_PARAMS);
     CHECK_STR(err, "'cells' is not distances, voronoi, fmap or auto");
     char line[1024];
@@ -232,4 +235,26 @@ TEST(coarse_is_off_or_a_vertex_count_in_range)
     CHECK(proto_param_check(PROTO_P_coarse, PROTO_COARSE_MIN - 1, err, sizeof err) != PROTO_OK);
     CHECK(strstr(err, "coarse") && strstr(err, "500"));
     CHECK(proto_param_check(PROTO_P_coarse, (double)PROTO_COARSE_MAX + 1, err, sizeof err) != PROTO_OK);
+}
+
+/* The CLI's naming: the option the user typed, its value and the whole
+ * range from the list, never the wire's internal form. */
+TEST(validator_names_the_option_for_the_cli)
+{
+    proto_params w;
+    char err[256];
+    proto_params_init(&w);
+    w.iterations = 0;
+    CHECK_INT(proto_params_check_as(&w, PROTO_NAME_CLI, err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_STR(err, "--iterations 0: out of range [1, 1000000]");
+    CHECK_INT(proto_params_check(&w, err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_STR(err, "iterations = 0: out of range [1, 1000000]");
+    proto_params_init(&w);
+    w.inner_iterations = 500000;
+    CHECK_INT(proto_params_check_as(&w, PROTO_NAME_CLI, err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_STR(err, "--inner-iterations 500000: out of range [1, 100000]");
+    proto_params_init(&w);
+    w.backend = "gpu";
+    CHECK_INT(proto_params_check_as(&w, PROTO_NAME_CLI, err, sizeof err), PROTO_EBAD_PARAMS);
+    CHECK_STR(err, "--backend 'gpu': not cpu, opencl or auto (optionally :DEVICE)");
 }

@@ -3,9 +3,13 @@
  * tokens), writes the icosphere pair and runs one case of
  * tests/python/test_meshcorr.py with Debian's /usr/bin/python3 over
  * build/libmeshcorr.so.1. A case fails when the script exits non-zero, and
- * the test fails when the daemon died or exits non-zero. Last, `make
- * install PREFIX=tmp` (no root) and README's example script run from
- * PYTHONPATH against the installed library, whose ldd is slim. */
+ * the test fails when the daemon died or exits non-zero. Then the two ways
+ * users install it: `make install PREFIX=tmp` (no root) with README's
+ * example script and match() run from PYTHONPATH against the installed
+ * libraries (libmeshcorr's ldd slim); and `pip install ./client-c/python` into a fresh venv (made
+ * with --system-site-packages for Debian's numpy; offline), whose match()
+ * gives a daemon's map. /usr/bin/python3 is Debian's interpreter (the one
+ * with python3-numpy): pyenv's or a venv's python3 on PATH may lack numpy. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testfile.h"
@@ -60,12 +64,13 @@ static void write_inputs(const testdaemon *d)
     unsetenv("MESHCORR_TOKEN");
 }
 
-static void run_case(const char *name)
+/* Runs one case against a daemon started with args (NULL-terminated, or NULL). */
+static void run_case_with(const char *name, const char *const *args)
 {
     testdaemon_need_worker();
     need_python();
     testdaemon d;
-    testdaemon_start(&d, "py", NULL);
+    testdaemon_start(&d, "py", args);
     write_inputs(&d);
     int rc = testrunf(out, sizeof out,
                       "MESHCORR_LIB=build/libmeshcorr.so.1 PYTHONPATH=client-c/python PYTHONDONTWRITEBYTECODE=1 " PYTHON
@@ -78,6 +83,11 @@ static void run_case(const char *name)
     snprintf(done, sizeof done, "ok %s\n", name);
     CHECK_STR_HAS(out, done);
     testdaemon_stop(&d, SIGTERM);          /* fails unless the daemon exits 0 */
+}
+
+static void run_case(const char *name)
+{
+    run_case_with(name, NULL);
 }
 
 TEST_T(submit_from_files_watch_and_result_match_the_cli, 120)
@@ -118,6 +128,93 @@ TEST_T(a_job_failing_numerically_has_the_numeric_error_as_its_error, 120)
 TEST_T(progress_dicts_have_the_clis_names_and_the_whole_jobs_fraction, 120)
 {
     run_case("progress_keys_are_the_clis");
+}
+
+TEST_T(a_closed_client_raises_value_error_from_every_method_never_segfaults, 120)
+{
+    run_case("closed_client_raises_value_error");
+}
+
+TEST(version_is_the_version_file_through_mc_version)
+{
+    run_case("version_is_the_project_version");
+}
+
+TEST_T(errors_are_the_builtin_exceptions_they_mean_with_code_and_field, 120)
+{
+    static const char *const args[] = {"--max-jobs-per-user", "1", NULL};
+    run_case_with("errors_are_builtin_subclasses", args);
+}
+
+TEST_T(wait_and_watch_timeouts_raise_timeout_error_while_the_job_runs_on, 120)
+{
+    run_case("timeouts_raise_timeout_error_and_the_job_keeps_running");
+}
+
+TEST(read_mesh_gives_the_engines_arrays_for_every_format)
+{
+    run_case("read_mesh_gives_the_engines_arrays");
+}
+
+TEST(maps_give_nearest_vertices_and_carry_fields_exactly)
+{
+    run_case("maps_give_vertex_ids_and_carry_fields");
+}
+
+TEST_T(landmarks_must_be_integer_vertex_ids_named_when_refused, 120)
+{
+    run_case("landmarks_must_be_integer_vertex_ids");
+}
+
+TEST_T(match_in_process_gives_the_daemons_maps_progress_and_refusals, 180)
+{
+    run_case("match_in_process_equals_the_daemons_job");
+}
+
+TEST(reprs_name_the_object_and_type_hints_resolve)
+{
+    run_case("reprs_and_type_hints");
+}
+
+TEST_T(every_python_example_of_docs_python_md_runs, 180)
+{
+    run_case("docs_examples_run");
+}
+
+/* The install docs/python.md gives: a venv that sees Debian's numpy, pip
+ * without build isolation (offline), MESHCORR_LIB naming the built library;
+ * the case runs from outside the tree with the venv's python. */
+TEST_T(pip_install_into_a_fresh_venv_matches_the_daemons_map, 300)
+{
+    testdaemon_need_worker();
+    need_python();
+    if (testrun(PYTHON " -m venv --help >/dev/null 2>&1 && " PYTHON " -c 'import ensurepip, setuptools, wheel' 2>&1",
+                out, sizeof out) != 0)
+        SKIP("python3-venv, python3-setuptools or python3-wheel is not installed (deploy/install-deps.sh)");
+    char repo[512], venv[600];
+    CHECK(getcwd(repo, sizeof repo));
+    snprintf(venv, sizeof venv, "%s/venv", harness_tmpdir());
+    int rc = testrunf(out, sizeof out, PYTHON " -m venv --system-site-packages %s 2>&1", venv);
+    if (rc)
+        FAILF("python3 -m venv failed (%d):\n%s", rc, out);
+    rc = testrunf(out, sizeof out, "PIP_NO_INDEX=1 PIP_DISABLE_PIP_VERSION_CHECK=1 %s/bin/pip install "
+                  "--no-build-isolation ./client-c/python 2>&1", venv);
+    if (rc)
+        FAILF("pip install --no-build-isolation ./client-c/python failed (%d):\n%s", rc, out);
+    CHECK_STR_HAS(out, "Successfully installed meshcorr-");
+
+    testdaemon d;
+    testdaemon_start(&d, "py-venv", NULL);
+    write_inputs(&d);
+    rc = testrunf(out, sizeof out, "cd %s && env -u PYTHONPATH MESHCORR_TEST_REPO=%s MESHCORR_LIB=%s/build/libmeshcorr.so.1 "
+                  "PYTHONDONTWRITEBYTECODE=1 %s/bin/python %s/tests/python/test_meshcorr.py venv_match_equals_daemon 2>&1",
+                  harness_tmpdir(), repo, repo, venv, repo);
+    if (rc) {
+        fprintf(stderr, "%s", out);
+        FAILF("test_meshcorr.py venv_match_equals_daemon with the venv's python exited %d", rc);
+    }
+    CHECK_STR_HAS(out, "ok venv_match_equals_daemon\n");
+    testdaemon_stop(&d, SIGTERM);
 }
 
 TEST_T(installed_package_runs_the_readme_example_against_meshcorrd, 240)
@@ -167,5 +264,14 @@ TEST_T(installed_package_runs_the_readme_example_against_meshcorrd, 240)
     char *text = (char *)testfile_read(map, &(size_t){0});
     CHECK_STR_HAS(text, "# meshcorr-map 1\n# meshcorrd job 1\n162 162\n");
     free(text);
+    /* the installed engine library, next to the installed libmeshcorr: match() in-process */
+    rc = testrunf(out, sizeof out, "%s -c 'import meshcorr, meshcorr._lib as l; "
+                  "r = meshcorr.match(\"%s\", \"%s\", landmarks=[[i, i] for i in range(6)], iterations=2); "
+                  "print(len(r.p), l.engine()._name)' 2>&1", env, getenv("MESHCORR_TEST_SRC"),
+                  getenv("MESHCORR_TEST_TGT"));
+    if (rc)
+        FAILF("meshcorr.match from the installed package exited %d:\n%s", rc, out);
+    snprintf(path, sizeof path, "162 %s/lib/libmeshcorr-engine.so.1\n", dest);
+    CHECK_STR_HAS(out, path);
     testdaemon_stop(&d, SIGTERM);
 }

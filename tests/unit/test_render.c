@@ -1,8 +1,9 @@
 /* test_render.c — the pictures of client-c/render: the z-buffer keeps the
  * nearer face, marked faces hatched, the fitted rotation, the picture of a map (the identity of
  * a mesh onto itself gives two equal halves pixel for pixel, a mirrored
- * map does not), the PNG read back with libpng, and the same through
- * `meshcorr eval --out-png`. */
+ * map does not), the PNG read back with libpng, text in the embedded font
+ * and the captions around a picture, and the same through `meshcorr eval
+ * --out-png`, whose captions say which side is which and which map. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "map/bmap.h"
@@ -255,6 +256,97 @@ static int eval_png(const char *src, const char *tgt, const char *map, const cha
     return run(cmd, out, outsz);
 }
 
+/* The pixels of text drawn alone at (x, y) on white, as the w by h region
+ * of rgb (stride w_full) whose top-left is (0, 0) of that region: the
+ * number that differ. */
+static long text_differs(const unsigned char *rgb, int w_full, int x0, int y0, int w, int h, int x, int y,
+                         int scale, const unsigned char ink[3], const char *text)
+{
+    render_image *want = render_image_new(w, h, white);
+    CHECK(want);
+    render_text(want, x, y, scale, ink, text);
+    long n = 0;
+    for (int r = 0; r < h; r++)
+        for (int c = 0; c < w; c++)
+            n += memcmp(rgb + 3 * ((size_t)(y0 + r) * w_full + (size_t)(x0 + c)),
+                        want->rgb + 3 * ((size_t)r * w + (size_t)c), 3) != 0;
+    render_image_free(want);
+    return n;
+}
+
+/* A glyph lands where and as wide as render_text_width says, each font
+ * pixel a scale by scale block; a byte outside printable ASCII draws as
+ * '?'; text past the image's edge is cut, not written out of bounds. */
+TEST(text_draws_glyphs_in_place_scaled_and_clipped)
+{
+    static const unsigned char ink[3] = {0, 0, 0};
+    render_image *im = render_image_new(40, 30, white);
+    CHECK(im);
+    CHECK_INT(render_text(im, 3, 2, 2, ink, "T"), render_text_width("T", 2));
+    CHECK_INT(render_text_width("T", 2), RENDER_FONT_W * 2);
+    CHECK_INT(render_text_width("ab", 2), 2 * RENDER_FONT_ADVANCE * 2 - 2);
+    CHECK_INT(render_text_width("", 3), 0);
+    /* the bar of the T: its first two rows, ten pixels across */
+    for (int y = 0; y < 30; y++)
+        for (int x = 0; x < 40; x++) {
+            int bar = y >= 2 && y < 4 && x >= 3 && x < 13;
+            int stem = y >= 2 && y < 2 + 2 * 7 && x >= 7 && x < 9;
+            int inked = memcmp(im->rgb + 3 * ((size_t)y * 40 + x), ink, 3) == 0;
+            if (inked != (bar || stem))
+                FAILF("pixel (%d, %d) is %s", x, y, inked ? "inked" : "blank");
+        }
+    render_image *a = render_image_new(40, 30, white), *b = render_image_new(40, 30, white);
+    render_text(a, 0, 0, 1, ink, "\xc3\xa9");
+    render_text(b, 0, 0, 1, ink, "??");
+    CHECK(memcmp(a->rgb, b->rgb, 3 * 40 * 30) == 0);
+    render_text(a, 30, 25, 4, ink, "WWWW");          /* mostly outside: clipped */
+    render_image_free(a);
+    render_image_free(b);
+    render_image_free(im);
+}
+
+/* The captioned picture is the picture, unchanged, between a band above
+ * (each column's two lines, in place) and a band below (a line per entry;
+ * an entry left NULL stays blank); a line too long ends in "...". */
+TEST(captions_frame_the_picture_unchanged_and_write_each_line_in_place)
+{
+    mesh *S = shape();
+    bmap *P = identity_map(S);
+    render_image *pic = picture(S, S, P), *im = NULL;
+    char longer[400];
+    memset(longer, 'x', sizeof longer - 1);
+    longer[sizeof longer - 1] = '\0';
+    render_caption c = {{"source: a.off", "through the map"}, {"target: b.off", "by position"},
+                        {"map: p.map", longer, NULL, NULL}};
+    CHECK_INT(render_captioned(pic, &c, &im), RENDER_OK);
+    int top = render_caption_top(pic->w), bottom = render_caption_bottom(pic->w);
+    CHECK(top > 0 && bottom > 0);
+    CHECK_INT(im->w, pic->w);
+    CHECK_INT(im->h, pic->h + top + bottom);
+    CHECK(memcmp(im->rgb + 3 * (size_t)top * im->w, pic->rgb, 3 * (size_t)pic->w * pic->h) == 0);
+    static const unsigned char ink[3] = {20, 20, 20}, grey[3] = {90, 90, 90};
+    int half = pic->w / 2, line = RENDER_FONT_LINE, m = 4;   /* a 240-pixel picture: scale 1 */
+    /* above: each column's title, then its second line */
+    CHECK_INT(text_differs(im->rgb, im->w, 0, 0, half, m + line, m, m, 1, ink, "source: a.off"), 0);
+    CHECK(text_differs(im->rgb, im->w, 0, 0, half, m + line, m, m, 1, ink, "source: b.off") > 0);
+    CHECK_INT(text_differs(im->rgb, im->w, 0, m + line, half, line, m, 0, 1, grey, "through the map"), 0);
+    CHECK_INT(text_differs(im->rgb, im->w, half, 0, half, m + line, m, m, 1, ink, "target: b.off"), 0);
+    CHECK_INT(text_differs(im->rgb, im->w, half, m + line, half, line, m, 0, 1, grey, "by position"), 0);
+    /* below: the map's line, the long one cut to the width with "...",
+     * and two blank lines */
+    int y0 = top + pic->h + m;
+    CHECK_INT(text_differs(im->rgb, im->w, 0, y0, im->w, line, m, 0, 1, ink, "map: p.map"), 0);
+    int fit = (im->w - 2 * m + 1) / RENDER_FONT_ADVANCE;
+    char cut[400];
+    snprintf(cut, sizeof cut, "%.*s...", fit - 3, longer);
+    CHECK_INT(text_differs(im->rgb, im->w, 0, y0 + line, im->w, line, m, 0, 1, grey, cut), 0);
+    CHECK_INT(text_differs(im->rgb, im->w, 0, y0 + 2 * line, im->w, 2 * line, 0, 0, 1, grey, ""), 0);
+    render_image_free(im);
+    render_image_free(pic);
+    bmap_free(P);
+    mesh_free(S);
+}
+
 TEST(eval_out_png_of_identity_and_mirrored_maps)
 {
     mesh *T = shape(), *M = testmesh_mirrored(T);
@@ -269,21 +361,32 @@ TEST(eval_out_png_of_identity_and_mirrored_maps)
     CHECK_INT(mesh_write(m, M, err, sizeof err), 0);
     CHECK_INT(bmap_write(map, P, NULL, err, sizeof err), 0);
     CHECK_INT(eval_png(t, t, map, png, out, sizeof out), 0);
-    int w, h;
+    int w, h, top = render_caption_top(800), bottom = render_caption_bottom(800);
     unsigned char *rgb = png_read(png, &w, &h);
     CHECK_INT(w, 800);
-    CHECK_INT(h, 800);
-    CHECK_INT(halves_differ(rgb, w, h), 0);
+    CHECK_INT(h, 800 + top + bottom);
+    CHECK_INT(halves_differ(rgb + 3 * (size_t)top * w, w, 800), 0);     /* the picture's halves */
+    /* the captions: which side is which, which map, its quality (scale 2
+     * on the 800-pixel picture, margins of 4 font pixels) */
+    static const unsigned char ink[3] = {20, 20, 20}, grey[3] = {90, 90, 90};
+    int line = 2 * RENDER_FONT_LINE;
+    CHECK_INT(text_differs(rgb, w, 0, 0, 400, line + 8, 8, 8, 2, ink, "source: shape.off"), 0);
+    CHECK_INT(text_differs(rgb, w, 0, 8 + line, 400, line, 8, 0, 2, grey, "coloured through the map"), 0);
+    CHECK_INT(text_differs(rgb, w, 400, 0, 400, line + 8, 8, 8, 2, ink, "target: shape.off"), 0);
+    CHECK_INT(text_differs(rgb, w, 400, 8 + line, 400, line, 8, 0, 2, grey, "coloured by position"), 0);
+    CHECK_INT(text_differs(rgb, w, 0, top + 800 + 8, 800, line, 8, 0, 2, ink, "map: id.map"), 0);
+    CHECK_INT(text_differs(rgb, w, 0, top + 800 + 8 + line, 800, line, 8, 0, 2, grey,
+                           "source triangles flipped 0.00 %, collapsed 0.00 %"), 0);
     free(rgb);
     CHECK_INT(eval_png(m, t, map, png, out, sizeof out), 0);
     rgb = png_read(png, &w, &h);
-    CHECK(halves_differ(rgb, w, h) > 10000);
+    CHECK(halves_differ(rgb + 3 * (size_t)top * w, w, 800) > 10000);
     free(rgb);
     snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --mark-folds 2>&1", t, t, map);
     CHECK_INT(run(cmd, out, sizeof out), 2);
     CHECK_STR_HAS(out, "--mark-folds goes with --out-png");
     snprintf(png, sizeof png, "%s/no/such/dir/id.png", dir);
-    CHECK_INT(eval_png(t, t, map, png, out, sizeof out), 1);
+    CHECK_INT(eval_png(t, t, map, png, out, sizeof out), 2);       /* refused before the work */
     CHECK_STR_HAS(out, "no/such/dir/id.png");
     bmap_free(P);
     mesh_free(M);

@@ -225,7 +225,7 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report r
                 char *err, size_t errsz);
 
 /* A job's parameters (the wire form of the one list, proto_params.h) as the
- * engine's: checked with proto_params_check (CORR_EPARAMS, "params.NAME ..."
+ * engine's: checked with proto_params_check (CORR_EPARAMS, "NAME = V: ..."
  * in err), a 0 that means the default left at the default, backend
  * "NAME[:DEVICE]" split into p->backend and p->device, threads into both.
  * p and r start from their _init defaults (log_eps stays ECTM's). */
@@ -266,6 +266,18 @@ int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t err
 int corr_coarse_carry(const corr_input *in, const corr_coarse *c, const bmap *Pc,
                       const bmap *Qc, int repair, bmap **P, bmap **Q, char *err, size_t errsz);
 void corr_coarse_close(corr_coarse *c);
+
+/* The worker's peak memory for the job in with parameters p, in bytes:
+ * an estimate from the sizes (vertices and faces of both meshes, the
+ * landmarks, the stages that run, the start, the coarse-to-fine size,
+ * DDM's and ZoomOut's bases) that is meant to lie above what a run takes
+ * and within a small factor of it (corr_cost.c says how it is counted).
+ * what (may be NULL): the term that drives it, e.g. "the functional-map
+ * start's landmark descriptors: 65536 landmarks on meshes of 65536 and
+ * 65536 vertices (decimated from 163842 and 163842)". The daemon's SUBMIT
+ * check refuses a job whose estimate is over the worker's memory limit;
+ * p->backend opencl or auto adds the OpenCL runtime. */
+double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, size_t wsz);
 
 /* Runs the pipeline: the stages of in->stages (corr_stages_check first).
  * When the chain ends before ECTM, out->P and out->Q are the last stage's

@@ -73,7 +73,7 @@ void ectm_params_init(ectm_params *p);
  * 200 iterations, γ = 2e4 (twice the released code's β and γ). */
 void ectm_params_paper(ectm_params *p);
 /* 0 or ECTM_EPARAM with the offending field named in err (the job
- * parameters by proto_param_check: "params.alpha = 0 <= 0"). */
+ * parameters by proto_param_check: "alpha = 0: out of range (0, inf)"). */
 int ectm_params_check(const ectm_params *p, char *err, size_t errsz);
 /* β at outer iteration k (1-based). */
 double ectm_beta(const ectm_params *p, int k);

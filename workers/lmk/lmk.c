@@ -1,6 +1,7 @@
-/* lmk.c — landmark files: parsing and validation (see lmk.h). Knows nothing
- * about how landmarks are used. */
-#include "lmk/lmk.h"
+/* lmk.c — landmark sets: the one validation rule (lmk_from_arrays) and the
+ * pairs and lists readers on top of the file reader (lmk_file.c). Knows
+ * nothing about how landmarks are used. */
+#include "lmk/lmk_int.h"
 #include "util/errbuf.h"
 
 #include <errno.h>
@@ -26,67 +27,6 @@ void lmk_free(lmk_set *l)
     free(l->src);
     free(l->tgt);
     free(l);
-}
-
-/* Reads `cols` integers per data line (first `cols` columns; the rest of the
- * line is ignored), as written in the file, into a growing array. */
-static int read_columns(const char *path, int cols, long **vals, int *rows,
-                        char *err, size_t errsz)
-{
-    FILE *fp = fopen(path, "r");
-    if (!fp)
-        return errbuf_set(err, errsz, LMK_EIO, "%s: cannot open: %s", path, strerror(errno));
-    char line[4096];
-    long lineno = 0;
-    int n = 0, cap = 0, rc = LMK_OK;
-    long *v = NULL;
-    while (fgets(line, sizeof line, fp)) {
-        lineno++;
-        char *hash = strchr(line, '#');
-        if (hash)
-            *hash = '\0';
-        char *p = line;
-        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
-            p++;
-        if (*p == '\0')
-            continue;
-        if (n == PROTO_MAX_LANDMARKS) {
-            rc = errbuf_set(err, errsz, LMK_ECOUNT, "%s:%ld: more than %d landmarks",
-                            path, lineno, PROTO_MAX_LANDMARKS);
-            goto out;
-        }
-        if (n == cap) {
-            cap = cap ? 2 * cap : 64;
-            long *nv = realloc(v, sizeof(long) * (size_t)cap * (size_t)cols);
-            if (!nv) {
-                rc = errbuf_set(err, errsz, LMK_ENOMEM, "%s: out of memory", path);
-                goto out;
-            }
-            v = nv;
-        }
-        for (int c = 0; c < cols; c++) {
-            char *e;
-            errno = 0;
-            double d = strtod(p, &e);
-            if (e == p || errno == ERANGE || !(fabs(d) < 1e15) || d != (double)(long)d) {
-                rc = errbuf_set(err, errsz, LMK_EPARSE,
-                                "%s:%ld: column %d is not a vertex index", path, lineno, c + 1);
-                goto out;
-            }
-            v[(size_t)n * cols + c] = (long)d;
-            p = e;
-        }
-        n++;
-    }
-out:
-    fclose(fp);
-    if (rc) {
-        free(v);
-        return rc;
-    }
-    *vals = v;
-    *rows = n;
-    return LMK_OK;
 }
 
 static lmk_set *set_new(long n)
@@ -157,50 +97,76 @@ int lmk_from_arrays(const long *src, const long *tgt, long n, int one_based,
     return LMK_OK;
 }
 
-int lmk_read_pairs(const char *path, int one_based, const mesh *S, const mesh *T,
+/* What a pairs reader and a list reader say they want, after what a file
+ * in another layout looks like. */
+#define LMK_WANT_PAIRS "landmark pairs are `source_vertex target_vertex` a line"
+#define LMK_WANT_LIST "a list holds one vertex id a line (or BIM .vts `id x y z` / .pid `id 0 0 0` lines)"
+
+int lmk_read_pairs(const char *path, int base, const mesh *S, const mesh *T,
                    lmk_set **out, char *err, size_t errsz)
 {
     *out = NULL;
-    long *v = NULL;
-    int n = 0;
-    int rc = read_columns(path, 2, &v, &n, err, errsz);
+    lmk__file f;
+    int rc = lmk__file_read(path, PROTO_MAX_LANDMARKS, &f, err, errsz);
     if (rc)
         return rc;
-    long *a = malloc(sizeof(long) * ((size_t)n + 1)), *b = malloc(sizeof(long) * ((size_t)n + 1));
-    if (!a || !b) {
+    long *a = malloc(sizeof(long) * ((size_t)f.n + 1)), *b = malloc(sizeof(long) * ((size_t)f.n + 1));
+    int ba = 0, bb = 0;
+    if (f.layout != LMK__PAIRS)
+        rc = lmk__file_refuse(path, &f, LMK_WANT_PAIRS, err, errsz);
+    else if (!a || !b)
         rc = errbuf_set(err, errsz, LMK_ENOMEM, "%s: out of memory", path);
-    } else {
-        for (int k = 0; k < n; k++) {
-            a[k] = v[2 * k];
-            b[k] = v[2 * k + 1];
-        }
-        rc = lmk_from_arrays(a, b, n, one_based, path, path, S, T, out, err, errsz);
-    }
+    else if (!(rc = lmk__file_ids(path, &f, 0, base, NULL, S->nv, "source vertex", 1, a, &ba, err, errsz)) &&
+             !(rc = lmk__file_ids(path, &f, 1, base, NULL, T->nv, "target vertex", 1, b, &bb, err, errsz)))
+        rc = lmk_from_arrays(a, b, f.n, ba, path, path, S, T, out, err, errsz);
     free(a);
     free(b);
-    free(v);
+    lmk__file_close(&f);
     return rc;
 }
 
-int lmk_read_lists(const char *src_path, const char *tgt_path, int one_based,
+/* One list of a landmark pair of files: its ids as written and their base. */
+static int read_list(const char *path, int base, const mesh *m, const char *what, lmk__file *f,
+                     long **ids, int *b, char *err, size_t errsz)
+{
+    *ids = NULL;
+    int rc = lmk__file_read(path, PROTO_MAX_LANDMARKS, f, err, errsz);
+    if (rc)
+        return rc;
+    if (f->layout == LMK__PAIRS)
+        return lmk__file_refuse(path, f, LMK_WANT_LIST, err, errsz);
+    if (!(*ids = malloc(sizeof(long) * ((size_t)f->n + 1))))
+        return errbuf_set(err, errsz, LMK_ENOMEM, "%s: out of memory", path);
+    return lmk__file_ids(path, f, 0, base, m, m->nv, what, 1, *ids, b, err, errsz);
+}
+
+int lmk_read_lists(const char *src_path, const char *tgt_path, int base,
                    const mesh *S, const mesh *T, lmk_set **out, char *err, size_t errsz)
 {
     *out = NULL;
+    lmk__file fa, fb;
+    memset(&fb, 0, sizeof fb);
     long *a = NULL, *b = NULL;
-    int na = 0, nb = 0;
-    int rc = read_columns(src_path, 1, &a, &na, err, errsz);
-    if (rc)
-        return rc;
-    if ((rc = read_columns(tgt_path, 1, &b, &nb, err, errsz)))
+    int ba = 0, bb = 0;
+    int rc = read_list(src_path, base, S, "source vertex", &fa, &a, &ba, err, errsz);
+    if (rc || (rc = read_list(tgt_path, base, T, "target vertex", &fb, &b, &bb, err, errsz)))
         goto out;
-    if (na != nb) {
+    if (fa.n != fb.n) {
         rc = errbuf_set(err, errsz, LMK_ECOUNT, "%s has %d landmarks but %s has %d",
-                        src_path, na, tgt_path, nb);
+                        src_path, fa.n, tgt_path, fb.n);
         goto out;
     }
-    rc = lmk_from_arrays(a, b, na, one_based, src_path, tgt_path, S, T, out, err, errsz);
+    /* files at different bases (a .vts beside a 1-based list): the set is
+     * built from 0-based ids; else from the ids as written, for messages */
+    for (int k = 0; ba != bb && k < fa.n; k++) {
+        a[k] -= ba;
+        b[k] -= bb;
+    }
+    rc = lmk_from_arrays(a, b, fa.n, ba == bb ? ba : 0, src_path, tgt_path, S, T, out, err, errsz);
 out:
     free(a);
     free(b);
+    lmk__file_close(&fa);
+    lmk__file_close(&fb);
     return rc;
 }

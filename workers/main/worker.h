@@ -2,7 +2,10 @@
  * daemon, and meshcorr-validate, the short-lived check of a SUBMIT before it
  * is accepted (the contract of both is workers/WORKER.md). Declarations
  * shared by their files (prefix wrk_); this folder is not part of the engine
- * library and nothing here is called from outside these two programs.
+ * library; outside these two programs only libmeshcorr-engine.so
+ * (client-c/local/mc_match.c) links the job's mapping (worker_job.c,
+ * worker_result.c, worker_progress.c), to run a job in-process as a
+ * worker does.
  * meshcorr-validate is worker_validate.c with worker_job.c and worker_cli.c
  * only, so it loads Draco and none of the engine's solvers.
  *
@@ -17,6 +20,7 @@
 #include "proto.h"
 #include "spool.h"        /* file names and exit statuses: SPOOL_* */
 #include "corr/corr.h"
+#include "sandbox/sandbox.h"
 
 typedef struct wrk_limits {
     int max_vertices, max_faces;   /* per mesh, checked while decoding */
@@ -98,9 +102,20 @@ void wrk_result_close(wrk_result *r);
 /* worker_validate.c — meshcorr-validate, the daemon's check of a SUBMIT
  * (its main is there). wrk_validate reads one SUBMIT frame from in_fd and
  * builds the job from it as a run would (wrk_job_from_submit), running
- * nothing. SPOOL_EXIT_OK when it would run; else one ERROR frame (the code and
- * the message naming the blob or field) on out_fd and SPOOL_EXIT_JOB. */
-int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim);
+ * nothing; with worker_memory_mb (0: none) a job whose estimated peak
+ * memory (corr_cost_bytes) is over it is OVER_LIMIT. SPOOL_EXIT_OK when it
+ * would run; else one ERROR frame (the code and the message naming the
+ * blob, field or estimate) on out_fd and SPOOL_EXIT_JOB. */
+int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim, unsigned long long worker_memory_mb);
+
+/* The limits the worker sets whatever the daemon passes (WORKER.md,
+ * "Sandbox"): its largest file is one frame (result.frame), it needs few
+ * descriptors; --max-cpu-s is at most WRK_MAX_CPU_S, and a run that uses it
+ * up gets SIGXCPU, then SIGKILL WRK_CPU_GRACE_S CPU seconds later. */
+#define WRK_MAX_FILE_BYTES ((rlim_t)PROTO_MAX_FRAME)
+#define WRK_MAX_FILES 1024
+#define WRK_MAX_CPU_S (1ull << 40)
+#define WRK_CPU_GRACE_S 10
 
 /* worker_cli.c — shared by both programs' mains. wrk_parse_num: the decimal
  * s of option --opt in [lo, hi], or -1 with a message naming prog and the
@@ -116,6 +131,16 @@ int wrk_setlimit(const char *prog, int res, const char *what, rlim_t v);
 int wrk_limit_option(const char *prog, int opt, const char *arg, wrk_limits *lim,
                      unsigned long long *memory_mb);
 void wrk_error_msg(proto_msg *m, int code, const char *msg, char text[PROTO_MAX_STRING + 1]);
+/* RLIMIT_CPU: soft cpu_s (SIGXCPU), hard WRK_CPU_GRACE_S later (SIGKILL). */
+int wrk_setlimit_cpu(const char *prog, rlim_t cpu_s);
+/* What both programs set before they read their input: no core file, files
+ * of at most max_file bytes, max_files descriptors, and RLIMIT_NPROC at half
+ * the system's task ids (the limit counts every process and thread of the
+ * user, the daemon's included: it keeps a runaway from taking them all). */
+int wrk_base_limits(const char *prog, rlim_t max_file, rlim_t max_files);
+/* The worker's sandbox profile (sandbox.h) for a job: the OpenCL one when
+ * its backend is opencl or auto (both set PoCL up), else the CPU one. */
+sbx_profile wrk_sandbox_profile(const proto_submit *s);
 
 /* worker_devices.c — `--list-devices`: "cpu:N" and every OpenCL device with
  * fp64, one per line on stdout; 0 when printed. */

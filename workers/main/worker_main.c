@@ -37,9 +37,10 @@ static void usage(void)
 {
     fprintf(stderr,
         "usage: meshcorr-worker --job DIR --job-id ID [--progress-fd N] [--threads N]\n"
-        "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N]\n"
+        "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N] [--max-cpu-s N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
         "       meshcorr-worker --list-devices [--threads N]\n"
+        "       meshcorr-worker --version\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage; 4: neither could be written.\n"
         "See workers/WORKER.md.\n");
@@ -87,12 +88,14 @@ int main(int argc, char **argv)
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"list-devices", no_argument, 0, 'L'},
-        {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
+        {"max-cpu-s", required_argument, 0, 'C'},    {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
     const char *dir = NULL;
     uint64_t job_id = 0;
     int have_id = 0, progress_fd = -1, bad = 0, list_devices = 0;
-    unsigned long long max_memory_mb = 0;
+    unsigned long long max_memory_mb = 0, max_cpu_s = 0;
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
     unsigned long long v;
     int c;
@@ -116,10 +119,14 @@ int main(int argc, char **argv)
         case 'v': case 'f': case 'm':
             bad |= wrk_limit_option(PROG, c, optarg, &lim, &max_memory_mb) != 0;
             break;
+        case 'C':
+            bad |= wrk_parse_num(PROG, "max-cpu-s", optarg, 1, WRK_MAX_CPU_S, &max_cpu_s) != 0;
+            break;
         case 'c': progress_tcp = optarg; break;
         case 's': secret_file = optarg; break;
         case 'L': list_devices = 1; break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
+        case 'V': printf(PROG " %s\n", MC_VERSION); return 0;
         default: bad = 1;
         }
     }
@@ -142,8 +149,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "meshcorr-worker: --progress-fd %d: not an open descriptor\n", progress_fd);
         bad = 1;
     }
-    /* allocations past the limit fail (NOMEM) instead of waking the OOM killer */
-    if (!bad && max_memory_mb && wrk_setlimit(PROG, RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20))
+    /* allocations past the limit fail (NOMEM) instead of waking the OOM killer;
+     * CPU seconds past the limit end the run by SIGXCPU (a crash); the
+     * largest file the worker writes is one frame; no core */
+    if (!bad && ((max_memory_mb && wrk_setlimit(PROG, RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20)) ||
+                 (max_cpu_s && wrk_setlimit_cpu(PROG, (rlim_t)max_cpu_s)) ||
+                 wrk_base_limits(PROG, WRK_MAX_FILE_BYTES, WRK_MAX_FILES)))
         bad = 1;
     if (bad) {
         usage();
@@ -178,16 +189,22 @@ int main(int argc, char **argv)
         status = fail(dir, job_id, rc, err);
         goto done;
     }
-    if ((rc = wrk_job_from_submit(&sub.u.submit, &lim, &job, err, sizeof err))) {
-        status = fail(dir, job_id, rc, err);
-        goto done;
-    }
     ctx.pg.fd = progress_fd;
     ctx.pg.job_id = job_id;
     ctx.t0 = t0;
-    if (progress_tcp) {
+    if (progress_tcp) {        /* a socket: before the sandbox, which allows none */
         snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, SPOOL_PROGRESS_FILE);
         wrk_progress_connect(&ctx.pg, progress_tcp, secret_file);
+    }
+    /* the meshes are Draco bytes from a client: decoded and solved in the
+     * sandbox only, the profile by the backend the job asks for */
+    if ((rc = sbx_enter(wrk_sandbox_profile(&sub.u.submit), PROG, err, sizeof err))) {
+        status = fail(dir, job_id, PROTO_EINTERNAL, err);
+        goto done;
+    }
+    if ((rc = wrk_job_from_submit(&sub.u.submit, &lim, &job, err, sizeof err))) {
+        status = fail(dir, job_id, rc, err);
+        goto done;
     }
     corr_input in;
     wrk_job_input(&job, &in);

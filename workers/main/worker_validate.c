@@ -3,7 +3,9 @@
  * from its stdin, builds the job exactly as a run would
  * (wrk_job_from_submit: the parameters by the one validator, both meshes
  * decoded by Draco and checked by corr_validate, the landmarks against the
- * decoded vertex counts, the maps' rows) and runs nothing. The daemon starts
+ * decoded vertex counts, the maps' rows, and, given the worker's memory
+ * limit, the job's estimated peak memory: corr_cost_bytes) and runs
+ * nothing. The daemon starts
  * it as a short-lived process under memory and CPU-time limits, so that
  * Draco (which throws and aborts on malformed input) never runs inside the
  * daemon. A program of its own, not a mode of meshcorr-worker: it links
@@ -59,7 +61,38 @@ static int write_error(int fd, int code, const char *msg)
     return rc;
 }
 
-int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim)
+/* bytes as people read them: "137 GB", "6.9 TB", "450 MB" (decimal units) */
+static const char *human_bytes(double b, char *buf, size_t sz)
+{
+    static const char *const unit[] = {"bytes", "kB", "MB", "GB", "TB", "PB"};
+    int u = 0;
+    while (b >= 1000 && u < 5) {
+        b /= 1000;
+        u++;
+    }
+    snprintf(buf, sz, b < 10 && u ? "%.1f %s" : "%.0f %s", b, unit[u]);
+    return buf;
+}
+
+/* The job's memory at its peak (corr_cost_bytes) against the worker's
+ * address-space limit: 0, or PROTO_EOVER_LIMIT naming the estimate, what
+ * drives it and the limit. worker_memory_mb 0: no limit, no check. */
+static int check_cost(const wrk_job *job, unsigned long long worker_memory_mb, char *err, size_t errsz)
+{
+    if (!worker_memory_mb)
+        return 0;
+    corr_input in;
+    wrk_job_input(job, &in);
+    char what[256], est[32];
+    double bytes = corr_cost_bytes(&in, &job->params, what, sizeof what);
+    if (bytes <= (double)worker_memory_mb * 1048576.0)
+        return 0;
+    return errbuf_set(err, errsz, PROTO_EOVER_LIMIT, "job too large for a worker: about %s at its peak for %s,"
+                      " over the worker's memory limit of %llu MB (--worker-memory-mb)",
+                      human_bytes(bytes, est, sizeof est), what, worker_memory_mb);
+}
+
+int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim, unsigned long long worker_memory_mb)
 {
     uint8_t hdr_bytes[PROTO_HDR_SIZE];
     unsigned char *frame = NULL;
@@ -94,7 +127,8 @@ int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim)
                         proto_type_name(m.type));
         goto done;
     }
-    rc = wrk_job_from_submit(&m.u.submit, lim, &job, err, sizeof err);
+    if ((rc = wrk_job_from_submit(&m.u.submit, lim, &job, err, sizeof err)) == 0)
+        rc = check_cost(&job, worker_memory_mb, err, sizeof err);
 done:
     wrk_job_close(&job);
     proto_msg_free(&m);
@@ -111,8 +145,12 @@ static void usage(void)
 {
     fprintf(stderr,
         "usage: " PROG " [--max-vertices N] [--max-faces N] [--max-memory-mb N] [--max-cpu-s N]\n"
+        "                         [--worker-memory-mb N]\n"
+        "       " PROG " --version\n"
         "Reads one SUBMIT frame on stdin and checks it as a run would, running nothing:\n"
         "exit 0 when the job would run; else one ERROR frame on stdout and exit 1.\n"
+        "--worker-memory-mb: the worker's memory limit; a job whose estimated peak is\n"
+        "over it is refused OVER_LIMIT (0, the default: no check).\n"
         "Exit 2: bad usage. See workers/WORKER.md.\n");
 }
 
@@ -121,9 +159,11 @@ int main(int argc, char **argv)
     static const struct option opts[] = {
         {"max-vertices", required_argument, 0, 'v'}, {"max-faces", required_argument, 0, 'f'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"max-cpu-s", required_argument, 0, 'C'},
-        {"help", no_argument, 0, 'h'},               {0, 0, 0, 0}};
+        {"worker-memory-mb", required_argument, 0, 'W'}, {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
+        {0, 0, 0, 0}};
     wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
-    unsigned long long max_memory_mb = 0, max_cpu_s = 0;
+    unsigned long long max_memory_mb = 0, max_cpu_s = 0, worker_memory_mb = 0;
     int c, bad = 0;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
@@ -131,7 +171,11 @@ int main(int argc, char **argv)
             bad |= wrk_limit_option(PROG, c, optarg, &lim, &max_memory_mb) != 0;
             break;
         case 'C': bad |= wrk_parse_num(PROG, "max-cpu-s", optarg, 1, 1ull << 20, &max_cpu_s) != 0; break;
+        case 'W':
+            bad |= wrk_parse_num(PROG, "worker-memory-mb", optarg, 0, 1ull << 40, &worker_memory_mb) != 0;
+            break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
+        case 'V': printf(PROG " %s\n", MC_VERSION); return 0;
         default: bad = 1;
         }
     }
@@ -142,7 +186,8 @@ int main(int argc, char **argv)
         return SPOOL_EXIT_USAGE;
     }
     /* the sandbox: bounded memory and CPU time, no files written, no core
-     * dumped, few descriptors; set before any input is read */
+     * dumped, few descriptors, then the seccomp allow-list (sandbox.h);
+     * all before any input is read */
     signal(SIGPIPE, SIG_IGN);
     /* the two meshes' buffers come and go: keep freed memory for reuse
      * instead of an mmap and its page faults per large buffer */
@@ -150,8 +195,12 @@ int main(int argc, char **argv)
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
     if ((max_memory_mb && wrk_setlimit(PROG, RLIMIT_AS, "--max-memory-mb", (rlim_t)max_memory_mb << 20)) ||
         (max_cpu_s && wrk_setlimit(PROG, RLIMIT_CPU, "--max-cpu-s", (rlim_t)max_cpu_s)) ||
-        wrk_setlimit(PROG, RLIMIT_FSIZE, "file size", 0) || wrk_setlimit(PROG, RLIMIT_CORE, "core size", 0) ||
-        wrk_setlimit(PROG, RLIMIT_NOFILE, "descriptors", 16))
+        wrk_base_limits(PROG, 0, 16))
         return SPOOL_EXIT_USAGE;
-    return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim);
+    char err[256];
+    if (sbx_enter(SBX_VALIDATOR, PROG, err, sizeof err)) {
+        fprintf(stderr, PROG ": %s\n", err);
+        return SPOOL_EXIT_USAGE;
+    }
+    return wrk_validate(STDIN_FILENO, STDOUT_FILENO, &lim, worker_memory_mb);
 }

@@ -1,31 +1,60 @@
 """_lib.py — libmeshcorr.so.1 through ctypes: finding and loading it, the C
-structs of meshcorr.h, and the mc_job_spec laid out from the library's own
-parameter list (mc_param_*), checked against mc_job_spec_size().
+structs of meshcorr.h, the mc_job_spec laid out from the library's own
+parameter list (mc_param_*), checked against mc_job_spec_size(), and the
+in-process engine libmeshcorr-engine.so.1, loaded on first use.
 
-The library is $MESHCORR_LIB when set, else the path `make install` wrote
-into _libpath.py, else build/libmeshcorr.so.1 of the source tree this
-package sits in, else the system loader's libmeshcorr.so.1."""
+libmeshcorr is, in this order, the first of these that loads:
+  $MESHCORR_LIB (a path; when set, nothing else is tried),
+  the path `make install-python` wrote into _libpath.py,
+  build/libmeshcorr.so.1 of the source tree this package sits in,
+  libmeshcorr.so.1 through the system loader (LD_LIBRARY_PATH, or the
+  ldconfig cache after `make install` and ldconfig).
+libmeshcorr-engine.so.1 is taken from the folder libmeshcorr was loaded
+from, else through the system loader."""
+from __future__ import annotations
+
 import ctypes
 import os
+import threading
 
-from .errors import MeshcorrError
+import numpy as np
+
+from . import errors
+
+LIBNAME, ENGINE_LIBNAME = "libmeshcorr.so.1", "libmeshcorr-engine.so.1"
 
 
-def _find():
+def _candidates():
     env = os.environ.get("MESHCORR_LIB")
     if env:
-        return env
+        return [env]
+    found = []
     try:
         from ._libpath import LIBMESHCORR
-        return LIBMESHCORR
+        found.append(LIBMESHCORR)
     except ImportError:
         pass
     here = os.path.dirname(os.path.abspath(__file__))
-    tree = os.path.join(here, "..", "..", "..", "build", "libmeshcorr.so.1")
-    return tree if os.path.exists(tree) else "libmeshcorr.so.1"
+    tree = os.path.normpath(os.path.join(here, "..", "..", "..", "build", LIBNAME))
+    if os.path.exists(tree):
+        found.append(tree)
+    return found + [LIBNAME]
 
 
-lib = ctypes.CDLL(_find())
+def _load():
+    tried = []
+    for path in _candidates():
+        if os.sep in path:                   # a path: kept absolute, for the engine's folder
+            path = os.path.abspath(path)
+        try:
+            return ctypes.CDLL(path)
+        except OSError as e:
+            tried.append("%s (%s)" % (path, e))
+    raise ImportError("meshcorr: cannot load libmeshcorr: tried %s. Set MESHCORR_LIB to the path of "
+                      "build/libmeshcorr.so.1, or run `make install` (and ldconfig)" % "; ".join(tried))
+
+
+lib = _load()
 _libc = ctypes.CDLL(None)
 _libc.free.argtypes = [ctypes.c_void_p]
 free = _libc.free
@@ -35,6 +64,11 @@ c_u8p = ctypes.POINTER(ctypes.c_ubyte)
 
 class MapRow(ctypes.Structure):
     _fields_ = [("face", ctypes.c_uint32), ("w", ctypes.c_double * 3)]
+
+
+# mc_map_row as a numpy record, to read and write arrays of rows in place.
+MAP_ROW_DTYPE = np.dtype([("face", np.uint32), ("w", np.float64, 3)], align=True)
+assert MAP_ROW_DTYPE.itemsize == ctypes.sizeof(MapRow)
 
 
 class Progress(ctypes.Structure):
@@ -153,6 +187,8 @@ _declare("mc_job_spec_set", ctypes.c_int, ctypes.POINTER(JobSpec), ctypes.c_char
          c_err, ctypes.c_size_t)
 _declare("mc_connect", ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(c_client_p),
          c_err, ctypes.c_size_t)
+_declare("mc_connect_ca", ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p,
+         ctypes.POINTER(c_client_p), c_err, ctypes.c_size_t)
 _declare("mc_close", None, c_client_p)
 _declare("mc_set_timeout", None, c_client_p, ctypes.c_int)
 _declare("mc_errmsg", ctypes.c_char_p, c_client_p)
@@ -184,9 +220,75 @@ def errbuf():
     return ctypes.create_string_buffer(4096)
 
 
-def check(rc, detail):
-    """Raises MeshcorrError(rc, detail) when rc is not 0; detail is bytes or str."""
+def error(rc, detail, cls=None, field=None):
+    """The exception of code rc with detail (bytes or str): the class of the
+    code unless cls says, field as given or as the message names it. The
+    client's messages of server refusals start with the code's name
+    ("BAD_PARAMS: ..."), which the exception's text already shows: dropped."""
+    if isinstance(detail, (bytes, bytearray)):
+        detail = detail.decode(errors="replace")
+    name = lib.mc_err_name(rc).decode()
+    if detail.startswith(name + ": "):
+        detail = detail[len(name) + 2:]
+    return (cls or errors.error_class(rc))(rc, name, lib.mc_strerror(rc).decode(), detail,
+                                           field if field is not None else errors.field_of(detail))
+
+
+def check(rc, detail, cls=None, field=None):
+    """Raises error(rc, detail, cls, field) when rc is not 0."""
     if rc:
-        if isinstance(detail, (bytes, bytearray)):
-            detail = detail.decode(errors="replace")
-        raise MeshcorrError(rc, lib.mc_err_name(rc).decode(), lib.mc_strerror(rc).decode(), detail)
+        raise error(rc, detail, cls, field)
+
+
+if not hasattr(lib, "mc_version"):
+    raise ImportError("meshcorr: %s is older than this package (it has no mc_version): rebuild it with make, "
+                      "or point MESHCORR_LIB at a current one" % lib._name)
+_declare("mc_version", ctypes.c_char_p)
+_declare("mc_interrupt", None, c_client_p)
+_declare("mc_read_mesh", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
+         ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.POINTER(ctypes.c_int)), ctypes.POINTER(ctypes.c_int),
+         c_err, ctypes.c_size_t)
+VERSION = lib.mc_version().decode()
+
+
+class _DlInfo(ctypes.Structure):
+    _fields_ = [("dli_fname", ctypes.c_char_p), ("dli_fbase", ctypes.c_void_p),
+                ("dli_sname", ctypes.c_char_p), ("dli_saddr", ctypes.c_void_p)]
+
+
+def _loaded_from():
+    """The file libmeshcorr was loaded from (the system loader's choice
+    too, which lib._name does not tell), by dladdr of one of its functions."""
+    info = _DlInfo()
+    _libc.dladdr.argtypes = [ctypes.c_void_p, ctypes.POINTER(_DlInfo)]
+    if _libc.dladdr(ctypes.cast(lib.mc_version, ctypes.c_void_p), ctypes.byref(info)) and info.dli_fname:
+        return os.path.abspath(os.fsdecode(info.dli_fname))
+    return lib._name
+
+
+LIBPATH = _loaded_from()
+_engine = None
+_engine_lock = threading.Lock()
+
+
+def engine():
+    """libmeshcorr-engine.so.1 with mc_match declared, loaded on the first
+    call. OpenMP threads then wait passively (OMP_WAIT_POLICY=passive, as
+    meshcorr's programs run) unless the environment says otherwise."""
+    global _engine
+    with _engine_lock:
+        if _engine is None:
+            path = os.path.join(os.path.dirname(LIBPATH), ENGINE_LIBNAME)
+            if not os.path.exists(path):
+                path = ENGINE_LIBNAME            # the system loader's, as a last resort
+            os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+            try:
+                e = ctypes.CDLL(path)
+            except OSError as ex:
+                raise ImportError("meshcorr.match: cannot load %s (%s): build it with `make` or install it with "
+                                  "`make install-lib`" % (path, ex)) from None
+            e.mc_match.restype = ctypes.c_int
+            e.mc_match.argtypes = [ctypes.POINTER(JobSpec), ctypes.c_int, ctypes.c_uint, PROGRESS_FN,
+                                   ctypes.c_void_p, ctypes.POINTER(JobResult), c_err, ctypes.c_size_t]
+            _engine = e
+        return _engine

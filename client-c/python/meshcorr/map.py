@@ -1,38 +1,95 @@
 """map.py — a barycentric map (per source vertex a face of the other mesh
-and three weights), its points on that mesh, and the `meshcorr-map 1` text
-format `meshcorr result` and `meshcorr match` write (workers/map/bmap.c):
-the header line, `#` comments, "<source vertices> <target vertices>", then
-"<face> <w0> <w1> <w2>" per source vertex, weights as %.17g. Also
-vertex-to-vertex maps (one target vertex per source vertex, the layout
-BCICP and BIM write) as Maps, with the base rule of `meshcorr match
---init-base` (workers/map/vmap.h)."""
+and three weights), its points on that mesh, fields carried across it
+(transfer), its nearest vertices (to_vertex_map), and the `meshcorr-map 1`
+text format `meshcorr result` and `meshcorr match` write
+(workers/map/bmap.c): the header line, `#` comments, "<source vertices>
+<target vertices>", then "<face> <w0> <w1> <w2>" per source vertex, weights
+as %.17g. Also vertex-to-vertex maps (one target vertex per source vertex,
+the layout BCICP and BIM write) as Maps, with the base rule of `meshcorr
+match --init-base` (workers/map/vmap.h)."""
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Union
+
 import numpy as np
 
 HEADER = "# meshcorr-map 1"
 
 
 class Map:
-    """faces: (n,) int32 faces of the target; weights: (n, 3) float64;
-    n_target: the target's vertex count (the format's header needs it)."""
+    """faces: (n,) int32 faces of the target; weights: (n, 3) float64, row i
+    the barycentric coordinates of source vertex i's point on the target
+    triangle faces[i]; n_target: the target's vertex count (the format's
+    header needs it). The target's faces F2 (m, 3) and positions V2
+    (n_target, 3) are the arrays read_mesh() returns for the target."""
 
-    def __init__(self, faces, weights, n_target):
+    def __init__(self, faces: Any, weights: Any, n_target: int) -> None:
         self.faces = np.ascontiguousarray(faces, dtype=np.int32)
         self.weights = np.ascontiguousarray(weights, dtype=np.float64)
         if self.faces.ndim != 1 or self.weights.shape != (len(self.faces), 3):
-            raise ValueError("a map is n faces and n by 3 weights")
+            raise ValueError("a map is n faces and n by 3 weights, got faces of shape %s and weights of shape %s"
+                             % (self.faces.shape, self.weights.shape))
         self.n_target = int(n_target)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self.faces)
 
-    def points(self, V2, F2):
-        """The mapped points on the target (V2: m by 3 positions, F2: its
-        faces): n by 3, row i = sum_k weights[i, k] V2[F2[faces[i], k]]."""
-        V2 = np.asarray(V2, dtype=np.float64)
+    def _target_faces(self, F2: Any) -> np.ndarray:
+        """F2 checked against the map: an (m, 3) array of vertex ids below
+        n_target holding every face the map uses."""
         F2 = np.asarray(F2)
-        return np.einsum("ik,ikd->id", self.weights, V2[F2[self.faces]])
+        if F2.ndim != 2 or F2.shape[1] != 3 or F2.dtype.kind not in "iu":
+            raise ValueError("F2: expected the target's faces, an (m, 3) integer array, got shape %s of %s"
+                             % (F2.shape, F2.dtype))
+        if len(self) and int(self.faces.max()) >= len(F2):
+            raise ValueError("F2 has %d faces, the map uses face %d: not the map's target"
+                             % (len(F2), int(self.faces.max())))
+        bad = F2[(F2 < 0) | (F2 >= self.n_target)]
+        if bad.size:
+            raise ValueError("F2: vertex id %d outside [0, %d), the target's vertices" % (int(bad[0]), self.n_target))
+        return F2
 
-    def write(self, path, comment=None):
+    def transfer(self, values: Any, F2: Any) -> np.ndarray:
+        """A per-vertex field of the target carried to the source: values of
+        shape (n_target,) or (n_target, k) (a scalar, texture coordinates,
+        colours, positions...) give (n,) or (n, k), row i the field
+        interpolated linearly at source vertex i's point, sum_k
+        weights[i, k] * values[F2[faces[i], k]] (exact at the barycentric
+        point). F2: the target's faces."""
+        F2 = self._target_faces(F2)
+        vals = np.asarray(values)
+        if vals.ndim not in (1, 2) or vals.shape[0] != self.n_target:
+            raise ValueError("values: expected shape (%d,) or (%d, k), one row per target vertex, got %s"
+                             % (self.n_target, self.n_target, vals.shape))
+        if vals.dtype.kind not in "iufc":
+            raise ValueError("values: expected numbers, got %s" % vals.dtype)
+        at = vals[F2[self.faces]]                    # (n, 3) or (n, 3, k): the corners' values
+        return np.einsum("ik,ik->i" if vals.ndim == 1 else "ik,ikd->id", self.weights, at)
+
+    def points(self, V2: Any, F2: Any) -> np.ndarray:
+        """The mapped points on the target (V2: its (n_target, 3) positions,
+        F2: its faces): (n, 3), row i = sum_k weights[i, k] V2[F2[faces[i], k]]."""
+        V2 = np.asarray(V2, dtype=np.float64)
+        if V2.shape != (self.n_target, 3):
+            raise ValueError("V2: expected the target's positions, shape (%d, 3), got %s" % (self.n_target, V2.shape))
+        return self.transfer(V2, F2)
+
+    def to_vertex_map(self, V2: Any, F2: Any) -> np.ndarray:
+        """The map as vertex-to-vertex: an (n,) int64 array, entry i the
+        target vertex nearest (in space) to source vertex i's point among
+        the three corners of its face (the first of equals); vertex_map()
+        turns it back into a Map."""
+        F2 = self._target_faces(F2)
+        V2 = np.asarray(V2, dtype=np.float64)
+        if V2.shape != (self.n_target, 3):
+            raise ValueError("V2: expected the target's positions, shape (%d, 3), got %s" % (self.n_target, V2.shape))
+        corners = F2[self.faces].astype(np.int64)   # (n, 3)
+        at = self.transfer(V2, F2)
+        d2 = ((V2[corners] - at[:, None, :]) ** 2).sum(axis=2)
+        return corners[np.arange(len(self)), np.argmin(d2, axis=1)]
+
+    def write(self, path: Union[str, "os.PathLike[str]"], comment: Optional[str] = None) -> None:
         """Writes the map as `meshcorr-map 1`; comment lines follow the header."""
         with open(path, "w") as fp:
             fp.write(HEADER + "\n")
@@ -42,19 +99,20 @@ class Map:
             for f, w in zip(self.faces.tolist(), self.weights.tolist()):
                 fp.write("%d %s %s %s\n" % (f, _g17(w[0]), _g17(w[1]), _g17(w[2])))
 
-    def __eq__(self, other):
+    def __eq__(self, other: object) -> bool:
         return (isinstance(other, Map) and self.n_target == other.n_target and
                 np.array_equal(self.faces, other.faces) and np.array_equal(self.weights, other.weights))
 
-    def __repr__(self):
-        return "Map(%d -> %d vertices)" % (len(self), self.n_target)
+    def __repr__(self) -> str:
+        return "Map(%d rows onto %d faces of a %d-vertex target)" % (len(self), len(np.unique(self.faces)),
+                                                                     self.n_target)
 
 
-def _g17(x):
+def _g17(x: float) -> str:
     return "%.17g" % x
 
 
-def read_map(path):
+def read_map(path: Union[str, "os.PathLike[str]"]) -> Map:
     """Reads a `meshcorr-map 1` file into a Map (ValueError when it is not one)."""
     with open(path) as fp:
         lines = fp.read().split("\n")
@@ -75,12 +133,12 @@ def read_map(path):
     return Map(faces, weights, nt)
 
 
-def write_map(path, m, comment=None):
+def write_map(path: Union[str, "os.PathLike[str]"], m: Map, comment: Optional[str] = None) -> None:
     """m.write(path, comment)."""
     m.write(path, comment)
 
 
-def vertex_map(ids, F2, n_target):
+def vertex_map(ids: Any, F2: Any, n_target: int) -> Map:
     """A Map from 0-based target vertex ids, one per source vertex: weight 1
     at the vertex, in the lowest face of F2 (the target's faces) listing it."""
     ids = np.asarray(ids, dtype=np.int64)
@@ -99,7 +157,8 @@ def vertex_map(ids, F2, n_target):
     return Map((q // 3).astype(np.int32), weights, n_target)
 
 
-def read_vertex_map(path, F2, n_target, n_source=None, base=None):
+def read_vertex_map(path: Union[str, "os.PathLike[str]"], F2: Any, n_target: int, n_source: Optional[int] = None,
+                    base: Optional[int] = None) -> Map:
     """Reads a vertex-map file (one target vertex index a line; '#' and
     blank lines skipped) into a Map on the target with faces F2. base 0 or
     1, or None: a 0 among the indices means 0-based, n_target among them
@@ -136,7 +195,7 @@ def read_vertex_map(path, F2, n_target, n_source=None, base=None):
     return vertex_map(np.array(ids, dtype=np.int64) - base, F2, n_target)
 
 
-def is_map_file(path):
+def is_map_file(path: Union[str, bytes, "os.PathLike[str]"]) -> bool:
     """True when the file starts with the meshcorr-map 1 header."""
     with open(path) as fp:
         return fp.readline().rstrip() == HEADER
