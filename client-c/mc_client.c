@@ -66,6 +66,17 @@ const char *mc_err_name(int code)
     }
 }
 
+int mc_reason_error(const char *reason)
+{
+    char name[32];
+    size_t n = reason ? strcspn(reason, ":") : 0;
+    if (!reason || !reason[n] || n == 0 || n >= sizeof name)
+        return 0;
+    memcpy(name, reason, n);
+    name[n] = '\0';
+    return proto_err_code(name);
+}
+
 const char *mc_state_name(int state) { return proto_state_name(state); }
 
 int mc_state_parse(const char *name)
@@ -728,6 +739,9 @@ int mc_list(mc_client *c, const char *user, uint32_t state_mask, mc_job_info **j
             o->outer = s->outer;
             o->total = s->total;
             o->quality = (mc_quality){s->quality.verdict, s->quality.flipped, s->quality.collapsed};
+            o->fraction = s->fraction;
+            o->eta_s = s->eta_s;
+            o->ahead = s->ahead;
             after = s->job_id;
         }
         *n += k;

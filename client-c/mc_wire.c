@@ -11,7 +11,8 @@
 #define MC_SAME(name) ((int)MC_E##name == (int)PROTO_E##name)
 _Static_assert(MC_SAME(UNAUTHORIZED) && MC_SAME(FORBIDDEN) && MC_SAME(NOT_FOUND) && MC_SAME(BAD_STATE) &&
                    MC_SAME(QUEUE_FULL) && MC_SAME(USER_LIMIT) && MC_SAME(BAD_MESH) && MC_SAME(BAD_LANDMARKS) &&
-                   MC_SAME(BAD_PARAMS) && MC_SAME(CANCELLED) && MC_SAME(BUSY) && MC_SAME(TIMED_OUT),
+                   MC_SAME(BAD_PARAMS) && MC_SAME(CANCELLED) && MC_SAME(BUSY) && MC_SAME(TIMED_OUT) &&
+                   MC_SAME(OVER_QUOTA) && MC_SAME(BAD_MAP) && MC_SAME(NUMERIC),
                "one numbering of the server's codes");
 #undef MC_SAME
 
@@ -62,6 +63,9 @@ void mc__progress_of(mc_progress *o, const proto_progress *p)
     o->beta = p->beta;
     o->gamma = p->gamma;
     o->elapsed_s = p->elapsed_s;
+    o->fraction = p->fraction;
+    o->eta_s = p->eta_s;
+    o->ahead = p->ahead;
 }
 
 void mc_result_free(mc_job_result *r)

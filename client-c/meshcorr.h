@@ -53,6 +53,8 @@ enum mc_error {
     MC_EBUSY = -26,            /* a connection limit: retry later (at connect) */
     MC_ETIMED_OUT = -27,       /* the server cut a silent, slow or idle connection */
     MC_EOVER_QUOTA = -28,      /* SUBMIT: the user's stored bytes, or the spool's, would pass its quota */
+    MC_EBAD_MAP = -29,         /* an initial map that does not fit the meshes */
+    MC_ENUMERIC = -30,         /* a stage of the job failed numerically (mc_match; a job's reason) */
 #define MC_ENUM(name, val, msg) name = val,
     MC_ERRORS(MC_ENUM)
 #undef MC_ENUM
@@ -64,6 +66,12 @@ const char *mc_version(void);
 /* The code's name: "BAD_PARAMS" (the protocol's name of a server code), "MC_EARG"
  * (this library's); "UNKNOWN" for others. */
 const char *mc_err_name(int code);
+/* The server code a failed job's reason starts with: a job that failed in
+ * its worker ends with the reason "NAME: message", NAME the code's name
+ * (mc_err_name: "NUMERIC", "BAD_MESH", ...; PROTOCOL.md, Errors: the
+ * kinds of a job's failure). 0 when the reason starts with no code's name
+ * (a timeout, a crash, a cancel before the job ran; NULL too). */
+int mc_reason_error(const char *reason);
 
 /* Job states (Slurm's names) and stages, as in the protocol. */
 enum mc_state { MC_PENDING, MC_RUNNING, MC_COMPLETED, MC_FAILED, MC_CANCELLED, MC_TIMEOUT,
@@ -140,7 +148,10 @@ size_t mc_job_spec_size(void);
 int mc_job_spec_set(mc_job_spec *s, const char *name, const char *text, char *err, size_t errsz);
 
 enum { MC_START_DISTANCES = 0, MC_START_VORONOI = 1, MC_START_FMAP = 2, MC_START_AUTO = 3 };
-enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3, MC_STAGE_DDM = 4 };
+/* MC_STAGE_INIT is not sent by servers from protocol version 5 on;
+ * MC_STAGE_QUEUED is a pending job's record: its place in the queue. */
+enum { MC_STAGE_START = 0, MC_STAGE_RHM = 1, MC_STAGE_ECTM = 2, MC_STAGE_INIT = 3, MC_STAGE_DDM = 4,
+       MC_STAGE_REPAIR = 5, MC_STAGE_QUEUED = 6 };
 /* Values of the stages parameter (PROTO_PARAMS; `meshcorr submit --stages`). */
 enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM = 3,
        MC_STAGES_DDM_ECTM = 4, MC_STAGES_DDM_RHM = 5, MC_STAGES_DDM_RHM_ECTM = 6,
@@ -150,14 +161,20 @@ enum { MC_STAGES_ALL = 0, MC_STAGES_RHM = 1, MC_STAGES_ECTM = 2, MC_STAGES_DDM =
 enum { MC_DDM_PLAIN = 0, MC_DDM_BIJECTIVE = 1, MC_DDM_AUTO = 2 };
 
 /* For stages start and rhm the five terms are RHM's (PROTOCOL.md,
- * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse. */
+ * PROGRESS): membrane = Dirichlet, bending = landmark, mismatch, reverse.
+ * fraction and eta_s are the whole job's: every stage weighted by its
+ * expected cost. */
 typedef struct mc_progress {
     uint64_t job_id;
-    int stage;                 /* MC_STAGE_*: 0 start, 1 rhm, 2 ectm, 3 init, 4 ddm */
-    uint32_t outer, total;     /* outer iteration, planned */
+    int stage;                 /* MC_STAGE_*: 0 start, 1 rhm, 2 ectm, 3 init, 4 ddm,
+                                  5 repair, 6 queued */
+    uint32_t outer, total;     /* the stage's iteration, planned */
     uint32_t inner[2];         /* L-BFGS iterations: [0] source side, [1] target side */
     double membrane[2], bending[2], mismatch[2], reverse[2], energy[2];
     double beta, gamma, elapsed_s;
+    double fraction;           /* of the whole job done, 0 to 1; NaN not known */
+    double eta_s;              /* seconds left; NaN not known */
+    uint32_t ahead;            /* MC_STAGE_QUEUED: jobs that start before it */
 } mc_progress;
 
 /* How good a COMPLETED job's map is, as its worker measured it. */
@@ -194,6 +211,8 @@ typedef struct mc_job_info {   /* one LIST row */
     char label[1025];
     uint32_t outer, total;
     mc_quality quality;
+    double fraction, eta_s;    /* the latest progress record's; NaN not known */
+    uint32_t ahead;            /* PENDING: jobs that start before it */
 } mc_job_info;
 
 typedef struct mc_job_result {

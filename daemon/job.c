@@ -49,6 +49,12 @@ static void tell_ended(mcd *d, uint64_t id)
         J.l.ended(d, id);
 }
 
+static void tell_queue(mcd *d)
+{
+    if (J.l.queue)
+        J.l.queue(d);
+}
+
 static void on_retry(uv_timer_t *t)
 {
     (void)t;
@@ -126,6 +132,7 @@ void job_running(mcd *d, uint64_t id, long pid)
 {
     if (store_set_running(d->store, id, store_now_ms(), pid))
         dlog(DLOG_ERROR, "job %llu: cannot record it RUNNING (the store is failing)", (unsigned long long)id);
+    tell_queue(d);
 }
 
 void job_listen(mcd *d, const job_listener *l)
@@ -253,8 +260,11 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
         if (store_get(d->store, id, &j) != 0 || sched_add(d->sched, id, user, j.priority) != 0)
             dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue: it runs after the next restart",
                  (unsigned long long)id);
+        tell_queue(d);
         return;
     }
+    if (counted)
+        tell_queue(d);          /* one running job fewer: the fair share's order moves */
     quality_read *q = state == PROTO_STATE_COMPLETED ? calloc(1, sizeof *q) : NULL;
     if (q) {
         q->work.data = q;
@@ -277,6 +287,7 @@ int job_cancel_pending(mcd *d, uint64_t id)
         return PROTO_ESTORAGE;
     dlog(DLOG_INFO, "job %llu: CANCELLED while pending", (unsigned long long)id);
     tell_ended(d, id);
+    tell_queue(d);
     return 0;
 }
 

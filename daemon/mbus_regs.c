@@ -56,7 +56,13 @@ void mbus_fill(const mcd_snapshot *s, uint16_t *r)
         mbus_put_f32(b + 8, (float)o->energy);
         mbus_put_f32(b + 10, (float)o->beta);
         mbus_put_u32(b + 12, o->elapsed_s);
-        b[14] = o->total ? (uint16_t)((uint64_t)(o->outer < o->total ? o->outer : o->total) * 100 / o->total) : 0;
+        int known = o->has_progress && o->fraction >= 0 && o->fraction <= 1;
+        /* rounded down; the 1e-9 keeps 7/20 at 35 % where its double is a hair below */
+        b[14] = known ? (uint16_t)(o->fraction * 100 + 1e-9) : 0;
         b[15] = o->has_progress;
+        mbus_put_u32(b + 16, o->has_progress && o->eta_s >= 0 && o->eta_s < 4294967295.0
+                                 ? (uint32_t)o->eta_s : 0xFFFFFFFFu);
+        b[18] = o->total ? (uint16_t)((uint64_t)(o->outer < o->total ? o->outer : o->total) * 100 / o->total) : 0;
+        b[19] = known ? (uint16_t)(o->fraction * 10000 + 1e-9) : 0;
     }
 }

@@ -272,6 +272,7 @@ typedef struct store_job {
     int64_t progress_off;         /* bytes of spool/<id>/progress.frames already taken */
     int verdict;                  /* the map's quality (metric_verdict), -1 not known */
     double flipped, collapsed;    /* its fractions of flipped/collapsed faces; NaN not known */
+    double fraction, eta_s;       /* latest progress: the whole job's share done, seconds left; NaN not known */
 } store_job;
 typedef int (*store_job_fn)(void *ctx, const store_job *j);          /* non-zero stops */
 typedef int (*store_progress_fn)(void *ctx, const proto_progress *p); /* non-zero stops */
@@ -375,6 +376,9 @@ int sched_remove(sched *s, uint64_t id);   /* a pending job leaves: 0, or -1 not
 uint64_t sched_next(sched *s, char user[AUTH_MAX_USER]);
 void sched_done(sched *s, const char *user);        /* one of user's running jobs ended */
 uint32_t sched_queued(const sched *s);              /* pending, all users */
+/* Jobs that start before pending job id in the order as it stands (the
+ * running counts and last starts as they are now); -1 when id is not queued. */
+int64_t sched_ahead(const sched *s, uint64_t id);
 uint32_t sched_user_pending(const sched *s, const char *user);
 uint32_t sched_user_running(const sched *s, const char *user);
 
@@ -390,6 +394,8 @@ typedef struct snap_slot {
     double energy;                /* total energy: both directions summed */
     double beta;                  /* mismatch weight */
     uint32_t elapsed_s;           /* wall time since the job started */
+    double fraction;              /* the whole job's share done, 0..1; NaN not known */
+    double eta_s;                 /* its seconds left; NaN not known */
 } snap_slot;
 
 typedef struct mcd_snapshot {
@@ -431,8 +437,8 @@ void dash_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t s
 
 /* ---- mbus_ ---------------------------------------------------------------- */
 /* MODBUS.md is the register map. 32-bit values: high word first. */
-#define MBUS_SLOT_BASE 16         /* slot i's block starts at 16 + 16 i */
-#define MBUS_SLOT_STRIDE 16
+#define MBUS_SLOT_BASE 16         /* slot i's block starts at 16 + 20 i */
+#define MBUS_SLOT_STRIDE 20
 #define MBUS_MAX_CLIENTS 8        /* more are accepted and closed at once */
 #define MBUS_FRAME_TIMEOUT_MS 500 /* a request must arrive whole within this */
 #define MBUS_IDLE_TIMEOUT_S 60    /* a connection without a request is closed */
@@ -548,6 +554,8 @@ struct mcd {
 typedef struct job_listener {
     void (*progress)(mcd *d, const proto_progress *p);
     void (*ended)(mcd *d, uint64_t id);     /* its terminal state is in the store */
+    void (*queue)(mcd *d);                  /* the queue's order may have changed: a job
+                                               started, ended, or left it */
 } job_listener;
 void job_init(mcd *d);            /* before the backend starts */
 void job_listen(mcd *d, const job_listener *l);

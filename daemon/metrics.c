@@ -54,7 +54,7 @@ static void value(FILE *fp, double v)
 
 /* Per-slot gauges: field selects which figure; slots without progress are
  * left out of the progress gauges. */
-enum slot_field { F_STATE, F_STAGE, F_OUTER, F_TOTAL, F_ENERGY, F_BETA, F_ELAPSED, F_PROGRESS };
+enum slot_field { F_STATE, F_STAGE, F_OUTER, F_TOTAL, F_ENERGY, F_BETA, F_ELAPSED, F_PROGRESS, F_ETA };
 
 static void slot_family(FILE *fp, const mcd_snapshot *s, const char *name, const char *help, enum slot_field f)
 {
@@ -72,7 +72,8 @@ static void slot_family(FILE *fp, const mcd_snapshot *s, const char *name, const
         case F_ENERGY:   v = o->energy; break;
         case F_BETA:     v = o->beta; break;
         case F_ELAPSED:  v = o->elapsed_s; break;
-        case F_PROGRESS: v = o->total ? (double)(o->outer < o->total ? o->outer : o->total) / o->total : 0; break;
+        case F_PROGRESS: v = o->fraction; break;
+        case F_ETA:      v = o->eta_s; break;
         }
         fprintf(fp, "%s{slot=\"%u\",job_id=\"%llu\"} ", name, i, (unsigned long long)o->job_id);
         value(fp, v);
@@ -97,10 +98,14 @@ static void format(FILE *fp, const mcd_snapshot *s)
     fprintf(fp, "meshcorr_snapshots_total %u\n", s->seq);
     slot_family(fp, s, "meshcorr_slot_state", "Worker slot state: 0 idle, 1 starting, 2 busy, 3 draining (job_id 0: none).", F_STATE);
     slot_family(fp, s, "meshcorr_slot_elapsed_seconds", "Wall time since the slot's job started.", F_ELAPSED);
-    slot_family(fp, s, "meshcorr_slot_stage", "Stage of the latest progress: 0 start, 1 rhm, 2 ectm, 3 init, 4 ddm.", F_STAGE);
-    slot_family(fp, s, "meshcorr_slot_outer_iteration", "Outer iteration of the latest progress.", F_OUTER);
-    slot_family(fp, s, "meshcorr_slot_total_iterations", "Outer iterations planned.", F_TOTAL);
-    slot_family(fp, s, "meshcorr_slot_progress_ratio", "Outer iteration over iterations planned (0 to 1).", F_PROGRESS);
+    slot_family(fp, s, "meshcorr_slot_stage",
+                "Stage of the latest progress: 0 start, 1 rhm, 2 ectm, 3 init, 4 ddm, 5 repair.", F_STAGE);
+    slot_family(fp, s, "meshcorr_slot_outer_iteration", "Iteration of the latest progress's stage.", F_OUTER);
+    slot_family(fp, s, "meshcorr_slot_total_iterations", "Iterations planned in that stage.", F_TOTAL);
+    slot_family(fp, s, "meshcorr_slot_progress_ratio",
+                "The whole job's share done (0 to 1): every stage weighted by its expected cost.", F_PROGRESS);
+    slot_family(fp, s, "meshcorr_slot_eta_seconds",
+                "Seconds the job has left, from the time its share done took (NaN not known).", F_ETA);
     slot_family(fp, s, "meshcorr_slot_energy", "Total energy of the latest progress (both directions summed).", F_ENERGY);
     slot_family(fp, s, "meshcorr_slot_beta", "Mismatch weight beta of the latest progress.", F_BETA);
 }

@@ -53,10 +53,12 @@ struct req_watch {
     uint32_t request_id;
     uint64_t job_id;
     uint32_t from_outer;
+    int64_t ahead;                /* the place in the queue last sent; -1 none */
     req_watch *next;
 };
 
 static int iterating;             /* fan-out in progress: unlink watches later */
+static void on_queue(mcd *d);
 static mcd_idle_fn quiesced;      /* a drain waits for the work items */
 
 static void prune(mcd *d)
@@ -381,6 +383,7 @@ static void submit_done(uv_work_t *w, int status)    /* loop */
                  id, s->user);
         reply_id(c, PROTO_MSG_SUBMIT_OK, s->request_id, s->id);   /* a no-op on a closed connection */
         bk_schedule(d);
+        on_queue(d);              /* a job of higher priority goes before watched ones */
     }
     work_end(d, c);
     free(s);
@@ -462,6 +465,22 @@ static void on_submit(conn *c, const proto_msg *m, const void *frame, size_t len
     d->submits = w;
 }
 
+/* The record of a pending job: its place in the queue (stage QUEUED,
+ * never stored); 0 when the job is not in the queue. */
+static int queued_record(mcd *d, uint64_t id, proto_progress *p)
+{
+    int64_t ahead = sched_ahead(d->sched, id);
+    if (ahead < 0)
+        return 0;
+    memset(p, 0, sizeof *p);
+    p->job_id = id;
+    p->stage = PROTO_STAGE_QUEUED;
+    p->ahead = ahead > UINT32_MAX ? UINT32_MAX : (uint32_t)ahead;
+    p->fraction = 0;
+    p->eta_s = NAN;
+    return 1;
+}
+
 static proto_quality quality_of(const store_job *j)
 {
     return (proto_quality){j->verdict, j->flipped, j->collapsed};
@@ -485,7 +504,9 @@ static void on_status(conn *c, const proto_msg *m)
     s->submit_ms = j.submit_ms;
     s->start_ms = j.start_ms;
     s->end_ms = j.end_ms;
-    s->has_progress = store_latest_progress(srv_conn_daemon(c)->store, j.id, &s->progress) == 0;
+    mcd *d = srv_conn_daemon(c);
+    s->has_progress = (j.state == PROTO_STATE_PENDING && queued_record(d, j.id, &s->progress)) ||
+                      store_latest_progress(d->store, j.id, &s->progress) == 0;
     s->quality = quality_of(&j);
     reply(c, &r, m->request_id);
 }
@@ -535,10 +556,15 @@ static void on_list(conn *c, const proto_msg *m)
         srv_send_error(c, m->request_id, rc, "job store failure listing jobs");
         goto done;
     }
-    for (uint32_t i = 0; i < l.n; i++)
-        sum[i] = (proto_job_summary){l.jobs[i].id, (uint8_t)l.jobs[i].state, l.jobs[i].priority,
-                                     l.jobs[i].submit_ms, l.jobs[i].user, l.jobs[i].label,
-                                     l.jobs[i].outer, l.jobs[i].total, quality_of(&l.jobs[i])};
+    for (uint32_t i = 0; i < l.n; i++) {
+        const store_job *j = &l.jobs[i];
+        proto_progress q;
+        int queued = j->state == PROTO_STATE_PENDING && queued_record(d, j->id, &q);
+        sum[i] = (proto_job_summary){j->id, (uint8_t)j->state, j->priority, j->submit_ms, j->user,
+                                     j->label, j->outer, j->total, quality_of(j),
+                                     queued ? 0 : j->fraction, queued ? NAN : j->eta_s,
+                                     queued ? q.ahead : 0};
+    }
     proto_msg r;
     memset(&r, 0, sizeof r);
     r.type = PROTO_MSG_LIST_OK;
@@ -659,8 +685,28 @@ static void on_watch(conn *c, const proto_msg *m)
         srv_send_error(c, m->request_id, PROTO_ENOMEM, "out of memory for the watch");
         return;
     }
-    *nw = (req_watch){c, m->request_id, j.id, w->from_outer, d->watches};
+    *nw = (req_watch){c, m->request_id, j.id, w->from_outer, -1, d->watches};
     d->watches = nw;
+    proto_progress q;
+    if (j.state == PROTO_STATE_PENDING && queued_record(d, j.id, &q)) {   /* where it waits */
+        nw->ahead = q.ahead;
+        send_progress(c, m->request_id, &q);
+    }
+}
+
+/* The queue moved: each watcher of a pending job hears its new place. */
+static void on_queue(mcd *d)
+{
+    iterating = 1;
+    for (req_watch *w = d->watches; w; w = w->next) {
+        proto_progress q;
+        if (w->c && queued_record(d, w->job_id, &q) && q.ahead != w->ahead) {
+            w->ahead = q.ahead;
+            send_progress(w->c, w->request_id, &q);
+        }
+    }
+    iterating = 0;
+    prune(d);
 }
 
 static void on_job_progress(mcd *d, const proto_progress *p)
@@ -692,7 +738,7 @@ static void on_job_ended(mcd *d, uint64_t id)
 
 void req_init(mcd *d)
 {
-    static const job_listener l = {on_job_progress, on_job_ended};
+    static const job_listener l = {on_job_progress, on_job_ended, on_queue};
     job_listen(d, &l);
 }
 

@@ -140,6 +140,20 @@ uint64_t sched_next(sched *s, char user[AUTH_MAX_USER])
     return e.id;
 }
 
+int64_t sched_ahead(const sched *s, uint64_t id)
+{
+    const sched_entry *e = NULL;
+    for (size_t i = 0; i < s->nq && !e; i++)
+        if (s->q[i].id == id)
+            e = &s->q[i];
+    if (!e)
+        return -1;
+    int64_t n = 0;
+    for (size_t i = 0; i < s->nq; i++)
+        n += &s->q[i] != e && before(s, &s->q[i], e);
+    return n;
+}
+
 void sched_done(sched *s, const char *user)
 {
     int u = find_user(s, user);

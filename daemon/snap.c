@@ -15,6 +15,7 @@
 #include "mcd.h"
 #include "util/errbuf.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -95,7 +96,14 @@ void snap_progress(mcd *d, const proto_progress *p)
         uint8_t state;
         slot_cache *c = sync_slot(d, i, &state);
         if (c->job_id == p->job_id) {
+            proto_progress kept = c->p;
             c->p = *p;
+            if (p->stage == PROTO_STAGE_REPAIR && c->has_progress) {
+                /* a repair has no energy of its own: the dashboards keep the
+                 * last iteration's energy and beta */
+                memcpy(c->p.terms, kept.terms, sizeof kept.terms);
+                c->p.beta = kept.beta;
+            }
             c->has_progress = 1;
         }
     }
@@ -116,6 +124,8 @@ void snap_collect(mcd *d, mcd_snapshot *out)
         o->total = c->has_progress ? c->p.total : 0;
         o->energy = c->has_progress ? c->p.terms[0][PROTO_TERM_ENERGY] + c->p.terms[1][PROTO_TERM_ENERGY] : 0;
         o->beta = c->has_progress ? c->p.beta : 0;
+        o->fraction = c->has_progress ? c->p.fraction : NAN;
+        o->eta_s = c->has_progress ? c->p.eta_s : NAN;
         o->elapsed_s = c->job_id && c->start_ms && now > c->start_ms ? (uint32_t)((now - c->start_ms) / 1000) : 0;
     }
     out->nslots = n;

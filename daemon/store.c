@@ -113,6 +113,7 @@ static const char schema[] =
     " crashes INTEGER NOT NULL DEFAULT 0," /* runs whose worker crashed */
     " verdict INTEGER NOT NULL DEFAULT -1," /* the map's quality_verdict; -1 not known */
     " flipped REAL, collapsed REAL,"      /* its flipped and collapsed fractions */
+    " fraction REAL, eta_s REAL,"         /* latest progress: the whole job's share done, time left */
     " bytes INTEGER NOT NULL DEFAULT 0);" /* its spool files' size (spool_bytes) */
     "CREATE INDEX IF NOT EXISTS jobs_user ON jobs(user, id);"
     "CREATE TABLE IF NOT EXISTS history("
@@ -120,14 +121,15 @@ static const char schema[] =
     " total INTEGER NOT NULL, inner0 INTEGER NOT NULL, inner1 INTEGER NOT NULL,"
     " membrane0 REAL, bending0 REAL, mismatch0 REAL, reverse0 REAL, energy0 REAL,"
     " membrane1 REAL, bending1 REAL, mismatch1 REAL, reverse1 REAL, energy1 REAL,"
-    " beta REAL, gamma REAL, elapsed_s REAL);"
+    " beta REAL, gamma REAL, elapsed_s REAL, fraction REAL, eta_s REAL);"
     "CREATE INDEX IF NOT EXISTS history_job ON history(job, outer_it);"
     "CREATE TABLE IF NOT EXISTS counters(name TEXT PRIMARY KEY, value INTEGER NOT NULL);";
 
 #define HISTORY_COLS "stage, outer_it, total, inner0, inner1, membrane0, bending0, mismatch0," \
-    " reverse0, energy0, membrane1, bending1, mismatch1, reverse1, energy1, beta, gamma, elapsed_s"
+    " reverse0, energy0, membrane1, bending1, mismatch1, reverse1, energy1, beta, gamma, elapsed_s," \
+    " fraction, eta_s"
 #define JOB_COLS "id, user, label, priority, state, reason, submit_ms, start_ms, end_ms, outer_it, total," \
-    " slurm_id, progress_off, verdict, flipped, collapsed"
+    " slurm_id, progress_off, verdict, flipped, collapsed, fraction, eta_s"
 
 int64_t store_now_ms(void)
 {
@@ -326,6 +328,11 @@ int store_open(const char *dir, store **out, char *err, size_t errsz)
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN verdict INTEGER NOT NULL DEFAULT -1", NULL, NULL, NULL);
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN flipped REAL", NULL, NULL, NULL);
     sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN collapsed REAL", NULL, NULL, NULL);
+    /* and those from before the whole job's progress */
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN fraction REAL", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN eta_s REAL", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "ALTER TABLE history ADD COLUMN fraction REAL", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "ALTER TABLE history ADD COLUMN eta_s REAL", NULL, NULL, NULL);
     /* a jobs.db from before the byte quota gains the column, counted once
      * from the files (the ALTER succeeds only when the column is new) */
     if (sqlite3_exec(s->db, "ALTER TABLE jobs ADD COLUMN bytes INTEGER NOT NULL DEFAULT 0", NULL, NULL, NULL)
@@ -454,7 +461,7 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     /* 0. Slurm runs without the Slurm backend: they run here again. */
     if (!keep_slurm) {
         if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
-                         " energy = NULL, slurm_id = '', progress_off = 0"
+                         " energy = NULL, fraction = NULL, eta_s = NULL, slurm_id = '', progress_off = 0"
                          " WHERE state IN ('PENDING', 'RUNNING') AND slurm_id != ''", NULL)))
             return errbuf_set(err, errsz, rc, "recover: cannot re-queue Slurm jobs");
         if (sqlite3_changes(s->db))
@@ -469,7 +476,8 @@ int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
     if ((rc = kill_orphan_workers(s, err, errsz)) || (rc = adopt_results(s, &adopted, err, errsz)))
         return rc;
     if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
-                     " energy = NULL WHERE state = 'RUNNING' AND slurm_id = ''", NULL)))
+                     " energy = NULL, fraction = NULL, eta_s = NULL"
+                     " WHERE state = 'RUNNING' AND slurm_id = ''", NULL)))
         return errbuf_set(err, errsz, rc, "recover: cannot re-queue running jobs");
     int requeued = sqlite3_changes(s->db);
     /* 2. spool directories without a committed row. */
@@ -645,6 +653,21 @@ fail:
     return PROTO_ESTORAGE;
 }
 
+/* A REAL column: NULL for NaN (SQLite stores NaN as NULL anyway). */
+static void bind_real(sqlite3_stmt *st, int k, double v)
+{
+    if (isnan(v))
+        sqlite3_bind_null(st, k);
+    else
+        sqlite3_bind_double(st, k, v);
+}
+
+/* A REAL column that may be NULL: NaN for NULL. */
+static double column_real(sqlite3_stmt *st, int k)
+{
+    return sqlite3_column_type(st, k) == SQLITE_NULL ? NAN : sqlite3_column_double(st, k);
+}
+
 static void read_job(sqlite3_stmt *st, store_job *j)
 {
     memset(j, 0, sizeof *j);
@@ -664,6 +687,8 @@ static void read_job(sqlite3_stmt *st, store_job *j)
     j->verdict = (int)sqlite3_column_int64(st, 13);
     j->flipped = sqlite3_column_type(st, 14) == SQLITE_NULL ? NAN : sqlite3_column_double(st, 14);
     j->collapsed = sqlite3_column_type(st, 15) == SQLITE_NULL ? NAN : sqlite3_column_double(st, 15);
+    j->fraction = column_real(st, 16);
+    j->eta_s = column_real(st, 17);
 }
 
 int store_get(store *s, uint64_t id, store_job *out)
@@ -722,7 +747,8 @@ int store_set_state(store *s, uint64_t id, int state, const char *reason)
 {
     if (!store_is_terminal(state))
         return exec_v(s->db, "UPDATE jobs SET state = ?, reason = ?, start_ms = 0, end_ms = 0, pid = 0,"
-                      " outer_it = 0, energy = NULL, slurm_id = '', progress_off = 0 WHERE id = ?", "tti",
+                      " outer_it = 0, energy = NULL, fraction = NULL, eta_s = NULL, slurm_id = '',"
+                      " progress_off = 0 WHERE id = ?", "tti",
                       proto_state_name(state), reason ? reason : "", (int64_t)id);
     const char *counter = state == PROTO_STATE_COMPLETED ? "completed"
                         : state == PROTO_STATE_CANCELLED ? "cancelled" : "failed";
@@ -757,7 +783,7 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p)
     int rc = exec_v(s->db, "BEGIN", NULL);
     sqlite3_stmt *st = NULL;
     if (!rc && sqlite3_prepare_v2(s->db, "INSERT INTO history(job, " HISTORY_COLS ") VALUES"
-                                  "(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)", -1, &st, NULL) != SQLITE_OK)
+                                  "(?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)", -1, &st, NULL) != SQLITE_OK)
         rc = PROTO_ESTORAGE;
     if (!rc) {
         int k = 1;
@@ -773,13 +799,21 @@ int store_add_progress(store *s, uint64_t id, const proto_progress *p)
         sqlite3_bind_double(st, k++, p->beta);
         sqlite3_bind_double(st, k++, p->gamma);
         sqlite3_bind_double(st, k++, p->elapsed_s);
+        bind_real(st, k++, p->fraction);
+        bind_real(st, k++, p->eta_s);
         rc = sqlite3_step(st) == SQLITE_DONE ? 0 : PROTO_ESTORAGE;
     }
     sqlite3_finalize(st);
-    if (!rc)
-        rc = exec_v(s->db, "UPDATE jobs SET outer_it = ?, total = ?, energy = ? WHERE id = ?", "iidi",
-                    (int64_t)p->outer, (int64_t)p->total,
-                    p->terms[0][PROTO_TERM_ENERGY] + p->terms[1][PROTO_TERM_ENERGY], (int64_t)id);
+    /* a repair's record has no iteration or energy of its own: the row keeps
+     * the last iteration's, and takes the whole job's share */
+    if (!rc && p->stage == PROTO_STAGE_REPAIR)
+        rc = exec_v(s->db, "UPDATE jobs SET fraction = ?, eta_s = ? WHERE id = ?", "ddi", p->fraction, p->eta_s,
+                    (int64_t)id);
+    else if (!rc)
+        rc = exec_v(s->db, "UPDATE jobs SET outer_it = ?, total = ?, energy = ?, fraction = ?, eta_s = ?"
+                    " WHERE id = ?", "iidddi", (int64_t)p->outer, (int64_t)p->total,
+                    p->terms[0][PROTO_TERM_ENERGY] + p->terms[1][PROTO_TERM_ENERGY], p->fraction, p->eta_s,
+                    (int64_t)id);
     if (!rc)
         rc = exec_v(s->db, "COMMIT", NULL);
     if (rc)
@@ -885,6 +919,8 @@ static void read_progress(sqlite3_stmt *st, uint64_t id, proto_progress *p)
     p->beta = sqlite3_column_double(st, k++);
     p->gamma = sqlite3_column_double(st, k++);
     p->elapsed_s = sqlite3_column_double(st, k++);
+    p->fraction = column_real(st, k++);
+    p->eta_s = column_real(st, k++);
 }
 
 int store_latest_progress(store *s, uint64_t id, proto_progress *out)

@@ -27,7 +27,7 @@
 
 /* ---- framing ------------------------------------------------------------ */
 #define PROTO_MAGIC      0x5052434Du  /* bytes "MCRP" on the wire */
-#define PROTO_VERSION    4
+#define PROTO_VERSION    5
 #define PROTO_HDR_SIZE   20
 
 /* ---- limits (PROTOCOL.md repeats each one) ------------------------------ */
@@ -72,7 +72,9 @@
     X(PROTO_ECANCELLED,   -25, "CANCELLED",     "job cancelled")                      \
     X(PROTO_EBUSY,        -26, "BUSY",          "server at a connection limit; retry later") \
     X(PROTO_ETIMED_OUT,   -27, "TIMED_OUT",     "connection idle, or a request too slow, past its timeout") \
-    X(PROTO_EOVER_QUOTA,  -28, "OVER_QUOTA",    "the user's stored bytes, or the spool's, would pass its quota")
+    X(PROTO_EOVER_QUOTA,  -28, "OVER_QUOTA",    "the user's stored bytes, or the spool's, would pass its quota") \
+    X(PROTO_EBAD_MAP,     -29, "BAD_MAP",       "initial map does not fit the meshes") \
+    X(PROTO_ENUMERIC,     -30, "NUMERIC",       "a stage of the job failed numerically")
 
 enum proto_error {
 #define PROTO_ENUM(sym, val, name, msg) sym = val,
@@ -81,6 +83,10 @@ enum proto_error {
 };
 const char *proto_strerror(int code);  /* "checksum mismatch"; unknown -> "unknown error" */
 const char *proto_err_name(int code);  /* "BAD_CHECKSUM"; unknown -> "UNKNOWN" */
+/* The code named name ("NUMERIC"); 0 for a name that is none of the list's. */
+int proto_err_code(const char *name);
+/* How a job fails: the kinds, each with its code above (proto_kind.h). */
+#include "proto_kind.h"
 
 /* ---- enumerations carried on the wire (u8) ------------------------------ */
 #define PROTO_TYPES(X)                                                        \
@@ -107,12 +113,15 @@ enum proto_state {
     PROTO_STATE_LAST = 6
 };
 
-#define PROTO_STAGES(X) X(START, 0) X(RHM, 1) X(ECTM, 2) X(INIT, 3) X(DDM, 4)
+/* INIT is not sent from version 5 on (a job's first record is a real
+ * one); QUEUED is the daemon's record of a pending job (its place in the
+ * queue), never stored. */
+#define PROTO_STAGES(X) X(START, 0) X(RHM, 1) X(ECTM, 2) X(INIT, 3) X(DDM, 4) X(REPAIR, 5) X(QUEUED, 6)
 enum proto_stage {
 #define PROTO_ENUM(name, val) PROTO_STAGE_##name = val,
     PROTO_STAGES(PROTO_ENUM)
 #undef PROTO_ENUM
-    PROTO_STAGE_LAST = 4
+    PROTO_STAGE_LAST = 6
 };
 
 #define PROTO_SLOTS(X) X(IDLE, 0) X(STARTING, 1) X(BUSY, 2) X(DRAINING, 3)
@@ -152,7 +161,7 @@ enum proto_term {
 /* Names for logs and the CLI; NULL for a value outside the list. */
 const char *proto_type_name(int type);    /* "SUBMIT" */
 const char *proto_state_name(int state);  /* "OUT_OF_MEMORY" */
-const char *proto_stage_name(int stage);  /* "rhm" */
+const char *proto_stage_name(int stage);  /* "rhm"; "queued" */
 const char *proto_slot_name(int slot);    /* "busy" */
 
 /* ---- CRC32C (Castagnoli, reflected 0x82F63B78) -------------------------- */
@@ -312,10 +321,13 @@ size_t proto_params_table(char *buf, size_t sz);
 typedef struct proto_progress {
     uint64_t job_id;
     uint8_t stage;                    /* enum proto_stage */
-    uint32_t outer, total;            /* outer iteration, planned total */
+    uint32_t outer, total;            /* the stage's iteration, planned total */
     uint32_t inner[2];                /* inner iterations: [0] forward, [1] reverse */
     double terms[2][PROTO_NTERMS];    /* per direction, enum proto_term */
     double beta, gamma, elapsed_s;
+    double fraction;                  /* of the whole job done, [0, 1]; NaN not known */
+    double eta_s;                     /* seconds left, >= 0; NaN not known */
+    uint32_t ahead;                   /* stage QUEUED: jobs that start before it; else 0 */
 } proto_progress;
 
 /* How good a COMPLETED job's map is (the worker's metrics, RESULT_OK):
@@ -330,6 +342,8 @@ typedef struct proto_job_summary {
     const char *user, *label;
     uint32_t outer, total;
     proto_quality quality;
+    double fraction, eta_s;           /* the latest record's (proto_progress); NaN not known */
+    uint32_t ahead;                   /* PENDING: jobs that start before it; else 0 */
 } proto_job_summary;
 
 typedef struct proto_metric { const char *key; double value; } proto_metric;

@@ -12,6 +12,7 @@
 #include "proto.h"
 #include "proto_int.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -302,6 +303,18 @@ static void io_map(io *c, proto_map *m, const char *what)
     io_section_end(c, at);
 }
 
+/* A whole job's fraction done (NaN, or in [0, 1]) and its seconds left
+ * (NaN, or finite and >= 0); both directions refuse others. */
+static void io_share(io *c, double *fraction, double *eta_s)
+{
+    io_f64(c, fraction);
+    io_f64(c, eta_s);
+    if (!c->err && !isnan(*fraction) && !(*fraction >= 0 && *fraction <= 1))
+        io_fail(c, PROTO_EBAD_FRAME, "progress fraction %g is not in [0, 1]", *fraction);
+    if (!c->err && !isnan(*eta_s) && !(*eta_s >= 0 && isfinite(*eta_s)))
+        io_fail(c, PROTO_EBAD_FRAME, "progress eta_s %g is not a time", *eta_s);
+}
+
 static void io_progress(io *c, proto_progress *g)
 {
     io_u64(c, &g->job_id);
@@ -316,6 +329,8 @@ static void io_progress(io *c, proto_progress *g)
     io_f64(c, &g->beta);
     io_f64(c, &g->gamma);
     io_f64(c, &g->elapsed_s);
+    io_share(c, &g->fraction, &g->eta_s);
+    io_u32(c, &g->ahead);
 }
 
 /* The parameters, one field per PROTO_PARAMS row in list order; ENUM and
@@ -343,7 +358,7 @@ static void io_params(io *c, proto_params *p)
 }
 
 /* Smallest wire sizes of list elements (strings empty), for io_count. */
-#define SUMMARY_MIN (8 + 1 + 4 + 8 + 5 + 5 + 4 + 4 + 20)
+#define SUMMARY_MIN (8 + 1 + 4 + 8 + 5 + 5 + 4 + 4 + 20 + 8 + 8 + 4)
 #define METRIC_MIN  (5 + 8)
 #define SLOT_MIN    (8 + 1)
 #define DEVICE_MIN  5
@@ -432,6 +447,8 @@ static void io_payload(io *c, proto_msg *m)
             io_u32(c, &j->outer);
             io_u32(c, &j->total);
             io_quality(c, &j->quality);
+            io_share(c, &j->fraction, &j->eta_s);
+            io_u32(c, &j->ahead);
         }
         break;
     }

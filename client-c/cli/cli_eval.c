@@ -19,6 +19,7 @@
 #include "map/vmap.h"
 #include "mesh/mesh.h"
 #include "metric/metric.h"
+#include "proto.h"
 #include "render/render.h"
 #include "viz/viz.h"
 
@@ -345,9 +346,14 @@ int cli_eval(int argc, char **argv)
         const double *curve = curves[a];
         metric_summary ms;
         double curv, cover = metric_coverage(T, P, METRIC_COVER_RADIUS), trip = NAN;
-        if (metric_summarize(S, T, P, &ms) || metric_curvature_error(S, T, P, &curv) ||
-            (Q && metric_round_trip(S, T, P, Q, &trip)))
+        if (metric_summarize(S, T, P, &ms) || (Q && metric_round_trip(S, T, P, Q, &trip)))
             goto oom;
+        int crc = metric_curvature_error(S, T, P, &curv, err, sizeof err);
+        if (crc) {              /* a mesh eval can read but not measure: say which and why */
+            fprintf(stderr, "meshcorr eval: curvature error of %s: %s\n", ppath, err);
+            status = crc == METRIC_ENOMEM ? proto_kind_exit(PROTO_KIND_NOMEM) : 1;
+            goto done;
+        }
         if (a == 0) {
             words.flipped = ms.flipped_fraction;
             words.collapsed = ms.collapsed_fraction;

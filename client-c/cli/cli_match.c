@@ -5,6 +5,7 @@
  * no numerics. */
 #include "cli/cli.h"
 #include "cli/cli_job.h"
+#include "cli/cli_progress.h"
 #include "util/ompenv.h"
 #include "corr/corr.h"
 #include "lmk/lmk.h"
@@ -21,133 +22,39 @@
 
 #define MATCH_MAX_THREADS 4096   /* --threads: more is a typo, not a machine */
 
-enum progress_mode { PROGRESS_AUTO, PROGRESS_TEXT, PROGRESS_JSON, PROGRESS_NONE };
-
 static void usage(FILE *fp)
 {
     fprintf(fp,
         "usage: meshcorr match SOURCE TARGET INPUTS --out P.map [--out-reverse Q.map]\n"
         "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--stages CHAIN]\n"
-        "         [--log-eps E] [--threads N] [--progress auto|text|json|none] [job options]\n"
+        "         [--log-eps E] [--threads N] [--progress auto|bar|text|json|none] [job options]\n"
         "--stages rhm stops after RHM and writes its maps; --stages ectm runs ECTM alone\n"
         "(needs --init); --init P.map --stages ddm,ectm denoises the given map by DDM, then\n"
         "refines it by ECTM. Job options:\n");
     cli_job_usage(fp);
 }
 
-typedef struct progress_state {
-    enum progress_mode mode;
-} progress_state;
-
-/* One RHM report (stage start: the start map, rhm: an iteration). */
-static void rhm_progress(progress_state *ps, const corr_progress *cp)
-{
-    const rhm_report *r = cp->rhm;
-    if (ps->mode == PROGRESS_JSON) {
-        fprintf(stderr, "{\"stage\":\"%s\",\"iteration\":%d,\"total\":%d,\"beta\":%.17g,"
-                "\"energy\":%.17g,\"elapsed\":%.3f,\"t_setup\":%.3f,\"t_project\":%.3f,"
-                "\"t_solve\":%.3f", corr_stage_name(cp->stage), r->iteration, r->total, r->beta,
-                r->energy, r->elapsed, r->t_setup, r->t_project, r->t_solve);
-        static const char *names[2] = {"forward", "backward"};
-        for (int d = 0; d < 2; d++)
-            fprintf(stderr, ",\"%s\":{\"dirichlet\":%.17g,\"reverse\":%.17g,\"mismatch\":%.17g,"
-                    "\"landmark\":%.17g}", names[d], r->dir[d].dirichlet, r->dir[d].reverse,
-                    r->dir[d].mismatch, r->dir[d].landmark);
-        fprintf(stderr, "}\n");
-    } else if (ps->mode == PROGRESS_TEXT) {
-        fprintf(stderr, "rhm %d/%d beta %.4g energy %.10g (dirichlet %.4g, reverse %.4g, "
-                "mismatch %.4g, landmark %.4g)  %.1f s\n", r->iteration, r->total, r->beta,
-                r->energy, r->dir[0].dirichlet + r->dir[1].dirichlet,
-                r->dir[0].reverse + r->dir[1].reverse, r->dir[0].mismatch + r->dir[1].mismatch,
-                r->dir[0].landmark + r->dir[1].landmark, r->elapsed);
-    } else if (ps->mode == PROGRESS_AUTO) {
-        int width = 30, done = (int)((long)width * r->iteration / r->total);
-        fprintf(stderr, "\r[%.*s%*s] rhm %d/%d energy %.6g  %.1f s ", done,
-                "##############################", width - done, "", r->iteration, r->total,
-                r->energy, r->elapsed);
-    }
-}
-
+/* Each stage report as the wire's record, shown as `meshcorr watch` shows
+ * a job's (cli_progress.h). */
 static int on_progress(void *ctx, const corr_progress *cp)
 {
-    progress_state *ps = ctx;
-    if (cp->rhm) {
-        rhm_progress(ps, cp);
-        fflush(stderr);
-        return 0;
-    }
-    if (cp->ddm) {               /* directions denoised of total, each one's objective */
-        const corr_ddm_report *d = cp->ddm;
-        const char *mode = d->mode == CORR_DDM_BIJECTIVE ? "bijective" : "plain";
-        if (ps->mode == PROGRESS_JSON) {
-            fprintf(stderr, "{\"stage\":\"ddm\",\"done\":%d,\"total\":%d,\"k\":%d,\"mode\":\"%s\",",
-                    d->done, d->total, d->k, mode);
-            if (isfinite(d->round_trip))
-                fprintf(stderr, "\"round_trip\":%.17g,", d->round_trip);
-            else
-                fprintf(stderr, "\"round_trip\":null,");
-            fprintf(stderr, "\"objective\":[%.17g,%.17g],\"elapsed\":%.3f}\n", d->cost[0], d->cost[1],
-                    cp->elapsed);
-        } else if (ps->mode != PROGRESS_NONE) {
-            if (d->done == 0 && isfinite(d->round_trip))   /* ddm_mode auto's choice */
-                fprintf(stderr, "ddm: %s (the given maps' round trip %.4f %s %g)\n", mode,
-                        d->round_trip, d->mode == CORR_DDM_BIJECTIVE ? "<=" : ">",
-                        CORR_DDM_AUTO_ROUND_TRIP);
-            fprintf(stderr, "ddm %d/%d (k %d) objective %.6g  %.1f s\n", d->done, d->total, d->k,
-                    d->done ? d->cost[d->done - 1] : 0.0, cp->elapsed);
-        }
-        fflush(stderr);
-        return 0;
-    }
-    if (cp->stage != CORR_STAGE_ECTM) {
-        if (ps->mode == PROGRESS_JSON)
-            fprintf(stderr, "{\"stage\":\"%s\",\"elapsed\":%.3f}\n", corr_stage_name(cp->stage), cp->elapsed);
-        else if (ps->mode != PROGRESS_NONE)
-            fprintf(stderr, "stage %s\n", corr_stage_name(cp->stage));
-        return 0;
-    }
-    const ectm_report *r = cp->ectm;
-    if (ps->mode == PROGRESS_JSON) {
-        fprintf(stderr,
-                "{\"stage\":\"ectm\",\"outer\":%d,\"total\":%d,\"beta\":%.17g,\"gamma\":%.17g,\"energy\":%.17g,"
-                "\"elapsed\":%.3f,\"t_project\":%.3f,\"t_solve\":%.3f",
-                r->outer, r->total, r->beta, r->gamma, r->energy, r->elapsed,
-                r->t_project, r->t_solve);
-        static const char *names[2] = {"source", "target"};
-        for (int d = 0; d < 2; d++)
-            fprintf(stderr,
-                    ",\"%s\":{\"membrane\":%.17g,\"bending\":%.17g,\"mismatch\":%.17g,"
-                    "\"reverse\":%.17g,\"energy\":%.17g,\"inner\":%d,\"admissible\":%d}",
-                    names[d], r->dir[d].w_mem, r->dir[d].w_bnd, r->dir[d].mismatch,
-                    r->dir[d].reverse, r->dir[d].energy, r->dir[d].inner_iterations,
-                    r->dir[d].admissible_edges);
-        fprintf(stderr, "}\n");
-    } else if (ps->mode == PROGRESS_TEXT) {
-        fprintf(stderr, "iter %d/%d beta %.4g energy %.10g (source %.6g, target %.6g) "
-                "inner %d/%d  %.1f s\n", r->outer, r->total, r->beta, r->energy,
-                r->dir[0].energy, r->dir[1].energy, r->dir[0].inner_iterations,
-                r->dir[1].inner_iterations, r->elapsed);
-    } else if (ps->mode == PROGRESS_AUTO) {
-        int width = 30, done = (int)((long)width * r->outer / r->total);
-        fprintf(stderr, "\r[%.*s%*s] %d/%d energy %.6g  %.1f s ", done,
-                "##############################", width - done, "", r->outer, r->total,
-                r->energy, r->elapsed);
-        if (r->outer == r->total)
-            fputc('\n', stderr);
-    }
-    fflush(stderr);
+    proto_progress rec;
+    corr_progress_record(cp, &rec);
+    cli_progress_print(stderr, *(const int *)ctx, &rec, 0);
     return 0;
 }
 
 /* Reads a mesh and refuses one the optimizer cannot use before any other
  * input is read, so the user hears about the mesh first. */
-static mesh *load(const char *path)
+static mesh *load(const char *path, int *status)
 {
     char err[4096];
     mesh *m = NULL;
-    if (mesh_read(path, &m, err, sizeof err) || corr_validate(m, path, err, sizeof err)) {
+    int rc = corr_from_mesh(mesh_read(path, &m, err, sizeof err));
+    if (rc || (rc = corr_validate(m, path, err, sizeof err))) {
         fprintf(stderr, "meshcorr match: %s\n", err);
         mesh_free(m);
+        *status = proto_kind_exit(-rc);
         return NULL;
     }
     return m;
@@ -184,7 +91,7 @@ int cli_match(int argc, char **argv)
     ectm_params_init(&pe);               /* log_eps and threads: match's own options */
     double log_eps = pe.log_eps;
     int threads = 0;
-    progress_state ps = { PROGRESS_AUTO };
+    int progress = CLI_PROGRESS_AUTO;
     int c;
     char *e;
     optind = 1;
@@ -211,12 +118,9 @@ int cli_match(int argc, char **argv)
                                        "pair's size)", optarg, MATCH_MAX_THREADS);
             break;
         case O_PROGRESS:
-            if (strcmp(optarg, "auto") == 0) ps.mode = PROGRESS_AUTO;
-            else if (strcmp(optarg, "text") == 0) ps.mode = PROGRESS_TEXT;
-            else if (strcmp(optarg, "json") == 0) ps.mode = PROGRESS_JSON;
-            else if (strcmp(optarg, "none") == 0) ps.mode = PROGRESS_NONE;
-            else
-                return cli_usage_error("match", "--progress: '%s' is not auto, text, json or none", optarg);
+            if (cli_progress_parse(optarg, &progress))
+                return cli_usage_error("match", "--progress: '%s' is not auto, bar, text, json or none",
+                                       optarg);
             break;
         case 'h': usage(stdout); return 0;
         default: return cli_usage_see("match");
@@ -240,8 +144,7 @@ int cli_match(int argc, char **argv)
         cli_output_check("match", "--out-remeshed", out_rem))
         return CLI_EXIT_USAGE;
     char err[1024];
-    if (ps.mode == PROGRESS_AUTO && !isatty(STDERR_FILENO))
-        ps.mode = PROGRESS_TEXT;
+    progress = cli_progress_resolve(progress, stderr);
 
     int status = 1;
     mesh *S = NULL, *T = NULL;
@@ -249,15 +152,20 @@ int cli_match(int argc, char **argv)
     lmk_set *L = NULL;
     ectm_result res = {0};
     const char *src = argv[optind], *tgt = argv[optind + 1];
-    if (!(S = load(src)) || !(T = load(tgt)) || cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
+    if (!(S = load(src, &status)) || !(T = load(tgt, &status)) ||
+        cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
     /* --threads, else as many as the pair's size pays for (as the worker) */
     pe.threads = rp.threads = ompenv_threads_for(S->nv + T->nv, threads);
     omp_set_num_threads(pe.threads);
     corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k,
                       (corr_ddm_mode)job.w.ddm_mode };
-    if (corr_run(&in, &pe, on_progress, &ps, &res, err, sizeof err)) {
-        fprintf(stderr, "\nmeshcorr match: %s\n", err);
+    int rc = corr_run(&in, &pe, on_progress, &progress, &res, err, sizeof err);
+    cli_progress_end(stderr, progress);
+    if (rc) {
+        /* the kind's name and exit status, as a job through meshcorrd ends */
+        fprintf(stderr, "meshcorr match: %s: %s\n", proto_kind_name(-rc), err);
+        status = proto_kind_exit(-rc);
         goto done;
     }
     char comment[512];

@@ -12,6 +12,7 @@
 #include "cli/cli.h"
 #include "metric/metric.h"
 #include "cli/cli_job.h"
+#include "cli/cli_progress.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/draco_bridge.h"
@@ -192,20 +193,28 @@ static void json_str(const char *s)
     putchar('"');
 }
 
-static const char *stage_name(int stage)
+/* A record from libmeshcorr as the wire's, for cli_progress. */
+static void record_of(const mc_progress *m, proto_progress *p)
 {
-    static const char *const names[] = {"start", "rhm", "ectm", "init", "ddm"};
-    return stage >= 0 && stage < 5 ? names[stage] : "?";
-}
-
-/* One line per iteration; every term is the sum of both directions
- * (source -> target and target -> source; --progress json has each). */
-static void print_progress_text(const mc_progress *p)
-{
-    printf("job %llu %s iter %u/%u energy %.3e membrane %.2e bending %.2e mismatch %.2e reverse %.2e "
-           "beta %.2e %.1f s\n", (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total,
-           p->energy[0] + p->energy[1], p->membrane[0] + p->membrane[1], p->bending[0] + p->bending[1],
-           p->mismatch[0] + p->mismatch[1], p->reverse[0] + p->reverse[1], p->beta, p->elapsed_s);
+    memset(p, 0, sizeof *p);
+    p->job_id = m->job_id;
+    p->stage = (uint8_t)m->stage;
+    p->outer = m->outer;
+    p->total = m->total;
+    for (int d = 0; d < 2; d++) {
+        p->inner[d] = m->inner[d];
+        p->terms[d][PROTO_TERM_MEMBRANE] = m->membrane[d];
+        p->terms[d][PROTO_TERM_BENDING] = m->bending[d];
+        p->terms[d][PROTO_TERM_MISMATCH] = m->mismatch[d];
+        p->terms[d][PROTO_TERM_REVERSE] = m->reverse[d];
+        p->terms[d][PROTO_TERM_ENERGY] = m->energy[d];
+    }
+    p->beta = m->beta;
+    p->gamma = m->gamma;
+    p->elapsed_s = m->elapsed_s;
+    p->fraction = m->fraction;
+    p->eta_s = m->eta_s;
+    p->ahead = m->ahead;
 }
 
 /* ,"quality":..,"flipped":..,"collapsed":.. of a job (null when not known). */
@@ -214,19 +223,6 @@ static void print_quality_json(const mc_quality *q)
     printf(",\"quality\":\"%s\",\"quality_verdict\":%d", mc_quality_name(q->verdict), q->verdict);
     printf(isfinite(q->flipped) ? ",\"flipped\":%.9g" : ",\"flipped\":null", q->flipped);
     printf(isfinite(q->collapsed) ? ",\"collapsed\":%.9g" : ",\"collapsed\":null", q->collapsed);
-}
-
-static void print_progress_json(const mc_progress *p)
-{
-    printf("{\"job\":%llu,\"stage\":\"%s\",\"outer\":%u,\"total\":%u,\"beta\":%.17g,\"gamma\":%.17g,"
-           "\"elapsed\":%.3f", (unsigned long long)p->job_id, stage_name(p->stage), p->outer, p->total, p->beta,
-           p->gamma, p->elapsed_s);
-    static const char *names[2] = {"source", "target"};
-    for (int d = 0; d < 2; d++)
-        printf(",\"%s\":{\"membrane\":%.17g,\"bending\":%.17g,\"mismatch\":%.17g,\"reverse\":%.17g,"
-               "\"energy\":%.17g,\"inner\":%u}", names[d], p->membrane[d], p->bending[d], p->mismatch[d],
-               p->reverse[d], p->energy[d], p->inner[d]);
-    printf("}\n");
 }
 
 static mc_map_row *rows_of(const bmap *P)
@@ -239,9 +235,9 @@ static mc_map_row *rows_of(const bmap *P)
     return r;
 }
 
-typedef struct watch_opts { long from; int json, progress_given; } watch_opts;
+typedef struct watch_opts { long from; int mode, progress_given; } watch_opts;
 
-/* --from K and --progress text|json; -1 after the usage error. */
+/* --from K and --progress auto|bar|text|json; -1 after the usage error. */
 static int watch_opt(const char *cmd, int c, void *ctx)
 {
     watch_opts *w = ctx;
@@ -252,31 +248,33 @@ static int watch_opt(const char *cmd, int c, void *ctx)
             return cli_usage_error(cmd, "--from: '%s' is not an outer iteration in [0, %u]", optarg,
                                    UINT32_MAX), -1;
     } else if (c == 'p') {
-        if (strcmp(optarg, "json") && strcmp(optarg, "text"))
-            return cli_usage_error(cmd, "--progress: '%s' is not text or json", optarg), -1;
-        w->json = strcmp(optarg, "json") == 0;
+        if (cli_progress_parse(optarg, &w->mode) || w->mode == CLI_PROGRESS_NONE)
+            return cli_usage_error(cmd, "--progress: '%s' is not auto, bar, text or json", optarg), -1;
         w->progress_given = 1;
     }
     return 0;
 }
 
-static int on_progress(void *ctx, const mc_progress *p)
+static int on_progress(void *ctx, const mc_progress *m)
 {
-    if (((watch_opts *)ctx)->json)
-        print_progress_json(p);
-    else
-        print_progress_text(p);
-    fflush(stdout);
+    proto_progress p;
+    record_of(m, &p);
+    cli_progress_print(stdout, ((watch_opts *)ctx)->mode, &p, 1);
     return 0;
 }
 
 /* Follows job id on c to its end (c is closed); exit status 0 when it
- * COMPLETED, 1 otherwise with the state and reason on stderr. */
+ * COMPLETED; else the state and reason on stderr and the status of its
+ * error kind (proto_kind.h): the one its reason names, else CANCELLED's
+ * for a cancelled job and NOMEM's for one out of memory; 1 for any other
+ * end (a timeout, a crash). */
 static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
 {
     int state = -1;
     char reason[1100];
+    w->mode = cli_progress_resolve(w->mode, stdout);
     int rc = mc_watch(c, id, (uint32_t)w->from, on_progress, w, &state, reason, sizeof reason);
+    cli_progress_end(stdout, w->mode);
     if (rc)
         return fail(cmd, c, rc);
     mc_close(c);
@@ -287,7 +285,12 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     fflush(stdout);
     fprintf(stderr, "meshcorr %s: job %llu %s%s%s\n", cmd, (unsigned long long)id,
             mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", shown(reason));
-    return 1;
+    int kind = proto_kind_of_code(mc_reason_error(reason));
+    if (!kind && state == MC_CANCELLED)
+        kind = PROTO_KIND_CANCELLED;
+    if (!kind && state == MC_OUT_OF_MEMORY)
+        kind = PROTO_KIND_NOMEM;
+    return kind ? proto_kind_exit(kind) : 1;
 }
 
 static int is_drc(const char *path)
@@ -321,7 +324,7 @@ int cli_submit(int argc, char **argv)
     cli_job job;
     cli_job_init(&job, argc, argv);
     int c, watch = 0, qbits = MC_QUANTIZATION_LOSSLESS;
-    watch_opts w = {0, 0, 0};
+    watch_opts w = {0, CLI_PROGRESS_AUTO, 0};
     char *e;
     optind = 1;
     while ((c = cli_getopt("submit", argc, argv, opts)) != -1) {
@@ -352,7 +355,7 @@ int cli_submit(int argc, char **argv)
             break;
         case 'h':
             printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
-                   "         [--quantization BITS] [--watch [--progress text|json]]\n" REMOTE_USAGE
+                   "         [--quantization BITS] [--watch [--progress auto|bar|text|json]]\n" REMOTE_USAGE
                    "prints the job id; with --watch then follows the job as `meshcorr watch` does\n"
                    "(and exits as it: 0 when the job COMPLETED)\n"
                    "Meshes go to the server lossless: it computes on exactly the positions read and\n"
@@ -514,17 +517,22 @@ static void print_quality_object(const mc_quality *q)
     printf("}");
 }
 
-/* A progress record as the Python package's dict: per direction and the
- * sums `meshcorr watch` prints. */
+/* A progress record as the Python package's dict: the keys of `meshcorr
+ * watch --progress json` and the sums `meshcorr watch` prints. */
 static void print_progress_object(const mc_progress *p)
 {
-    printf("{\"job\":%llu,\"stage\":\"%s\",\"outer\":%u,\"total\":%u,\"beta\":", (unsigned long long)p->job_id,
-           stage_name(p->stage), p->outer, p->total);
+    const char *stage = proto_stage_name(p->stage);
+    printf("{\"job\":%llu,\"stage\":\"%s\",\"outer\":%u,\"total\":%u,\"fraction\":",
+           (unsigned long long)p->job_id, stage ? stage : "?", p->outer, p->total);
+    json_num(p->fraction);
+    printf(",\"eta\":");
+    json_num(p->eta_s);
+    printf(",\"elapsed\":");
+    json_num(p->elapsed_s);
+    printf(",\"ahead\":%u,\"beta\":", p->ahead);
     json_num(p->beta);
     printf(",\"gamma\":");
     json_num(p->gamma);
-    printf(",\"elapsed\":");
-    json_num(p->elapsed_s);
     static const char *names[2] = {"source", "target"};
     for (int d = 0; d < 2; d++) {
         const double t[5] = {p->membrane[d], p->bending[d], p->mismatch[d], p->reverse[d], p->energy[d]};
@@ -600,9 +608,17 @@ int cli_status(int argc, char **argv)
     print_time("submitted", s.submit_ms);
     print_time("started", s.start_ms);
     print_time("ended", s.end_ms);
-    if (s.has_progress)
-        printf("progress  %u/%u, energy %.10g, %.1f s\n", s.progress.outer, s.progress.total,
-               s.progress.energy[0] + s.progress.energy[1], s.progress.elapsed_s);
+    if (s.has_progress) {
+        proto_progress p;
+        char share[64];
+        record_of(&s.progress, &p);
+        if (p.stage == PROTO_STAGE_QUEUED)
+            printf("progress  %s\n", cli_progress_share(&p, share, sizeof share));
+        else
+            printf("progress  %s, %s %u/%u, energy %.10g, %.1f s\n", cli_progress_share(&p, share, sizeof share),
+                   proto_stage_name(p.stage) ? proto_stage_name(p.stage) : "?", p.outer, p.total,
+                   s.progress.energy[0] + s.progress.energy[1], s.progress.elapsed_s);
+    }
     if (s.quality.verdict != MC_QUALITY_UNKNOWN)
         printf("quality   %s: %.2f %% flipped, %.2f %% collapsed\n", mc_quality_name(s.quality.verdict),
                100 * s.quality.flipped, 100 * s.quality.collapsed);
@@ -616,10 +632,13 @@ int cli_watch(int argc, char **argv)
                                           {"progress", required_argument, 0, 'p'}, {0, 0, 0, 0}};
     remote r;
     uint64_t id;
-    watch_opts w = {0, 0, 0};
-    static const char usage[] = "usage: meshcorr watch ID [--from K] [--progress text|json]\n" REMOTE_USAGE
-                                "one line per iteration, each term summed over both directions;\n"
-                                "exit 0 when the job COMPLETED, 1 otherwise\n";
+    watch_opts w = {0, CLI_PROGRESS_AUTO, 0};
+    static const char usage[] = "usage: meshcorr watch ID [--from K] [--progress auto|bar|text|json]\n"
+                                REMOTE_USAGE
+                                "its place in the queue while it waits, then one record per iteration:\n"
+                                "the whole job's share done and time left, each term summed over both\n"
+                                "directions (a bar on a terminal); exit 0 when the job COMPLETED, else\n"
+                                "the status of its error kind (3 numeric, 4 memory, 5 cancelled; else 1)\n";
     int u = one_id("watch", usage, argc, argv, &r, &id, extra, watch_opt, &w);
     if (u)
         return u > 0 ? 0 : CLI_EXIT_USAGE;
@@ -808,6 +827,21 @@ int cli_delete(int argc, char **argv)
     return simple("delete", "usage: meshcorr delete ID\n" REMOTE_USAGE, argc, argv, mc_delete, "deleted");
 }
 
+/* A LIST row's progress column: "3 ahead" while it waits, "42 %" while it
+ * runs, "100 %" once COMPLETED, else "-". */
+static const char *list_progress(const mc_job_info *j, char *buf, size_t sz)
+{
+    if (j->state == MC_PENDING)
+        snprintf(buf, sz, "%u ahead", j->ahead);
+    else if (j->state == MC_COMPLETED)
+        snprintf(buf, sz, "100 %%");
+    else if (j->state == MC_RUNNING && isfinite(j->fraction))
+        snprintf(buf, sz, "%.0f %%", 100 * j->fraction);
+    else
+        snprintf(buf, sz, "-");
+    return buf;
+}
+
 /* --state S: a state's bit, or -1 after the usage error naming the states. */
 static int state_bit(const char *arg)
 {
@@ -888,21 +922,25 @@ int cli_list(int argc, char **argv)
                    (long long)jobs[i].submit_ms, jobs[i].outer, jobs[i].total);
             json_str(jobs[i].label);
             print_quality_json(&jobs[i].quality);
-            printf("}");
+            printf(isfinite(jobs[i].fraction) ? ",\"fraction\":%.6g" : ",\"fraction\":null", jobs[i].fraction);
+            printf(isfinite(jobs[i].eta_s) ? ",\"eta\":%.3f" : ",\"eta\":null", jobs[i].eta_s);
+            printf(",\"ahead\":%u}", jobs[i].ahead);
         }
         printf("]\n");
         free(jobs);
         mc_close(cl);
         return 0;
     }
-    printf("%-8s %-13s %-10s %4s %11s %-8s  %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "QUALITY", "LABEL");
+    printf("%-8s %-13s %-10s %4s %11s %-8s %-10s %s\n", "ID", "STATE", "USER", "PRIO", "ITER", "QUALITY",
+           "PROGRESS", "LABEL");
     for (uint32_t i = 0; i < n; i++) {
-        char it[32];
+        char it[32], pg[32];
         snprintf(it, sizeof it, "%u/%u", jobs[i].outer, jobs[i].total);
         int v = jobs[i].quality.verdict;
-        printf("%-8llu %-13s %-10s %4d %11s %-8s  %s\n", (unsigned long long)jobs[i].job_id,
+        printf("%-8llu %-13s %-10s %4d %11s %-8s %-10s %s\n", (unsigned long long)jobs[i].job_id,
                mc_state_name(jobs[i].state), shown(jobs[i].user), jobs[i].priority, it,
-               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), shown(jobs[i].label));
+               v == MC_QUALITY_UNKNOWN ? "-" : mc_quality_name(v), list_progress(&jobs[i], pg, sizeof pg),
+               shown(jobs[i].label));
     }
     free(jobs);
     mc_close(cl);

@@ -20,7 +20,6 @@ typedef struct match_run {
     mc_progress_fn cb;
     void *ctx;
     struct timespec t0;
-    int total;                 /* planned outer iterations */
     int last_outer;            /* the last ECTM iteration reported */
     int stopped;               /* cb asked to stop */
 } match_run;
@@ -41,7 +40,7 @@ static int on_progress(void *ctx, const corr_progress *cp)
         return 0;
     proto_progress wire;
     mc_progress p;
-    wrk_progress_fill(cp, 0, run->total, since(&run->t0), &wire);
+    wrk_progress_fill(cp, 0, since(&run->t0), &wire);
     mc__progress_of(&p, &wire);
     run->stopped = run->cb(run->ctx, &p) != 0;
     return run->stopped;
@@ -81,7 +80,7 @@ int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn
                  MC_MATCH_MAX_THREADS);
         return MC_EARG;
     }
-    match_run run = { cb, ctx, {0, 0}, 0, 0, 0 };
+    match_run run = { cb, ctx, {0, 0}, 0, 0 };
     clock_gettime(CLOCK_MONOTONIC, &run.t0);
     proto_buf frame;
     proto_buf_init(&frame);
@@ -98,15 +97,14 @@ int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn
     int rc = submit_as_received(spec, &frame, &sub, err, errsz);
     if (rc || (rc = wrk_job_from_submit(&sub.u.submit, &lim, &job, err, errsz)))
         goto done;
-    run.total = job.params.iterations;
     corr_input in;
     wrk_job_input(&job, &in);
     rc = corr_run(&in, &job.params, on_progress, &run, &res, err, errsz);
-    if (rc == CORR_ECANCELED && run.stopped)
+    if (rc == CORR_ECANCELLED && run.stopped)
         snprintf(err, errsz, "cancelled by the progress callback after %d of %d outer iterations",
                  run.last_outer, job.params.iterations);
     if (rc) {
-        rc = wrk_code_of_corr(rc);
+        rc = corr_wire_code(rc);
         goto done;
     }
     if ((rc = wrk_result_build(&job, &res, 0, since(&run.t0), &result, err, errsz)))

@@ -573,9 +573,10 @@ score:
         fig->err[a] = hs_n ? s / hs_n : NAN;   /* the demo: nothing held out */
         for (int k = 0; ps->a && k < hs_n && k < HELD_SHOWN; k++)
             fig->lerr[a][k] = e[(size_t)a * hs_n + k];
-        if (metric_summarize(S, T, maps[a], &fig->ms[a]) ||
-            metric_curvature_error(S, T, maps[a], &fig->curv[a]))
+        if (metric_summarize(S, T, maps[a], &fig->ms[a]))
             FAILF("out of memory");
+        if (metric_curvature_error(S, T, maps[a], &fig->curv[a], err, sizeof err))
+            FAILF("curvature error: %s", err);
     }
 out:
     snprintf(fig->why, sizeof fig->why, "%s", err);

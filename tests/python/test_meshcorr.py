@@ -72,7 +72,7 @@ def case_files_watch_result_same_as_cli():
             assert set(r[side]) == set(TERMS + ("inner",)), r[side]
         assert abs(r["energy"] - r["source"]["energy"] - r["target"]["energy"]) <= 1e-12 * abs(r["energy"]) + 1e-300
     stages = [r["stage"] for r in records]
-    assert "ectm" in stages and stages[-1] == "ectm", stages
+    assert "ectm" in stages and stages[-1] == "repair", stages     # the repair of ECTM's maps ends it
     ectm = [r for r in records if r["stage"] == "ectm"]
     assert [r["outer"] for r in ectm] == [1, 2, 3, 4] and ectm[-1]["total"] == 4, ectm
     st = c.job(job.id).status()
@@ -204,6 +204,49 @@ def case_vertex_map_refined_by_ddm_then_ectm():
     expect_error(-100, "MC_EARG", c.submit, SRC, TGT, init=np.arange(len(V)), stages="ectm,ddm", has="ectm,ddm")
 
 
+def case_failed_job_error_is_its_kind():
+    """A job whose stage fails numerically (ECTM's energy overflows with a
+    mismatch weight of 1e308) ends FAILED with Job.error the NUMERIC
+    error (NumericError: a MeshcorrError and an ArithmeticError), the code
+    and name the C layers use, its message the reason's after the name."""
+    c = meshcorr.Client(UNIX)
+    job = c.submit(SRC, TGT, landmarks=LANDMARKS, **dict(JOB, beta0=1e308, beta1=1e308))
+    assert job.wait() == "FAILED", (job.state, job.reason)
+    assert type(job.error) is meshcorr.NumericError, type(job.error)
+    assert isinstance(job.error, meshcorr.MeshcorrError) and isinstance(job.error, ArithmeticError), job.error
+    assert (job.error.code, job.error.name) == (-30, "NUMERIC"), job.error
+    assert job.reason.startswith("NUMERIC: ") and job.error.message == job.reason[len("NUMERIC: "):], job.reason
+    assert str(job.error) == "NUMERIC (-30): " + job.error.message, str(job.error)   # the name once
+    ok = c.submit(SRC, TGT, landmarks=LANDMARKS, **JOB)
+    assert ok.wait() == "COMPLETED" and ok.error is None, (ok.state, ok.reason)
+
+
+def case_progress_keys_are_the_clis():
+    """The progress dicts have the keys of `meshcorr watch --progress json`
+    (and of meshcorr match's), and the whole job's fraction rises to 1."""
+    c = meshcorr.Client(UNIX)
+    job = c.submit(SRC, TGT, landmarks=LANDMARKS, **JOB)
+    records = list(job.watch())
+    assert job.state == "COMPLETED", (job.state, job.reason)
+    import json
+    lines = [json.loads(l) for l in cli("watch", str(job.id), "--progress", "json", "--server", UNIX).splitlines()
+             if l.startswith("{")]
+    assert len(lines) == len(records), (len(lines), len(records))
+    for d, j in zip(records, lines):
+        assert set(j) <= set(d), set(j) - set(d)
+        for k in j:
+            if k in ("source", "target"):
+                assert set(j[k]) == set(d[k]), (j[k], d[k])
+            elif isinstance(j[k], float) and k not in ("eta", "elapsed"):
+                assert abs(j[k] - d[k]) <= 1e-12 * abs(j[k]), (k, j[k], d[k])
+            elif k not in ("eta", "elapsed"):
+                assert j[k] == d[k], (k, j[k], d[k])
+    fr = [d["fraction"] for d in records]
+    assert fr == sorted(fr) and fr[0] > 0 and fr[-1] == 1, fr
+    assert records[0]["stage"] == "start", records[0]
+    listed = {j["id"]: j for j in c.list()}
+    assert listed[job.id]["fraction"] == 1 and listed[job.id]["ahead"] == 0, listed[job.id]
+    assert job.status()["progress"]["fraction"] == 1
 
 
 def expect(cls, fn, *args, has=None, **kw):
@@ -431,8 +474,9 @@ def case_match_in_process_equals_the_daemons_job():
         assert np.array_equal(local.deformed[0], remote.deformed[0])
         assert {k: v for k, v in local.metrics.items() if k != "elapsed_s"} == \
             {k: v for k, v in remote.metrics.items() if k != "elapsed_s"}
-        strip = [{k: v for k, v in r.items() if k not in ("job", "elapsed")} for r in remote_records]
-        assert [{k: v for k, v in r.items() if k not in ("job", "elapsed")} for r in local_records] == strip
+        clock = ("job", "elapsed", "eta")             # the daemon's id, and each run's own clock
+        strip = [{k: v for k, v in r.items() if k not in clock} for r in remote_records]
+        assert [{k: v for k, v in r.items() if k not in clock} for r in local_records] == strip
     # from arrays, as submit() takes them
     files = meshcorr.match(SRC, TGT, landmarks=LANDMARKS, **JOB)
     arrays = meshcorr.match(read_off(SRC), read_off(TGT), landmarks=LANDMARKS, **JOB)

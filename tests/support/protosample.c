@@ -61,6 +61,9 @@ static void fill_progress(proto_progress *g, int v)
     g->beta = 0.5;
     g->gamma = v ? 0.0 : 1e300;
     g->elapsed_s = 12.375;
+    g->fraction = v ? 0.0 : 0.4375;
+    g->eta_s = v ? NAN : 1e6;
+    g->ahead = v ? 0 : UINT32_MAX;
 }
 
 void protosample_fill(int type, int v, proto_msg *m)
@@ -133,7 +136,8 @@ void protosample_fill(int type, int v, proto_msg *m)
         for (int i = 0; i < 5; i++)
             jobs[i] = (proto_job_summary){ 100u + (uint64_t)i, (uint8_t)(i % 7), i - 2,
                                            1700000000000 + i, i ? "carol" : max_string(), i == 3 ? "" : "run",
-                                           (uint32_t)i, 40, {i % 4 - 1, i ? 0.25 * i : NAN, 1e-4 * i} };
+                                           (uint32_t)i, 40, {i % 4 - 1, i ? 0.25 * i : NAN, 1e-4 * i},
+                                           i == 4 ? NAN : 0.25 * i, i ? 3.5 * i : NAN, (uint32_t)(7 * i) };
         m->u.list_ok = (proto_list_ok){ v ? NULL : jobs, v ? 0 : 5 };
         break;
     case PROTO_MSG_WATCH:
@@ -216,6 +220,12 @@ static int map_ne(proto_map a, proto_map b)
     return a.n != b.n || (a.n && memcmp(a.rows, b.rows, a.n * sizeof *a.rows) != 0);
 }
 
+/* Equal, or both NaN. */
+static int same_num(double a, double b)
+{
+    return a == b || (isnan(a) && isnan(b));
+}
+
 static const char *progress_diff(const proto_progress *a, const proto_progress *b)
 {
     DIFF(a->job_id != b->job_id || a->stage != b->stage, "progress job/stage");
@@ -224,6 +234,8 @@ static const char *progress_diff(const proto_progress *a, const proto_progress *
     DIFF(memcmp(a->terms, b->terms, sizeof a->terms) != 0, "progress terms");
     DIFF(a->beta != b->beta || a->gamma != b->gamma || a->elapsed_s != b->elapsed_s,
          "progress beta/gamma/elapsed");
+    DIFF(!same_num(a->fraction, b->fraction) || !same_num(a->eta_s, b->eta_s) || a->ahead != b->ahead,
+         "progress fraction/eta_s/ahead");
     return NULL;
 }
 
@@ -300,6 +312,8 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
                  "list_ok job numbers");
             DIFF(str_ne(x->user, y->user) || str_ne(x->label, y->label), "list_ok job strings");
             DIFF(quality_ne(&x->quality, &y->quality), "list_ok job quality");
+            DIFF(!same_num(x->fraction, y->fraction) || !same_num(x->eta_s, y->eta_s) || x->ahead != y->ahead,
+                 "list_ok job progress");
         }
         return NULL;
     case PROTO_MSG_WATCH:

@@ -3,6 +3,7 @@
  * refusals that name the file. */
 #include "support/harness.h"
 #include "support/testfile.h"
+#include "support/testmesh.h"
 #include "mesh/mesh.h"
 
 #include <string.h>
@@ -192,6 +193,41 @@ TEST(eval_reads_published_vertex_maps)
     snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s --map-base 0", s0, s1, bim);
     CHECK_INT(run(cmd, out, sizeof out), 0);
     CHECK_STR_HAS(out, "conformal distortion: median");
+}
+
+/* A mesh eval reads but cannot measure (an edge of three faces: no edge
+ * table for the curvature fit) is named with the reason, not reported as
+ * "out of memory". */
+TEST(eval_names_a_non_manifold_mesh_instead_of_running_out_of_memory)
+{
+    mesh *T = testmesh_icosphere(1), *S = testmesh_icosphere(1), *N = NULL;
+    CHECK(S && T);
+    /* S with one more vertex and a third face on the edge of face 0's first two corners */
+    CHECK((N = mesh_new(S->nv + 1, S->nf + 1)) != NULL);
+    memcpy(N->v, S->v, sizeof(double) * 3 * (size_t)S->nv);
+    memcpy(N->f, S->f, sizeof(int) * 3 * (size_t)S->nf);
+    N->v[3 * S->nv] = N->v[3 * S->nv + 1] = N->v[3 * S->nv + 2] = 0.5;
+    N->f[3 * S->nf] = S->f[0];
+    N->f[3 * S->nf + 1] = S->f[1];
+    N->f[3 * S->nf + 2] = S->nv;
+    char spath[600], tpath[600], err[512], out[8192], cmd[2048], *map = malloc(64 * (size_t)(N->nv + 2));
+    snprintf(spath, sizeof spath, "%s/nm.off", harness_tmpdir());
+    snprintf(tpath, sizeof tpath, "%s/t.off", harness_tmpdir());
+    CHECK_INT(mesh_write(spath, N, err, sizeof err), 0);
+    CHECK_INT(mesh_write(tpath, T, err, sizeof err), 0);
+    size_t n = (size_t)sprintf(map, "# meshcorr-map 1\n%d %d\n", N->nv, T->nv);
+    for (int i = 0; i < N->nv; i++)         /* every vertex onto T's vertex at face 0's corner */
+        n += (size_t)sprintf(map + n, "0 1 0 0\n");
+    snprintf(cmd, sizeof cmd, "build/meshcorr eval %s %s %s", spath, tpath, testfile_text("nm.map", map));
+    CHECK_INT(run(cmd, out, sizeof out), 1);
+    CHECK_STR_HAS(out, "curvature error of");
+    CHECK_STR_HAS(out, "source mesh: edge");
+    CHECK_STR_HAS(out, "has 3 faces");
+    CHECK(strstr(out, "out of memory") == NULL);
+    free(map);
+    mesh_free(N);
+    mesh_free(S);
+    mesh_free(T);
 }
 
 /* eval reads BIM landmark files as match does (workers/lmk: 0-based, the

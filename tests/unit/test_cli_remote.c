@@ -94,6 +94,9 @@ TEST_T(submit_prints_the_id_watch_prints_energies_and_exits_0_and_result_writes_
                 if (k == 4)
                     e4 = e;
             }
+        } else if (sscanf(l, "job %llu repair iter %u/%u (", &jid, &k, &total) == 3) {
+            CHECK_INT(jid, id);          /* a fold repair: no energies, its maps done of total */
+            CHECK(total == 2 && (k == 0 || k == 2));
         } else if (strcmp(l, last) != 0) {
             FAILF("watch line is not in the documented format: %.*s", (int)strcspn(l, "\n"), l);
         }
@@ -149,7 +152,7 @@ TEST_T(submit_prints_the_id_watch_prints_energies_and_exits_0_and_result_writes_
     testdaemon_stop(&d, SIGTERM);
 }
 
-TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_1_saying_why, 90)
+TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_5_saying_why, 90)
 {
     testdaemon_need_worker();
     write_inputs();
@@ -172,7 +175,7 @@ TEST_T(submit_watch_streams_to_the_end_and_watch_of_a_cancelled_job_exits_1_sayi
                        d.unix_addr), 0);
     rc = testrunf(out, sizeof out, "build/meshcorr watch %llu --server %s 2>&1 >/dev/null",
                   (unsigned long long)long_id, d.unix_addr);
-    CHECK_INT(rc, 1);
+    CHECK_INT(rc, 5);                   /* the kind CANCELLED's status (proto_kind.h) */
     CHECK_STR_HAS(out, "CANCELLED");
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
@@ -204,6 +207,8 @@ TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
     CHECK_STR_HAS(out, want);
     CHECK_STR_HAS(out, "\"outer\":4,\"total\":4");
     CHECK_STR_HAS(out, "\"label\":\"a \\\"quoted\\\" label\"");
+    /* and the whole job's progress: done, nothing ahead */
+    CHECK_STR_HAS(out, ",\"fraction\":1,\"eta\":0.000,\"ahead\":0}");
     /* the map's quality: this small pair maps cleanly */
     CHECK_STR_HAS(out, ",\"quality\":\"ok\",\"quality_verdict\":0,\"flipped\":");
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr status %llu --server %s", (unsigned long long)id,
@@ -212,6 +217,9 @@ TEST_T(list_and_stats_json_are_json_with_the_jobs_fields, 90)
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s", d.unix_addr), 0);
     CHECK_STR_HAS(out, " QUALITY ");
     CHECK_STR_HAS(out, " ok ");
+    CHECK_STR_HAS(out, " PROGRESS ");
+    CHECK_STR_HAS(out, " 4/4 ");                 /* ITER beside the PROGRESS column */
+    CHECK_STR_HAS(out, " 100 % ");
 
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr stats --json --server %s", d.unix_addr), 0);
     if (!testjson_valid(out))
@@ -459,8 +467,10 @@ TEST_T(status_and_result_json_are_one_object_with_the_python_fields, 90)
     CHECK_STR_HAS(out, want);
     static const char *const fields[] = {"\"priority\":", "\"user\":", "\"label\":\"lab\"", "\"reason\":",
                                          "\"submit_ms\":", "\"start_ms\":", "\"end_ms\":",
-                                         "\"progress\":{\"job\":", "\"stage\":\"ectm\"", "\"outer\":4,",
-                                         "\"source\":{\"membrane\":", "\"inner\":", "\"energy\":",
+                                         "\"progress\":{\"job\":", "\"stage\":\"repair\"",
+                                         "\"outer\":2,\"total\":2,\"fraction\":1,\"eta\":",
+                                         "\"ahead\":0,", "\"source\":{\"membrane\":", "\"inner\":",
+                                         "\"energy\":",
                                          "\"quality\":{\"verdict\":\"ok\",\"flipped\":"};
     for (size_t k = 0; k < sizeof fields / sizeof fields[0]; k++)
         CHECK_STR_HAS(out, fields[k]);

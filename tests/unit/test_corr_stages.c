@@ -73,23 +73,27 @@ TEST(chains_the_inputs_cannot_run_are_refused)
               0);                                  /* no DDM stage: the mode is not used */
     CHECK_INT(corr_stages_check(CORR_STAGES_DDM, 1, 0, 0, 0, 0, CORR_DDM_AUTO, err, sizeof err),
               0);                                  /* auto without a reverse map: plain */
-    static const struct { int s, map, rev, nl, inj; double gamma; int mode; const char *msg; } bad[] = {
-        {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map"},
-        {CORR_STAGES_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map"},
-        {CORR_STAGES_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map"},
-        {CORR_STAGES_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks"},
-        {CORR_STAGES_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2"},
-        {CORR_STAGES_DDM_RHM, 1, 0, 0, 0, 0.5, 0, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks"},
-        {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model"},
-        {CORR_STAGES_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map"},
-        {CORR_STAGES_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too"},
-        {CORR_STAGES_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3"},
-        {8, 1, 0, 0, 0, 0, 0, "stages value 8"}};
+    /* each refusal with its kind: a chain that does not fit the inputs is
+     * PARAMS, missing landmarks LANDMARKS, a reverse map alone MAP */
+    static const struct { int s, map, rev, nl, inj; double gamma; int mode; const char *msg; int kind; } bad[] = {
+        {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
+        {CORR_STAGES_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
+        {CORR_STAGES_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map", CORR_EPARAMS},
+        {CORR_STAGES_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks", CORR_ELANDMARKS},
+        {CORR_STAGES_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2", CORR_ELANDMARKS},
+        {CORR_STAGES_DDM_RHM, 1, 0, 0, 0, 0.5, 0, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks",
+         CORR_EPARAMS},
+        {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model", CORR_EPARAMS},
+        {CORR_STAGES_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map", CORR_EMAP},
+        {CORR_STAGES_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too",
+         CORR_EPARAMS},
+        {CORR_STAGES_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3", CORR_EPARAMS},
+        {8, 1, 0, 0, 0, 0, 0, "stages value 8", CORR_EPARAMS}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         err[0] = '\0';
         CHECK_INT(corr_stages_check((corr_stages)bad[k].s, bad[k].map, bad[k].rev, bad[k].nl,
                                     bad[k].inj, bad[k].gamma, (corr_ddm_mode)bad[k].mode, err,
-                                    sizeof err), CORR_EINPUT);
+                                    sizeof err), bad[k].kind);
         CHECK_STR_HAS(err, bad[k].msg);
     }
 }
@@ -105,7 +109,7 @@ static int record(void *ctx, const corr_progress *p)
     if (l->n < 1024) {
         l->stage[l->n] = p->stage;
         l->outer[l->n] = p->ectm ? p->ectm->outer : p->rhm ? p->rhm->iteration
-                       : p->ddm ? p->ddm->done : 0;
+                       : p->ddm ? p->ddm->done : p->repair ? p->repair->done : 0;
         l->total[l->n] = p->ectm ? p->ectm->total : 0;
         l->n++;
     }
@@ -213,10 +217,14 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     memset(&l, 0, sizeof l);
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
         FAILF("%s", err);
-    CHECK_INT(l.n, 2 + 1 + 3);
+    CHECK_INT(l.n, 2 + 1 + 3 + 2);    /* ... and the repair of RHM's maps: its start and end */
     CHECK_INT(l.stage[2], CORR_STAGE_START);
     CHECK_INT(l.stage[5], CORR_STAGE_RHM);
     CHECK_INT(l.outer[5], 3);
+    CHECK_INT(l.stage[6], CORR_STAGE_REPAIR);
+    CHECK_INT(l.outer[6], 0);
+    CHECK_INT(l.stage[7], CORR_STAGE_REPAIR);
+    CHECK_INT(l.outer[7], 2);
     CHECK(r.P && r.Q && !r.Y);
     printf("  ddm,rhm (3 iterations): error %.4f\n", mean_error(&g, r.P));
     ectm_result_close(&r);
@@ -224,7 +232,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     /* a basis larger than the mesh allows names the parameter */
     in.stages = CORR_STAGES_DDM;
     in.ddm_k = 4999;
-    CHECK_INT(corr_run(&in, &p, NULL, NULL, &r, err, sizeof err), CORR_EINPUT);
+    CHECK_INT(corr_run(&in, &p, NULL, NULL, &r, err, sizeof err), CORR_EPARAMS);
     CHECK_STR_HAS(err, "params.ddm_k = 4999");
 
     bmap_free(D);

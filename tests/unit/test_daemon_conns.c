@@ -308,7 +308,8 @@ TEST_T(silent_half_sent_and_idle_clients_are_cut_after_their_timeouts_and_a_quie
                                        "--idle-timeout", "2", NULL};
     testdaemon d;
     testdaemon_start(&d, "timeouts", args);
-    /* a job pending behind a running one: its WATCH sends nothing */
+    /* a job pending behind a running one: its WATCH sends its place in the
+     * queue, then nothing while the queue stands still */
     mc_client *c = testdaemon_client(&d, NULL);
     int rc;
     uint64_t running = testdaemon_submit(c, 100000, 1, 0, &rc);
@@ -345,11 +346,17 @@ TEST_T(silent_half_sent_and_idle_clients_are_cut_after_their_timeouts_and_a_quie
     double cut = now_s() - t0;
     CHECK(cut >= 1.9);
     /* the watcher outlives the idle timeout; ending the job ends its WATCH */
+    proto_msg m;
+    uint8_t *buf;
+    raw_read_msg(watcher, &m, &buf, 10);
+    CHECK_INT(m.type, PROTO_MSG_PROGRESS);
+    CHECK_INT(m.u.progress.stage, PROTO_STAGE_QUEUED);
+    CHECK_INT(m.u.progress.ahead, 0);
+    proto_msg_free(&m);
+    free(buf);
     expect_quiet(watcher, 2.5);
     c = testdaemon_client(&d, NULL);
     CHECK_INT(mc_cancel(c, pending), 0);
-    proto_msg m;
-    uint8_t *buf;
     raw_read_msg(watcher, &m, &buf, 10);
     CHECK_INT(m.type, PROTO_MSG_END);
     CHECK_INT(m.request_id, 9);

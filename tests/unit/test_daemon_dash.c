@@ -207,9 +207,10 @@ TEST(register_map_puts_each_figure_at_its_documented_address)
     s->completed = 0x100000003ull;            /* low 32 bits */
     s->failed = 4;
     s->cancelled = 5;
-    s->slots[1] = (snap_slot){0x200000009ull, PROTO_SLOT_BUSY, 1, PROTO_STAGE_ECTM, 5, 20, -2.5, 1.0, 42};
+    s->slots[1] = (snap_slot){0x200000009ull, PROTO_SLOT_BUSY, 1, PROTO_STAGE_ECTM, 5, 20, -2.5, 1.0, 42,
+                              0.8765, 77000.4};
     size_t n = mbus_nregs(2);
-    CHECK_INT(n, 48);
+    CHECK_INT(n, 56);
     uint16_t *r = calloc(n, sizeof *r);
     mbus_fill(s, r);
     CHECK_INT(r[0], 70001 & 0xFFFF);
@@ -223,9 +224,11 @@ TEST(register_map_puts_each_figure_at_its_documented_address)
     CHECK_INT(r[11], 4);
     CHECK_INT(r[13], 5);
     CHECK_INT(r[14], 16);
-    CHECK_INT(r[15], 16);
+    CHECK_INT(r[15], 20);
     CHECK_INT(r[16 + 3], 0xFFFF);             /* idle slot 0: no progress */
-    const uint16_t *b = r + 32;
+    CHECK_INT(r[16 + 14], 0);
+    CHECK_INT(r[16 + 16] << 16 | r[16 + 17], 0xFFFF << 16 | 0xFFFF);   /* no time left known */
+    const uint16_t *b = r + 36;
     CHECK_INT(b[0] << 16 | b[1], 9);
     CHECK_INT(b[2], PROTO_SLOT_BUSY);
     CHECK_INT(b[3], PROTO_STAGE_ECTM);
@@ -235,8 +238,11 @@ TEST(register_map_puts_each_figure_at_its_documented_address)
     CHECK_INT(b[9], 0);
     CHECK_INT(b[10], 0x3F80);
     CHECK_INT(b[13], 42);
-    CHECK_INT(b[14], 25);
+    CHECK_INT(b[14], 87);                     /* the whole job's share, not the stage's 5 of 20 */
     CHECK_INT(b[15], 1);
+    CHECK_INT(b[16] << 16 | b[17], 77000);    /* seconds left */
+    CHECK_INT(b[18], 25);                     /* the stage's own: 5 of 20 */
+    CHECK_INT(b[19], 8765);
     free(r);
 }
 
@@ -323,13 +329,13 @@ static void wait_iterating(dash *x)
     FAILF("job %llu reported no ECTM iteration within 60 s", (unsigned long long)x->job);
 }
 
-/* Block 0 and slot 0: 32 registers read by mbpoll. */
-static void poll_regs(dash *x, double r[32])
+/* Block 0 and slot 0: 36 registers read by mbpoll. */
+static void poll_regs(dash *x, double r[36])
 {
     char out[8192];
-    int n = mbpoll(x->modbus, "3", 1, 0, 32, r, out, sizeof out);
-    if (n != 32)
-        FAILF("mbpoll read %d of 32 registers:\n%s", n, out);
+    int n = mbpoll(x->modbus, "3", 1, 0, 36, r, out, sizeof out);
+    if (n != 36)
+        FAILF("mbpoll read %d of 36 registers:\n%s", n, out);
 }
 
 TEST_T(modbus_registers_follow_a_running_job_and_agree_with_stats, 90)
@@ -343,7 +349,7 @@ TEST_T(modbus_registers_follow_a_running_job_and_agree_with_stats, 90)
 
     /* STATUS, registers, STATUS: when the three agree on the iteration, the
      * floats must be the same numbers rounded to float32 */
-    double r[32], first_outer, first_beat;
+    double r[36], first_outer, first_beat;
     mc_job_status a, b;
     int matched = 0;
     for (int tries = 0; tries < 100 && !matched; tries++) {
@@ -359,8 +365,14 @@ TEST_T(modbus_registers_follow_a_running_job_and_agree_with_stats, 90)
         CHECK_INT(r[18], PROTO_SLOT_BUSY);
         CHECK_INT(r[19], PROTO_STAGE_ECTM);
         CHECK_INT(u32(r, 22), 20);
+        /* an ECTM-only job: the whole job's share is ECTM's, and the
+         * registers say the record's share and time left */
+        CHECK_INT(r[30], (int)(a.progress.fraction * 100 + 1e-9));
         CHECK_INT(r[30], a.progress.outer * 100 / 20);
         CHECK_INT(r[31], 1);
+        CHECK_INT(u32(r, 32), (uint32_t)a.progress.eta_s);
+        CHECK_INT(r[34], a.progress.outer * 100 / 20);
+        CHECK_INT(r[35], (int)(a.progress.fraction * 10000 + 1e-9));
         float e = (float)(a.progress.energy[0] + a.progress.energy[1]), be = (float)a.progress.beta;
         double got_e = decode_f32((uint16_t)r[24], (uint16_t)r[25]), got_b = decode_f32((uint16_t)r[26], (uint16_t)r[27]);
         if (got_e != (double)e || got_b != (double)be)
@@ -646,6 +658,11 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(metric(s, n, "meshcorr_slot_stage", lab), PROTO_STAGE_ECTM);
     CHECK_INT(metric(s, n, "meshcorr_slot_total_iterations", lab), 20);
     CHECK(metric(s, n, "meshcorr_slot_outer_iteration", lab) >= 1);
+    /* the ratio is the whole job's share done; an ECTM-only job's is ECTM's */
+    double ratio = metric(s, n, "meshcorr_slot_progress_ratio", lab);
+    CHECK(ratio > 0 && ratio <= 1);
+    CHECK_NEAR(ratio, metric(s, n, "meshcorr_slot_outer_iteration", lab) / 20, 1e-9);
+    CHECK(metric(s, n, "meshcorr_slot_eta_seconds", lab) >= 0);
     CHECK(metric(s, n, "meshcorr_slot_energy", lab) > 0);
     CHECK(metric(s, n, "meshcorr_slot_beta", lab) > 0);
     mc_stats_free(&st);
@@ -715,7 +732,8 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
              " --expect meshcorr_workers --expect meshcorr_uptime_seconds --expect meshcorr_snapshots_total"
              " --expect meshcorr_slot_state --expect meshcorr_slot_elapsed_seconds --expect meshcorr_slot_stage"
              " --expect meshcorr_slot_outer_iteration --expect meshcorr_slot_total_iterations"
-             " --expect meshcorr_slot_progress_ratio --expect meshcorr_slot_energy --expect meshcorr_slot_beta",
+             " --expect meshcorr_slot_progress_ratio --expect meshcorr_slot_eta_seconds"
+             " --expect meshcorr_slot_energy --expect meshcorr_slot_beta",
              files[0], files[1]);
     int rc = promcheck(args, report, sizeof report);
     if (rc != 0)

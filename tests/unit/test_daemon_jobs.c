@@ -20,7 +20,7 @@ typedef struct watch_log {
     int n;
     int stage[64];
     uint32_t outer[64];
-    double energy[64];
+    double energy[64], fraction[64];
 } watch_log;
 
 static int on_progress(void *ctx, const mc_progress *p)
@@ -30,6 +30,7 @@ static int on_progress(void *ctx, const mc_progress *p)
         w->stage[w->n] = p->stage;
         w->outer[w->n] = p->outer;
         w->energy[w->n] = p->energy[0] + p->energy[1];
+        w->fraction[w->n] = p->fraction;
         w->n++;
     }
     return 0;
@@ -50,23 +51,31 @@ TEST_T(submitted_job_streams_energies_and_completes, 60)
         FAILF("WATCH: %s (%s)", mc_strerror(rc), mc_errmsg(c));
     if (state != MC_COMPLETED)
         FAILF("job ended %s: %s", mc_state_name(state), reason);
-    /* stages in order (init, start, rhm, ectm), iterations rising in each */
-    int last = 0, ectm = 0, rhm = 0;
+    /* stages in order (start, rhm, repair, ectm, repair), iterations rising
+     * in each; the first record is the start map's, with its energies; the
+     * whole job's fraction never falls and is 1 at the end */
+    int last = 0, ectm = 0, rhm = 0, last_ectm = 0;
+    CHECK_INT(w.stage[0], MC_STAGE_START);
+    CHECK(isfinite(w.energy[0]) && w.energy[0] > 0);
     for (int i = 0; i < w.n; i++) {
         if (i > 0 && w.stage[i] != w.stage[i - 1])
             last = 0;
         CHECK(w.outer[i] >= (uint32_t)last);
+        CHECK(i == 0 || w.fraction[i] >= w.fraction[i - 1]);
+        CHECK(w.stage[i] != MC_STAGE_INIT);
         last = (int)w.outer[i];
         rhm += w.stage[i] == MC_STAGE_RHM;
         if (w.stage[i] == MC_STAGE_ECTM) {
             CHECK(isfinite(w.energy[i]) && w.energy[i] > 0);
             ectm++;
+            last_ectm = (int)w.outer[i];
         }
     }
     CHECK_INT(rhm, 3);
     CHECK_INT(ectm, 3);
-    CHECK_INT(w.stage[w.n - 1], MC_STAGE_ECTM);
-    CHECK_INT(last, 3);
+    CHECK_INT(last_ectm, 3);
+    CHECK_INT(w.stage[w.n - 1], MC_STAGE_REPAIR);   /* the repair of ECTM's maps ends the job */
+    CHECK(w.fraction[w.n - 1] == 1);
     /* a second watch from iteration 2 replays only the tail of each stage
      * (RHM 2, 3 and ECTM 2, 3), then END */
     watch_log tail = {0};

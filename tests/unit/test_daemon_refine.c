@@ -193,7 +193,7 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     s.nlandmarks = 4;
     id = 0;
     int rc = mc_submit(c, &s, &id);
-    CHECK_INT(rc, PROTO_EBAD_LANDMARKS);   /* the protocol's number */
+    CHECK_INT(rc, PROTO_EBAD_PARAMS);      /* the protocol's number: the stages do not fit the inputs */
     CHECK_STR_HAS(mc_errmsg(c), "params.stages: the DDM stage denoises a given map");
     CHECK_INT(id, 0);
     /* a basis larger than the decoded meshes allow (162 vertices: at most

@@ -43,15 +43,19 @@ typedef struct watch_log {
     int monotone, finite;
 } watch_log;
 
+/* Counts every record; follows the ECTM records' iterations (a repair's
+ * record, which ends a landmark job, counts its maps instead). */
 static int on_progress(void *ctx, const mc_progress *p)
 {
     watch_log *w = ctx;
-    if (w->n && p->outer < w->last_outer)
-        w->monotone = 0;
     if (!isfinite(p->energy[0] + p->energy[1]))
         w->finite = 0;
-    w->last_outer = p->outer;
     w->n++;
+    if (p->stage == MC_STAGE_REPAIR)
+        return 0;
+    if (w->n > 1 && p->outer < w->last_outer)
+        w->monotone = 0;
+    w->last_outer = p->outer;
     return 0;
 }
 

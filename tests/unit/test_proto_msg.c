@@ -4,6 +4,7 @@
 #include "support/protosample.h"
 #include "proto.h"
 
+#include <math.h>
 #include <string.h>
 
 static proto_buf frame;   /* the frame under test (zeroed = initialised) */
@@ -281,4 +282,40 @@ TEST(error_names_and_messages_come_from_one_list)
     CHECK(strcmp(proto_slot_name(PROTO_SLOT_BUSY), "busy") == 0);
     for (int c = 0; c >= PROTO_EOVER_QUOTA; c--)
         CHECK(strcmp(proto_err_name(c), "UNKNOWN") != 0);
+}
+
+/* PROGRESS's whole-job fields: a fraction outside [0, 1] or a time left
+ * that is negative or infinite is refused both ways (NaN means not known);
+ * the stages of version 5 have their names. */
+TEST(progress_fraction_and_time_left_are_checked_both_ways)
+{
+    encode(PROTO_MSG_PROGRESS, 0);
+    size_t at = 8 + 1 + 4 + 4 + 2 * (4 + 5 * 8) + 3 * 8;   /* the fraction's offset */
+    uint64_t bits;
+    double v = 1.5;
+    memcpy(&bits, &v, 8);
+    for (int k = 0; k < 8; k++)
+        payload()[at + k] = (uint8_t)(bits >> (8 * k));
+    expect(PROTO_EBAD_FRAME, "fraction 1.5");
+    encode(PROTO_MSG_PROGRESS, 0);
+    v = -2;
+    memcpy(&bits, &v, 8);
+    for (int k = 0; k < 8; k++)
+        payload()[at + 8 + k] = (uint8_t)(bits >> (8 * k));
+    expect(PROTO_EBAD_FRAME, "eta_s -2");
+
+    proto_msg m;
+    protosample_fill(PROTO_MSG_PROGRESS, 1, &m);        /* fraction 0, eta_s NaN: fine */
+    proto_buf b;
+    proto_buf_init(&b);
+    CHECK_INT(proto_msg_encode(&b, &m, NULL, 0), 0);
+    m.u.progress.fraction = -0.25;
+    CHECK_INT(proto_msg_encode(&b, &m, NULL, 0), PROTO_EBAD_FRAME);
+    m.u.progress.fraction = 1;
+    m.u.progress.eta_s = INFINITY;
+    CHECK_INT(proto_msg_encode(&b, &m, NULL, 0), PROTO_EBAD_FRAME);
+    proto_buf_free(&b);
+    CHECK(strcmp(proto_stage_name(PROTO_STAGE_REPAIR), "repair") == 0);
+    CHECK(strcmp(proto_stage_name(PROTO_STAGE_QUEUED), "queued") == 0);
+    CHECK_INT(PROTO_VERSION, 5);
 }

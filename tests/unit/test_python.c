@@ -120,6 +120,16 @@ TEST_T(a_vertex_map_file_refined_by_ddm_then_ectm_streams_the_ddm_stage, 120)
     run_case("vertex_map_refined_by_ddm_then_ectm");
 }
 
+TEST_T(a_job_failing_numerically_has_the_numeric_error_as_its_error, 120)
+{
+    run_case("failed_job_error_is_its_kind");
+}
+
+TEST_T(progress_dicts_have_the_clis_names_and_the_whole_jobs_fraction, 120)
+{
+    run_case("progress_keys_are_the_clis");
+}
+
 TEST_T(a_closed_client_raises_value_error_from_every_method_never_segfaults, 120)
 {
     run_case("closed_client_raises_value_error");

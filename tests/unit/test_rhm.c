@@ -209,7 +209,7 @@ static rhm__problem *faust_problem_from(testgt *g, int iters, int start)
         FAILF("%s", err);
     for (int k = 1; k <= iters; k++)
         for (int i = 0; i < 2; i++) {
-            CHECK_INT(rhm__step_p(pb, i, rhm_beta(&p, k)), 0);
+            CHECK_INT(rhm__step_p(pb, i, rhm_beta(&p, k), NULL, 0), 0);
             CHECK_INT(rhm__step_x(pb, i, rhm_beta(&p, k)), 0);
         }
     return pb;
@@ -388,7 +388,7 @@ TEST_T(anchors_are_a_farthest_point_sample_that_the_x_step_holds, 60)
     rhm_terms t[2];
     for (int i = 0; i < 2; i++) {
         rhm__side *a = &pb->side[i];
-        CHECK_INT(rhm__step_p(pb, i, beta), 0);
+        CHECK_INT(rhm__step_p(pb, i, beta, NULL, 0), 0);
         CHECK_INT(rhm__step_x(pb, i, beta), 0);
         double e0 = rhm__energy(pb, beta, t);
         CHECK(t[i].landmark > 0);            /* the anchor term, counted there */
@@ -416,7 +416,7 @@ TEST_T(anchors_are_a_farthest_point_sample_that_the_x_step_holds, 60)
     pb->p.anchor = 1e6;
     for (int i = 0; i < 2; i++) {
         rhm__side *a = &pb->side[i];
-        CHECK_INT(rhm__step_p(pb, i, beta), 0);
+        CHECK_INT(rhm__step_p(pb, i, beta, NULL, 0), 0);
         CHECK_INT(rhm__step_x(pb, i, beta), 0);
         double worst = 0;
         for (int l = 0; l < a->n; l++)
@@ -443,7 +443,7 @@ TEST_T(p_step_equals_brute_force_projection, 60)
             double *Z = malloc(sizeof(double) * (size_t)b->n * d), s;
             double *Q = malloc(sizeof(double) * (size_t)a->n * d);
             rhm__projection_setup(pb, i, beta, Z, Q, &s);
-            CHECK_INT(rhm__step_p(pb, i, beta), 0);
+            CHECK_INT(rhm__step_p(pb, i, beta, NULL, 0), 0);
             int *face = malloc(sizeof(int) * rows);
             double *bary = malloc(sizeof(double) * 3 * rows), *cost = malloc(sizeof(double) * rows);
             int stride = a->n / rows;
@@ -479,7 +479,7 @@ TEST_T(energy_never_increases_over_block_steps, 60)
     for (int k = 1; k <= 6; k++) {
         double beta = rhm_beta(&pb->p, k), e = rhm__energy(pb, beta, t);
         for (int i = 0; i < 2; i++) {
-            CHECK_INT(rhm__step_p(pb, i, beta), 0);
+            CHECK_INT(rhm__step_p(pb, i, beta, NULL, 0), 0);
             double e1 = rhm__energy(pb, beta, t);
             CHECK(e1 <= e * (1 + 1e-12));
             CHECK_INT(rhm__step_x(pb, i, beta), 0);
@@ -555,7 +555,7 @@ TEST(refuses_too_few_landmarks_and_bad_parameters)
     rhm_params_init(&p);
     rhm_result res;
     char err[256];
-    CHECK_INT(rhm_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_EINPUT);
+    CHECK_INT(rhm_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_ELANDMARKS);
     CHECK_STR_HAS(err, "at least 3");
     L.n = 3;
     L.src = (int[]){0, 5, 9};

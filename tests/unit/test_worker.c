@@ -347,26 +347,38 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     CHECK_INT(wait_exit(pid), 0);
     proto_progress pr[16];
     int np = progress_frames(pbuf, plen, pr, 16);
-    /* init; the start map and 3 RHM iterations, twice: after 3 iterations
-     * from 4 landmarks the distances start's maps are still folded (over
-     * 5 % of the triangles: mirrored), so start auto (the default) runs RHM again
-     * from the functional-map start and keeps the less folded; then 2 ECTM
-     * iterations */
-    CHECK_INT(np, 11);
-    CHECK_INT(pr[0].stage, PROTO_STAGE_INIT);
+    /* the start map, 3 RHM iterations and the repair of RHM's maps (its
+     * start and end), twice: after 3 iterations from 4 landmarks the
+     * distances start's maps are still folded (over 5 % of the triangles:
+     * mirrored), so start auto (the default) runs RHM again from the
+     * functional-map start and keeps the less folded; then 2 ECTM
+     * iterations and the repair of ECTM's maps. No record before the
+     * start map's: the first is a real one. The whole job's fraction never
+     * falls and is 1 at the last record. */
+    CHECK_INT(np, 16);
     for (int run = 0; run < 2; run++) {
-        const proto_progress *q = pr + 1 + 4 * run;
+        const proto_progress *q = pr + 6 * run;
         CHECK_INT(q[0].stage, PROTO_STAGE_START);
         CHECK_INT(q[0].outer, 0);
+        CHECK(isfinite(q[0].terms[0][PROTO_TERM_ENERGY]) && q[0].terms[0][PROTO_TERM_ENERGY] > 0);
         for (int k = 1; k <= 3; k++) {
             CHECK_INT(q[k].stage, PROTO_STAGE_RHM);
             CHECK_INT(q[k].outer, k);
             CHECK_INT(q[k].total, 3);
             CHECK(isfinite(q[k].terms[0][PROTO_TERM_ENERGY]) && q[k].terms[0][PROTO_TERM_ENERGY] > 0);
         }
+        CHECK_INT(q[4].stage, PROTO_STAGE_REPAIR);
+        CHECK_INT(q[5].stage, PROTO_STAGE_REPAIR);
+        CHECK_INT(q[5].outer, 2);
     }
-    CHECK_INT(pr[9].stage, PROTO_STAGE_ECTM);
-    CHECK_INT(pr[10].outer, 2);
+    CHECK_INT(pr[12].stage, PROTO_STAGE_ECTM);
+    CHECK_INT(pr[13].outer, 2);
+    CHECK_INT(pr[15].stage, PROTO_STAGE_REPAIR);
+    CHECK(pr[0].fraction > 0);
+    for (int k = 1; k < np; k++)
+        CHECK(pr[k].fraction >= pr[k - 1].fraction);
+    CHECK(pr[15].fraction == 1);
+    CHECK(isfinite(pr[14].eta_s) && pr[14].eta_s >= 0);
     free(pbuf);
     proto_msg m;
     unsigned char *file;

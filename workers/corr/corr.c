@@ -1,24 +1,17 @@
 /* corr.c — the correspondence pipeline (see corr.h): validation, the
  * chosen stages in their order (DDM, RHM from landmarks or from the maps,
- * ECTM), progress fan-in. Combines modules; computes nothing itself. */
+ * ECTM), progress fan-in: every stage's report goes out with the whole
+ * job's fraction and time left (corr__plan.h). Combines modules; computes
+ * nothing itself. */
 #include "corr/corr.h"
 #include "corr/corr__ddm.h"
+#include "corr/corr__plan.h"
 #include "mesh/mesh_check.h"
 #include "metric/metric.h"
 #include "util/errbuf.h"
 
 #include <string.h>
 #include <time.h>
-
-const char *corr_strerror(int code)
-{
-    switch (code) {
-#define CORR_STR(name, val, msg) case name: return msg;
-        CORR_ERRORS(CORR_STR)
-#undef CORR_STR
-    }
-    return "unknown pipeline error";
-}
 
 const char *corr_stage_name(corr_stage s)
 {
@@ -27,6 +20,7 @@ const char *corr_stage_name(corr_stage s)
     case CORR_STAGE_START: return "start";
     case CORR_STAGE_RHM: return "rhm";
     case CORR_STAGE_DDM: return "ddm";
+    case CORR_STAGE_REPAIR: return "repair";
     default: return "init";
     }
 }
@@ -38,72 +32,56 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Where a chain's reports go: the caller's callback, with the job's plan
+ * (one for the whole job: the coarse chain shares it). */
 typedef struct relay {
     corr_progress_fn fn;
     void *ctx;
     double t0;
+    corr__plan *plan;
     int ectm_before, ectm_total;   /* coarse to fine: one count over both ECTM runs */
 } relay;
+
+/* p with its time, fraction and time left to the caller; non-zero cancels. */
+static int forward(relay *rl, corr_progress *p)
+{
+    if (!rl || !rl->fn)
+        return 0;
+    p->elapsed = now() - rl->t0;
+    corr__plan_update(rl->plan, p);
+    return rl->fn(rl->ctx, p);
+}
 
 static int relay_ectm(void *ctx, const ectm_report *r)
 {
     relay *rl = ctx;
-    if (!rl->fn)
-        return 0;
     ectm_report q = *r;
     if (rl->ectm_total) {            /* the fine run after the coarse one's iterations */
         q.outer += rl->ectm_before;
         q.total = rl->ectm_total;
     }
-    corr_progress p = { CORR_STAGE_ECTM, &q, now() - rl->t0, NULL, NULL };
-    return rl->fn(rl->ctx, &p);
-}
-
-/* The coarse chain's reports as the job's: seconds since the job's start,
- * ECTM's iterations counted over both runs (rl's ectm_total). */
-static int relay_coarse(void *ctx, const corr_progress *cp)
-{
-    const relay *rl = ctx;
-    corr_progress p = *cp;
-    ectm_report q;
-    if (cp->ectm) {
-        q = *cp->ectm;
-        q.total = rl->ectm_total;
-        p.ectm = &q;
-    }
-    p.elapsed = now() - rl->t0;
-    return rl->fn(rl->ctx, &p);
+    corr_progress p = { .stage = CORR_STAGE_ECTM, .ectm = &q };
+    return forward(rl, &p);
 }
 
 static int relay_ddm(void *ctx, const corr_ddm_report *r)
 {
-    relay *rl = ctx;
-    if (!rl->fn)
-        return 0;
-    corr_progress p = { CORR_STAGE_DDM, NULL, now() - rl->t0, NULL, r };
-    return rl->fn(rl->ctx, &p);
+    corr_progress p = { .stage = CORR_STAGE_DDM, .ddm = r };
+    return forward(ctx, &p);
 }
 
 static int relay_rhm(void *ctx, const rhm_report *r)
 {
-    relay *rl = ctx;
-    if (!rl->fn)
-        return 0;
-    corr_progress p = { r->iteration ? CORR_STAGE_RHM : CORR_STAGE_START, NULL,
-                        now() - rl->t0, r, NULL };
-    return rl->fn(rl->ctx, &p);
+    corr_progress p = { .stage = r->iteration ? CORR_STAGE_RHM : CORR_STAGE_START, .rhm = r };
+    return forward(ctx, &p);
 }
 
-static int from_rhm(int rc)
+/* A repair's report: done of total maps. */
+static int relay_repair(relay *rl, int done, int total)
 {
-    switch (rc) {
-    case RHM_OK: return CORR_OK;
-    case RHM_ECANCELED: return CORR_ECANCELED;
-    case RHM_ENOMEM: return CORR_ENOMEM;
-    case RHM_EPARAM: case RHM_EINPUT: return CORR_EINPUT;
-    case RHM_EMESH: return CORR_EMESH;
-    default: return CORR_EINIT;
-    }
+    corr_repair_report r = { done, total };
+    corr_progress p = { .stage = CORR_STAGE_REPAIR, .repair = &r };
+    return forward(rl, &p);
 }
 
 int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
@@ -127,7 +105,7 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report r
         rep[1].bad_after = r.bad_after;
     }
     if (rc)
-        return errbuf_set(err, errsz, rc == FOLD_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+        return errbuf_set(err, errsz, corr_from_fold(rc),
                           "repairing the folds of the maps: %s", fold_strerror(rc));
     return CORR_OK;
 }
@@ -155,25 +133,43 @@ static bmap *if_folded(const mesh *A, const mesh *B, bmap *m)
     return m && metric_verdict(folded_map(A, B, m), 0) != METRIC_VERDICT_OK ? m : NULL;
 }
 
+/* corr_repair of P and Q (either may be NULL) between two reports of
+ * the repair stage (rl NULL: none); a report's non-zero return cancels. */
+static int repair_reported(const corr_input *in, relay *rl, bmap *P, bmap *Q, int relax,
+                           fold_report rep[2], char *err, size_t errsz)
+{
+    int total = !!P + !!Q, rc;
+    if (relay_repair(rl, 0, total))
+        return errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled before the fold repair");
+    if ((rc = corr_repair(in, P, Q, relax, rep, err, errsz)))
+        return rc;
+    if (relay_repair(rl, total, total))
+        return errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled after the fold repair");
+    return CORR_OK;
+}
+
 /* One RHM run from q and its repair; raw: a copy of P12 before it. */
-static int rhm_repaired(const corr_input *in, const rhm_params *q, rhm_progress_fn progress,
-                        void *ctx, rhm_result *out, bmap **raw, fold_report rep[2], char *err,
-                        size_t errsz)
+static int rhm_repaired(const corr_input *in, const rhm_params *q, relay *rl,
+                        rhm_progress_fn progress, void *ctx, rhm_result *out, bmap **raw,
+                        fold_report rep[2], char *err, size_t errsz)
 {
     int rc = rhm_run(in->S, in->T, in->L, q, progress, ctx, out, err, errsz);
     if (rc)
-        return from_rhm(rc);
+        return corr_from_rhm(rc);
     if (raw) {
         if (!(*raw = bmap_new(out->P12->n, out->P12->nt)))
             return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory");
         memcpy((*raw)->face, out->P12->face, sizeof(int) * (size_t)out->P12->n);
         memcpy((*raw)->w, out->P12->w, sizeof(double) * 3 * (size_t)out->P12->n);
     }
-    return corr_repair(in, out->P12, out->P21, 0, rep, err, errsz);
+    return repair_reported(in, rl, out->P12, out->P21, 0, rep, err, errsz);
 }
 
-int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
-             rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz)
+/* corr_rhm, with the repairs reported and a second run planned through rl
+ * (NULL: neither). */
+static int rhm_chain(const corr_input *in, const rhm_params *rp, relay *rl,
+                     rhm_progress_fn progress, void *ctx, rhm_result *out, bmap **raw,
+                     fold_report rep[2], char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
     if (raw)
@@ -182,17 +178,20 @@ int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progres
     int autos = q.start == RHM_START_AUTO;
     if (autos)
         q.start = RHM_START_DISTANCES;
-    int rc = rhm_repaired(in, &q, progress, ctx, out, raw, rep, err, errsz);
+    int rc = rhm_repaired(in, &q, rl, progress, ctx, out, raw, rep, err, errsz);
     double bad = rc ? 2 : folded(in, out);
-    if (rc || !autos || metric_verdict(bad, 0) == METRIC_VERDICT_OK)
+    int again = !rc && autos && metric_verdict(bad, 0) != METRIC_VERDICT_OK;
+    if (rl && rl->plan && autos && !rc)
+        corr__plan_rerun(rl->plan, again);
+    if (!again)
         return rc;
     q.start = RHM_START_FMAP;
     rhm_result alt;
     bmap *raw2 = NULL;
     fold_report rep2[2];
     char why[1024];
-    rc = rhm_repaired(in, &q, progress, ctx, &alt, raw ? &raw2 : NULL, rep2, why, sizeof why);
-    if (rc == CORR_ECANCELED || rc == CORR_ENOMEM) {
+    rc = rhm_repaired(in, &q, rl, progress, ctx, &alt, raw ? &raw2 : NULL, rep2, why, sizeof why);
+    if (rc == CORR_ECANCELLED || rc == CORR_ENOMEM) {
         rhm_result_close(&alt);
         bmap_free(raw2);
         return errbuf_set(err, errsz, rc, "%s", why);
@@ -213,16 +212,10 @@ int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progres
     return CORR_OK;
 }
 
-static int from_ectm(int rc)
+int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
+             rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz)
 {
-    switch (rc) {
-    case ECTM_OK: return CORR_OK;
-    case ECTM_ECANCELED: return CORR_ECANCELED;
-    case ECTM_ENOMEM: return CORR_ENOMEM;
-    case ECTM_EMAP: case ECTM_EPARAM: return CORR_EINPUT;
-    case ECTM_EMESH: return CORR_EMESH;
-    default: return CORR_EFAILED;
-    }
+    return rhm_chain(in, rp, NULL, progress, ctx, out, raw, rep, err, errsz);
 }
 
 /* RHM from the given (or denoised) maps P, Q and the repair of its maps. */
@@ -231,10 +224,13 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
                          size_t errsz)
 {
     fold_report rep[2];
-    int rc = from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err,
-                                        errsz));
-    return rc ? rc : corr_repair(in, out->P12, out->P21, 0, rep, err, errsz);
+    int rc = corr_from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err,
+                                             errsz));
+    return rc ? rc : repair_reported(in, rl, out->P12, out->P21, 0, rep, err, errsz);
 }
+
+static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm_result *out,
+                     char *err, size_t errsz);
 
 /* The chain of in (from landmarks) on the decimated pair, its last maps
  * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL).
@@ -242,7 +238,9 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
  * mesh still over twice the coarse size (collapses refused everywhere by
  * its normals or its faces' shapes), or a decimation that failed other
  * than for memory (OpenMesh refusing a face, a copy corr_validate
- * refuses); the job then runs on in's meshes as given. */
+ * refuses); the job then runs on in's meshes as given. The coarse chain
+ * reports through rl as part of the job: one plan, ECTM's iterations
+ * counted over both runs. */
 static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bmap **P,
                       bmap **Q, int *ran, char *err, size_t errsz)
 {
@@ -259,9 +257,16 @@ static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bma
         return rc;
     }
     rl->ectm_total = 2 * p->iterations;   /* the coarse ECTM's, then the fine one's */
-    if (!(rc = corr_run(&c.in, p, rl->fn ? relay_coarse : NULL, rl, &cr, err, errsz))) {
+    relay coarse = *rl;
+    fold_report rep[2];
+    if (!(rc = run_chain(&c.in, p, &coarse, &cr, err, errsz))) {
         rl->ectm_before = cr.last.outer;   /* fewer than planned if it stopped early */
-        rc = corr_coarse_carry(in, &c, cr.P, cr.Q, 1, P, Q, err, errsz);
+        if (relay_repair(rl, 0, 1 + !!cr.Q))
+            rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled before the fold repair");
+        else if (!(rc = corr_coarse_carry(in, &c, cr.P, cr.Q, 0, P, Q, err, errsz)) &&
+                 !(rc = corr_repair(in, *P, Q ? *Q : NULL, 0, rep, err, errsz)) &&
+                 relay_repair(rl, 1 + !!cr.Q, 1 + !!cr.Q))
+            rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled after the fold repair");
     }
     ectm_result_close(&cr);
     corr_coarse_close(&c);
@@ -272,10 +277,22 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
              void *ctx, ectm_result *out, char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
-    relay rl = { progress, ctx, now(), 0, 0 };
+    corr__plan plan;
+    memset(&plan, 0, sizeof plan);
+    relay rl = { progress, ctx, now(), &plan, 0, 0 };
+    return run_chain(in, p, &rl, out, err, errsz);
+}
+
+/* corr_run's body on in, reporting through rl: the job's chain, or the
+ * coarse pair's (run_coarse) as part of it. The outermost call plans the
+ * job. */
+static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm_result *out,
+                     char *err, size_t errsz)
+{
+    memset(out, 0, sizeof *out);
     int rc = ectm_params_check(p, err, errsz);
     if (rc)
-        return CORR_EINPUT;
+        return corr_from_ectm(rc);
     if ((rc = corr_validate(in->S, in->S_name, err, errsz)) ||
         (rc = corr_validate(in->T, in->T_name, err, errsz)))
         return rc;
@@ -290,14 +307,18 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         (rc = corr_check_sizes(in, err, errsz)))
         return rc;
     unsigned run = corr_stages_run(in->stages, !!in->P0);
-    if ((run & CORR_RUN_RHM) && rhm_params_check(&rp, err, errsz))
-        return CORR_EINPUT;
+    if ((run & CORR_RUN_RHM) && (rc = rhm_params_check(&rp, err, errsz)))
+        return corr_from_rhm(rc);
+    corr_input planned = *in;
+    planned.rhm = &rp;
+    if (rl->plan->n == 0)
+        corr__plan_build(rl->plan, &planned, p, &rp);
 
     bmap *dP = NULL, *dQ = NULL;               /* DDM's maps */
     rhm_result init = {0};                     /* RHM's maps (or the coarse chain's) */
     const bmap *P = in->P0, *Q = bij ? in->Q0 : NULL;
     if (run & CORR_RUN_DDM) {
-        if ((rc = corr__ddm(in, P, Q, relay_ddm, &rl, &dP, &dQ, err, errsz)))
+        if ((rc = corr__ddm(in, P, Q, relay_ddm, rl, &dP, &dQ, err, errsz)))
             goto done;
         P = dP;
         Q = dQ;
@@ -309,23 +330,21 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
         }
     }
     if (run & CORR_RUN_RHM) {
-        if (!P && progress) {
-            corr_progress cp = { CORR_STAGE_INIT, NULL, now() - rl.t0, NULL, NULL };
-            if (progress(ctx, &cp)) {
-                rc = errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before the initial map");
-                goto done;
-            }
-        }
         int coarse = 0;
-        if (corr_coarse_wanted(in))
+        if (corr_coarse_wanted(in)) {
             /* the chain on the decimated pair; ECTM below finishes its
              * maps on in's meshes */
-            rc = run_coarse(in, p, &rl, &init.P12, &init.P21, &coarse, err, errsz);
+            rc = run_coarse(in, p, rl, &init.P12, &init.P21, &coarse, err, errsz);
+            if (!rc && !coarse) {              /* no usable decimated pair: planned again */
+                rp.coarse = 0;
+                corr__plan_build(rl->plan, &planned, p, &rp);
+            }
+        }
         fold_report rep[2];
         if (!rc && !coarse && P)
-            rc = rhm_from_maps(in, P, Q, &rp, &rl, &init, err, errsz);
+            rc = rhm_from_maps(in, P, Q, &rp, rl, &init, err, errsz);
         else if (!rc && !coarse)
-            rc = corr_rhm(in, &rp, relay_rhm, &rl, &init, NULL, rep, err, errsz);
+            rc = rhm_chain(in, &rp, rl, relay_rhm, rl, &init, NULL, rep, err, errsz);
         if (rc)
             goto done;
         if (!(run & CORR_RUN_ECTM)) {
@@ -340,7 +359,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
     /* the job's landmarks, pinned in ECTM's P- and Q-steps (issue 12) */
     ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
                           in->L ? in->L->n : 0 };
-    rc = from_ectm(ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, &rl, out, err, errsz));
+    rc = corr_from_ectm(ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz));
     if (rc == CORR_OK) {
         /* ECTM's projection folds where its deformed surface passes a thin
          * part at an angle: the same repair, on the maps it returns, in
@@ -360,7 +379,7 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
             rQ = if_folded(in->T, in->S, out->Q);
         }
         fold_report rep[2];
-        if ((rP || rQ) && (rc = corr_repair(in, rP, rQ, 1, rep, err, errsz)))
+        if ((rP || rQ) && (rc = repair_reported(in, rl, rP, rQ, 1, rep, err, errsz)))
             ectm_result_close(out);
     }
 done:

@@ -29,30 +29,44 @@
 #include "rhm/rhm.h"
 #include "proto.h"
 
-#define CORR_ERRORS(X)                                                          \
-    X(CORR_OK,         0, "ok")                                                 \
-    X(CORR_EMESH,     -1, "mesh not usable")                                    \
-    X(CORR_EINPUT,    -2, "inputs do not fit together")                         \
-    X(CORR_EINIT,     -3, "initial map could not be built")                     \
-    X(CORR_ENOMEM,    -4, "out of memory")                                      \
-    X(CORR_ECANCELED, -5, "cancelled")                                          \
-    X(CORR_EFAILED,   -6, "optimisation failed")
-
+/* The pipeline's errors are the kinds of a job's failure (proto_kind.h):
+ * CORR_EMESH, CORR_ELANDMARKS, CORR_EPARAMS, CORR_EMAP, CORR_ENUMERIC,
+ * CORR_ENOMEM, CORR_ECANCELLED, CORR_EIO, CORR_EINTERNAL, each -kind. */
 enum corr_error {
-#define CORR_ENUM(name, val, msg) name = val,
-    CORR_ERRORS(CORR_ENUM)
+    CORR_OK = 0,
+#define CORR_ENUM(kind, code, exit, text) CORR_E##kind = -PROTO_KIND_##kind,
+    PROTO_KINDS(CORR_ENUM)
 #undef CORR_ENUM
 };
-const char *corr_strerror(int code);
+const char *corr_strerror(int code);   /* the kind's text (proto_kind_text) */
+/* The wire code of a pipeline code (0 for CORR_OK): what the worker's
+ * error.frame carries. */
+int corr_wire_code(int code);
+/* An engine module's code as the pipeline's, by the kind column of the
+ * module's error list (corr_kind.c); an unknown code is CORR_EINTERNAL. */
+int corr_from_rhm(int rc);
+int corr_from_ectm(int rc);
+int corr_from_fold(int rc);
+int corr_from_ddm(int rc);
+int corr_from_ctf(int rc);
+int corr_from_geod(int rc);
+int corr_from_lbo(int rc);
+int corr_from_lmk(int rc);
+int corr_from_bmap(int rc);
+int corr_from_mesh(int rc);
 
 typedef enum corr_stage {
-    CORR_STAGE_INIT = 0,     /* building the initial map starts             */
+    CORR_STAGE_INIT = 0,     /* not reported: the first report is the start
+                                map's (or DDM's start)                      */
     CORR_STAGE_ECTM = 1,     /* one report per ECTM outer iteration         */
     CORR_STAGE_START = 2,  /* the start map is built (its RHM energies)  */
     CORR_STAGE_RHM = 3,      /* one report per RHM iteration                */
-    CORR_STAGE_DDM = 4       /* DDM denoising: at its start, per direction  */
+    CORR_STAGE_DDM = 4,      /* DDM denoising: at its start, per direction  */
+    CORR_STAGE_REPAIR = 5    /* the fold repair of a stage's maps: at its
+                                start and at its end                        */
 } corr_stage;
-const char *corr_stage_name(corr_stage s);   /* "init", "ectm", "start", "rhm", "ddm" */
+/* "init", "ectm", "start", "rhm", "ddm", "repair" */
+const char *corr_stage_name(corr_stage s);
 
 /* Which stages run, the values of the job parameter stages (PROTO_PARAMS,
  * the names "ddm,ectm" etc.: proto_param_value_name). A chain always runs
@@ -94,12 +108,14 @@ typedef enum corr_ddm_mode {
  * that comes back farther has come back to another part. */
 #define CORR_DDM_AUTO_ROUND_TRIP 0.1
 
-/* Whether the chain can run on these inputs: 0, or CORR_EINPUT with the
- * reason in err (ddm without a map, RHM from landmarks with fewer than
- * PROTO_MIN_LANDMARKS, ECTM or RHM with neither, a reverse map with the
- * injective model, a weak landmark term without landmarks, bijective DDM
- * without a reverse map or a ddm_mode outside the list; auto without a
- * reverse map runs plain). The worker's
+/* Whether the chain can run on these inputs: 0, or an error with the
+ * reason in err: CORR_EPARAMS (ddm without a map, ECTM alone without one,
+ * a reverse map with the injective model, a weak landmark term without
+ * landmarks, bijective DDM without a reverse map, a stages or ddm_mode
+ * value outside the list; auto without a reverse map runs plain),
+ * CORR_ELANDMARKS (RHM from neither a map nor at least
+ * PROTO_MIN_LANDMARKS landmarks), CORR_EMAP (a reverse map without a
+ * map). The worker's
  * SUBMIT check and corr_run use it. */
 int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
                       int injective, double rhm_landmark_weight, corr_ddm_mode ddm_mode,
@@ -139,15 +155,33 @@ typedef struct corr_input {
     corr_ddm_mode ddm_mode;   /* plain, or bijective (needs Q0)              */
 } corr_input;
 
+/* A REPAIR stage report: maps repaired (0 at the start) of total (1: P
+ * only, 2: P and Q). */
+typedef struct corr_repair_report {
+    int done, total;
+} corr_repair_report;
+
 typedef struct corr_progress {
     corr_stage stage;
     const ectm_report *ectm;  /* the outer iteration's report (stage ECTM)  */
     double elapsed;           /* seconds since corr_run started             */
     const rhm_report *rhm;    /* the RHM report (stages START and RHM)      */
     const corr_ddm_report *ddm; /* the DDM report (stage DDM)               */
+    const corr_repair_report *repair; /* the repair's report (stage REPAIR) */
+    double fraction;          /* of the whole job done, 0..1, never falling:
+                                 each stage weighted by its expected cost
+                                 (corr__plan.h)                             */
+    double eta_s;             /* seconds left, from the time the done
+                                 fraction took; NaN while not known         */
 } corr_progress;
 
 typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
+
+/* p as the wire's progress record (PROTOCOL.md, PROGRESS): stage, counts,
+ * the five terms of each direction in their slots, beta, gamma, the
+ * fraction, the time left and elapsed (p->elapsed); job_id and ahead 0.
+ * The worker sends it, `meshcorr match` prints it. */
+void corr_progress_record(const corr_progress *p, proto_progress *out);
 
 /* 0 when the optimizer can use m; else CORR_EMESH with one line per problem
  * ("name: ...") in err. */
@@ -157,7 +191,7 @@ int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
  * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM may start from the
  * functional map: start fmap, or auto's second run) hold at most
  * vertices - 2 eigenfunctions of either mesh.
- * CORR_OK, or CORR_EINPUT with the parameter and both meshes named.
+ * CORR_OK, or CORR_EPARAMS with the parameter and both meshes named.
  * corr_run checks it first; the check of a job where it is built (the
  * daemon's of a SUBMIT) calls it too, so such a job is refused before it
  * is queued. */
@@ -185,13 +219,13 @@ int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progres
  * fold_relax of each: on ECTM's maps, which the pipeline returns, not on
  * RHM's, whose folds corr_rhm reads to choose the start and which ECTM
  * moves anyway. rep[0], rep[1]: P's and Q's reports (bad_after and
- * relaxed: after fold_relax when it ran). CORR_OK, CORR_ENOMEM or
- * CORR_EINIT. */
+ * relaxed: after fold_relax when it ran). CORR_OK, or CORR_ENOMEM,
+ * CORR_EMESH or CORR_EINTERNAL (corr_from_fold). */
 int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
                 char *err, size_t errsz);
 
 /* A job's parameters (the wire form of the one list, proto_params.h) as the
- * engine's: checked with proto_params_check (CORR_EINPUT, "NAME = V: ..."
+ * engine's: checked with proto_params_check (CORR_EPARAMS, "NAME = V: ..."
  * in err), a 0 that means the default left at the default, backend
  * "NAME[:DEVICE]" split into p->backend and p->device, threads into both.
  * p and r start from their _init defaults (log_eps stays ECTM's). */
@@ -222,7 +256,7 @@ typedef struct corr_coarse {
 /* Whether corr_run takes the coarse path for in. */
 int corr_coarse_wanted(const corr_input *in);
 /* Decimates in's meshes into c (c->in: the coarse pair's input, checked
- * with corr_validate). CORR_OK, CORR_ENOMEM, CORR_EINPUT or CORR_EFAILED
+ * with corr_validate). CORR_OK, CORR_ENOMEM, CORR_ENUMERIC or CORR_EINTERNAL
  * (the decimation), CORR_EMESH (a copy corr_validate refuses); on failure
  * c holds nothing. corr_run runs a job whose decimation fails other than
  * for memory on its meshes as given. */

@@ -30,14 +30,14 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz)
     int most = (S->nv < T->nv ? S->nv : T->nv) - 2;
     unsigned run = corr_stages_run(in->stages, !!in->P0);
     if ((run & CORR_RUN_DDM) && in->ddm_k > most)
-        return errbuf_set(err, errsz, CORR_EINPUT,
+        return errbuf_set(err, errsz, CORR_EPARAMS,
                           "params.ddm_k = %d: DDM's basis holds at most vertices - 2 = %d "
                           "eigenfunctions here (%s: %d vertices, %s: %d)",
                           in->ddm_k, most, in->S_name, S->nv, in->T_name, T->nv);
     const rhm_params *rp = in->rhm;
     int fmap = rp && (rp->start == RHM_START_FMAP || rp->start == RHM_START_AUTO);
     if ((run & CORR_RUN_RHM) && !in->P0 && fmap && rp->zoomout > most)
-        return errbuf_set(err, errsz, CORR_EINPUT,
+        return errbuf_set(err, errsz, CORR_EPARAMS,
                           "params.zoomout = %d: a basis holds at most vertices - 2 = %d "
                           "eigenfunctions here (%s: %d vertices, %s: %d)",
                           rp->zoomout, most, in->S_name, S->nv, in->T_name, T->nv);

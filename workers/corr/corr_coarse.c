@@ -24,11 +24,6 @@ int corr_coarse_wanted(const corr_input *in)
            (in->S->nv > 2 * c || in->T->nv > 2 * c);
 }
 
-static int from_ctf(int rc)
-{
-    return rc == CTF_ENOMEM ? CORR_ENOMEM : rc == CTF_EINPUT ? CORR_EINPUT : CORR_EFAILED;
-}
-
 /* m decimated into *out (left NULL when m is small already), with the
  * landmark vertices lmk[0..n) renumbered to the copy's in clmk. */
 static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, int nc,
@@ -41,7 +36,7 @@ static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, i
     int *fine = NULL;
     int rc = ctf_decimate(m, nc, lmk, n, out, &fine, why, sizeof why);
     if (rc)
-        return errbuf_set(err, errsz, from_ctf(rc), "%s: decimation: %s", name, why);
+        return errbuf_set(err, errsz, corr_from_ctf(rc), "%s: decimation: %s", name, why);
     int *at = malloc(sizeof(int) * (size_t)m->nv);
     if (!at) {
         free(fine);
@@ -89,7 +84,7 @@ int corr_coarse_carry(const corr_input *in, const corr_coarse *c, const bmap *Pc
     if (!rc && Qc && Q)
         rc = ctf_prolong(c->in.T, c->in.S, Qc, in->T, in->S, Q, why, sizeof why);
     if (rc)
-        rc = errbuf_set(err, errsz, from_ctf(rc), "carrying the coarse maps to the meshes: %s", why);
+        rc = errbuf_set(err, errsz, corr_from_ctf(rc), "carrying the coarse maps to the meshes: %s", why);
     fold_report rep[2];
     if (!rc && repair)
         rc = corr_repair(in, *P, Q ? *Q : NULL, 0, rep, err, errsz);

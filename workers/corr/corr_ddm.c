@@ -24,12 +24,12 @@ static int basis_open(basis *bs, const mesh *m, const char *name, int k, char *e
     char detail[512] = "";
     int rc = geod_solver_new(m, 0, &bs->s, detail, sizeof detail);
     if (rc)
-        return errbuf_set(err, errsz, rc == GEOD_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+        return errbuf_set(err, errsz, corr_from_geod(rc),
                           "DDM: %s: Laplacian: %s", name, detail);
     rc = lbo_eigenpairs(geod_solver_laplacian(bs->s), geod_solver_mass(bs->s), m->nv, k, &bs->b,
                         detail, sizeof detail);
     if (rc)
-        return errbuf_set(err, errsz, rc == LBO_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+        return errbuf_set(err, errsz, corr_from_lbo(rc),
                           "DDM: %s: %d eigenpairs: %s", name, k, detail);
     return CORR_OK;
 }
@@ -58,7 +58,7 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
                                                                  : CORR_DDM_PLAIN;
     }
     if (report && report(ctx, &r))
-        return errbuf_set(err, errsz, CORR_ECANCELED, "cancelled before DDM");
+        return errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled before DDM");
     basis bs[2];
     memset(bs, 0, sizeof bs);
     int rc;
@@ -69,7 +69,7 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
         char detail[512] = "";
         double energy[DDM_BIJ_ITERATIONS_DEFAULT + 1];
         if (!Q0) {
-            rc = errbuf_set(err, errsz, CORR_EINPUT,
+            rc = errbuf_set(err, errsz, CORR_EPARAMS,
                             "bijective DDM (ddm_mode bijective) needs an initial reverse map");
             goto out;
         }
@@ -82,14 +82,14 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
                                         DDM_BIJ_ALPHA_DEFAULT, DDM_BIJ_ITERATIONS_DEFAULT, *P, *Q,
                                         energy, detail, sizeof detail);
         if (drc) {
-            rc = errbuf_set(err, errsz, drc == DDM_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+            rc = errbuf_set(err, errsz, corr_from_ddm(drc),
                             "bijective DDM denoising of the initial maps: %s", detail);
             goto out;
         }
         r.done = 2;
         r.cost[0] = r.cost[1] = energy[DDM_BIJ_ITERATIONS_DEFAULT] / 2;
         rc = report && report(ctx, &r)
-                 ? errbuf_set(err, errsz, CORR_ECANCELED, "cancelled in DDM") : CORR_OK;
+                 ? errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled in DDM") : CORR_OK;
         goto out;
     }
     const bmap *in_map[2] = {P0, Q0};
@@ -106,14 +106,14 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
         int drc = ddm_denoise(&a->b, geod_solver_mass(a->s), &b->b, to, in_map[d], k, k,
                               *out_map[d], &st, detail, sizeof detail);
         if (drc) {
-            rc = errbuf_set(err, errsz, drc == DDM_ENOMEM ? CORR_ENOMEM : CORR_EINIT,
+            rc = errbuf_set(err, errsz, corr_from_ddm(drc),
                             "DDM denoising of the %s map: %s", d ? "reverse" : "initial", detail);
             goto out;
         }
         r.done = d + 1;
         r.cost[d] = st.cost;
         if (report && report(ctx, &r)) {
-            rc = errbuf_set(err, errsz, CORR_ECANCELED, "cancelled in DDM");
+            rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled in DDM");
             goto out;
         }
     }

@@ -11,13 +11,13 @@ extern "C" {
 #include "mesh/mesh.h"
 
 #define CTF_ERRORS(X)                                                       \
-    X(CTF_OK,       0, "ok")                                                \
-    X(CTF_EINPUT,  -1, "invalid input")                                     \
-    X(CTF_ENOMEM,  -2, "out of memory")                                     \
-    X(CTF_EFAILED, -3, "decimation or projection failed")
+    X(CTF_OK,       0, "ok", NONE)                                            \
+    X(CTF_EINPUT,  -1, "invalid input", INTERNAL)                             \
+    X(CTF_ENOMEM,  -2, "out of memory", NOMEM)                                \
+    X(CTF_EFAILED, -3, "decimation or projection failed", NUMERIC)
 
 enum ctf_error {
-#define CTF_ENUM(name, val, msg) name = val,
+#define CTF_ENUM(name, val, msg, kind) name = val,
     CTF_ERRORS(CTF_ENUM)
 #undef CTF_ENUM
 };

@@ -33,12 +33,12 @@
 #include <stddef.h>
 
 #define DDM_ERRORS(X)                                                       \
-    X(DDM_OK,      0, "ok")                                                 \
-    X(DDM_ENOMEM, -1, "out of memory")                                      \
-    X(DDM_EINVAL, -2, "invalid argument")
+    X(DDM_OK,      0, "ok", NONE)                                             \
+    X(DDM_ENOMEM, -1, "out of memory", NOMEM)                                 \
+    X(DDM_EINVAL, -2, "invalid argument", INTERNAL)
 
 enum ddm_error {
-#define DDM_ENUM(name, val, msg) name = val,
+#define DDM_ENUM(name, val, msg, kind) name = val,
     DDM_ERRORS(DDM_ENUM)
 #undef DDM_ENUM
 };

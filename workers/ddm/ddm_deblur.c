@@ -14,7 +14,7 @@
 const char *ddm_strerror(int code)
 {
     switch (code) {
-#define DDM_STR(name, val, msg) case name: return msg;
+#define DDM_STR(name, val, msg, kind) case name: return msg;
         DDM_ERRORS(DDM_STR)
 #undef DDM_STR
     }

@@ -25,17 +25,17 @@
 #include "map/bmap.h"
 
 #define ECTM_ERRORS(X)                                                          \
-    X(ECTM_OK,          0, "ok")                                                \
-    X(ECTM_EPARAM,     -1, "invalid parameter")                                 \
-    X(ECTM_EMESH,      -2, "mesh not usable by the optimizer")                  \
-    X(ECTM_EMAP,       -3, "initial map does not fit the meshes")               \
-    X(ECTM_ENOMEM,     -4, "out of memory")                                     \
-    X(ECTM_ECANCELED,  -5, "cancelled")                                         \
-    X(ECTM_ENUMERIC,   -6, "numerical failure (non-finite energy)")         \
-    X(ECTM_EBACKEND,   -7, "energy backend unavailable or failed")
+    X(ECTM_OK,          0, "ok", NONE)                                        \
+    X(ECTM_EPARAM,     -1, "invalid parameter", PARAMS)                       \
+    X(ECTM_EMESH,      -2, "mesh not usable by the optimizer", MESH)          \
+    X(ECTM_EMAP,       -3, "initial map does not fit the meshes", MAP)        \
+    X(ECTM_ENOMEM,     -4, "out of memory", NOMEM)                            \
+    X(ECTM_ECANCELED,  -5, "cancelled", CANCELLED)                            \
+    X(ECTM_ENUMERIC,   -6, "numerical failure (non-finite energy)", NUMERIC)  \
+    X(ECTM_EBACKEND,   -7, "energy backend unavailable or failed", PARAMS)
 
 enum ectm_error {
-#define ECTM_ENUM(name, val, msg) name = val,
+#define ECTM_ENUM(name, val, msg, kind) name = val,
     ECTM_ERRORS(ECTM_ENUM)
 #undef ECTM_ENUM
 };

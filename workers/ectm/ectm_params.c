@@ -13,7 +13,7 @@
 const char *ectm_strerror(int code)
 {
     switch (code) {
-#define ECTM_STR(name, val, msg) case name: return msg;
+#define ECTM_STR(name, val, msg, kind) case name: return msg;
         ECTM_ERRORS(ECTM_STR)
 #undef ECTM_STR
     }

@@ -81,13 +81,13 @@
 #include "mesh/mesh.h"
 
 #define FOLD_ERRORS(X)                                                       \
-    X(FOLD_OK,      0, "ok")                                                 \
-    X(FOLD_EINVAL, -1, "invalid argument (map, meshes or parameters)")       \
-    X(FOLD_ENOMEM, -2, "out of memory")                                      \
-    X(FOLD_EMESH,  -3, "a mesh is not manifold (its edge table failed)")
+    X(FOLD_OK,      0, "ok", NONE)                                            \
+    X(FOLD_EINVAL, -1, "invalid argument (map, meshes or parameters)", INTERNAL) \
+    X(FOLD_ENOMEM, -2, "out of memory", NOMEM)                                \
+    X(FOLD_EMESH,  -3, "a mesh is not manifold (its edge table failed)", MESH)
 
 enum fold_error {
-#define FOLD_ENUM(name, val, msg) name = val,
+#define FOLD_ENUM(name, val, msg, kind) name = val,
     FOLD_ERRORS(FOLD_ENUM)
 #undef FOLD_ENUM
 };

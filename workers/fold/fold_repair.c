@@ -57,7 +57,7 @@
 const char *fold_strerror(int code)
 {
     switch (code) {
-#define FOLD_STR(name, val, msg) case name: return msg;
+#define FOLD_STR(name, val, msg, kind) case name: return msg;
         FOLD_ERRORS(FOLD_STR)
 #undef FOLD_STR
     }

@@ -58,14 +58,14 @@
 #define GEOD_BATCH 32              /* right-hand sides solved together */
 
 #define GEOD_ERRORS(X)                                                      \
-    X(GEOD_OK,          0, "ok")                                            \
-    X(GEOD_ENOMEM,     -1, "out of memory")                                 \
-    X(GEOD_EINVAL,     -2, "invalid argument")                              \
-    X(GEOD_EMESH,      -3, "mesh unusable for geodesics")                   \
-    X(GEOD_EFACTOR,    -4, "sparse factorisation or solve failed")
+    X(GEOD_OK,          0, "ok", NONE)                                        \
+    X(GEOD_ENOMEM,     -1, "out of memory", NOMEM)                            \
+    X(GEOD_EINVAL,     -2, "invalid argument", INTERNAL)                      \
+    X(GEOD_EMESH,      -3, "mesh unusable for geodesics", MESH)               \
+    X(GEOD_EFACTOR,    -4, "sparse factorisation or solve failed", NUMERIC)
 
 enum geod_error {
-#define GEOD_ENUM(name, val, msg) name = val,
+#define GEOD_ENUM(name, val, msg, kind) name = val,
     GEOD_ERRORS(GEOD_ENUM)
 #undef GEOD_ENUM
 };

@@ -39,15 +39,15 @@
 #define LBO_MAX_RESTARTS 2000   /* ARPACK restarts at most */
 
 #define LBO_ERRORS(X)                                                       \
-    X(LBO_OK,        0, "ok")                                               \
-    X(LBO_ENOMEM,   -1, "out of memory")                                    \
-    X(LBO_EINVAL,   -2, "invalid argument")                                 \
-    X(LBO_EFACTOR,  -3, "sparse factorisation failed")                      \
-    X(LBO_EARPACK,  -4, "ARPACK failed")                                    \
-    X(LBO_ENOCONV,  -5, "eigenpairs did not converge")
+    X(LBO_OK,        0, "ok", NONE)                                           \
+    X(LBO_ENOMEM,   -1, "out of memory", NOMEM)                               \
+    X(LBO_EINVAL,   -2, "invalid argument", INTERNAL)                         \
+    X(LBO_EFACTOR,  -3, "sparse factorisation failed", NUMERIC)               \
+    X(LBO_EARPACK,  -4, "ARPACK failed", NUMERIC)                             \
+    X(LBO_ENOCONV,  -5, "eigenpairs did not converge", NUMERIC)
 
 enum lbo_error {
-#define LBO_ENUM(name, val, msg) name = val,
+#define LBO_ENUM(name, val, msg, kind) name = val,
     LBO_ERRORS(LBO_ENUM)
 #undef LBO_ENUM
 };

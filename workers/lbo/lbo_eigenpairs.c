@@ -13,7 +13,7 @@
 const char *lbo_strerror(int code)
 {
     switch (code) {
-#define LBO_STR(name, val, msg) case name: return msg;
+#define LBO_STR(name, val, msg, kind) case name: return msg;
         LBO_ERRORS(LBO_STR)
 #undef LBO_STR
     }

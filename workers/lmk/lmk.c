@@ -13,7 +13,7 @@
 const char *lmk_strerror(int code)
 {
     switch (code) {
-#define LMK_STR(name, val, msg) case name: return msg;
+#define LMK_STR(name, val, msg, kind) case name: return msg;
         LMK_ERRORS(LMK_STR)
 #undef LMK_STR
     }

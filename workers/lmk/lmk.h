@@ -43,18 +43,18 @@
                                       fraction of the mesh's bounding-box diagonal */
 
 #define LMK_ERRORS(X)                                                     \
-    X(LMK_OK,        0, "ok")                                             \
-    X(LMK_EIO,      -1, "cannot read the landmark file")                  \
-    X(LMK_EPARSE,   -2, "malformed landmark file")                        \
-    X(LMK_ERANGE,   -3, "landmark index out of range")                    \
-    X(LMK_EDUP,     -4, "duplicate source landmark")                      \
-    X(LMK_ECOUNT,   -5, "wrong number of landmarks")                      \
-    X(LMK_ENOMEM,   -6, "out of memory")                                  \
-    X(LMK_ELAYOUT,  -7, "the file is not in a layout this reader takes")  \
-    X(LMK_EBASE,    -8, "the file's positions contradict the index base")
+    X(LMK_OK,        0, "ok", NONE)                                             \
+    X(LMK_EIO,      -1, "cannot read the landmark file", IO)                    \
+    X(LMK_EPARSE,   -2, "malformed landmark file", LANDMARKS)                   \
+    X(LMK_ERANGE,   -3, "landmark index out of range", LANDMARKS)               \
+    X(LMK_EDUP,     -4, "duplicate source landmark", LANDMARKS)                 \
+    X(LMK_ECOUNT,   -5, "wrong number of landmarks", LANDMARKS)                 \
+    X(LMK_ENOMEM,   -6, "out of memory", NOMEM)                                 \
+    X(LMK_ELAYOUT,  -7, "the file is not in a layout this reader takes", LANDMARKS) \
+    X(LMK_EBASE,    -8, "the file's positions contradict the index base", LANDMARKS)
 
 enum lmk_error {
-#define LMK_ENUM(name, val, msg) name = val,
+#define LMK_ENUM(name, val, msg, kind) name = val,
     LMK_ERRORS(LMK_ENUM)
 #undef LMK_ENUM
 };

@@ -47,15 +47,12 @@ typedef struct wrk_job {
  * proto_params_check: BAD_PARAMS naming the field), checks that there are
  * landmarks or a map (and q only with p, bijective), builds the landmark set
  * (lmk_from_arrays: BAD_LANDMARKS) and the initial maps (bmap_check_row:
- * BAD_PARAMS), and the sizes the meshes bound (corr_check_sizes: DDM's and
- * ZoomOut's bases, BAD_PARAMS). On error job is left closed. */
+ * BAD_MAP), and the sizes the meshes bound (corr_check_sizes: DDM's and
+ * ZoomOut's bases, BAD_PARAMS). Each code is the wire code of the kind of
+ * the failure (proto_kind.h, corr_wire_code). On error job is left closed. */
 int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
                         char *err, size_t errsz);
 void wrk_job_close(wrk_job *job);
-/* The ERROR code of corr_run's failure corr_rc (BAD_MESH, BAD_PARAMS,
- * BAD_LANDMARKS, NOMEM, CANCELLED, else INTERNAL): the worker's, and the
- * in-process job's (client-c/local/mc_match.c). */
-int wrk_code_of_corr(int corr_rc);
 /* The job as corr_run's input (pointers into job; the meshes named
  * "source mesh" and "target mesh", as in every message of a job). */
 void wrk_job_input(const wrk_job *job, corr_input *in);
@@ -78,15 +75,15 @@ int wrk_frame_write(const char *dir, const char *name, const proto_msg *m, char 
 typedef struct wrk_progress {
     int fd;
     uint64_t job_id;
-    int total;                     /* planned outer iterations */
     char file[4096];               /* fallback: "" none, else DIR/progress.frames */
 } wrk_progress;
 /* Connects to host:port (a TCP stream, send timeout set) and sends the hello
  * line with job_id and the secret read from secret_file; on any failure
  * pg->fd stays -1 and the frames go to pg->file. Reasons go to stderr. */
 void wrk_progress_connect(wrk_progress *pg, const char *hostport, const char *secret_file);
-void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, int total, double elapsed,
-                       proto_progress *out);
+/* The record of cp (corr_progress_record) as job job_id's, elapsed seconds
+ * since the worker started. */
+void wrk_progress_fill(const corr_progress *cp, uint64_t job_id, double elapsed, proto_progress *out);
 void wrk_progress_send(wrk_progress *pg, const corr_progress *cp, double elapsed);
 
 /* worker_result.c — the RESULT_OK message of a finished job: P, Q

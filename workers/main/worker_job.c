@@ -29,24 +29,22 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
     int rc = mesh_read_drc_mem(b->data, b->len, lim->max_vertices, lim->max_faces, name, out,
                                err, errsz);
     if (rc)                 /* over the limits included: "N points / M faces, over ..." */
-        return rc == MESH_ENOMEM ? PROTO_ENOMEM : PROTO_EBAD_MESH;
-    rc = corr_validate(*out, name, err, errsz);
-    if (rc)
-        return rc == CORR_ENOMEM ? PROTO_ENOMEM : PROTO_EBAD_MESH;
-    return 0;
+        return corr_wire_code(corr_from_mesh(rc));
+    return corr_wire_code(corr_validate(*out, name, err, errsz));
 }
 
 /* The inputs' combination: a map or landmarks, q only with p and bijective. */
 static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 {
     if (s->p.n == 0 && s->nlandmarks == 0)
-        return errbuf_set(err, errsz, PROTO_EBAD_LANDMARKS,
+        return errbuf_set(err, errsz, corr_wire_code(CORR_ELANDMARKS),
                           "landmarks: none, and no initial map p: need one or at least %d pairs",
                           PROTO_MIN_LANDMARKS);
     if (s->q.n && !s->p.n)
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q without p");
+        return errbuf_set(err, errsz, corr_wire_code(CORR_EMAP), "initial map q without p");
     if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS, "initial map q needs the bijective model");
+        return errbuf_set(err, errsz, corr_wire_code(CORR_EPARAMS),
+                          "initial map q needs the bijective model");
     return 0;
 }
 
@@ -55,13 +53,11 @@ static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 static int check_stages(const proto_submit *s, char *err, size_t errsz)
 {
     char why[256];
-    if (corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
-                          (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
-                          s->params.rhm_landmark_weight, (corr_ddm_mode)s->params.ddm_mode, why,
-                          sizeof why))
-        return errbuf_set(err, errsz, s->p.n ? PROTO_EBAD_PARAMS : PROTO_EBAD_LANDMARKS,
-                          "params.stages: %s", why);
-    return 0;
+    int rc = corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
+                               (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
+                               s->params.rhm_landmark_weight, (corr_ddm_mode)s->params.ddm_mode,
+                               why, sizeof why);
+    return rc ? errbuf_set(err, errsz, corr_wire_code(rc), "params.stages: %s", why) : 0;
 }
 
 void wrk_job_input(const wrk_job *job, corr_input *in)
@@ -76,7 +72,7 @@ static int check_sizes(const wrk_job *job, char *err, size_t errsz)
 {
     corr_input in;
     wrk_job_input(job, &in);
-    return corr_check_sizes(&in, err, errsz) ? PROTO_EBAD_PARAMS : 0;
+    return corr_wire_code(corr_check_sizes(&in, err, errsz));
 }
 
 static int map_landmarks(const proto_submit *s, const mesh *S, const mesh *T, lmk_set **out,
@@ -96,8 +92,7 @@ static int map_landmarks(const proto_submit *s, const mesh *S, const mesh *T, lm
         b[k] = s->landmarks[k].tgt;
     }
     rc = lmk_from_arrays(a, b, s->nlandmarks, 0, "landmarks", "landmarks", S, T, out, err, errsz);
-    if (rc)
-        rc = rc == LMK_ENOMEM ? PROTO_ENOMEM : PROTO_EBAD_LANDMARKS;
+    rc = corr_wire_code(corr_from_lmk(rc));
 done:
     free(a);
     free(b);
@@ -111,7 +106,7 @@ static int map_map(const proto_map *w, const char *name, const mesh *from, const
     if (w->n == 0)
         return 0;
     if (w->n != (uint32_t)from->nv)
-        return errbuf_set(err, errsz, PROTO_EBAD_PARAMS,
+        return errbuf_set(err, errsz, corr_wire_code(CORR_EMAP),
                           "%s has %u rows, its mesh has %d vertices", name, w->n, from->nv);
     bmap *P = bmap_new(from->nv, to->nv);
     if (!P)
@@ -124,7 +119,7 @@ static int map_map(const proto_map *w, const char *name, const mesh *from, const
             snprintf(where, sizeof where, "%s: row %d", name, i);
             bmap_check_row(w->rows[i].face, wt, to->nf, where, err, errsz);
             bmap_free(P);
-            return PROTO_EBAD_PARAMS;
+            return corr_wire_code(CORR_EMAP);
         }
         P->face[i] = (int)w->rows[i].face;
     }
@@ -139,7 +134,7 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
     int rc;
     if ((rc = corr_params_from_job(&s->params, lim->threads, &job->params, &job->rhm, err, errsz))) {
         wrk_job_close(job);
-        return rc == CORR_ENOMEM ? PROTO_ENOMEM : PROTO_EBAD_PARAMS;
+        return corr_wire_code(rc);
     }
     job->stages = (corr_stages)s->params.stages;
     job->ddm_k = (int)s->params.ddm_k;
@@ -162,16 +157,4 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
     job->params.threads = job->rhm.threads = threads;
     omp_set_num_threads(threads);
     return 0;
-}
-
-int wrk_code_of_corr(int corr_rc)
-{
-    switch (corr_rc) {
-    case CORR_EMESH: return PROTO_EBAD_MESH;
-    case CORR_EINPUT: return PROTO_EBAD_PARAMS;
-    case CORR_EINIT: return PROTO_EBAD_LANDMARKS;
-    case CORR_ENOMEM: return PROTO_ENOMEM;
-    case CORR_ECANCELED: return PROTO_ECANCELLED;
-    default: return PROTO_EINTERNAL;
-    }
 }

@@ -206,20 +206,19 @@ int main(int argc, char **argv)
         status = fail(dir, job_id, rc, err);
         goto done;
     }
-    ctx.pg.total = job.params.iterations;
     corr_input in;
     wrk_job_input(&job, &in);
     if (cancel_requested)
-        rc = CORR_ECANCELED;
+        rc = CORR_ECANCELLED;
     else
         rc = corr_run(&in, &job.params, on_progress, &ctx, &res, err, sizeof err);
     if (rc == CORR_OK && cancel_requested)
-        rc = CORR_ECANCELED;                 /* SIGTERM during the last iteration */
-    if (rc == CORR_ECANCELED)
+        rc = CORR_ECANCELLED;                 /* SIGTERM during the last iteration */
+    if (rc == CORR_ECANCELLED)
         snprintf(err, sizeof err, "cancelled by SIGTERM after %d of %d outer iterations",
                  ctx.last_outer, job.params.iterations);
     if (rc) {
-        status = fail(dir, job_id, wrk_code_of_corr(rc), err);
+        status = fail(dir, job_id, corr_wire_code(rc), err);
         goto done;
     }
     if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err))) {

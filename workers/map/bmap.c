@@ -16,7 +16,7 @@
 const char *bmap_strerror(int code)
 {
     switch (code) {
-#define BMAP_STR(name, val, msg) case name: return msg;
+#define BMAP_STR(name, val, msg, kind) case name: return msg;
         BMAP_ERRORS(BMAP_STR)
 #undef BMAP_STR
     }

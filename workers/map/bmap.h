@@ -19,16 +19,16 @@
 #define BMAP_WEIGHT_TOL 1e-4   /* |sum - 1| and -w allowed when reading */
 
 #define BMAP_ERRORS(X)                                                      \
-    X(BMAP_OK,        0, "ok")                                              \
-    X(BMAP_EIO,      -1, "cannot read or write the map file")               \
-    X(BMAP_EPARSE,   -2, "malformed map file")                              \
-    X(BMAP_ESIZE,    -3, "map sized for other meshes")                      \
-    X(BMAP_ERANGE,   -4, "face index out of range")                         \
-    X(BMAP_EWEIGHT,  -5, "weights negative or not summing to 1")            \
-    X(BMAP_ENOMEM,   -6, "out of memory")
+    X(BMAP_OK,        0, "ok", NONE)                                          \
+    X(BMAP_EIO,      -1, "cannot read or write the map file", IO)             \
+    X(BMAP_EPARSE,   -2, "malformed map file", MAP)                           \
+    X(BMAP_ESIZE,    -3, "map sized for other meshes", MAP)                   \
+    X(BMAP_ERANGE,   -4, "face index out of range", MAP)                      \
+    X(BMAP_EWEIGHT,  -5, "weights negative or not summing to 1", MAP)         \
+    X(BMAP_ENOMEM,   -6, "out of memory", NOMEM)
 
 enum bmap_error {
-#define BMAP_ENUM(name, val, msg) name = val,
+#define BMAP_ENUM(name, val, msg, kind) name = val,
     BMAP_ERRORS(BMAP_ENUM)
 #undef BMAP_ENUM
 };

@@ -10,7 +10,7 @@
 const char *mesh_strerror(int code)
 {
     switch (code) {
-#define MESH_STR(name, val, msg) case name: return msg;
+#define MESH_STR(name, val, msg, kind) case name: return msg;
         MESH_ERRORS(MESH_STR)
 #undef MESH_STR
     }

@@ -23,17 +23,17 @@
 #define MESH_MAX_FILE_BYTES (2LL << 30)
 
 #define MESH_ERRORS(X)                                                  \
-    X(MESH_OK,       0, "ok")                                           \
-    X(MESH_EIO,     -1, "cannot read or write the file")                \
-    X(MESH_EPARSE,  -2, "malformed file")                               \
-    X(MESH_ELIMIT,  -3, "size over a limit")                            \
-    X(MESH_ENOMEM,  -4, "out of memory")                                \
-    X(MESH_EFORMAT, -5, "unknown or unsupported format")                \
-    X(MESH_EDRACO,  -6, "Draco error")                                  \
-    X(MESH_EINVAL,  -7, "invalid mesh data")
+    X(MESH_OK,       0, "ok", NONE)                                           \
+    X(MESH_EIO,     -1, "cannot read or write the file", IO)                  \
+    X(MESH_EPARSE,  -2, "malformed file", MESH)                               \
+    X(MESH_ELIMIT,  -3, "size over a limit", MESH)                            \
+    X(MESH_ENOMEM,  -4, "out of memory", NOMEM)                               \
+    X(MESH_EFORMAT, -5, "unknown or unsupported format", MESH)                \
+    X(MESH_EDRACO,  -6, "Draco error", MESH)                                  \
+    X(MESH_EINVAL,  -7, "invalid mesh data", MESH)
 
 enum mesh_error {
-#define MESH_ENUM(name, val, msg) name = val,
+#define MESH_ENUM(name, val, msg, kind) name = val,
     MESH_ERRORS(MESH_ENUM)
 #undef MESH_ENUM
 };

@@ -9,7 +9,9 @@
  * coverage of the target, round trip, and geodesic error to a ground truth
  * (definitions at each function). Every measure is taken with both meshes
  * scaled to unit area. Functions returning int allocate their scratch and
- * return -1 when out of memory; nothing here reads files. */
+ * return METRIC_ENOMEM (-1) when out of memory; one that needs more of a
+ * mesh than the caller checked (its edge table) says why in a caller's
+ * buffer (METRIC_EMESH); nothing here reads files. */
 #ifndef METRIC_H
 #define METRIC_H
 #include "geod/geod.h"
@@ -17,6 +19,18 @@
 #include "mesh/mesh.h"
 
 #include <stddef.h>
+
+#define METRIC_ERRORS(X)                                                    \
+    X(METRIC_OK,      0, "ok")                                              \
+    X(METRIC_ENOMEM, -1, "out of memory")                                   \
+    X(METRIC_EMESH,  -2, "a mesh is not usable for this measure (not manifold)")
+
+enum metric_error {
+#define METRIC_ENUM(name, val, msg) name = val,
+    METRIC_ERRORS(METRIC_ENUM)
+#undef METRIC_ENUM
+};
+const char *metric_strerror(int code);
 
 /* logratio: nf values. src_area, img_area_total: total areas used for the
  * unit-area normalisation of source and image (the target's total area). */
@@ -79,7 +93,11 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
  * on irregular meshes, uncorrelated between S and T, used to dominate this
  * figure: an exact map scored nearly what a rough one did.) */
 #define METRIC_CURVATURE_EDGES 3.0
-int metric_curvature_error(const mesh *S, const mesh *T, const bmap *P, double *out);
+/* METRIC_OK; METRIC_ENOMEM, or METRIC_EMESH for a mesh without an edge
+ * table (an edge of more than two faces: "source mesh: ...") or a fit that
+ * fails, with why in err (*out NaN). */
+int metric_curvature_error(const mesh *S, const mesh *T, const bmap *P, double *out, char *err,
+                           size_t errsz);
 
 /* Coverage of the target by the map P: the fraction of T's area (lumped
  * vertex masses) at target vertices lying within `radius` (unit-area

@@ -66,16 +66,17 @@
 #include "mesh/mesh.h"
 
 #define RHM_ERRORS(X)                                                           \
-    X(RHM_OK,         0, "ok")                                                  \
-    X(RHM_EPARAM,    -1, "invalid parameter")                                   \
-    X(RHM_EMESH,     -2, "mesh not usable (geodesics or embedding failed)")     \
-    X(RHM_EINPUT,    -3, "landmarks do not fit the meshes")                     \
-    X(RHM_ENOMEM,    -4, "out of memory")                                       \
-    X(RHM_ECANCELED, -5, "cancelled")                                           \
-    X(RHM_ENUMERIC,  -6, "numerical failure (factorisation or projection)")
+    X(RHM_OK,         0, "ok", NONE)                                          \
+    X(RHM_EPARAM,    -1, "invalid parameter", PARAMS)                         \
+    X(RHM_EMESH,     -2, "mesh not usable (geodesics or embedding failed)", MESH) \
+    X(RHM_ELANDMARKS, -3, "landmarks do not fit the meshes", LANDMARKS)       \
+    X(RHM_ENOMEM,    -4, "out of memory", NOMEM)                              \
+    X(RHM_ECANCELED, -5, "cancelled", CANCELLED)                              \
+    X(RHM_ENUMERIC,  -6, "numerical failure (factorisation or projection)", NUMERIC) \
+    X(RHM_EMAP,      -7, "a given map does not fit the meshes", MAP)
 
 enum rhm_error {
-#define RHM_ENUM(name, val, msg) name = val,
+#define RHM_ENUM(name, val, msg, kind) name = val,
     RHM_ERRORS(RHM_ENUM)
 #undef RHM_ENUM
 };
@@ -182,7 +183,7 @@ void rhm_result_close(rhm_result *r);
 /* Runs RHM from the landmark pairs L (L->src on S = M1, L->tgt on T = M2,
  * at least PROTO_MIN_LANDMARKS), from p->start (auto: distances). The
  * meshes must be validated (manifold,
- * connected, no degenerate face). Errors: RHM_EPARAM, RHM_EINPUT,
+ * connected, no degenerate face). Errors: RHM_EPARAM, RHM_ELANDMARKS,
  * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC; detail in err. */
 int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
             rhm_progress_fn progress, void *ctx, rhm_result *out,
@@ -199,7 +200,7 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
  * the iterations of rhm_run. L may be NULL or hold any number of pairs:
  * landmarks serve only the weak landmark term, so p->gamma > 0 needs at
  * least one. p->start is unused. The maps are copied, not kept. Errors as
- * rhm_run; RHM_EINPUT also for maps sized for other meshes or with a face
+ * rhm_run; RHM_EMAP for maps sized for other meshes or with a face
  * out of range. */
 int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap *P12,
                       const bmap *P21, const rhm_params *p, rhm_progress_fn progress, void *ctx,

@@ -81,8 +81,9 @@ double rhm__now(void);   /* monotonic seconds */
 int rhm__init_start(rhm__problem *pb, char *err, size_t errsz);
 
 /* P_ij <- argmin over maps of (1−α)Ē_R(P, X_ji) + βĒ_Q(P, X_ij), row by row
- * (closest point in R^{2m}, exact, seeded with the current P_ij). */
-int rhm__step_p(rhm__problem *pb, int i, double beta);
+ * (closest point in R^{2m}, exact, seeded with the current P_ij). why: the
+ * projection tree's reason when it cannot be built. */
+int rhm__step_p(rhm__problem *pb, int i, double beta, char *why, size_t whysz);
 /* X_ij <- argmin over R^{n_i × m} of αĒ_D + (1−α)Ē_R(P_ji, ·) + βĒ_Q(P_ij, ·)
  * + γĒ_L [+ δĒ_A when the side has anchors]: the sparse SPD system
  * (CHOLMOD, numeric factorisation only). */

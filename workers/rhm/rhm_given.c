@@ -14,11 +14,11 @@ static int check_map(const bmap *P, const mesh *from, const mesh *to, const char
                      char *err, size_t errsz)
 {
     if (P->n != from->nv || P->nt != to->nv)
-        return errbuf_set(err, errsz, RHM_EINPUT, "RHM: %s is %d by %d, the meshes have %d and %d "
+        return errbuf_set(err, errsz, RHM_EMAP, "RHM: %s is %d by %d, the meshes have %d and %d "
                           "vertices", name, P->n, P->nt, from->nv, to->nv);
     for (int i = 0; i < P->n; i++)
         if (P->face[i] < 0 || P->face[i] >= to->nf)
-            return errbuf_set(err, errsz, RHM_EINPUT, "RHM: %s row %d: face %d of %d", name, i,
+            return errbuf_set(err, errsz, RHM_EMAP, "RHM: %s row %d: face %d of %d", name, i,
                               P->face[i], to->nf);
     return RHM_OK;
 }
@@ -112,12 +112,12 @@ int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap
     double t0 = rhm__now();
     int rc;
     if (!P12)
-        return errbuf_set(err, errsz, RHM_EINPUT, "RHM from given maps: no map");
+        return errbuf_set(err, errsz, RHM_EMAP, "RHM from given maps: no map");
     if ((rc = check_map(P12, S, T, "the given map", err, errsz)) ||
         (P21 && (rc = check_map(P21, T, S, "the given reverse map", err, errsz))))
         return rc;
     if (p->gamma > 0 && (!L || L->n == 0))
-        return errbuf_set(err, errsz, RHM_EINPUT, "RHM's weak landmark term (landmark weight %g) "
+        return errbuf_set(err, errsz, RHM_EPARAM, "RHM's weak landmark term (landmark weight %g) "
                           "needs landmarks", p->gamma);
     if (p->threads > 0)
         omp_set_num_threads(p->threads);

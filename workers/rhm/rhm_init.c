@@ -162,12 +162,13 @@ static int start_distances(rhm__problem *pb, char *err, size_t errsz)
         rhm__side *a = &pb->side[i], *b = &pb->side[1 - i];
         mesh *emb = mesh_new(b->n, b->m->nf);
         proj_tree *t = NULL;
+        char why[256] = "";
         rc = RHM_ENOMEM;
         if (emb) {
             for (int v = 0; v < b->n; v++)
                 memcpy(emb->v + 3 * v, D[1 - i] + (size_t)v * dd, 3 * sizeof(double));
             memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
-            rc = (t = proj_tree_new(emb, NULL, 0)) ? RHM_OK
+            rc = (t = proj_tree_new(emb, why, sizeof why)) ? RHM_OK
                  : errno == ENOMEM                   ? RHM_ENOMEM
                                                      : RHM_ENUMERIC;
         }
@@ -176,8 +177,8 @@ static int start_distances(rhm__problem *pb, char *err, size_t errsz)
         if (rc == RHM_OK && proj_closest(t, dd, D[1 - i], 1, a->n, D[i], a->P->face, a->P->w, NULL))
             rc = RHM_ENUMERIC;
         if (rc)
-            errbuf_set(err, errsz, rc, "the start map %s: projection failed",
-                       i ? "target -> source" : "source -> target");
+            errbuf_set(err, errsz, rc, "the start map %s: projection failed%s%s",
+                       i ? "target -> source" : "source -> target", why[0] ? ": " : "", why);
         proj_tree_free(t);
         mesh_free(emb);
     }
@@ -202,7 +203,7 @@ static int start_voronoi(rhm__problem *pb, char *err, size_t errsz)
     }
     int g = geod_voronoi_new(a->geod, a->lmk, nl, &vor, detail, sizeof detail);
     if (g) {
-        rc = errbuf_set(err, errsz, g == GEOD_ENOMEM ? RHM_ENOMEM : g == GEOD_EINVAL ? RHM_EINPUT
+        rc = errbuf_set(err, errsz, g == GEOD_ENOMEM ? RHM_ENOMEM : g == GEOD_EINVAL ? RHM_ELANDMARKS
                                                                                     : RHM_EMESH,
                         "Voronoi cells of the source landmarks: %s", detail);
         goto out;

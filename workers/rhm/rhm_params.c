@@ -12,7 +12,7 @@
 const char *rhm_strerror(int code)
 {
     switch (code) {
-#define RHM_STR(name, val, msg) case name: return msg;
+#define RHM_STR(name, val, msg, kind) case name: return msg;
         RHM_ERRORS(RHM_STR)
 #undef RHM_STR
     }

@@ -139,11 +139,11 @@ static int problem_new(const mesh *S, const mesh *T, const lmk_set *L, int min_l
     if (!L)
         L = &none;
     if (L->n < min_landmarks)
-        return errbuf_set(err, errsz, RHM_EINPUT, "RHM needs at least %d landmark pairs, got %d",
+        return errbuf_set(err, errsz, RHM_ELANDMARKS, "RHM needs at least %d landmark pairs, got %d",
                           min_landmarks, L->n);
     for (int r = 0; r < L->n; r++) {
         if (L->src[r] < 0 || L->src[r] >= S->nv || L->tgt[r] < 0 || L->tgt[r] >= T->nv)
-            return errbuf_set(err, errsz, RHM_EINPUT, "landmark %d (%d, %d) out of range",
+            return errbuf_set(err, errsz, RHM_ELANDMARKS, "landmark %d (%d, %d) out of range",
                               r + 1, L->src[r], L->tgt[r]);
     }
     rhm__problem *pb = calloc(1, sizeof *pb);

@@ -36,8 +36,10 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
         int rc;
         for (int i = 0; i < 2; i++) {
             double ta = rhm__now();
-            if ((rc = rhm__step_p(pb, i, beta)))
-                return errbuf_set(err, errsz, rc, "RHM iteration %d: projection failed", k);
+            char why[256] = "";
+            if ((rc = rhm__step_p(pb, i, beta, why, sizeof why)))
+                return errbuf_set(err, errsz, rc, "RHM iteration %d: projection failed%s%s", k,
+                                  why[0] ? ": " : "", why);
             double tb = rhm__now();
             if ((rc = rhm__step_x(pb, i, beta)))
                 return errbuf_set(err, errsz, rc, "RHM iteration %d: X-step solve failed "

@@ -59,7 +59,7 @@ int rhm__projection_setup(const rhm__problem *pb, int i, double beta,
     return rev;
 }
 
-int rhm__step_p(rhm__problem *pb, int i, double beta)
+int rhm__step_p(rhm__problem *pb, int i, double beta, char *why, size_t whysz)
 {
     rhm__side *a = &pb->side[i], *b = &pb->side[1 - i];
     int d = 2 * pb->dim;
@@ -80,7 +80,7 @@ int rhm__step_p(rhm__problem *pb, int i, double beta)
             for (int c = 0; c < 3; c++)
                 emb->v[3 * v + c] = Z[(size_t)v * d + c] / s;
         memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
-        if (!(tmp = proj_tree_new(emb, NULL, 0))) {
+        if (!(tmp = proj_tree_new(emb, why, whysz))) {
             rc = errno == ENOMEM ? RHM_ENOMEM : RHM_ENUMERIC;
             goto out;
         }

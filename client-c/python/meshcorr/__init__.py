@@ -21,10 +21,10 @@ the library's version (mc_version). Every failure is a MeshcorrError that
 is also the built-in exception it means (errors.py)."""
 from ._lib import PARAMS, VERSION as __version__
 from .client import Client, Job
-from .errors import (AccessDeniedError, BadLandmarksError, BadMeshError, BadParamsError, ClientClosedError,
-                     InvalidInputError, JobCancelledError, JobNotFoundError, JobStateError, MeshcorrError,
-                     MeshcorrMemoryError, MeshcorrTimeoutError, MeshFileNotFoundError, ProtocolError,
-                     ServerBusyError, ServerConnectionError, ServerError)
+from .errors import (AccessDeniedError, BadLandmarksError, BadMapError, BadMeshError, BadParamsError,
+                     ClientClosedError, InvalidInputError, JobCancelledError, JobNotFoundError, JobStateError,
+                     MeshcorrError, MeshcorrMemoryError, MeshcorrTimeoutError, MeshFileNotFoundError, NumericError,
+                     ProtocolError, ServerBusyError, ServerConnectionError, ServerError)
 from .local import match
 from .map import Map, read_map, read_vertex_map, vertex_map, write_map
 from .mesh import read_mesh
@@ -33,6 +33,6 @@ from .result import Result
 __all__ = ["Client", "Job", "Result", "Map", "match", "read_mesh", "read_map", "read_vertex_map", "vertex_map",
            "write_map", "PARAMS", "__version__",
            "MeshcorrError", "InvalidInputError", "BadMeshError", "BadLandmarksError", "BadParamsError",
-           "ClientClosedError", "MeshFileNotFoundError", "AccessDeniedError", "JobNotFoundError", "JobStateError",
+           "BadMapError", "ClientClosedError", "MeshFileNotFoundError", "AccessDeniedError", "JobNotFoundError", "JobStateError",
            "JobCancelledError", "ServerBusyError", "ServerConnectionError", "MeshcorrTimeoutError",
-           "MeshcorrMemoryError", "ProtocolError", "ServerError"]
+           "MeshcorrMemoryError", "NumericError", "ProtocolError", "ServerError"]

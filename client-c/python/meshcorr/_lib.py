@@ -79,7 +79,8 @@ class Progress(ctypes.Structure):
                 ("mismatch", ctypes.c_double * 2), ("reverse", ctypes.c_double * 2),
                 ("energy", ctypes.c_double * 2),
                 ("beta", ctypes.c_double), ("gamma", ctypes.c_double),
-                ("elapsed_s", ctypes.c_double)]
+                ("elapsed_s", ctypes.c_double), ("fraction", ctypes.c_double),
+                ("eta_s", ctypes.c_double), ("ahead", ctypes.c_uint32)]
 
 
 class Quality(ctypes.Structure):
@@ -100,7 +101,8 @@ class JobInfo(ctypes.Structure):
                 ("priority", ctypes.c_int32), ("submit_ms", ctypes.c_int64),
                 ("user", ctypes.c_char * 256), ("label", ctypes.c_char * 1025),
                 ("outer", ctypes.c_uint32), ("total", ctypes.c_uint32),
-                ("quality", Quality)]
+                ("quality", Quality), ("fraction", ctypes.c_double), ("eta_s", ctypes.c_double),
+                ("ahead", ctypes.c_uint32)]
 
 
 class JobResult(ctypes.Structure):
@@ -176,6 +178,7 @@ PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(Pro
 
 _declare("mc_strerror", ctypes.c_char_p, ctypes.c_int)
 _declare("mc_err_name", ctypes.c_char_p, ctypes.c_int)
+_declare("mc_reason_error", ctypes.c_int, ctypes.c_char_p)
 _declare("mc_state_name", ctypes.c_char_p, ctypes.c_int)
 _declare("mc_quality_name", ctypes.c_char_p, ctypes.c_int)
 _declare("mc_state_parse", ctypes.c_int, ctypes.c_char_p)

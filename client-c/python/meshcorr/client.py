@@ -15,8 +15,9 @@ from typing import Any, Dict, Iterator, List, Optional, Sequence
 from . import _lib
 from ._lib import check, errbuf, lib
 from ._spec import MeshLike, Spec
-from .errors import MC_EADDRESS, MC_EARG, MC_ETIMEOUT, ClientClosedError, InvalidInputError, MeshcorrTimeoutError
-from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, progress_dict, result_of
+from .errors import (MC_EADDRESS, MC_EARG, MC_ETIMEOUT, ClientClosedError, InvalidInputError, MeshcorrError,
+                     MeshcorrTimeoutError)
+from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, number, progress_dict, result_of
 
 
 def _default_server() -> str:
@@ -178,8 +179,10 @@ class Client:
 
     def list(self, user: Optional[str] = None, states: Optional[Sequence[str]] = None) -> List[Dict[str, Any]]:
         """Jobs as dicts (id, state, user, priority, submit_ms, outer, total,
-        label, quality: see Job.status): own ones, or user's (admin);
-        states: names to keep."""
+        label, quality: see Job.status; fraction, eta: the latest progress
+        record's share of the whole job done and seconds left, None when not
+        known; ahead: a pending job's place in the queue): own ones, or
+        user's (admin); states: names to keep."""
         c = self._handle()
         mask = 0
         for s in states or ():
@@ -192,7 +195,8 @@ class Client:
         try:
             return [{"id": j.job_id, "state": _state_name(j.state), "user": j.user.decode(),
                      "priority": j.priority, "submit_ms": j.submit_ms, "outer": j.outer, "total": j.total,
-                     "label": j.label.decode(), "quality": _quality(j.quality)} for j in jobs[:n.value]]
+                     "label": j.label.decode(), "quality": _quality(j.quality), "fraction": number(j.fraction),
+                     "eta": number(j.eta_s), "ahead": j.ahead} for j in jobs[:n.value]]
         finally:
             _lib.free(jobs)
 
@@ -227,15 +231,19 @@ class Job:
     """A job on the server. id: its number; state: its state's name as last
     seen here ("PENDING" after submit; status(), watch() and wait() update
     it; None for Client.job() until then); reason: why it ended, after
-    watch() or wait()."""
+    watch() or wait(); error: after watch() or wait(), the exception of the
+    kind the job failed with (errors.py's class of its code: NumericError,
+    BadMeshError, ...; code and name NUMERIC, BAD_MESH, ...), None when it
+    did not fail in its worker."""
 
     id: int
     state: Optional[str]
     reason: str
+    error: Optional[MeshcorrError]
 
     def __init__(self, client: Client, job_id: int, n_target: Optional[int]) -> None:
         self.client, self.id, self._n_target = client, job_id, n_target
-        self.state, self.reason = None, ""
+        self.state, self.reason, self.error = None, "", None
 
     def __repr__(self) -> str:
         return "Job(id=%d, state=%r)" % (self.id, self.state)
@@ -259,8 +267,10 @@ class Job:
     def watch(self, from_outer: int = 0, timeout: Optional[float] = None) -> Iterator[Dict[str, Any]]:
         """Yields a progress dict per record (replayed from outer iteration
         from_outer, then live) until the job ends; then self.state and
-        self.reason tell how it ended. A dict: job, stage (start, rhm, ectm,
-        init, ddm), outer, total, beta, gamma, elapsed (s), membrane, bending,
+        self.reason tell how it ended. A dict: job, stage (queued, start,
+        rhm, ddm, repair, ectm), outer, total, fraction (the whole job's
+        share done), eta (seconds left; None not known), elapsed (s), ahead
+        (queued: jobs before it), beta, gamma, membrane, bending,
         mismatch, reverse, energy (both directions summed), and source,
         target: each direction's terms and inner iterations. timeout:
         seconds the whole watch may take; past it MeshcorrTimeoutError (a
@@ -312,6 +322,8 @@ class Job:
         check(end.rc, end.err)
         self.state = _state_name(end.state)
         self.reason = end.reason
+        code = lib.mc_reason_error(end.reason.encode())     # the kind the job failed with, if any
+        self.error = _lib.error(code, end.reason) if code else None
 
     def _timed_out(self, timeout: float) -> Exception:
         try:

@@ -7,7 +7,8 @@ built-in exception it means, so callers catch it either way:
     ├── InvalidInputError (ValueError)     bad arguments, OVER_LIMIT, TOO_LARGE
     │   ├── BadMeshError                   BAD_MESH, a mesh file that does not parse
     │   ├── BadLandmarksError              BAD_LANDMARKS, malformed landmarks
-    │   └── BadParamsError                 BAD_PARAMS, unknown or bad parameters
+    │   ├── BadParamsError                 BAD_PARAMS, unknown or bad parameters
+    │   └── BadMapError                    BAD_MAP, an initial map that does not fit its meshes
     ├── ClientClosedError (ValueError)     a call on a closed Client
     ├── MeshFileNotFoundError (FileNotFoundError)
     ├── AccessDeniedError (PermissionError)  UNAUTHORIZED, FORBIDDEN, an unreadable file
@@ -20,6 +21,7 @@ built-in exception it means, so callers catch it either way:
     │                                      SHUTTING_DOWN, TIMED_OUT (cut by the server)
     ├── MeshcorrTimeoutError (TimeoutError)  no answer in time, wait()/watch() timeout
     ├── MeshcorrMemoryError (MemoryError)  out of memory here
+    ├── NumericError (ArithmeticError)     NUMERIC: a stage of the job failed numerically
     ├── ProtocolError                      a reply that breaks the protocol
     └── ServerError                        the server's own failure (INTERNAL, STORAGE, NOMEM)
 """
@@ -79,6 +81,11 @@ class BadParamsError(InvalidInputError):
     """BAD_PARAMS, or a parameter name or value that does not parse."""
 
 
+class BadMapError(InvalidInputError):
+    """BAD_MAP: an initial map (init, init_reverse) with the wrong rows, a
+    bad face or weights, or a reverse map without a forward one."""
+
+
 class ClientClosedError(MeshcorrError, ValueError):
     """A call on a Client after close() (or after its `with` block), as a
     closed file's read() raises ValueError."""
@@ -123,6 +130,11 @@ class MeshcorrMemoryError(MeshcorrError, MemoryError):
     """Out of memory in this process."""
 
 
+class NumericError(MeshcorrError, ArithmeticError):
+    """NUMERIC: a stage of the job failed numerically (a factorisation, the
+    eigen-solver, a non-finite energy); Job.error of a job that ended so."""
+
+
 class ProtocolError(MeshcorrError):
     """A frame or reply that does not follow the protocol."""
 
@@ -137,7 +149,7 @@ _CLASSES = {
     -16: JobStateError, -17: ServerBusyError, -18: ServerBusyError, -19: BadMeshError,
     -20: BadLandmarksError, -21: BadParamsError, -22: ServerError, -23: ServerError,
     -24: ServerConnectionError, -25: JobCancelledError, -26: ServerBusyError, -27: ServerConnectionError,
-    -28: ServerBusyError,
+    -28: ServerBusyError, -29: BadMapError, -30: NumericError,
     MC_EARG: InvalidInputError, MC_EADDRESS: ServerConnectionError, MC_ECONNECT: ServerConnectionError,
     MC_EIO: ServerConnectionError, MC_ETIMEOUT: MeshcorrTimeoutError, MC_EPROTO: ProtocolError,
     MC_ENOMEM: MeshcorrMemoryError, MC_EFILE: BadMeshError, MC_ETLS: ServerConnectionError,

@@ -12,7 +12,7 @@ from . import _lib
 from ._spec import decode
 from .map import Map
 
-STAGES = ("start", "rhm", "ectm", "init", "ddm")
+STAGES = ("start", "rhm", "ectm", "init", "ddm", "repair", "queued")
 TERMS = ("membrane", "bending", "mismatch", "reverse", "energy")
 WANT_P, WANT_Q, WANT_DEFORMED, WANT_METRICS = 1, 2, 4, 8
 
@@ -62,13 +62,22 @@ def result_of(r: _lib.JobResult, n_target: Optional[int], what: str) -> Result:
     return Result(p, q, y, m)
 
 
+def number(v: float) -> Optional[float]:
+    """A C double as JSON has it: None for NaN."""
+    return None if v != v else v
+
+
 def progress_dict(p: _lib.Progress) -> Dict[str, Any]:
-    """A progress record as Job.watch() yields it: job, stage, outer, total,
-    beta, gamma, elapsed, the terms of both directions summed, and source,
-    target: each direction's terms and inner iterations."""
+    """A progress record as Job.watch() yields it, with the names `meshcorr
+    watch --progress json` prints: job, stage, outer, total, fraction (the
+    whole job's share done), eta (seconds left; None while not known),
+    elapsed, ahead (a queued record: jobs that start before it), beta,
+    gamma, the terms of both directions summed, and source, target: each
+    direction's terms and inner iterations."""
     d: Dict[str, Any] = {"job": p.job_id, "stage": STAGES[p.stage] if p.stage < len(STAGES) else str(p.stage),
-                         "outer": p.outer, "total": p.total, "beta": p.beta, "gamma": p.gamma,
-                         "elapsed": p.elapsed_s}
+                         "outer": p.outer, "total": p.total, "fraction": number(p.fraction),
+                         "eta": number(p.eta_s), "elapsed": p.elapsed_s, "ahead": p.ahead,
+                         "beta": number(p.beta), "gamma": number(p.gamma)}
     for side, name in enumerate(("source", "target")):
         d[name] = {t: getattr(p, t)[side] for t in TERMS}
         d[name]["inner"] = p.inner[side]

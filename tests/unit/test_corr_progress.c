@@ -1,0 +1,249 @@
+/* test_corr_progress.c — the whole job's progress (corr__plan.h): every
+ * report carries the fraction of the whole job done, weighted by each
+ * step's expected cost from the one table, never falling, from the first
+ * report (a real one: the start map's) to 1 at the last; the time left is
+ * known once some of the job is done; a second RHM run (start auto) and
+ * coarse to fine's two ECTM runs are parts of one fraction; and the two
+ * iteration counts belong to their stages (--iterations is ECTM's, RHM's is
+ * rhm_iterations). */
+#include "support/harness.h"
+#include "support/testmesh.h"
+#include "support/testrun.h"
+#include "corr/corr.h"
+#include "corr/corr__plan.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct log {
+    int n;
+    corr_stage stage[4096];
+    int outer[4096], total[4096];
+    double fraction[4096], eta[4096], energy[4096];
+} log_t;
+
+static int record(void *ctx, const corr_progress *p)
+{
+    log_t *l = ctx;
+    if (l->n < 4096) {
+        proto_progress w;
+        corr_progress_record(p, &w);
+        l->stage[l->n] = p->stage;
+        l->outer[l->n] = (int)w.outer;
+        l->total[l->n] = (int)w.total;
+        l->fraction[l->n] = p->fraction;
+        l->eta[l->n] = p->eta_s;
+        l->energy[l->n] = w.terms[0][PROTO_TERM_ENERGY] + w.terms[1][PROTO_TERM_ENERGY];
+        l->n++;
+    }
+    return 0;
+}
+
+/* The fraction rises from the first report to 1 at the last, never falls;
+ * the time left is a time from the first report on. */
+static void check_whole_job(const log_t *l)
+{
+    CHECK(l->n >= 2);
+    CHECK(l->fraction[0] > 0 && l->fraction[0] < 1);
+    for (int i = 1; i < l->n; i++)
+        if (l->fraction[i] < l->fraction[i - 1])
+            FAILF("record %d (%s %d/%d): fraction %.6f fell from %.6f", i, corr_stage_name(l->stage[i]),
+                  l->outer[i], l->total[i], l->fraction[i], l->fraction[i - 1]);
+    CHECK(l->fraction[l->n - 1] == 1);
+    for (int i = 0; i < l->n; i++)
+        CHECK(isfinite(l->eta[i]) && l->eta[i] >= 0);
+    CHECK(l->eta[l->n - 1] == 0);
+}
+
+/* The icosphere pair (the target scaled and bent) at level lv, 6
+ * identity landmarks. */
+static void pair(int lv, mesh **S, mesh **T)
+{
+    *S = testmesh_icosphere(lv);
+    *T = testmesh_icosphere(lv);
+    for (int i = 0; i < (*T)->nv; i++) {
+        double *x = &(*T)->v[3 * i];
+        x[0] *= 1.3;
+        x[2] += 0.15 * x[0] * x[0];
+    }
+}
+
+static int lsrc[6] = {0, 1, 2, 3, 4, 5};
+
+TEST_T(a_landmark_jobs_fraction_rises_over_every_stage_to_one, 120)
+{
+    mesh *S, *T;
+    pair(2, &S, &T);
+    lmk_set L = {6, lsrc, lsrc};
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 12;
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 9;
+    p.beta_ramp = 9;
+    p.inner_iterations = 10;
+    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+    static log_t l;
+    memset(&l, 0, sizeof l);
+    ectm_result r;
+    char err[512];
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    /* the first report is a real one: the start map with its energies,
+     * never a record of zeros before it */
+    CHECK_INT(l.stage[0], CORR_STAGE_START);
+    CHECK(l.energy[0] > 0);
+    check_whole_job(&l);
+    /* each stage counts its own iterations: RHM to rhm_iterations, ECTM to
+     * iterations */
+    int rhm_total = 0, ectm_total = 0, repairs = 0;
+    for (int i = 0; i < l.n; i++) {
+        if (l.stage[i] == CORR_STAGE_RHM)
+            rhm_total = l.total[i];
+        if (l.stage[i] == CORR_STAGE_ECTM)
+            ectm_total = l.total[i];
+        repairs += l.stage[i] == CORR_STAGE_REPAIR;
+    }
+    CHECK_INT(rhm_total, 12);
+    CHECK_INT(ectm_total, 9);
+    CHECK_INT(repairs, 4);   /* RHM's maps and ECTM's: a start and an end each */
+    /* the fraction after the start map is the start's expected share of
+     * the job: its cost over the sum of the planned steps' */
+    int nv = S->nv + T->nv;
+    double second = corr__plan_cost(CORR__START_FMAP, nv) + 12 * corr__plan_cost(CORR__RHM, nv) +
+                    corr__plan_cost(CORR__REPAIR, nv);   /* start auto's second run, maybe */
+    double total = corr__plan_cost(CORR__START, nv) + 12 * corr__plan_cost(CORR__RHM, nv) +
+                   corr__plan_cost(CORR__REPAIR, nv) + CORR__RERUN_SHARE * second +
+                   9 * corr__plan_cost(CORR__ECTM, nv) + corr__plan_cost(CORR__REPAIR_RELAX, nv);
+    CHECK_NEAR(l.fraction[0], corr__plan_cost(CORR__START, nv) / total, 1e-9);
+    ectm_result_close(&r);
+    mesh_free(S);
+    mesh_free(T);
+}
+
+/* Reports fed by hand to the plan of a start-auto job: the second RHM run
+ * that may follow the first is weighted by how often it runs until RHM
+ * decides; then it counts in full, or goes; either way the fraction goes on
+ * from where it was, never falling, to 1. */
+static void feed_rhm(corr__plan *pl, double *t, double *last)
+{
+    rhm_report h = {0};
+    h.total = 4;
+    for (int k = 0; k <= 4; k++) {
+        h.iteration = k;
+        corr_progress cp = {.stage = k ? CORR_STAGE_RHM : CORR_STAGE_START, .rhm = &h, .elapsed = *t += 1};
+        corr__plan_update(pl, &cp);
+        CHECK(cp.fraction >= *last && cp.fraction < 1);
+        *last = cp.fraction;
+    }
+}
+
+static void feed_repair(corr__plan *pl, double *t, double *last)
+{
+    corr_repair_report rr = {0, 2};
+    for (int d = 0; d <= 2; d += 2) {
+        rr.done = d;
+        corr_progress cp = {.stage = CORR_STAGE_REPAIR, .repair = &rr, .elapsed = *t += 1};
+        corr__plan_update(pl, &cp);
+        CHECK(cp.fraction >= *last);
+        *last = cp.fraction;
+    }
+}
+
+TEST(start_autos_second_rhm_run_continues_the_fraction_whether_it_runs_or_not)
+{
+    mesh *S, *T;
+    pair(1, &S, &T);
+    lmk_set L = {6, lsrc, lsrc};
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 4;
+    CHECK_INT(rp.start, RHM_START_AUTO);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 3;
+    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+    for (int again = 0; again < 2; again++) {
+        corr__plan pl;
+        corr__plan_build(&pl, &in, &p, &rp);
+        CHECK_INT(pl.n, 5 + 3);           /* and the second run's start, iterations and repair */
+        double last = 0, t = 0;
+        feed_rhm(&pl, &t, &last);
+        feed_repair(&pl, &t, &last);
+        double before = pl.last;
+        corr__plan_rerun(&pl, again);
+        CHECK_INT(pl.n, again ? 8 : 5);
+        CHECK(pl.last == before);
+        if (again) {
+            feed_rhm(&pl, &t, &last);
+            feed_repair(&pl, &t, &last);
+        }
+        ectm_report e = {0};
+        e.total = 3;
+        for (int k = 1; k <= 3; k++) {
+            e.outer = k;
+            corr_progress cp = {.stage = CORR_STAGE_ECTM, .ectm = &e, .elapsed = t += 1};
+            corr__plan_update(&pl, &cp);
+            CHECK(cp.fraction >= last && cp.fraction < 1);
+            last = cp.fraction;
+        }
+        feed_repair(&pl, &t, &last);
+        CHECK(last == 1);
+        CHECK(pl.last == 1);
+    }
+    mesh_free(S);
+    mesh_free(T);
+}
+
+TEST_T(coarse_to_fine_runs_both_ectm_runs_in_one_fraction, 300)
+{
+    mesh *S, *T;
+    pair(4, &S, &T);               /* 2562 vertices each: over twice the coarse size */
+    lmk_set L = {6, lsrc, lsrc};
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 5;
+    rp.coarse = 500;
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 4;
+    p.beta_ramp = 4;
+    p.inner_iterations = 10;
+    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+    CHECK(corr_coarse_wanted(&in));
+    static log_t l;
+    memset(&l, 0, sizeof l);
+    ectm_result r;
+    char err[512];
+    if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
+        FAILF("%s", err);
+    check_whole_job(&l);
+    int last_ectm = 0, repairs = 0;
+    double at_coarse_end = -1;
+    for (int i = 0; i < l.n; i++) {
+        if (l.stage[i] == CORR_STAGE_ECTM) {
+            CHECK_INT(l.total[i], 8);
+            last_ectm = l.outer[i];
+            if (l.outer[i] == 4)
+                at_coarse_end = l.fraction[i];
+        }
+        repairs += l.stage[i] == CORR_STAGE_REPAIR;
+    }
+    CHECK_INT(last_ectm, 8);
+    CHECK_INT(repairs, 8);   /* RHM's and ECTM's on the coarse pair, the carried maps, ECTM's last */
+    /* the fine ECTM on 5124 vertices costs more than the coarse on 1000: the
+     * coarse chain is done well before half the job */
+    CHECK(at_coarse_end > 0 && at_coarse_end < 0.5);
+    ectm_result_close(&r);
+    mesh_free(S);
+    mesh_free(T);
+}
+
+TEST(each_iteration_count_names_its_stage_in_the_help)
+{
+    static char out[1 << 16];
+    CHECK_INT(testrun("build/meshcorr match --help 2>&1", out, sizeof out), 0);
+    CHECK_STR_HAS(out, "ECTM: outer iterations K (the RHM stage before it has its own count, rhm_iterations)");
+    CHECK_STR_HAS(out, "RHM: at most this many iterations (not ECTM's: that count is iterations)");
+}
