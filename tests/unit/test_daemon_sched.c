@@ -84,8 +84,10 @@ TEST_T(daemon_starts_second_users_job_before_first_users_third, 90)
     mc_client *a = testdaemon_client(&d, TESTDAEMON_ALICE), *b = testdaemon_client(&d, TESTDAEMON_BOB);
     uint64_t ids[6], bid;
     int rc;
+    /* alice's first job is long, so that bob's SUBMIT is stored while it
+     * runs however slow the machine: the order is then the scheduler's */
     for (int i = 0; i < 6; i++) {
-        ids[i] = testdaemon_submit(a, 150, 0, 0, &rc);
+        ids[i] = testdaemon_submit(a, 150, i == 0, 0, &rc);
         CHECK_INT(rc, 0);
     }
     bid = testdaemon_submit(b, 3, 0, 0, &rc);

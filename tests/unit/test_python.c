@@ -217,14 +217,16 @@ TEST_T(pip_install_into_a_fresh_venv_matches_the_daemons_map, 300)
     testdaemon_stop(&d, SIGTERM);
 }
 
-TEST_T(installed_package_runs_the_readme_example_against_meshcorrd, 240)
+/* docs/python.md's install into a folder of one's own and its example
+ * script, against a real daemon. */
+TEST_T(installed_package_runs_the_documented_example_against_meshcorrd, 240)
 {
     testdaemon_need_worker();
     need_python();
-    char *readme = (char *)testfile_read("README.md", &(size_t){0});
-    CHECK_STR_HAS(readme, "make install-python PREFIX=");
-    CHECK_STR_HAS(readme, "client-c/python/examples/submit_pair.py");
-    free(readme);
+    char *doc = (char *)testfile_read("docs/python.md", &(size_t){0});
+    CHECK_STR_HAS(doc, "make install-python PREFIX=");
+    CHECK_STR_HAS(doc, "client-c/python/examples/submit_pair.py");
+    free(doc);
     char dest[600], repo[512], path[800], site[800];
     CHECK(getcwd(repo, sizeof repo));
     snprintf(dest, sizeof dest, "%s/inst", harness_tmpdir());
