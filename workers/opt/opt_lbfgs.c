@@ -1,7 +1,7 @@
 /* opt_lbfgs.c — see opt_lbfgs.h. L-BFGS as in Nocedal & Wright (Alg. 7.4,
  * two-loop recursion, H0 = sᵀy/yᵀy of the newest pair) with a backtracking
- * Armijo line search (halving, sufficient decrease 1e-4, 40 trials), the
- * conventions of liblbfgs 1.10, which this replaces: a first step of unit
+ * Armijo line search (halving, sufficient decrease 1e-4, 40 trials), liblbfgs
+ * 1.10's conventions: a first step of unit
  * length along −g when no pair is held, step 1 otherwise. A pair is kept
  * only when sᵀy > 0 (Armijo alone does not guarantee it). No energy
  * knowledge here. */
