@@ -39,7 +39,6 @@ enum corr_error {
     PROTO_KINDS(CORR_ENUM)
 #undef CORR_ENUM
 };
-const char *corr_strerror(int code);   /* the kind's text (proto_kind_text) */
 /* The wire code of a pipeline code (0 for CORR_OK): what the worker's
  * error.frame carries. */
 int corr_wire_code(int code);

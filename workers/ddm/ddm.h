@@ -42,7 +42,6 @@ enum ddm_error {
     DDM_ERRORS(DDM_ENUM)
 #undef DDM_ENUM
 };
-const char *ddm_strerror(int code);
 
 typedef struct ddm_stats {
     long long faces_solved;   /* exact face problems solved, all rows */

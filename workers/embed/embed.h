@@ -47,7 +47,6 @@ enum embed_error {
     EMBED_ERRORS(EMBED_ENUM)
 #undef EMBED_ENUM
 };
-const char *embed_strerror(int code);
 
 /* stress = sqrt(sum (d_emb - d_geo)^2 / sum d_geo^2); corr = Pearson
  * correlation of d_emb with d_geo. */

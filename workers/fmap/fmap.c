@@ -13,16 +13,6 @@
 void dposv_(const char *uplo, const int *n, const int *nrhs, double *a, const int *lda,
             double *b, const int *ldb, int *info, size_t);
 
-const char *fmap_strerror(int code)
-{
-    switch (code) {
-#define FMAP_STR(name, val, msg) case name: return msg;
-        FMAP_ERRORS(FMAP_STR)
-#undef FMAP_STR
-    }
-    return "unknown functional map error";
-}
-
 /* A (k by nd) = Psi^T M F (first k columns of Psi), each column of F
  * divided by its M-norm (a zero column stays zero). 0 when out of memory. */
 static int coefficients(const lbo_basis *b, const double *mass, const double *F, int nd, int k,

@@ -64,7 +64,6 @@ enum fmap_error {
     FMAP_ERRORS(FMAP_ENUM)
 #undef FMAP_ENUM
 };
-const char *fmap_strerror(int code);
 
 /* F1: n1 by nd, F2: n2 by nd (corresponding columns), m1, m2 the lumped
  * masses; C: k1 by k2. */

@@ -86,8 +86,6 @@ const geo_csr *geod_solver_laplacian(const geod_solver *s);
 const double *geod_solver_mass(const geod_solver *s);
 /* Edges flipped to make that triangulation Delaunay (0: the mesh was). */
 int geod_solver_flips(const geod_solver *s);
-/* The heat time t actually used. */
-double geod_solver_time(const geod_solver *s);
 
 /* dist: nv. Geodesic distance from every vertex to the nearest of the nsrc
  * sources (the heat starts from all of them at once). Shift rule: per

@@ -36,7 +36,6 @@ enum dracob_error {
     DRACOB_ERRORS(DRACOB_ENUM)
 #undef DRACOB_ENUM
 };
-const char *dracob_strerror(int code);
 
 /* Largest buffer dracob_decode accepts, checked before Draco sees it. */
 #define DRACOB_MAX_BUFFER_BYTES (1LL << 30)

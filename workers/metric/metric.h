@@ -30,7 +30,6 @@ enum metric_error {
     METRIC_ERRORS(METRIC_ENUM)
 #undef METRIC_ENUM
 };
-const char *metric_strerror(int code);
 
 /* logratio: nf values. src_area, img_area_total: total areas used for the
  * unit-area normalisation of source and image (the target's total area). */

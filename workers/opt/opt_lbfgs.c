@@ -14,16 +14,6 @@
 #define OPT_FTOL 1e-4            /* Armijo sufficient decrease */
 #define OPT_MAX_LINESEARCH 40    /* trials per line search */
 
-const char *opt_strerror(int code)
-{
-    switch (code) {
-#define OPT_STR(name, val, msg) case name: return msg;
-        OPT_ERRORS(OPT_STR)
-#undef OPT_STR
-    }
-    return "unknown solver error";
-}
-
 void opt_params_init(opt_params *p)
 {
     p->max_iter = 50;
@@ -79,11 +69,6 @@ void opt_memory_free(opt_memory *m)
     free(m->xt);
     free(m->gt);
     free(m);
-}
-
-void opt_memory_clear(opt_memory *m)
-{
-    m->count = m->head = 0;
 }
 
 int opt_memory_pairs(const opt_memory *m)

@@ -76,7 +76,6 @@ enum rhm_error {
     RHM_ERRORS(RHM_ENUM)
 #undef RHM_ENUM
 };
-const char *rhm_strerror(int code);
 
 /* Basis size of the functional-map start (the k of fmap's tests and
  * figures), capped by what a small mesh has; ZoomOut (rhm_params.zoomout)
