@@ -33,8 +33,8 @@
  * pair, its median, and the exponent of a least-squares fit of log time
  * against log(source + target vertices) per stage. Each pair runs in its
  * own process (support/testapart.h). Prints figures, never fails on
- * quality. What these figures showed is in docs/decisions.md, "The
- * SHREC'07 landmark benchmark".
+ * quality. What these figures showed is in docs/decisions.md, "The SHREC'07
+ * landmark benchmark: what it showed".
  *
  * Options: --pairs=A,B (labels), --ectm-iterations=K, --stop=start|rhm|repair
  * (the last stage to run), --out-dir=DIR (writes DIR/LABEL.STAGE.map for

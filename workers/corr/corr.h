@@ -123,7 +123,8 @@ int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errs
 
 /* The DDM stage's basis size when ddm_k is 0: min(CORR_DDM_K, vertices - 2).
  * Fewer functions smooth more and cost error (tests/unit/test_ddm.c);
- * docs/decisions.md, "DDM's basis size", says how the value was chosen. */
+ * docs/decisions.md, "Bijective denoising and its round-trip bound", says how
+ * the value was chosen. */
 #define CORR_DDM_K 100
 
 /* A DDM stage report: directions done of total (1: P only, 2: P and Q),

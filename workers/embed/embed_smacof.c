@@ -4,7 +4,7 @@
  *
  * Unit weights on purpose: weights that favour short distances (1/D, 1/D^2)
  * give RHM starts that fold more (docs/decisions.md, "SMACOF with unit
- * weights"). */
+ * weights, summed in a fixed order"). */
 #include "embed/embed.h"
 
 #include <math.h>
