@@ -541,11 +541,9 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
 }
 
 /* make demo's job as the engine runs it: cow -> camel from the demo's 16
- * landmarks, every stage with the defaults. Issue 12's targets for it:
+ * landmarks, every stage with the defaults. The fold targets for it:
  * at most 2 % of the triangles flipped and 0.5 % collapsed, here for both
- * maps (the pipeline, 875905a: 0.57 % and 0 % forward, 0.88 % and 0 %
- * back; 2.07 % and 0 % forward before fold_relax, 6.31 % and 2.31 % two
- * commits earlier: what a regression of the fold repair shows first). */
+ * maps: what a regression of the fold repair shows first. */
 TEST_T(make_demos_job_returns_both_maps_within_the_fold_targets, 600)
 {
     mesh *S, *T;
