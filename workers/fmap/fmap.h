@@ -105,7 +105,8 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
 /* Orientation weight and the descriptors it uses: per block of
  * fmap_landmark_descriptors' columns (the WKS, each landmark's WKM) the
  * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. The weight is
- * the smallest that keeps the mirrored plier of test_fmap below 10 % flipped
+ * the best of the values tried on SHREC'07 pairs, and the smallest of them
+ * that keeps the mirrored plier of test_fmap below 10 % flipped
  * (docs/decisions.md, "Functional map weights"). */
 #define FMAP_MU_ORIENT_DEFAULT 3.0
 #define FMAP_ORIENT_ENERGIES 5
