@@ -232,7 +232,7 @@ install-man:
 # The documentation, where the unit's Documentation= points, in the
 # repository's own layout so that the pages' links to each other work.
 DOCDIR ?= $(PREFIX)/share/doc/meshcorr
-DOCS   := README.md $(wildcard docs/*.md) protocol/PROTOCOL.md daemon/README.md daemon/MODBUS.md
+DOCS   := README.md $(wildcard docs/*.md) protocol/PROTOCOL.md daemon/README.md daemon/MODBUS.md workers/WORKER.md
 install: install-doc
 install-doc:
 	set -e; for f in $(DOCS); do d=$(DESTDIR)$(DOCDIR)/$$(dirname $$f); \
