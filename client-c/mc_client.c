@@ -78,6 +78,7 @@ int mc_reason_error(const char *reason)
 }
 
 const char *mc_state_name(int state) { return proto_state_name(state); }
+const char *mc_stage_name(int stage) { return proto_stage_name(stage); }
 
 int mc_state_parse(const char *name)
 {

@@ -78,6 +78,7 @@ enum mc_state { MC_PENDING, MC_RUNNING, MC_COMPLETED, MC_FAILED, MC_CANCELLED, M
                 MC_OUT_OF_MEMORY };
 const char *mc_state_name(int state);          /* "COMPLETED"; NULL when unknown */
 int mc_state_parse(const char *name);          /* state, or -1 */
+const char *mc_stage_name(int stage);          /* "rhm" (MC_STAGE_*); NULL when unknown */
 enum mc_model { MC_BIJECTIVE = 0, MC_INJECTIVE = 1 };
 
 /* RESULT parts. */

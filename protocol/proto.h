@@ -113,9 +113,11 @@ enum proto_state {
     PROTO_STATE_LAST = 6
 };
 
-/* INIT is not sent from version 5 on (a job's first record is a real
- * one); QUEUED is the daemon's record of a pending job (its place in the
- * queue), never stored. */
+/* The stages a progress record names, the one list the engine's corr_stage
+ * (workers/corr/corr.h), the wire, the CLI and the Python package's STAGES
+ * come from. INIT is not sent from version 5 on (a job's first record is a
+ * real one); QUEUED is the daemon's record of a pending job (its place in
+ * the queue), never stored nor made by the engine. */
 #define PROTO_STAGES(X) X(START, 0) X(RHM, 1) X(ECTM, 2) X(INIT, 3) X(DDM, 4) X(REPAIR, 5) X(QUEUED, 6)
 enum proto_stage {
 #define PROTO_ENUM(name, val) PROTO_STAGE_##name = val,
@@ -136,11 +138,16 @@ enum proto_slot_state {
 enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1 };
 /* RHM's start map from the landmarks (workers/rhm/rhm.h) */
 enum proto_start { PROTO_START_DISTANCES = 0, PROTO_START_VORONOI = 1, PROTO_START_FMAP = 2 };
-/* the stages a job runs (workers/corr/corr.h) */
-enum proto_stages {
-    PROTO_STAGES_ALL = 0, PROTO_STAGES_RHM = 1, PROTO_STAGES_ECTM = 2, PROTO_STAGES_DDM = 3,
-    PROTO_STAGES_DDM_ECTM = 4, PROTO_STAGES_DDM_RHM = 5, PROTO_STAGES_DDM_RHM_ECTM = 6,
-    PROTO_STAGES_RHM_ECTM = 7
+/* The chains of stages a job can run: the values of the ENUM parameter
+ * stages, named as PROTO_PARAMS lists them ("ddm,ectm"); the engine's
+ * corr_chain (workers/corr/corr.h) is this list. */
+#define PROTO_CHAINS(X) X(ALL, 0) X(RHM, 1) X(ECTM, 2) X(DDM, 3) X(DDM_ECTM, 4) X(DDM_RHM, 5) \
+    X(DDM_RHM_ECTM, 6) X(RHM_ECTM, 7)
+enum proto_chain {
+#define PROTO_ENUM(name, val) PROTO_CHAIN_##name = val,
+    PROTO_CHAINS(PROTO_ENUM)
+#undef PROTO_ENUM
+    PROTO_CHAIN_LAST = 7
 };
 /* DDM denoising of the given maps (workers/ddm/ddm.h) */
 enum proto_ddm_mode { PROTO_DDM_PLAIN = 0, PROTO_DDM_BIJECTIVE = 1, PROTO_DDM_AUTO = 2 };

@@ -78,8 +78,8 @@ int cli_job_option(cli_job *j, const char *cmd, int c, const char *arg)
         int i = c - CLI_O_PARAM;
         const proto_param_info *f = &proto_param_infos[i];
         if (i == PROTO_P_stages) {          /* a chain: say why one is not */
-            corr_stages s;
-            if (corr_stages_parse(arg, &s, err, sizeof err)) {
+            corr_chain s;
+            if (corr_chain_parse(arg, &s, err, sizeof err)) {
                 fprintf(stderr, "meshcorr %s: --%s: %s\n", cmd, f->cli, err);
                 return -1;
             }
@@ -139,7 +139,7 @@ int cli_job_check(cli_job *j, const char *cmd)
         fprintf(stderr, "meshcorr %s: --init-reverse needs the bijective model\n", cmd);
         return -1;
     }
-    unsigned run = corr_stages_run((corr_stages)j->w.stages, !!j->init);
+    unsigned run = corr_chain_run((corr_chain)j->w.stages, !!j->init);
     char sname[64] = "";
     proto_param_value_name(PROTO_P_stages, j->w.stages, sname, sizeof sname);
     if (run && !j->init && !(run & CORR_RUN_RHM)) {

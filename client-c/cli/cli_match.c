@@ -133,8 +133,8 @@ int cli_match(int argc, char **argv)
     if (cli_job_check(&job, "match") || cli_job_engine(&job, "match", threads, &pe, &rp))
         return cli_usage_see("match");
     pe.log_eps = log_eps;
-    corr_stages stages = (corr_stages)job.w.stages;
-    int ectm_last = corr_stages_run(stages, !!job.init) & CORR_RUN_ECTM;
+    corr_chain stages = (corr_chain)job.w.stages;
+    int ectm_last = corr_chain_run(stages, !!job.init) & CORR_RUN_ECTM;
     if (!ectm_last && out_def)
         return cli_usage_error("match", "--out-deformed needs the ECTM stage (the deformation is ECTM's)");
     if (pe.model == ECTM_INJECTIVE && out_rev)
@@ -173,7 +173,7 @@ int cli_match(int argc, char **argv)
     proto_param_value_name(PROTO_P_stages, (unsigned)stages, chain, sizeof chain);
     if (!ectm_last)
         snprintf(comment, sizeof comment, "meshcorr match %s -> %s, stages %s (%s)", src, tgt, chain,
-                 corr_stages_run(stages, !!job.init) & CORR_RUN_RHM ? "reversible harmonic map"
+                 corr_chain_run(stages, !!job.init) & CORR_RUN_RHM ? "reversible harmonic map"
                                                                     : "DDM-denoised map");
     else
         snprintf(comment, sizeof comment,

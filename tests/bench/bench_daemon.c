@@ -233,7 +233,7 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
     p.iterations = 3;
     p.threads = 1;
     ectm_result want = {0};
-    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_CHAIN_ALL, 0, CORR_DDM_PLAIN };
     double t0 = now();
     if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
         FAILF("corr_run: %s", err);
@@ -309,7 +309,7 @@ TEST_T(small_job_overhead_through_the_daemon, 600)
     double local[NSMALL];
     for (int k = 0; k < NSMALL; k++) {
         ectm_result r = {0};
-        corr_input in = { S, T, "S", "T", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+        corr_input in = { S, T, "S", "T", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_PLAIN };
         double t0 = now();
         if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err))
             FAILF("corr_run: %s", err);

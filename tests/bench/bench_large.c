@@ -109,7 +109,7 @@ static void run_pipeline(const mesh *S, const mesh *T, const char *pid_rel, int 
     const char *o_c = harness_option("coarse");
     if (o_c)
         rp.coarse = atoi(o_c);
-    corr_input in = { S, T, "source", "target", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
+    corr_input in = { S, T, "source", "target", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0,
                       CORR_DDM_PLAIN };
     ectm_result r = {0};
     marks m = { now(), {0}, {0} };

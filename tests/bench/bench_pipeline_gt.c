@@ -224,7 +224,7 @@ static void run_pair(const void *arg, void *out)
     /* the start map (a pair over twice the coarse size, 12 000: on the decimated
      * pair, as corr_run makes it, carried to the input meshes), and T's
      * geodesic solver for scoring */
-    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_STAGES_RHM, 0, CORR_DDM_PLAIN };
+    corr_input in = { g.S, g.T, S_name, T_name, L, NULL, NULL, &rp, CORR_CHAIN_RHM, 0, CORR_DDM_PLAIN };
     int coarse = corr_coarse_wanted(&in);
     if (coarse && corr_coarse_open(&in, &cc, err, sizeof err))
         goto out;
@@ -253,8 +253,8 @@ static void run_pair(const void *arg, void *out)
     fflush(stdout);
 
     /* with the landmarks, which ECTM's P/Q-steps pin, as in stages all */
-    corr_input in2 = { g.S, g.T, S_name, T_name, L, rr.P, rr.Q, &rp, CORR_STAGES_ECTM, 0, CORR_DDM_PLAIN };
-    in.stages = CORR_STAGES_ALL;
+    corr_input in2 = { g.S, g.T, S_name, T_name, L, rr.P, rr.Q, &rp, CORR_CHAIN_ECTM, 0, CORR_DDM_PLAIN };
+    in.stages = CORR_CHAIN_ALL;
     t0 = now();
     /* coarse to fine: the ECTM after the carried RHM maps is not the
      * pipeline's (ECTM runs on the decimated pair first), so stages all

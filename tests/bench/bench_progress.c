@@ -215,7 +215,7 @@ TEST_T(stage_costs_and_the_fraction_against_the_clock, 3600)
             x[2] += 0.15 * x[0] * x[0];
         }
         lmk_set L = {6, (int[]){0, 1, 2, 3, 4, 5}, (int[]){0, 1, 2, 3, 4, 5}};
-        corr_input in = {S, T, "ico", "ico bent", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+        corr_input in = {S, T, "ico", "ico bent", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
         run_job("icosphere_642", &in, 0);
         mesh_free(S);
         mesh_free(T);
@@ -224,7 +224,7 @@ TEST_T(stage_costs_and_the_fraction_against_the_clock, 3600)
         mesh *cow, *camel;
         lmk_set *L;
         testcowcamel_load(&cow, &camel, &L);
-        corr_input in = {cow, camel, "cow", "camel", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+        corr_input in = {cow, camel, "cow", "camel", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
         run_job("cow_camel_demo", &in, 0);
         lmk_free(L);
         mesh_free(cow);
@@ -238,7 +238,7 @@ TEST_T(stage_costs_and_the_fraction_against_the_clock, 3600)
         snprintf(b, sizeof b, "%s", harness_data_path("shrec07_bim/Corrs/393.vts"));
         if (lmk_read_lists(a, b, 0, S, T, &L, err, sizeof err))
             FAILF("%s", err);
-        corr_input in = {S, T, "381", "393", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+        corr_input in = {S, T, "381", "393", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
         run_job("shrec07_381_393", &in, 0);
         lmk_free(L);
         mesh_free(S);
@@ -248,7 +248,7 @@ TEST_T(stage_costs_and_the_fraction_against_the_clock, 3600)
         mesh *S = testmesh_read("tosca_hires/Meshes/centaur0.off");
         mesh *T = testmesh_read("tosca_hires/Meshes/centaur1.off");
         lmk_set *L = testgt_pid_landmarks("tosca_hires/Corrs/centaur.pid", S, T);
-        corr_input in = {S, T, "centaur0", "centaur1", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+        corr_input in = {S, T, "centaur0", "centaur1", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
         int c = rp.coarse, nc = (S->nv > 2 * c ? c : S->nv) + (T->nv > 2 * c ? c : T->nv);
         run_job("centaur_coarse_to_fine", &in, nc);
         lmk_free(L);
@@ -264,10 +264,10 @@ TEST_T(stage_costs_and_the_fraction_against_the_clock, 3600)
                                         "8_gorilla_01_8_man_01.map"),
                       VMAP_BASE_AUTO, g.S, g.T, &P0, NULL, err, sizeof err))
             FAILF("%s", err);
-        corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_STAGES_DDM_ECTM, 0,
+        corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_CHAIN_DDM_ECTM, 0,
                          CORR_DDM_AUTO};
         run_job("gorilla_man_ddm_ectm", &in, 0);
-        in.stages = CORR_STAGES_DDM_RHM_ECTM;
+        in.stages = CORR_CHAIN_DDM_RHM_ECTM;
         run_job("gorilla_man_ddm_rhm_ectm", &in, 0);
         bmap_free(P0);
         testgt_close(&g);

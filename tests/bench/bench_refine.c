@@ -78,7 +78,7 @@ static int ddm_k;   /* --ddm-k, 0: the default */
 
 /* The chain's P; with Q0 (and bijective DDM) its Q in *Q. */
 static bmap *run_chain(const testgt *g, const bmap *P0, const bmap *Q0, corr_ddm_mode mode,
-                       corr_stages st, const ectm_params *p, double *secs, bmap **Q)
+                       corr_chain st, const ectm_params *p, double *secs, bmap **Q)
 {
     char err[2048] = "";
     corr_input in = {g->S, g->T, "source", "target", NULL, P0, Q0, NULL, st, ddm_k, mode};
@@ -159,7 +159,7 @@ TEST_T(refine_published_tosca_maps, 7200)
             for (int mode = 0; table && mode < 3; mode++) {   /* plain, bijective, auto */
                 double secs, rt1;
                 bmap *Q1 = NULL;
-                bmap *P1 = run_chain(&g, P0, Q0, (corr_ddm_mode)mode, CORR_STAGES_DDM, &p, &secs, &Q1);
+                bmap *P1 = run_chain(&g, P0, Q0, (corr_ddm_mode)mode, CORR_CHAIN_DDM, &p, &secs, &Q1);
                 score b = score_of(&g, sT, P1);
                 if (metric_round_trip(g.S, g.T, P1, Q1, &rt1))
                     FAILF("round trip failed");
@@ -189,8 +189,8 @@ TEST_T(refine_published_tosca_maps, 7200)
             char text[32];
             snprintf(text, sizeof text, "%.*s", (int)n, c);
             c += n + (c[n] == ';');
-            corr_stages st;
-            if (corr_stages_parse(text, &st, err, sizeof err))
+            corr_chain st;
+            if (corr_chain_parse(text, &st, err, sizeof err))
                 FAILF("--chains: %s", err);
             refine_row *r = &rows[nrows < 63 ? nrows++ : 63];
             snprintf(r->name, sizeof r->name, "%s", name);

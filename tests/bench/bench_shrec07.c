@@ -237,7 +237,7 @@ static void run_pair(const void *arg, void *out)
     /* a pair over twice the coarse size (12 000): the stages run on the decimated
      * copies as corr_run's, each stage's map carried to the input meshes
      * to be scored (the last one repaired there too, as corr_run does) */
-    corr_input in0 = { S, T, S_name, T_name, L_all ? L_all : L, NULL, NULL, &rp, CORR_STAGES_ALL,
+    corr_input in0 = { S, T, S_name, T_name, L_all ? L_all : L, NULL, NULL, &rp, CORR_CHAIN_ALL,
                        0, CORR_DDM_PLAIN };
     double t0 = now();
     int coarse = corr_coarse_wanted(&in0);
@@ -300,7 +300,7 @@ static void run_pair(const void *arg, void *out)
     corr_input ing = in, in0g = in0;     /* ECTM's repairs: with the given ones */
     ing.L = &Lg;
     in0g.L = L;
-    corr_input in2 = { ri->S, ri->T, S_name, T_name, &Lg, rr.P12, rr.P21, &rp, CORR_STAGES_ECTM, 0,
+    corr_input in2 = { ri->S, ri->T, S_name, T_name, &Lg, rr.P12, rr.P21, &rp, CORR_CHAIN_ECTM, 0,
                        CORR_DDM_PLAIN };
     t0 = now();
     if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
@@ -315,7 +315,7 @@ static void run_pair(const void *arg, void *out)
         ectm_result fr = {0};
         if (corr_coarse_carry(&in0g, &cc, er.P, er.Q, 1, &cP, &cQ, err, sizeof err))
             FAILF("%s", err);
-        corr_input in3 = { S, T, S_name, T_name, L, cP, cQ, &rp, CORR_STAGES_ECTM, 0,
+        corr_input in3 = { S, T, S_name, T_name, L, cP, cQ, &rp, CORR_CHAIN_ECTM, 0,
                            CORR_DDM_PLAIN };
         if (corr_run(&in3, &ep, on_progress, NULL, &fr, err, sizeof err))
             FAILF("%s", err);

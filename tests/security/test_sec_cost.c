@@ -192,13 +192,13 @@ TEST_T(estimate_bounds_real_runs_on_icosphere_pairs, 900)
     char sp[600], tp[600];
     proto_landmark *lm = identity(300);
     sphere_files(2, sp, tp, sizeof sp);
-    compare("162 vertices, 6 landmarks", job_dir("l2", sp, tp, lm, 6, NULL, NULL, RHM_START_AUTO, CORR_STAGES_ALL), FEW);
+    compare("162 vertices, 6 landmarks", job_dir("l2", sp, tp, lm, 6, NULL, NULL, RHM_START_AUTO, CORR_CHAIN_ALL), FEW);
     sphere_files(5, sp, tp, sizeof sp);
-    compare("10242 vertices, 6 landmarks", job_dir("l5", sp, tp, lm, 6, NULL, NULL, RHM_START_AUTO, CORR_STAGES_ALL), FEW);
+    compare("10242 vertices, 6 landmarks", job_dir("l5", sp, tp, lm, 6, NULL, NULL, RHM_START_AUTO, CORR_CHAIN_ALL), FEW);
     sphere_files(4, sp, tp, sizeof sp);
-    compare("2562 vertices, 300 lm, distances", job_dir("l4d", sp, tp, lm, 300, NULL, NULL, RHM_START_DISTANCES, CORR_STAGES_RHM),
+    compare("2562 vertices, 300 lm, distances", job_dir("l4d", sp, tp, lm, 300, NULL, NULL, RHM_START_DISTANCES, CORR_CHAIN_RHM),
             FEW);
-    compare("2562 vertices, 30 lm, fmap", job_dir("l4f", sp, tp, lm, 30, NULL, NULL, RHM_START_FMAP, CORR_STAGES_RHM), FEW);
+    compare("2562 vertices, 30 lm, fmap", job_dir("l4f", sp, tp, lm, 30, NULL, NULL, RHM_START_FMAP, CORR_CHAIN_RHM), FEW);
     free(lm);
 }
 
@@ -207,7 +207,7 @@ TEST_T(estimate_bounds_a_coarse_to_fine_run, 900)
     char sp[600], tp[600];
     proto_landmark *lm = identity(6);
     sphere_files(6, sp, tp, sizeof sp);
-    compare("40962 vertices (coarse 6000), 6 lm", job_dir("l6", sp, tp, lm, 6, NULL, NULL, RHM_START_AUTO, CORR_STAGES_ALL), FEW);
+    compare("40962 vertices (coarse 6000), 6 lm", job_dir("l6", sp, tp, lm, 6, NULL, NULL, RHM_START_AUTO, CORR_CHAIN_ALL), FEW);
     free(lm);
 }
 
@@ -223,7 +223,7 @@ TEST_T(estimate_bounds_the_demo_cow_camel_job, 900)
     char sp[600], tp[600];
     snprintf(sp, sizeof sp, "%s/cow.off", harness_tmpdir());
     snprintf(tp, sizeof tp, "%s/camel.off", harness_tmpdir());
-    compare("cow -> camel, 16 landmarks", job_dir("cow", sp, tp, lm, (unsigned)L->n, NULL, NULL, RHM_START_AUTO, CORR_STAGES_ALL),
+    compare("cow -> camel, 16 landmarks", job_dir("cow", sp, tp, lm, (unsigned)L->n, NULL, NULL, RHM_START_AUTO, CORR_CHAIN_ALL),
             FEW);
     free(lm);
     lmk_free(L);
@@ -238,8 +238,8 @@ TEST_T(estimate_bounds_a_shrec07_pair_from_its_maps, 900)
     snprintf(tp, sizeof tp, "%s", harness_data_path("shrec07_bim/Meshes/390.off"));
     snprintf(p0, sizeof p0, "%s", harness_data_path("ectm_demo_381_390/init_381_to_390.map"));
     snprintf(q0, sizeof q0, "%s", harness_data_path("ectm_demo_381_390/init_390_to_381.map"));
-    compare("SHREC'07 381 -> 390, ectm", job_dir("ectm", sp, tp, NULL, 0, p0, q0, RHM_START_AUTO, CORR_STAGES_ECTM), FEW);
-    compare("SHREC'07 381 -> 390, ddm,ectm", job_dir("ddm", sp, tp, NULL, 0, p0, q0, RHM_START_AUTO, CORR_STAGES_DDM_ECTM), FEW);
+    compare("SHREC'07 381 -> 390, ectm", job_dir("ectm", sp, tp, NULL, 0, p0, q0, RHM_START_AUTO, CORR_CHAIN_ECTM), FEW);
+    compare("SHREC'07 381 -> 390, ddm,ectm", job_dir("ddm", sp, tp, NULL, 0, p0, q0, RHM_START_AUTO, CORR_CHAIN_DDM_ECTM), FEW);
 }
 
 TEST_T(a_job_whose_estimate_passes_the_worker_limit_is_refused_at_submit, 600)

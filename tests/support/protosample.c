@@ -100,7 +100,7 @@ void protosample_fill(int type, int v, proto_msg *m)
                                     (uint8_t)!v, 1e-3, 0.1, 1.0, 1e4, 2, 0.25, 30, 200,
                                     1e-8, 1e-6, v ? 0 : 150, v ? 0 : 12, v ? 0 : 1e-3,
                                     v ? 0 : 0.5, (uint8_t)!v, v ? "" : "opencl:pocl",
-                                    (uint8_t)(v ? PROTO_STAGES_ALL : PROTO_STAGES_DDM_RHM_ECTM),
+                                    (uint8_t)(v ? PROTO_CHAIN_ALL : PROTO_CHAIN_DDM_RHM_ECTM),
                                     v ? 0 : 60, (uint8_t)(v ? PROTO_DDM_PLAIN : PROTO_DDM_BIJECTIVE), v ? 0 : 120,
                                     v ? 0 : 4000 };
         u->priority = v ? 0 : -7;

@@ -47,7 +47,7 @@ static void check_whole_job(const log_t *l)
     CHECK(l->fraction[0] > 0 && l->fraction[0] < 1);
     for (int i = 1; i < l->n; i++)
         if (l->fraction[i] < l->fraction[i - 1])
-            FAILF("record %d (%s %d/%d): fraction %.6f fell from %.6f", i, corr_stage_name(l->stage[i]),
+            FAILF("record %d (%s %d/%d): fraction %.6f fell from %.6f", i, proto_stage_name(l->stage[i]),
                   l->outer[i], l->total[i], l->fraction[i], l->fraction[i - 1]);
     CHECK(l->fraction[l->n - 1] == 1);
     for (int i = 0; i < l->n; i++)
@@ -83,7 +83,7 @@ TEST_T(a_landmark_jobs_fraction_rises_over_every_stage_to_one, 120)
     p.iterations = 9;
     p.beta_ramp = 9;
     p.inner_iterations = 10;
-    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
     static log_t l;
     memset(&l, 0, sizeof l);
     ectm_result r;
@@ -163,7 +163,7 @@ TEST(start_autos_second_rhm_run_continues_the_fraction_whether_it_runs_or_not)
     ectm_params p;
     ectm_params_init(&p);
     p.iterations = 3;
-    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
     for (int again = 0; again < 2; again++) {
         corr__plan pl;
         corr__plan_build(&pl, &in, &p, &rp);
@@ -210,7 +210,7 @@ TEST_T(coarse_to_fine_runs_both_ectm_runs_in_one_fraction, 300)
     p.iterations = 4;
     p.beta_ramp = 4;
     p.inner_iterations = 10;
-    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_STAGES_ALL, 0, CORR_DDM_AUTO};
+    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
     CHECK(corr_coarse_wanted(&in));
     static log_t l;
     memset(&l, 0, sizeof l);

@@ -166,7 +166,7 @@ TEST_T(result_is_the_in_process_map_on_the_demo_pair, 120)
     p.iterations = 3;
     p.threads = 1;
     ectm_result want = {0};
-    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+    corr_input in = {dm.S, dm.T, "381", "390", NULL, dm.P0, dm.Q0, NULL, CORR_CHAIN_ALL, 0, CORR_DDM_PLAIN };
     if (corr_run(&in, &p, NULL, NULL, &want, err, sizeof err))
         FAILF("corr_run: %s", err);
 

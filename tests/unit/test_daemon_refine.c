@@ -144,7 +144,7 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     CHECK_INT(r.np, 162);
     CHECK_INT(r.nq, 0);
     CHECK(r.deformed_len > 0);                  /* the map's image P X~ */
-    corr_input in = {p.S, p.T, "source", "target", NULL, p.P0, NULL, NULL, CORR_STAGES_DDM, 30, CORR_DDM_PLAIN};
+    corr_input in = {p.S, p.T, "source", "target", NULL, p.P0, NULL, NULL, CORR_CHAIN_DDM, 30, CORR_DDM_PLAIN};
     ectm_params ep;
     ectm_params_init(&ep);
     ectm_result want = {0};

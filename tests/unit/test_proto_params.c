@@ -162,11 +162,11 @@ TEST(engine_checks_agree_with_the_validator_at_every_range_end)
             int got = ectm_params_check(&p, err, sizeof err) != 0 || rhm_params_check(&r, err, sizeof err) != 0;
             /* the rows the pipeline reads itself (ENGINE NONE): its own rules */
             if (i == PROTO_P_stages)
-                got = corr_stages_run((corr_stages)v, 1) == 0 || v != floor(v);
+                got = corr_chain_run((corr_chain)v, 1) == 0 || v != floor(v);
             else if (i == PROTO_P_ddm_k)
                 got = v < 0 || v > LBO_MAX_K;
             else if (i == PROTO_P_ddm_mode)
-                got = v != floor(v) || corr_stages_check(CORR_STAGES_DDM, 1, 1, 0, 0, 0,
+                got = v != floor(v) || corr_chain_check(CORR_CHAIN_DDM, 1, 1, 0, 0, 0,
                                                          (corr_ddm_mode)v, err, sizeof err) != 0;
             if (got != want)
                 FAILF("%s = %g: validator %s, engine %s", f->name, v, want ? "refuses" : "accepts",

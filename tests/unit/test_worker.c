@@ -267,7 +267,7 @@ TEST_T(worker_demo_job_gives_the_in_process_map_with_progress_and_metrics, 90)
     bmap *P0 = NULL, *Q0 = NULL;
     if (bmap_read(p0, S, T, &P0, err, sizeof err) || bmap_read(q0, T, S, &Q0, err, sizeof err))
         FAILF("%s", err);
-    corr_input in = { S, T, "source", "target", NULL, P0, Q0, NULL, CORR_STAGES_ALL, 0, CORR_DDM_PLAIN };
+    corr_input in = { S, T, "source", "target", NULL, P0, Q0, NULL, CORR_CHAIN_ALL, 0, CORR_DDM_PLAIN };
     ectm_result res;
     if (corr_run(&in, &prm, NULL, NULL, &res, err, sizeof err))
         FAILF("%s", err);

@@ -13,18 +13,6 @@
 #include <string.h>
 #include <time.h>
 
-const char *corr_stage_name(corr_stage s)
-{
-    switch (s) {
-    case CORR_STAGE_ECTM: return "ectm";
-    case CORR_STAGE_START: return "start";
-    case CORR_STAGE_RHM: return "rhm";
-    case CORR_STAGE_DDM: return "ddm";
-    case CORR_STAGE_REPAIR: return "repair";
-    default: return "init";
-    }
-}
-
 static double now(void)
 {
     struct timespec ts;
@@ -302,11 +290,11 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
     else
         rhm_params_init(&rp);
     int bij = p->model == ECTM_BIJECTIVE;
-    if ((rc = corr_stages_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
+    if ((rc = corr_chain_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
                                 rp.gamma, in->ddm_mode, err, errsz)) ||
         (rc = corr_check_sizes(in, err, errsz)))
         return rc;
-    unsigned run = corr_stages_run(in->stages, !!in->P0);
+    unsigned run = corr_chain_run(in->stages, !!in->P0);
     if ((run & CORR_RUN_RHM) && (rc = rhm_params_check(&rp, err, errsz)))
         return corr_from_rhm(rc);
     corr_input planned = *in;

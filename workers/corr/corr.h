@@ -2,7 +2,7 @@
  * `meshcorr match` runs in-process and `meshcorr-worker` runs for the daemon.
  *
  *   validate both meshes (manifold, one component, finite, no degenerate face)
- *   then the chosen stages, always in this order (corr_stages):
+ *   then the chosen stages, always in this order (corr_chain):
  *   DDM denoising of the uploaded P (and Q): the map's functional map
  *     C = Psi1^T M1 P Psi2, deblurred to a precise map (ddm.h, thesis §2.5)
  *   RHM: from landmarks (a start map, rhm.h) or from the uploaded or
@@ -55,18 +55,17 @@ int corr_from_lmk(int rc);
 int corr_from_bmap(int rc);
 int corr_from_mesh(int rc);
 
+/* A progress report's stage: the wire's list (PROTO_STAGES), so a report
+ * goes out as it is. START: the start map is built (its RHM energies); RHM:
+ * one report per RHM iteration; ECTM: one per ECTM outer iteration; DDM: at
+ * DDM's start and per direction; REPAIR: the fold repair of a stage's maps,
+ * at its start and end. INIT and QUEUED are never reported by the engine;
+ * proto_stage_name() names them all. */
 typedef enum corr_stage {
-    CORR_STAGE_INIT = 0,     /* not reported: the first report is the start
-                                map's (or DDM's start)                      */
-    CORR_STAGE_ECTM = 1,     /* one report per ECTM outer iteration         */
-    CORR_STAGE_START = 2,  /* the start map is built (its RHM energies)  */
-    CORR_STAGE_RHM = 3,      /* one report per RHM iteration                */
-    CORR_STAGE_DDM = 4,      /* DDM denoising: at its start, per direction  */
-    CORR_STAGE_REPAIR = 5    /* the fold repair of a stage's maps: at its
-                                start and at its end                        */
+#define CORR_STAGE_ENUM(name, val) CORR_STAGE_##name = PROTO_STAGE_##name,
+    PROTO_STAGES(CORR_STAGE_ENUM)
+#undef CORR_STAGE_ENUM
 } corr_stage;
-/* "init", "ectm", "start", "rhm", "ddm", "repair" */
-const char *corr_stage_name(corr_stage s);
 
 /* Which stages run, the values of the job parameter stages (PROTO_PARAMS,
  * the names "ddm,ectm" etc.: proto_param_value_name). A chain always runs
@@ -75,17 +74,17 @@ const char *corr_stage_name(corr_stage s);
  * comes last. all: landmarks -> start -> RHM -> ECTM, or ECTM alone on an
  * uploaded map (the meaning from before chains); rhm alone: RHM's maps are
  * the result; ectm alone: ECTM on an uploaded map. */
-typedef enum corr_stages {
-    CORR_STAGES_ALL = 0, CORR_STAGES_RHM = 1, CORR_STAGES_ECTM = 2, CORR_STAGES_DDM = 3,
-    CORR_STAGES_DDM_ECTM = 4, CORR_STAGES_DDM_RHM = 5, CORR_STAGES_DDM_RHM_ECTM = 6,
-    CORR_STAGES_RHM_ECTM = 7
-} corr_stages;
+typedef enum corr_chain {
+#define CORR_CHAIN_ENUM(name, val) CORR_CHAIN_##name = PROTO_CHAIN_##name,
+    PROTO_CHAINS(CORR_CHAIN_ENUM)
+#undef CORR_CHAIN_ENUM
+} corr_chain;
 #define CORR_RUN_DDM  1u
 #define CORR_RUN_RHM  2u
 #define CORR_RUN_ECTM 4u
 /* The CORR_RUN_* bits of s for a job with (have_map) or without an
  * uploaded map; 0 for a value outside the list. */
-unsigned corr_stages_run(corr_stages s, int have_map);
+unsigned corr_chain_run(corr_chain s, int have_map);
 /* How the DDM stage denoises (job parameter ddm_mode): each given map on
  * its own (ddm_denoise), or P and its reverse Q together, made consistent
  * (ddm_denoise_bijective, DDM_BIJ_ALPHA_DEFAULT, DDM_BIJ_ITERATIONS_DEFAULT),
@@ -113,13 +112,13 @@ typedef enum corr_ddm_mode {
  * PROTO_MIN_LANDMARKS landmarks), CORR_EMAP (a reverse map without a
  * map). The worker's
  * SUBMIT check and corr_run use it. */
-int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
+int corr_chain_check(corr_chain s, int have_map, int have_reverse, int nlandmarks,
                       int injective, double rhm_landmark_weight, corr_ddm_mode ddm_mode,
                       char *err, size_t errsz);
 /* A --stages text as the CLI reads it: a value of the list (*out), or -1
  * with why not in err: an unknown stage, a stage named twice, or a chain
  * out of the order ddm, rhm, ectm ("ectm before ddm: ..."). */
-int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errsz);
+int corr_chain_parse(const char *text, corr_chain *out, char *err, size_t errsz);
 
 /* The DDM stage's basis size when ddm_k is 0: min(CORR_DDM_K, vertices - 2).
  * Fewer functions smooth more and cost error (tests/unit/test_ddm.c);
@@ -144,7 +143,7 @@ typedef struct corr_input {
     const lmk_set *L;         /* landmark pairs, or NULL                     */
     const bmap *P0, *Q0;      /* uploaded initial maps, or NULL              */
     const rhm_params *rhm;    /* RHM parameters, NULL: rhm_params_init's     */
-    corr_stages stages;
+    corr_chain stages;
     int ddm_k;                /* DDM basis size; 0: min(CORR_DDM_K, nv - 2)  */
     corr_ddm_mode ddm_mode;   /* plain, or bijective (needs Q0)              */
 } corr_input;
@@ -273,7 +272,7 @@ void corr_coarse_close(corr_coarse *c);
  * p->backend opencl or auto adds the OpenCL runtime. */
 double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, size_t wsz);
 
-/* Runs the pipeline: the stages of in->stages (corr_stages_check first).
+/* Runs the pipeline: the stages of in->stages (corr_chain_check first).
  * When the chain ends before ECTM, out->P and out->Q are the last stage's
  * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
  * the model is bijective) and out->Y, out->Yt, out->last stay empty. */

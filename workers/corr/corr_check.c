@@ -28,7 +28,7 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz)
 {
     const mesh *S = in->S, *T = in->T;
     int most = (S->nv < T->nv ? S->nv : T->nv) - 2;
-    unsigned run = corr_stages_run(in->stages, !!in->P0);
+    unsigned run = corr_chain_run(in->stages, !!in->P0);
     if ((run & CORR_RUN_DDM) && in->ddm_k > most)
         return errbuf_set(err, errsz, CORR_EPARAMS,
                           "params.ddm_k = %d: DDM's basis holds at most vertices - 2 = %d "

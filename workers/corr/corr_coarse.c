@@ -20,7 +20,7 @@ static int coarse_size(const corr_input *in)
 int corr_coarse_wanted(const corr_input *in)
 {
     long c = coarse_size(in);
-    return c > 0 && !in->P0 && in->L && (corr_stages_run(in->stages, 0) & CORR_RUN_RHM) &&
+    return c > 0 && !in->P0 && in->L && (corr_chain_run(in->stages, 0) & CORR_RUN_RHM) &&
            (in->S->nv > 2 * c || in->T->nv > 2 * c);
 }
 

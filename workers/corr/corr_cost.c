@@ -95,7 +95,7 @@ double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, s
     const rhm_params *r = in->rhm ? in->rhm : &rdef;
     double nS = in->S->nv, nT = in->T->nv, fS = in->S->nf, fT = in->T->nf, N = nS + nT;
     double nl = in->L ? in->L->n : 0;
-    unsigned run = corr_stages_run(in->stages, in->P0 != NULL);
+    unsigned run = corr_chain_run(in->stages, in->P0 != NULL);
     char buf[256];
     stage_cost ectm = {0}, rhm = {0}, ddm = {0};
     if (run & CORR_RUN_ECTM) {

@@ -87,7 +87,7 @@ void corr__plan_build(corr__plan *pl, const corr_input *in, const ectm_params *p
                       const rhm_params *rp)
 {
     memset(pl, 0, sizeof *pl);
-    unsigned run = corr_stages_run(in->stages, !!in->P0);
+    unsigned run = corr_chain_run(in->stages, !!in->P0);
     int nv = in->S->nv + in->T->nv, K = p->iterations;
     int bij = p->model == ECTM_BIJECTIVE;
     if (run & CORR_RUN_DDM)

@@ -10,14 +10,7 @@
 void corr_progress_record(const corr_progress *cp, proto_progress *out)
 {
     memset(out, 0, sizeof *out);
-    switch (cp->stage) {
-    case CORR_STAGE_ECTM: out->stage = PROTO_STAGE_ECTM; break;
-    case CORR_STAGE_START: out->stage = PROTO_STAGE_START; break;
-    case CORR_STAGE_RHM: out->stage = PROTO_STAGE_RHM; break;
-    case CORR_STAGE_DDM: out->stage = PROTO_STAGE_DDM; break;
-    case CORR_STAGE_REPAIR: out->stage = PROTO_STAGE_REPAIR; break;
-    default: out->stage = PROTO_STAGE_INIT; break;
-    }
+    out->stage = (uint8_t)cp->stage;
     out->elapsed_s = cp->elapsed;
     out->fraction = isnan(cp->fraction) ? NAN : fmin(1, fmax(0, cp->fraction));
     out->eta_s = cp->eta_s >= 0 && isfinite(cp->eta_s) ? cp->eta_s : NAN;

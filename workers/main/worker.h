@@ -35,7 +35,7 @@ typedef struct wrk_job {
     bmap *P0, *Q0;                 /* NULL when absent */
     ectm_params params;
     rhm_params rhm;                /* for landmark jobs */
-    corr_stages stages;            /* the chain, DDM's basis and mode as sent */
+    corr_chain stages;            /* the chain, DDM's basis and mode as sent */
     int ddm_k;
     corr_ddm_mode ddm_mode;
 } wrk_job;

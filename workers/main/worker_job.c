@@ -48,12 +48,12 @@ static int check_inputs(const proto_submit *s, char *err, size_t errsz)
     return 0;
 }
 
-/* A chain of stages that can run on the inputs (corr_stages_check); after
+/* A chain of stages that can run on the inputs (corr_chain_check); after
  * the landmarks are read, so that their own rule speaks first. */
 static int check_stages(const proto_submit *s, char *err, size_t errsz)
 {
     char why[256];
-    int rc = corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
+    int rc = corr_chain_check((corr_chain)s->params.stages, s->p.n > 0, s->q.n > 0,
                                (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
                                s->params.rhm_landmark_weight, (corr_ddm_mode)s->params.ddm_mode,
                                why, sizeof why);
@@ -136,7 +136,7 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
         wrk_job_close(job);
         return corr_wire_code(rc);
     }
-    job->stages = (corr_stages)s->params.stages;
+    job->stages = (corr_chain)s->params.stages;
     job->ddm_k = (int)s->params.ddm_k;
     job->ddm_mode = (corr_ddm_mode)s->params.ddm_mode;
     if ((rc = check_inputs(s, err, errsz)) ||

@@ -12,7 +12,18 @@ from . import _lib
 from ._spec import decode
 from .map import Map
 
-STAGES = ("start", "rhm", "ectm", "init", "ddm", "repair", "queued")
+
+def _stage_names() -> Tuple[str, ...]:
+    """The protocol's stage names in their order, from libmeshcorr's one list."""
+    names = []
+    while True:
+        name = _lib.lib.mc_stage_name(len(names))
+        if not name:
+            return tuple(names)
+        names.append(name.decode())
+
+
+STAGES = _stage_names()
 TERMS = ("membrane", "bending", "mismatch", "reverse", "energy")
 WANT_P, WANT_Q, WANT_DEFORMED, WANT_METRICS = 1, 2, 4, 8
 

@@ -1,4 +1,4 @@
-/* test_corr_stages.c — the pipeline's stage chains (corr.h): reading
+/* test_corr_chain.c — the pipeline's stage chains (corr.h): reading
  * "ddm,rhm,ectm" and refusing chains out of order with the reason; which
  * chains the inputs allow; on TOSCA gorilla_01 -> man_01 from the published
  * BCICP vertex map: the ddm stage returns exactly ddm_denoise's map, the
@@ -28,14 +28,14 @@
 TEST(chains_parse_in_order_and_out_of_order_is_refused_with_the_reason)
 {
     static const struct { const char *text; int value; } ok[] = {
-        {"all", CORR_STAGES_ALL}, {"rhm", CORR_STAGES_RHM}, {"ectm", CORR_STAGES_ECTM},
-        {"ddm", CORR_STAGES_DDM}, {"ddm,ectm", CORR_STAGES_DDM_ECTM},
-        {"ddm,rhm", CORR_STAGES_DDM_RHM}, {"ddm,rhm,ectm", CORR_STAGES_DDM_RHM_ECTM},
-        {"rhm,ectm", CORR_STAGES_RHM_ECTM}};
+        {"all", CORR_CHAIN_ALL}, {"rhm", CORR_CHAIN_RHM}, {"ectm", CORR_CHAIN_ECTM},
+        {"ddm", CORR_CHAIN_DDM}, {"ddm,ectm", CORR_CHAIN_DDM_ECTM},
+        {"ddm,rhm", CORR_CHAIN_DDM_RHM}, {"ddm,rhm,ectm", CORR_CHAIN_DDM_RHM_ECTM},
+        {"rhm,ectm", CORR_CHAIN_RHM_ECTM}};
     char err[512], name[64];
     for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++) {
-        corr_stages s = (corr_stages)-1;
-        if (corr_stages_parse(ok[k].text, &s, err, sizeof err))
+        corr_chain s = (corr_chain)-1;
+        if (corr_chain_parse(ok[k].text, &s, err, sizeof err))
             FAILF("%s: %s", ok[k].text, err);
         CHECK_INT(s, ok[k].value);
         /* the same names as the job parameter's values (the wire, --help) */
@@ -52,9 +52,9 @@ TEST(chains_parse_in_order_and_out_of_order_is_refused_with_the_reason)
         {"", "'' is not a stage"},
         {"ddm,", "'' is not a stage"}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
-        corr_stages s;
+        corr_chain s;
         err[0] = '\0';
-        CHECK_INT(corr_stages_parse(bad[k].text, &s, err, sizeof err), -1);
+        CHECK_INT(corr_chain_parse(bad[k].text, &s, err, sizeof err), -1);
         CHECK_STR_HAS(err, bad[k].msg);
     }
 }
@@ -63,35 +63,35 @@ TEST(chains_the_inputs_cannot_run_are_refused)
 {
     char err[512];
     /* all: RHM then ECTM from landmarks, ECTM alone on a map */
-    CHECK(corr_stages_run(CORR_STAGES_ALL, 0) == (CORR_RUN_RHM | CORR_RUN_ECTM));
-    CHECK(corr_stages_run(CORR_STAGES_ALL, 1) == CORR_RUN_ECTM);
-    CHECK_INT(corr_stages_check(CORR_STAGES_ALL, 0, 0, 6, 0, 0, 0, err, sizeof err), 0);
-    CHECK_INT(corr_stages_check(CORR_STAGES_DDM_RHM_ECTM, 1, 1, 0, 0, 0, 0, err, sizeof err), 0);
-    CHECK_INT(corr_stages_check(CORR_STAGES_RHM, 1, 0, 0, 0, 0, 0, err, sizeof err), 0);
-    CHECK_INT(corr_stages_check(CORR_STAGES_DDM, 1, 1, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err), 0);
-    CHECK_INT(corr_stages_check(CORR_STAGES_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err),
+    CHECK(corr_chain_run(CORR_CHAIN_ALL, 0) == (CORR_RUN_RHM | CORR_RUN_ECTM));
+    CHECK(corr_chain_run(CORR_CHAIN_ALL, 1) == CORR_RUN_ECTM);
+    CHECK_INT(corr_chain_check(CORR_CHAIN_ALL, 0, 0, 6, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_chain_check(CORR_CHAIN_DDM_RHM_ECTM, 1, 1, 0, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_chain_check(CORR_CHAIN_RHM, 1, 0, 0, 0, 0, 0, err, sizeof err), 0);
+    CHECK_INT(corr_chain_check(CORR_CHAIN_DDM, 1, 1, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err), 0);
+    CHECK_INT(corr_chain_check(CORR_CHAIN_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, err, sizeof err),
               0);                                  /* no DDM stage: the mode is not used */
-    CHECK_INT(corr_stages_check(CORR_STAGES_DDM, 1, 0, 0, 0, 0, CORR_DDM_AUTO, err, sizeof err),
+    CHECK_INT(corr_chain_check(CORR_CHAIN_DDM, 1, 0, 0, 0, 0, CORR_DDM_AUTO, err, sizeof err),
               0);                                  /* auto without a reverse map: plain */
     /* each refusal with its kind: a chain that does not fit the inputs is
      * PARAMS, missing landmarks LANDMARKS, a reverse map alone MAP */
     static const struct { int s, map, rev, nl, inj; double gamma; int mode; const char *msg; int kind; } bad[] = {
-        {CORR_STAGES_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
-        {CORR_STAGES_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
-        {CORR_STAGES_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map", CORR_EPARAMS},
-        {CORR_STAGES_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks", CORR_ELANDMARKS},
-        {CORR_STAGES_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2", CORR_ELANDMARKS},
-        {CORR_STAGES_DDM_RHM, 1, 0, 0, 0, 0.5, 0, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks",
+        {CORR_CHAIN_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
+        {CORR_CHAIN_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
+        {CORR_CHAIN_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map", CORR_EPARAMS},
+        {CORR_CHAIN_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks", CORR_ELANDMARKS},
+        {CORR_CHAIN_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2", CORR_ELANDMARKS},
+        {CORR_CHAIN_DDM_RHM, 1, 0, 0, 0, 0.5, 0, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks",
          CORR_EPARAMS},
-        {CORR_STAGES_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model", CORR_EPARAMS},
-        {CORR_STAGES_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map", CORR_EMAP},
-        {CORR_STAGES_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too",
+        {CORR_CHAIN_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model", CORR_EPARAMS},
+        {CORR_CHAIN_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map", CORR_EMAP},
+        {CORR_CHAIN_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too",
          CORR_EPARAMS},
-        {CORR_STAGES_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3", CORR_EPARAMS},
+        {CORR_CHAIN_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3", CORR_EPARAMS},
         {8, 1, 0, 0, 0, 0, 0, "stages value 8", CORR_EPARAMS}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         err[0] = '\0';
-        CHECK_INT(corr_stages_check((corr_stages)bad[k].s, bad[k].map, bad[k].rev, bad[k].nl,
+        CHECK_INT(corr_chain_check((corr_chain)bad[k].s, bad[k].map, bad[k].rev, bad[k].nl,
                                     bad[k].inj, bad[k].gamma, (corr_ddm_mode)bad[k].mode, err,
                                     sizeof err), bad[k].kind);
         CHECK_STR_HAS(err, bad[k].msg);
@@ -160,7 +160,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     int k = CORR_DDM_K;             /* ddm_k 0: the default */
 
     /* ddm alone: the map ddm_denoise makes from the same bases */
-    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_STAGES_DDM, 0, CORR_DDM_PLAIN};
+    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, P0, NULL, &rp, CORR_CHAIN_DDM, 0, CORR_DDM_PLAIN};
     ectm_result r = {0};
     stage_log l = {0};
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
@@ -190,7 +190,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     ectm_result_close(&r);
 
     /* ddm,ectm: DDM's reports, then ECTM's 4 iterations from D */
-    in.stages = CORR_STAGES_DDM_ECTM;
+    in.stages = CORR_CHAIN_DDM_ECTM;
     memset(&l, 0, sizeof l);
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
         FAILF("%s", err);
@@ -213,7 +213,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     ectm_result_close(&r);
 
     /* ddm,rhm: RHM from the denoised map, no landmarks, its 3 iterations */
-    in.stages = CORR_STAGES_DDM_RHM;
+    in.stages = CORR_CHAIN_DDM_RHM;
     memset(&l, 0, sizeof l);
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
         FAILF("%s", err);
@@ -230,7 +230,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     ectm_result_close(&r);
 
     /* a basis larger than the mesh allows names the parameter */
-    in.stages = CORR_STAGES_DDM;
+    in.stages = CORR_CHAIN_DDM;
     in.ddm_k = 4999;
     CHECK_INT(corr_run(&in, &p, NULL, NULL, &r, err, sizeof err), CORR_EPARAMS);
     CHECK_STR_HAS(err, "params.ddm_k = 4999");
@@ -273,7 +273,7 @@ TEST_T(ddm_auto_denoises_an_agreeing_pair_together_and_a_disagreeing_one_apart, 
     char err[1024] = "";
     ectm_params p;
     ectm_params_init(&p);
-    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, NULL, NULL, NULL, CORR_STAGES_DDM, 0,
+    corr_input in = {g.S, g.T, "gorilla_01", "man_01", NULL, NULL, NULL, NULL, CORR_CHAIN_DDM, 0,
                      CORR_DDM_AUTO};
     ectm_result r = {0}, plain = {0};
 
@@ -359,7 +359,7 @@ TEST_T(rhm_from_a_given_map_is_held_to_it_by_its_anchors, 300)
         if (k)
             rp.anchor = 0;
         corr_input in = {g.S, g.T, "gorilla_01", "woman_01", NULL, P0, Q0, &rp,
-                         CORR_STAGES_DDM_RHM, 0, CORR_DDM_AUTO};
+                         CORR_CHAIN_DDM_RHM, 0, CORR_DDM_AUTO};
         ectm_result r = {0};
         if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err))
             FAILF("%s", err);
@@ -409,7 +409,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
     rhm_params rp;
     rhm_params_init(&rp);
     corr_input in = {g.S, g.T, "gorilla_01", "man_02", NULL, P0, NULL, &rp,
-                     CORR_STAGES_DDM_RHM, 0, CORR_DDM_AUTO};
+                     CORR_CHAIN_DDM_RHM, 0, CORR_DDM_AUTO};
     ectm_landmarks none = {NULL, NULL, 0};
 
     /* through RHM: ECTM by hand from ddm,rhm's maps, then the chain */
@@ -425,7 +425,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
     if (corr_repair(&in, metric_verdict(fP, 0) ? e.P : NULL, metric_verdict(fQ, 0) ? e.Q : NULL, 1,
                     rep, err, sizeof err))
         FAILF("%s", err);
-    in.stages = CORR_STAGES_DDM_RHM_ECTM;
+    in.stages = CORR_CHAIN_DDM_RHM_ECTM;
     if (corr_run(&in, &p, NULL, NULL, &c, err, sizeof err))
         FAILF("%s", err);
     CHECK(same_map(c.P, e.P));
@@ -439,7 +439,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
     ectm_result_close(&c);
 
     /* from the given map: ECTM by hand from DDM's map, then the chain */
-    in.stages = CORR_STAGES_DDM;
+    in.stages = CORR_CHAIN_DDM;
     if (corr_run(&in, &p, NULL, NULL, &r, err, sizeof err) ||
         ectm_run(g.S, g.T, r.P, NULL, &none, &p, NULL, NULL, &e, err, sizeof err))
         FAILF("%s", err);
@@ -447,7 +447,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
     printf("  ddm then ECTM: bad %.2f %% forward\n", 100 * fP);
     if (metric_verdict(fP, 0) == METRIC_VERDICT_OK)
         FAILF("ECTM from DDM's map left it unfolded: the rule is not tested");
-    in.stages = CORR_STAGES_DDM_ECTM;
+    in.stages = CORR_CHAIN_DDM_ECTM;
     if (corr_run(&in, &p, NULL, NULL, &c, err, sizeof err))
         FAILF("%s", err);
     CHECK(same_map(c.P, e.P));
@@ -483,7 +483,7 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     ectm_params_init(&p);
     rhm_params rp;
     rhm_params_init(&rp);
-    corr_input in = { S, T, "wolf0", "wolf2", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
+    corr_input in = { S, T, "wolf0", "wolf2", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0,
                       CORR_DDM_PLAIN };
     CHECK(S->nv > 2 * rp.coarse && corr_coarse_wanted(&in));
     ectm_result r = {0};
@@ -517,7 +517,7 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
     CHECK(m.collapsed_fraction < 0.005);
     ectm_result_close(&r);
 
-    in.stages = CORR_STAGES_RHM;
+    in.stages = CORR_CHAIN_RHM;
     memset(&l, 0, sizeof l);
     if (corr_run(&in, &p, record, &l, &r, err, sizeof err))
         FAILF("%s", err);
@@ -553,7 +553,7 @@ TEST_T(make_demos_job_returns_both_maps_within_the_fold_targets, 600)
     ectm_params_init(&p);
     rhm_params rp;
     rhm_params_init(&rp);
-    corr_input in = { S, T, "cow.off", "camel.off", L, NULL, NULL, &rp, CORR_STAGES_ALL, 0,
+    corr_input in = { S, T, "cow.off", "camel.off", L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0,
                       CORR_DDM_PLAIN };
     ectm_result r = {0};
     char err[1024];

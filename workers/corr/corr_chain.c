@@ -1,4 +1,4 @@
-/* corr_stages.c — the stage chains of a job (corr.h, corr_stages): which
+/* corr_chain.c — the stage chains of a job (corr.h, corr_chain): which
  * stages a value runs, whether a chain can run on the given inputs, and
  * reading a chain written "ddm,rhm,ectm" with a reason when it cannot be
  * one. */
@@ -8,26 +8,26 @@
 #include <stdio.h>
 #include <string.h>
 
-unsigned corr_stages_run(corr_stages s, int have_map)
+unsigned corr_chain_run(corr_chain s, int have_map)
 {
     switch (s) {
-    case CORR_STAGES_ALL: return have_map ? CORR_RUN_ECTM : CORR_RUN_RHM | CORR_RUN_ECTM;
-    case CORR_STAGES_RHM: return CORR_RUN_RHM;
-    case CORR_STAGES_ECTM: return CORR_RUN_ECTM;
-    case CORR_STAGES_DDM: return CORR_RUN_DDM;
-    case CORR_STAGES_DDM_ECTM: return CORR_RUN_DDM | CORR_RUN_ECTM;
-    case CORR_STAGES_DDM_RHM: return CORR_RUN_DDM | CORR_RUN_RHM;
-    case CORR_STAGES_DDM_RHM_ECTM: return CORR_RUN_DDM | CORR_RUN_RHM | CORR_RUN_ECTM;
-    case CORR_STAGES_RHM_ECTM: return CORR_RUN_RHM | CORR_RUN_ECTM;
+    case CORR_CHAIN_ALL: return have_map ? CORR_RUN_ECTM : CORR_RUN_RHM | CORR_RUN_ECTM;
+    case CORR_CHAIN_RHM: return CORR_RUN_RHM;
+    case CORR_CHAIN_ECTM: return CORR_RUN_ECTM;
+    case CORR_CHAIN_DDM: return CORR_RUN_DDM;
+    case CORR_CHAIN_DDM_ECTM: return CORR_RUN_DDM | CORR_RUN_ECTM;
+    case CORR_CHAIN_DDM_RHM: return CORR_RUN_DDM | CORR_RUN_RHM;
+    case CORR_CHAIN_DDM_RHM_ECTM: return CORR_RUN_DDM | CORR_RUN_RHM | CORR_RUN_ECTM;
+    case CORR_CHAIN_RHM_ECTM: return CORR_RUN_RHM | CORR_RUN_ECTM;
     }
     return 0;
 }
 
-int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandmarks,
+int corr_chain_check(corr_chain s, int have_map, int have_reverse, int nlandmarks,
                       int injective, double rhm_landmark_weight, corr_ddm_mode ddm_mode,
                       char *err, size_t errsz)
 {
-    unsigned run = corr_stages_run(s, have_map);
+    unsigned run = corr_chain_run(s, have_map);
     if (!run)
         return errbuf_set(err, errsz, CORR_EPARAMS, "stages value %d is not one of the list", (int)s);
     if (ddm_mode != CORR_DDM_PLAIN && ddm_mode != CORR_DDM_BIJECTIVE && ddm_mode != CORR_DDM_AUTO)
@@ -64,10 +64,10 @@ int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandma
 
 static const char *const stage_word[3] = {"ddm", "rhm", "ectm"};   /* the order they run in */
 
-int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errsz)
+int corr_chain_parse(const char *text, corr_chain *out, char *err, size_t errsz)
 {
     if (strcmp(text, "all") == 0) {
-        *out = CORR_STAGES_ALL;
+        *out = CORR_CHAIN_ALL;
         return 0;
     }
     unsigned run = 0;
@@ -104,9 +104,9 @@ int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errs
             break;
         s += n + 1;
     }
-    for (int v = CORR_STAGES_RHM; v <= CORR_STAGES_RHM_ECTM; v++)
-        if (corr_stages_run((corr_stages)v, 1) == run) {
-            *out = (corr_stages)v;
+    for (int v = CORR_CHAIN_RHM; v <= CORR_CHAIN_RHM_ECTM; v++)
+        if (corr_chain_run((corr_chain)v, 1) == run) {
+            *out = (corr_chain)v;
             return 0;
         }
     errbuf_set(err, errsz, -1, "'%s' is not a chain of ddm, rhm, ectm", text);
