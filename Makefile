@@ -125,6 +125,20 @@ $(BUILD)/gen/ener_ocl_src.h: $(OCL_SRC)
 	  xxd -i < $$s; echo ", 0};"; done > $@.tmp; mv $@.tmp $@
 $(BUILD)/obj/workers/ener/ener_ocl.o: $(BUILD)/gen/ener_ocl_src.h
 
+# The web UI's pages, scripts and style sheet (daemon/web/), embedded as C
+# arrays and a table of them by file name (web.c includes it): the daemon
+# serves them from its binary.
+WEB_ASSETS := $(sort $(wildcard daemon/web/*.html daemon/web/*.js daemon/web/*.css))
+$(BUILD)/gen/web_assets.h: $(WEB_ASSETS)
+	@mkdir -p $(dir $@)
+	set -e; for s in $(WEB_ASSETS); do echo "static const unsigned char web__$$(basename $$s | tr .- __)[] = {"; \
+	  xxd -i < $$s; echo "};"; done > $@.tmp; \
+	echo "static const struct web_asset web__assets[] = {" >> $@.tmp; \
+	for s in $(WEB_ASSETS); do n=$$(basename $$s); v=web__$$(echo $$n | tr .- __); \
+	  echo "    {\"$$n\", $$v, sizeof $$v},"; done >> $@.tmp; \
+	echo "};" >> $@.tmp; mv $@.tmp $@
+$(BUILD)/obj/daemon/web.o: $(BUILD)/gen/web_assets.h
+
 $(ENGINE_LIB): $(ENGINE_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^

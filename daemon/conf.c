@@ -23,7 +23,7 @@ static const struct option_def {
     const char *help;
 } options[] = {
     {"listen", K_LISTEN, 0, 0, 0, "unix:PATH | tls:HOST:PORT | tcp:HOST:PORT (repeatable; PORT 0 = any free port; tcp: loopback only)"},
-    {"tls-cert", K_PATH, OFF(tls_cert), 0, 0, "FILE PEM certificate chain for tls: listeners and HTTPS --metrics"},
+    {"tls-cert", K_PATH, OFF(tls_cert), 0, 0, "FILE PEM certificate chain for tls: listeners and HTTPS --http"},
     {"tls-key", K_PATH, OFF(tls_key), 0, 0, "FILE PEM private key of --tls-cert"},
     {"insecure-tcp", K_FLAG, OFF(insecure_tcp), 0, 1, "let a tcp: listener bind a non-loopback address (tokens in clear)"},
     {"state-dir", K_PATH, OFF(state_dir), 0, 0, "DIR: jobs.db and spool/ (required)"},
@@ -63,7 +63,8 @@ static const struct option_def {
     {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp: and tls:HOST:PORT addresses to"},
     {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
     {"modbus", K_ENDPOINT, OFF(modbus), 0, 0, "[HOST:]PORT Modbus TCP status registers (off; 1502 suits; host 127.0.0.1)"},
-    {"metrics", K_ENDPOINT, OFF(metrics), 0, 0, "[HOST:]PORT Prometheus GET /metrics over HTTP, HTTPS with --tls-cert (off; host 127.0.0.1)"},
+    {"http", K_ENDPOINT, OFF(http), 0, 0, "[HOST:]PORT web UI, JSON API and Prometheus /metrics over HTTP, HTTPS with --tls-cert (off; host 127.0.0.1)"},
+    {"metrics", K_ENDPOINT, OFF(http), 0, 0, "[HOST:]PORT the same as --http"},
     {"backend", K_PATH, OFF(backend), 0, 0, "local|slurm: where jobs run (default local)"},
     {"slurm-partition", K_PATH, OFF(slurm_partition), 0, 0, "NAME sbatch --partition (default: Slurm's)"},
     {"slurm-account", K_PATH, OFF(slurm_account), 0, 0, "NAME sbatch --account"},
@@ -108,7 +109,7 @@ void conf_init(mcd_conf *c)
     c->idle_timeout_s = CONF_DEFAULT_IDLE_TIMEOUT_S;
     c->admin_uid = -1;
     c->log_level = DLOG_INFO;
-    c->modbus.port = c->metrics.port = -1;
+    c->modbus.port = c->http.port = -1;
     strcpy(c->backend, "local");
     c->slurm_cpus = 1;
     c->slurm_max_jobs = CONF_DEFAULT_SLURM_MAX_JOBS;

@@ -1,5 +1,6 @@
 /* snap.c — the status snapshot: queue depth, running jobs, end counters,
- * worker slots and each running job's latest progress, computed in one
+ * worker slots, each running job's latest progress and the queue's order
+ * (positions for the web pages), computed in one
  * place (snap_collect) for STATS and for the dashboards (mbus.c, metrics.c).
  *
  * DESIGN: the loop thread owns the daemon's state; the dashboard servers run
@@ -132,6 +133,7 @@ void snap_collect(mcd *d, mcd_snapshot *out)
     out->workers = n;
     out->running = running;
     out->queued = sched_queued(d->sched);
+    out->nqueue = sched_order(d->sched, out->queue, SNAP_MAX_QUEUE);
     store_counters(d->store, &out->completed, &out->failed, &out->cancelled);
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);

@@ -541,7 +541,7 @@ TEST_T(modbus_refuses_writes_and_junk_and_keeps_serving, 60)
 /* ---- /metrics --------------------------------------------------------------- */
 
 /* GET (or method) path over a raw socket: the status code; the body into body. */
-static int http(int port, const char *method, const char *path, char *body, size_t bsz)
+static int http_ask(int port, const char *method, const char *path, char *body, size_t bsz)
 {
     int fd = tcp_connect(port);
     char req[256];
@@ -638,7 +638,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
     static char body[1 << 16];
     static sample s[256];
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     mc_server_stats st;
     CHECK_INT(mc_stats(x.c, &st), 0);
     int n = parse_metrics(body, s, 256);
@@ -672,7 +672,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(mc_cancel(x.c, x.job), 0);
     testdaemon_wait_state(x.c, x.job, MC_CANCELLED, 30);
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     CHECK_INT(mc_stats(x.c, &st), 0);
     n = parse_metrics(body, s, 256);
     CHECK_INT(st.cancelled, 2);
@@ -682,11 +682,12 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(metric(s, n, "meshcorr_slot_state", "slot=\"0\",job_id=\"0\""), 0);
     mc_stats_free(&st);
 
-    /* other paths and methods */
-    CHECK_INT(http(x.metrics, "GET", "/", body, sizeof body), 404);
-    CHECK_INT(http(x.metrics, "GET", "/metricsx", body, sizeof body), 404);
-    CHECK_INT(http(x.metrics, "POST", "/metrics", body, sizeof body), 405);
-    CHECK_INT(http(x.metrics, "DELETE", "/metrics", body, sizeof body), 405);
+    /* other paths and methods: / is the web UI, which sends a browser
+     * without a session to its login page */
+    CHECK_INT(http_ask(x.metrics, "GET", "/", body, sizeof body), 303);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metricsx", body, sizeof body), 404);
+    CHECK_INT(http_ask(x.metrics, "POST", "/metrics", body, sizeof body), 405);
+    CHECK_INT(http_ask(x.metrics, "DELETE", "/metrics", body, sizeof body), 405);
     mc_close(x.c);
     testdaemon_stop(&x.d, SIGTERM);
 }
@@ -705,7 +706,7 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
     dash x;
     dash_start(&x, "promparse");
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     snprintf(files[0], sizeof files[0], "%s", testfile_text("idle.prom", body));
 
     x.job = testdaemon_submit_ok(x.c, 1000, 1, 0);      /* runs until cancelled */
@@ -720,7 +721,7 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
     }
     CHECK(st.has_progress && st.progress.stage == PROTO_STAGE_ECTM);
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     snprintf(files[1], sizeof files[1], "%s", testfile_text("running.prom", body));
     CHECK_STR_HAS(body, "meshcorr_slot_energy{");
     CHECK_INT(mc_cancel(x.c, x.job), 0);
@@ -774,14 +775,16 @@ TEST(dashboard_options_parse_host_and_port)
     char err[256];
     conf_init(&c);
     CHECK_INT(c.modbus.port, -1);
-    CHECK_INT(c.metrics.port, -1);
+    CHECK_INT(c.http.port, -1);
     CHECK_INT(conf_set(&c, "modbus", "1502", err, sizeof err), 0);
     CHECK_STR_HAS(c.modbus.host, "127.0.0.1");
     CHECK_INT(c.modbus.port, 1502);
     CHECK_INT(conf_set(&c, "metrics", "0.0.0.0:9101", err, sizeof err), 0);
-    CHECK(!strcmp(c.metrics.host, "0.0.0.0") && c.metrics.port == 9101);
+    CHECK(!strcmp(c.http.host, "0.0.0.0") && c.http.port == 9101);
     CHECK_INT(conf_set(&c, "metrics", "[::1]:9102", err, sizeof err), 0);
-    CHECK(!strcmp(c.metrics.host, "::1") && c.metrics.port == 9102);
+    CHECK(!strcmp(c.http.host, "::1") && c.http.port == 9102);
+    CHECK_INT(conf_set(&c, "http", "9103", err, sizeof err), 0);     /* --metrics is its alias */
+    CHECK(!strcmp(c.http.host, "127.0.0.1") && c.http.port == 9103);
     CHECK(conf_set(&c, "modbus", "host:", err, sizeof err) != 0);
     CHECK(conf_set(&c, "modbus", ":1502", err, sizeof err) != 0);
     CHECK(conf_set(&c, "modbus", "70000", err, sizeof err) != 0);

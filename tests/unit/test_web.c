@@ -1,0 +1,84 @@
+/* test_web.c — meshcorrd's web UI and JSON API in a real browser, black-box:
+ * the real daemon on loopback with --http on a free port and two worker
+ * slots, jobs submitted by two users with the real client library (alice: a
+ * long job that runs and a quick one that completes; bob: one job), then
+ * tests/web/test_web.py drives Debian's headless chromium through
+ * chromedriver (python3-selenium) as alice: a wrong token refused, the
+ * list, the running job's plot gaining points, the completed job's quality
+ * and maps, bob's job 404 on the page and the API, no resource from
+ * anywhere but the daemon, a cancel. Its screenshots land in build/web-shots/.
+ * Here: the failed login is in the daemon's log with the address, the
+ * cancel reached the store, and the daemon exits cleanly. Skipped without
+ * chromium, chromedriver or selenium (deploy/install-deps.sh installs them). */
+#include "support/harness.h"
+#include "support/testdaemon.h"
+#include "support/testrun.h"
+#include "meshcorr.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+static int free_port(void)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {0};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t l = sizeof a;
+    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
+        FAILF("free port: %s", strerror(errno));
+    close(fd);
+    return ntohs(a.sin_port);
+}
+
+static void need_browser(void)
+{
+    char out[256];
+    if (access("/usr/bin/chromium", X_OK) || access("/usr/bin/chromedriver", X_OK) ||
+        testrun("/usr/bin/python3 -c 'import selenium' 2>&1", out, sizeof out) != 0)
+        SKIP("chromium, chromedriver or python3-selenium missing (deploy/install-deps.sh)\n");
+}
+
+TEST_T(browser_logs_in_sees_own_jobs_plot_result_and_cancels, 300)
+{
+    testdaemon_need_worker();
+    need_browser();
+    int port = free_port();
+    char http[16];
+    snprintf(http, sizeof http, "%d", port);
+    const char *args[] = {"--http", http, "--workers", "2", NULL};
+    testdaemon d;
+    testdaemon_start(&d, "web", args);
+    mc_client *alice = testdaemon_client(&d, TESTDAEMON_ALICE);
+    mc_client *bob = testdaemon_client(&d, TESTDAEMON_BOB);
+    uint64_t done = testdaemon_submit_ok(alice, 5, 0, 0);
+    uint64_t other = testdaemon_submit_ok(bob, 5, 0, 0);
+    testdaemon_wait_state(alice, done, MC_COMPLETED, 120);
+    testdaemon_wait_state(bob, other, MC_COMPLETED, 120);
+    /* long enough to run through the whole browser session; it is cancelled */
+    uint64_t running = testdaemon_submit_ok(alice, 100000, 1, 0);
+    testdaemon_wait_state(alice, running, MC_RUNNING, 60);
+
+    static char out[1 << 16];
+    int rc = testrunf(out, sizeof out,
+                      "/usr/bin/python3 tests/web/test_web.py --url http://127.0.0.1:%d --token %s"
+                      " --wrong-token tok-nobody-0123456789 --running %llu --done %llu --other %llu"
+                      " --shots build/web-shots 2>&1",
+                      port, TESTDAEMON_ALICE, (unsigned long long)running, (unsigned long long)done,
+                      (unsigned long long)other);
+    printf("%s", out);
+    if (rc != 0)
+        FAILF("tests/web/test_web.py exited %d", rc);
+    CHECK(testdaemon_log_has(&d, "web login from 127.0.0.1 refused: unknown token"));
+    CHECK(testdaemon_log_has(&d, "web login: alice from 127.0.0.1"));
+    CHECK_INT(testdaemon_wait_state(alice, running, MC_CANCELLED, 30), MC_CANCELLED);
+    mc_close(alice);
+    mc_close(bob);
+    testdaemon_stop(&d, SIGTERM);
+}
