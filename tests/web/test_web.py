@@ -10,7 +10,8 @@ job's page draws a plot that gains points while it runs; the finished job's
 page shows its quality and its map links; another user's job page and its
 API answer 404; every resource the pages load comes from the daemon (the
 browser resolves no other host, and the Content-Security-Policy allows
-nothing else); the cancel button cancels the running job.
+nothing else); every GET of docs/openapi.yaml answers; the cancel button
+cancels the running job.
 Screenshots go to --shots (PNG)."""
 import argparse
 import json
@@ -20,6 +21,7 @@ import time
 import urllib.error
 import urllib.request
 
+import yaml
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
@@ -173,6 +175,17 @@ def run(drv, a, base):
     status, body = api(base, "/jobs", a.wrong_token)
     check(status == 401, "a wrong Bearer token: %d" % status)
     shot(drv, a, "5-other-users-job")
+
+    # every GET of docs/openapi.yaml answers 200 for the user's completed job
+    with open("docs/openapi.yaml") as f:
+        spec = yaml.safe_load(f)
+    for path, ops in spec["paths"].items():
+        if "get" not in ops:
+            continue
+        url = path.replace("{id}", str(a.done)).replace("{map}", "p")
+        req = urllib.request.Request(base + "/api/v1" + url, headers={"Authorization": "Bearer " + a.token})
+        with urllib.request.urlopen(req, timeout=10) as r:
+            check(r.status == 200, "GET %s: %d" % (url, r.status))
 
     # the workers page
     drv.get(base + "/workers")
