@@ -72,7 +72,8 @@ CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
 
 # The CLI's pictures (client-c/render/: rasteriser and PNG writer): linked
-# into the CLI and the tests only, so libmeshcorr.so never needs libpng.
+# into the CLI, the worker (--picture, for the web UI) and the tests only,
+# so libmeshcorr.so never needs libpng.
 RENDER_C    := $(wildcard client-c/render/*.c)
 RENDER_OBJ  := $(RENDER_C:%.c=$(BUILD)/obj/%.o)
 RENDER_LIB  := $(BUILD)/libmcrender.a
@@ -177,8 +178,8 @@ $(BUILD)/meshcorr: $(CLI_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_
 $(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $< $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DAEMON_LIBS) $(LDLIBS)
 
-$(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
-	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+$(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(RENDER_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(RENDER_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(RENDER_LIBS)
 
 $(BUILD)/meshcorr-validate: $(VALIDATE_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -Wl,--as-needed -o $@ $(VALIDATE_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)

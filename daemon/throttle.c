@@ -88,12 +88,12 @@ static void write_line(entry *e, uint64_t now)
         return;
     char wait[96] = "";
     if (e->blocked_until_ms > now)
-        snprintf(wait, sizeof wait, "; its HELLOs are refused for %llu s more",
+        snprintf(wait, sizeof wait, "; its logins are refused for %llu s more",
                  (unsigned long long)((e->blocked_until_ms - now + 999) / 1000));
     if (n == 1 && e->failed == 1)
-        dlog(DLOG_WARN, "HELLO from %s refused: %s (client '%s')%s", e->peer, e->why, e->client, wait);
+        dlog(DLOG_WARN, "login from %s refused: %s (client '%s')%s", e->peer, e->why, e->client, wait);
     else
-        dlog(DLOG_WARN, "%u failed HELLOs from %s in the last %.0f s (%u token(s) checked and wrong, %u refused "
+        dlog(DLOG_WARN, "%u failed logins from %s in the last %.0f s (%u token(s) checked and wrong, %u refused "
              "unchecked: too many failed logins; first client '%s')%s", n, e->peer,
              e->logged_ms ? (double)(now - e->logged_ms) / 1000.0 : 0.0, e->failed, e->refused, e->client, wait);
     e->logged_ms = now;

@@ -79,6 +79,7 @@ web *web_new(mcd *d, int tls)
     w->snap = d->snap;
     w->tls = tls;
     w->cancels = d->web_cancel;
+    web_picture_init(d);
     snprintf(w->db_path, sizeof w->db_path, "%s/jobs.db", d->conf.state_dir);
     snprintf(w->backend, sizeof w->backend, "%s", d->conf.backend);
     return w;
@@ -338,9 +339,8 @@ static int login(web *w, web_req *r, const char *token, uint8_t hash[AUTH_HASH_L
     else
         rc = -1;
     if (rc) {
-        const char *why = token[0] ? "unknown token" : "no token";
-        dlog(DLOG_WARN, "web login from %s refused: %s", r->peer, why);
-        throttle_fail(r->peer, "web", why, now);
+        /* throttle_fail logs it with the address (a burst summed up) */
+        throttle_fail(r->peer, "web", token[0] ? "unknown token" : "no token", now);
     }
     return rc;
 }

@@ -1,7 +1,7 @@
 /* web.h — the web UI and the JSON API of the HTTP endpoint, shared by
  * http.c (which hands them requests) and the web files: web.c (logins,
  * sessions, pages, who may see what), web_api.c (/api/v1/), web_json.c
- * (JSON text). Everything here runs on libmicrohttpd's thread(s) under the
+ * (JSON text), web_picture.c (a map's picture, drawn by the worker). Everything here runs on libmicrohttpd's thread(s) under the
  * web's one lock, and reads the daemon only through the published snapshot
  * and a read-only SQLite connection to the job store. */
 #ifndef WEB_H
@@ -89,6 +89,13 @@ const char *web_job_stage(web *w, const store_job *j, int64_t *position);
 /* ---- web_api.c ---- */
 /* path is r->url after "/api/v1". */
 enum MHD_Result web_api(web *w, web_req *r, const char *path);
+
+/* ---- web_picture.c ---- */
+/* At start: the worker program and the limits a drawing runs with. */
+void web_picture_init(const mcd *d);
+/* GET /api/v1/jobs/ID/picture of a job r may see: the PNG, or 503 with
+ * Retry-After while it is being drawn. */
+enum MHD_Result web_picture(web *w, web_req *r, const store_job *j);
 
 /* ---- web_json.c ---- */
 /* s as a JSON string, quotes included: control characters and what

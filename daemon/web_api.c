@@ -1,6 +1,6 @@
 /* web_api.c — the JSON API under /api/v1/ (docs/openapi.yaml is its
  * reference): the session, the job list, one job, its progress history,
- * its quality, its maps, a cancel, the figures and the worker slots. Every
+ * its quality, its maps, its map's picture, a cancel, the figures and the worker slots. Every
  * call needs a login (web_auth: a Bearer token or a session cookie); a job
  * the caller may not see is answered 404 like one that does not exist.
  * Reads the snapshot web.c took for the request and the read-only job
@@ -393,6 +393,8 @@ enum MHD_Result web_api(web *w, web_req *r, const char *path)
         return quality(w, r, &j);
     if ((!strcmp(rest, "/maps/p") || !strcmp(rest, "/maps/q")) && get)
         return map(w, r, &j, rest[6]);
+    if (!strcmp(rest, "/picture") && get)
+        return web_picture(w, r, &j);
     if (!strcmp(rest, "/cancel") && post)
         return cancel(w, r, &j);
     return web_reply_error(r, MHD_HTTP_NOT_FOUND, "no such API path (docs/openapi.yaml lists them)");

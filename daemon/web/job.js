@@ -2,7 +2,8 @@
 // /api/v1/jobs/ID, its quality, and a plot of every energy term and beta
 // against the iteration over all stages (log scale: the terms span
 // decades), drawn as SVG from /api/v1/jobs/ID/history, which is read on
-// from where the last answer ended. Cancel for the owner and admins.
+// from where the last answer ended; once it completed, the picture of its
+// map. Cancel for the owner and admins.
 'use strict';
 (async () => {
   await mc.start();
@@ -100,6 +101,7 @@
     ended = !['PENDING', 'RUNNING'].includes(j.state);
     cancel.hidden = ended;
     if (j.state === 'COMPLETED') {
+      if (document.getElementById('result').hidden) showPicture();
       document.getElementById('result').hidden = false;
       document.getElementById('map-p').href = '/api/v1/jobs/' + id + '/maps/p';
       document.getElementById('map-q').href = '/api/v1/jobs/' + id + '/maps/q';
@@ -112,6 +114,29 @@
     if (j.quality.collapsed !== null) fact(ql, 'Collapsed faces', mc.percent(j.quality.collapsed));
     for (const k in q.metrics) fact(ql, k, q.metrics[k] === null ? '—' : Number(q.metrics[k]).toPrecision(4));
     document.getElementById('quality').replaceWith(ql);
+  }
+
+  // The map's picture is drawn by the server on the first request (503
+  // until it is there): asked again every second, then shown.
+  async function showPicture() {
+    const url = '/api/v1/jobs/' + id + '/picture';
+    const msg = document.getElementById('picture-msg');
+    for (let i = 0; i < 300; i++) {
+      const r = await fetch(url, { credentials: 'same-origin' });
+      if (r.ok) {
+        const img = document.getElementById('picture');
+        img.src = url;
+        img.hidden = false;
+        msg.hidden = true;
+        return;
+      }
+      if (r.status !== 503) {
+        msg.textContent = 'No picture: ' + ((await r.json()).error || r.statusText);
+        return;
+      }
+      await new Promise((res) => setTimeout(res, 1000));
+    }
+    msg.textContent = 'No picture yet: reload the page to try again.';
   }
 
   async function refreshPlot() {

@@ -73,9 +73,11 @@ TEST_T(browser_logs_in_sees_own_jobs_plot_result_and_cancels, 300)
                       port, TESTDAEMON_ALICE, (unsigned long long)running, (unsigned long long)done,
                       (unsigned long long)other);
     printf("%s", out);
-    if (rc != 0)
-        FAILF("tests/web/test_web.py exited %d", rc);
-    CHECK(testdaemon_log_has(&d, "web login from 127.0.0.1 refused: unknown token"));
+    if (rc != 0) {
+        testrunf(out, sizeof out, "tail -n 25 %s", d.log);
+        FAILF("tests/web/test_web.py exited %d; the daemon's log ends:\n%s", rc, out);
+    }
+    CHECK(testdaemon_log_has(&d, "login from 127.0.0.1 refused: unknown token (client 'web')"));
     CHECK(testdaemon_log_has(&d, "web login: alice from 127.0.0.1"));
     CHECK_INT(testdaemon_wait_state(alice, running, MC_CANCELLED, 30), MC_CANCELLED);
     mc_close(alice);

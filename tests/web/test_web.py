@@ -7,7 +7,7 @@ Checks, each an assertion (exit status 1 and the reason on stderr):
 a wrong token is refused and the login page says so; a good one logs in and
 the job list shows the user's jobs and not the other user's; the running
 job's page draws a plot that gains points while it runs; the finished job's
-page shows its quality and its map links; another user's job page and its
+page shows its quality, the picture of its map and its map links; another user's job page and its
 API answer 404; every resource the pages load comes from the daemon (the
 browser resolves no other host, and the Content-Security-Policy allows
 nothing else); every GET of docs/openapi.yaml answers; the cancel button
@@ -157,6 +157,11 @@ def run(drv, a, base):
     href = drv.find_element(By.ID, "map-p").get_attribute("href")
     check(href.endswith("/api/v1/jobs/%d/maps/p" % a.done), "map link %r" % href)
     wait_for("the finished plot", lambda: int(drv.find_element(By.ID, "plot").get_attribute("data-points")) > 0)
+    # the picture of the map: drawn by the server, then shown at its size
+    img = drv.find_element(By.ID, "picture")
+    wait_for("the map's picture", lambda: img.is_displayed() and drv.execute_script(
+        "return arguments[0].complete && arguments[0].naturalWidth", img) >= 800, 60)
+    drv.execute_script("arguments[0].scrollIntoView()", img)
     shot(drv, a, "4-completed-job")
     req = urllib.request.Request(href, headers={"Authorization": "Bearer " + a.token})
     with urllib.request.urlopen(req, timeout=10) as r:
