@@ -1,10 +1,10 @@
-/* http.c — the HTTP endpoint (--http, alias --metrics): libmicrohttpd on
- * its own polling thread serves GET /metrics (metrics.c, no login: what a
+/* http.c — the HTTP endpoint (--http, alias --metrics): libmicrohttpd, a
+ * thread per connection, serves GET /metrics (metrics.c, no login: what a
  * Prometheus scrape needs) and hands every other path to the web UI and
  * JSON API (web.c). Nothing here touches the daemon's loop-owned state: the
  * metrics format a copy of the published snapshot (snap_read), and web.c
  * reads the job store through a read-only SQLite connection of its own.
- * MHD bounds what a client can hold: MHD_OPTION_CONNECTION_LIMIT
+ * MHD bounds what clients can hold: MHD_OPTION_CONNECTION_LIMIT
  * connections, each closed after MHD_OPTION_CONNECTION_TIMEOUT idle
  * seconds, and a request body over WEB_MAX_BODY bytes is answered 413.
  * With --tls-cert/--tls-key it is HTTPS only (MHD_USE_TLS, the same
@@ -127,7 +127,9 @@ static void free_pem(char **p)
 static struct MHD_Daemon *serve(http *h, const char *cert, const char *key)
 {
     /* MHD_USE_ITC: a SIGHUP quiesces it, the socket goes on to a new one */
-    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ITC | (h->ipv6 ? MHD_USE_IPv6 : 0);
+    /* a thread per connection: an event stream's reader waits for records */
+    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION | MHD_USE_ITC |
+                     (h->ipv6 ? MHD_USE_IPv6 : 0);
     if (!cert)
         return MHD_start_daemon(flags, 0, NULL, NULL, on_request, h, MHD_OPTION_LISTEN_SOCKET, h->fd,
                                 MHD_OPTION_CONNECTION_LIMIT, (unsigned)HTTP_MAX_CONNECTIONS,
@@ -202,6 +204,7 @@ int http_set_tls(http *h, const tls_creds *tls, char *err, size_t errsz)
     /* the old daemon stops taking connections; the new one listens on the
      * same socket; then the old one ends its connections and stops */
     struct MHD_Daemon *old = h->mhd;
+    web_streams_end(h->web);      /* the old daemon's event streams end: its stop need not wait */
     if (MHD_quiesce_daemon(old) != h->fd) {
         free_pem(&cert);
         free_pem(&key);
@@ -233,8 +236,10 @@ void http_stop(http *h)
 {
     if (!h)
         return;
-    if (h->mhd)
-        MHD_stop_daemon(h->mhd);   /* joins its thread, closes the listening socket */
+    if (h->mhd) {
+        web_streams_end(h->web);   /* event streams end within WEB_STREAM_POLL_MS */
+        MHD_stop_daemon(h->mhd);   /* joins its threads, closes the listening socket */
+    }
     else if (h->fd >= 0)
         close(h->fd);
     free_pem(&h->cert);

@@ -90,6 +90,26 @@ const char *web_job_stage(web *w, const store_job *j, int64_t *position);
 /* path is r->url after "/api/v1". */
 enum MHD_Result web_api(web *w, web_req *r, const char *path);
 
+/* Job id's progress records after record `after`, at most max, written to
+ * fp: as the elements of a JSON array (comma-separated), or with sse as
+ * server-sent events (`id: RECORD`, `event: progress`, `data: {...}`). The
+ * last record's number (after when there was none), or -1 when the store
+ * cannot be read. */
+int64_t web_points(web *w, uint64_t id, uint64_t after, int max, FILE *fp, int sse);
+
+/* ---- web_events.c ---- */
+#define WEB_MAX_STREAMS 32          /* event streams open at once, all users */
+#define WEB_MAX_STREAMS_PER_USER 4  /* of one user; past either cap a new one is refused (503) */
+#define WEB_STREAM_POLL_MS 250      /* how often a stream looks for new records */
+#define WEB_STREAM_KEEPALIVE_S 5    /* a comment line at least this often (the idle timeout is longer) */
+/* GET /api/v1/jobs/ID/events of a job r may see: its progress records as
+ * server-sent events, from Last-Event-ID (or ?after=) on, then `event:
+ * end` with its final state once it has ended. */
+enum MHD_Result web_events(web *w, web_req *r, const store_job *j);
+/* The streams of the MHD daemon that is being replaced (a TLS reload) end,
+ * so that its stop does not wait for them (EventSource reconnects). */
+void web_streams_end(web *w);
+
 /* ---- web_picture.c ---- */
 /* At start: the worker program and the limits a drawing runs with. */
 void web_picture_init(const mcd *d);

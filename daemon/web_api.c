@@ -1,6 +1,7 @@
 /* web_api.c — the JSON API under /api/v1/ (docs/openapi.yaml is its
  * reference): the session, the job list, one job, its progress history,
- * its quality, its maps, its map's picture, a cancel, the figures and the worker slots. Every
+ * its quality, its maps, its map's picture, its progress as server-sent
+ * events (web_events.c), a cancel, the figures and the worker slots. Every
  * call needs a login (web_auth: a Bearer token or a session cookie); a job
  * the caller may not see is answered 404 like one that does not exist.
  * Reads the snapshot web.c took for the request and the read-only job
@@ -141,15 +142,8 @@ static enum MHD_Result one_job(web *w, web_req *r, const store_job *j, const cha
     return web_reply_json(r, MHD_HTTP_OK, fp, &buf, &len);
 }
 
-/* Progress records after rowid `after` (the answer's "next" continues):
- * per record its stage, iteration, every energy term summed over both
- * directions, beta and gamma. */
-static enum MHD_Result history(web *w, web_req *r, uint64_t id)
+int64_t web_points(web *w, uint64_t id, uint64_t after, int max, FILE *fp, int sse)
 {
-    const char *a = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "after");
-    uint64_t after = 0;
-    if (a && number(a, strlen(a), &after))
-        return web_reply_error(r, MHD_HTTP_BAD_REQUEST, "after: not a record number");
     sqlite3 *db = web_db(w);
     sqlite3_stmt *st = NULL;
     if (!db || sqlite3_prepare_v2(db, "SELECT rowid, stage, outer_it, total,"
@@ -159,36 +153,55 @@ static enum MHD_Result history(web *w, web_req *r, uint64_t id)
                                   " FROM history WHERE job = ? AND rowid > ? ORDER BY rowid LIMIT ?",
                                   -1, &st, NULL) != SQLITE_OK) {
         sqlite3_finalize(st);
-        return web_reply_error(r, MHD_HTTP_INTERNAL_SERVER_ERROR, "job store unreadable");
+        return -1;
     }
     sqlite3_bind_int64(st, 1, (sqlite3_int64)id);
     sqlite3_bind_int64(st, 2, (sqlite3_int64)after);
-    sqlite3_bind_int(st, 3, WEB_MAX_HISTORY);
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *fp = open_memstream(&buf, &len);
-    if (!fp) {
-        sqlite3_finalize(st);
-        return MHD_NO;
-    }
+    sqlite3_bind_int(st, 3, max);
     static const char *const keys[] = {"membrane", "bending", "mismatch", "reverse", "energy", "beta", "gamma",
                                        "elapsed_s", "fraction"};
-    fprintf(fp, "{\"id\":%llu,\"points\":[", (unsigned long long)id);
-    uint64_t next = after;
+    int64_t next = (int64_t)after;
     int n = 0;
     while (sqlite3_step(st) == SQLITE_ROW) {
-        next = (uint64_t)sqlite3_column_int64(st, 0);
+        next = sqlite3_column_int64(st, 0);
         int stage = sqlite3_column_int(st, 1);
-        fprintf(fp, "%s{\"stage\":\"%s\",\"outer\":%d,\"total\":%d", n++ ? "," : "", proto_stage_name(stage),
+        if (sse)
+            fprintf(fp, "id: %lld\nevent: progress\ndata: ", (long long)next);
+        else if (n)
+            fputc(',', fp);
+        n++;
+        fprintf(fp, "{\"stage\":\"%s\",\"outer\":%d,\"total\":%d", proto_stage_name(stage),
                 sqlite3_column_int(st, 2), sqlite3_column_int(st, 3));
         for (int k = 0; k < 9; k++) {
             fprintf(fp, ",\"%s\":", keys[k]);
             web_json_num(fp, sqlite3_column_type(st, 4 + k) == SQLITE_NULL ? NAN : sqlite3_column_double(st, 4 + k));
         }
-        fputc('}', fp);
+        fputs(sse ? "}\n\n" : "}", fp);
     }
     sqlite3_finalize(st);
-    fprintf(fp, "],\"next\":%llu}\n", (unsigned long long)next);
+    return next;
+}
+
+/* Progress records after `after` (the answer's "next" continues). */
+static enum MHD_Result history(web *w, web_req *r, uint64_t id)
+{
+    const char *a = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "after");
+    uint64_t after = 0;
+    if (a && number(a, strlen(a), &after))
+        return web_reply_error(r, MHD_HTTP_BAD_REQUEST, "after: not a record number");
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *fp = open_memstream(&buf, &len);
+    if (!fp)
+        return MHD_NO;
+    fprintf(fp, "{\"id\":%llu,\"points\":[", (unsigned long long)id);
+    int64_t next = web_points(w, id, after, WEB_MAX_HISTORY, fp, 0);
+    if (next < 0) {
+        fclose(fp);
+        free(buf);
+        return web_reply_error(r, MHD_HTTP_INTERNAL_SERVER_ERROR, "job store unreadable");
+    }
+    fprintf(fp, "],\"next\":%lld}\n", (long long)next);
     return web_reply_json(r, MHD_HTTP_OK, fp, &buf, &len);
 }
 
@@ -393,6 +406,8 @@ enum MHD_Result web_api(web *w, web_req *r, const char *path)
         return quality(w, r, &j);
     if ((!strcmp(rest, "/maps/p") || !strcmp(rest, "/maps/q")) && get)
         return map(w, r, &j, rest[6]);
+    if (!strcmp(rest, "/events") && get)
+        return web_events(w, r, &j);
     if (!strcmp(rest, "/picture") && get)
         return web_picture(w, r, &j);
     if (!strcmp(rest, "/cancel") && post)

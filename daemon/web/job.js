@@ -1,8 +1,8 @@
 // job.js — one job's page (/jobs/ID): its facts and progress from
 // /api/v1/jobs/ID, its quality, and a plot of every energy term and beta
 // against the iteration over all stages (log scale: the terms span
-// decades), drawn as SVG from /api/v1/jobs/ID/history, which is read on
-// from where the last answer ended; once it completed, the picture of its
+// decades), drawn as SVG from the job's event stream
+// (/api/v1/jobs/ID/events); once it completed, the picture of its
 // map. Cancel for the owner and admins.
 'use strict';
 (async () => {
@@ -139,14 +139,39 @@
     msg.textContent = 'No picture yet: reload the page to try again.';
   }
 
-  async function refreshPlot() {
+  // The plot follows the job's event stream (the browser reconnects with
+  // the last record's id); a stream the server refuses (all taken) falls
+  // back to reading the history every two seconds.
+  let drawing = null;
+  function drawSoon() {
+    if (!drawing) drawing = setTimeout(() => { drawing = null; draw(); }, 200);
+  }
+
+  async function poll() {
     for (;;) {
       const h = await mc.api('/jobs/' + id + '/history?after=' + after);
       points.push(...h.points);
       after = h.next;
       if (!h.points.length) break;
     }
-    draw();
+    drawSoon();
+  }
+
+  function follow() {
+    const es = new EventSource('/api/v1/jobs/' + id + '/events');
+    document.getElementById('plot').dataset.live = 'events';
+    es.addEventListener('progress', (e) => {
+      points.push(JSON.parse(e.data));
+      after = Number(e.lastEventId);
+      drawSoon();
+    });
+    es.addEventListener('end', () => { es.close(); drawSoon(); });
+    es.addEventListener('error', () => {
+      if (es.readyState === EventSource.CLOSED) {
+        document.getElementById('plot').dataset.live = 'polling';
+        mc.every(2000, poll);
+      }
+    });
   }
 
   document.getElementById('cancel').addEventListener('click', async () => {
@@ -159,9 +184,7 @@
     }
   });
 
-  mc.every(1000, async () => {
-    const was = ended;
-    await refreshJob();
-    if (!was) await refreshPlot();
-  });
+  draw();
+  follow();
+  mc.every(1000, refreshJob);
 })();

@@ -712,7 +712,7 @@ TEST_T(sighup_serves_a_renewed_certificate_and_keeps_the_old_one_when_the_new_is
     replace_file(key, key2);
     kill(d.pid, SIGHUP);
     wait_log(&d, "reload: TLS certificate and key read again");
-    wait_log(&d, "reload: metrics serve the new certificate");
+    wait_log(&d, "reload: --http serves the new certificate");
     expect_tls_refusal(addr, t.ca, "not trusted");       /* new connections get the renewed one */
     mc_client *after = tls_client(addr, t.other_ca);
     CHECK_INT(mc_ping(after), 0);

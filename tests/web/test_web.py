@@ -6,7 +6,8 @@ daemon tests/unit/test_web.c started on loopback with jobs of two users.
 Checks, each an assertion (exit status 1 and the reason on stderr):
 a wrong token is refused and the login page says so; a good one logs in and
 the job list shows the user's jobs and not the other user's; the running
-job's page draws a plot that gains points while it runs; the finished job's
+job's page draws a plot that gains points while it runs (from the job's
+server-sent events; the stream's events are checked, and its cap); the finished job's
 page shows its quality, the picture of its map and its map links; another user's job page and its
 API answer 404; every resource the pages load comes from the daemon (the
 browser resolves no other host, and the Content-Security-Policy allows
@@ -14,6 +15,7 @@ nothing else); every GET of docs/openapi.yaml answers; the cancel button
 cancels the running job.
 Screenshots go to --shots (PNG)."""
 import argparse
+import http.client
 import json
 import os
 import sys
@@ -142,10 +144,12 @@ def run(drv, a, base):
     plot = drv.find_element(By.ID, "plot")
     first = wait_for("the first points", lambda: int(plot.get_attribute("data-points")))
     wait_for("more points than %d" % first, lambda: int(plot.get_attribute("data-points")) > first, 60)
-    lines = drv.find_elements(By.CSS_SELECTOR, "#plot polyline")
-    series = sorted(p.get_attribute("data-series") for p in lines)
+    # read in one script: the plot is redrawn as records arrive
+    series = sorted(drv.execute_script(
+        "return [...document.querySelectorAll('#plot polyline')].map(p => p.dataset.series)"))
     check("energy" in series and "beta" in series and "membrane" in series, "plot series %r" % series)
     check(drv.find_element(By.ID, "cancel").is_displayed(), "no cancel button on a running job of the owner")
+    check(plot.get_attribute("data-live") == "events", "the plot is not following the event stream")
     own_resources_only(drv, base)
     shot(drv, a, "3-running-job")
 
@@ -197,6 +201,30 @@ def run(drv, a, base):
     wait_for("the slots", lambda: len(drv.find_elements(By.CSS_SELECTOR, "#slots tbody tr")) >= 1)
     wait_for("the backend", lambda: "Backend local" in drv.find_element(By.ID, "summary").text)
     shot(drv, a, "6-workers")
+
+    # the event stream: records as server-sent events, and a cap of 4 streams
+    # per user (the fifth is refused)
+    hostport = base.split("//")[1]
+    streams = []
+    for i in range(4):
+        c = http.client.HTTPConnection(hostport, timeout=10)
+        c.request("GET", "/api/v1/jobs/%d/events" % a.running, headers={"Authorization": "Bearer " + a.token})
+        r = c.getresponse()
+        check(r.status == 200 and r.getheader("Content-Type") == "text/event-stream",
+              "stream %d: %d %s" % (i, r.status, r.getheader("Content-Type")))
+        streams.append((c, r))
+    first = b""
+    while b"\n\n" not in first:
+        first += streams[0][1].read1(4096)
+    event = first.decode().split("\n\n")[0].split("\n")
+    check(event[0].startswith("id: ") and event[1] == "event: progress" and event[2].startswith("data: {"),
+          "first event %r" % event)
+    check("energy" in json.loads(event[2][6:]), "event data %r" % event[2])
+    status, body = api(base, "/jobs/%d/events" % a.running, a.token)
+    check(status == 503 and "too many event streams" in body.get("error", ""), "a fifth stream: %d %r" % (status, body))
+    for c, r in streams:
+        c.close()
+    time.sleep(6)  # the server notices the closed streams at their next write (a keepalive at most 5 s on)
 
     # cancel the running job from its page; a POST with the cookie alone (no
     # CSRF token) is refused
