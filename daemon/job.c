@@ -4,7 +4,7 @@
  * job's cancel too (a running one's is handed to its backend); and its last step, the deletion of a finished job
  * result-ttl after its end (the expiry sweep). It calls only the store, the
  * scheduler and, for a cancel, the backend; who tells the watchers (req.c) listens (job_listen), so no
- * call goes back up.
+ * call goes back up; an end is also queued for its user's --notify-url (hook.c).
  *
  * DESIGN: a job's end is recorded before anyone is told. job_ended writes
  * the state to the store, then sends END to the watchers; a run to do again
@@ -48,6 +48,7 @@ static void tell_ended(mcd *d, uint64_t id)
 {
     if (J.l.ended)
         J.l.ended(d, id);
+    hook_job_ended(d, id);
 }
 
 static void tell_queue(mcd *d)

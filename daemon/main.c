@@ -87,7 +87,7 @@ int main(int argc, char **argv)
     job_init(&d);
     req_init(&d);
     /* the TLS key is read while root is still at hand, with the binds */
-    if (web_cancel_init(&d)) {
+    if (web_cancel_init(&d) || hook_start(&d)) {
         dlog(DLOG_ERROR, "out of memory");
         goto done;
     }
@@ -128,6 +128,7 @@ done:
     }
     mbus_stop(d.mbus);
     http_stop(d.http);
+    hook_stop();
     tls_close(&d);
     snap_free(d.snap);
     uv_loop_close(d.loop);

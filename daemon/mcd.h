@@ -26,6 +26,7 @@
  *   metrics.c metrics_ Prometheus text format of the snapshot (GET /metrics)
  *   web.c, web_*.c web_ the web UI and the JSON API (web.h), sessions, cancel hand-off
  *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
+ *   hook.c   hook_   --notify-url: a job's end POSTed to its user's URL (threads of its own)
  *   drain.c  drain_  SIGTERM/SIGINT: the graceful shutdown
  *   reload.c reload_ SIGHUP: options and tokens read again
  *   priv.c   priv_   started as root: bind, then run as --user for good
@@ -90,6 +91,7 @@
 #define CONF_FD_RESERVE_BASE 32                   /* --fd-reserve 0: this many ... */
 #define CONF_FD_RESERVE_PER_SLOT 4                /* ... plus this many per backend slot */
 
+#define CONF_MAX_NOTIFY 64        /* --notify-url users */
 #define CONF_HOST 256
 /* A dashboard server's address (--modbus, --http); port -1 = off. */
 typedef struct conf_endpoint {
@@ -131,6 +133,8 @@ typedef struct mcd_conf {
     int log_level;                /* DLOG_* */
     conf_endpoint modbus;         /* Modbus TCP input registers (MODBUS.md) */
     conf_endpoint http;           /* web UI, JSON API and GET /metrics (--http; --metrics is its alias) */
+    char notify[CONF_MAX_NOTIFY][CONF_PATH]; /* "USER=http://HOST:PORT/PATH" (--notify-url) */
+    int nnotify;
     /* where jobs run (backend.h): "local" worker slots or "slurm" */
     char backend[CONF_PATH];
     char slurm_partition[CONF_PATH], slurm_account[CONF_PATH];
@@ -630,6 +634,31 @@ int job_cancel(mcd *d, const store_job *j);
 void dev_probe(mcd *d);
 /* The device lines into out (at most max); their number. */
 int dev_list(const mcd *d, const char **out, int max);
+
+/* ---- hook_: word to a URL when a job ends (hook.c) ------------------------- */
+#define HOOK_TIMEOUT_S 5          /* connect, send and the answer's status line, each attempt */
+#define HOOK_ATTEMPTS 5           /* then the note is dropped (logged) */
+#define HOOK_FIRST_RETRY_S 1      /* waits between attempts: 1, 2, 4, 8 s */
+#define HOOK_THREADS 4            /* deliveries at once: a dead listener holds one */
+#define HOOK_MAX_QUEUED 1024      /* notes waiting; past it the oldest is dropped (logged) */
+#define HOOK_MAX_BODY 2048
+typedef struct hook_url {
+    char host[CONF_HOST];
+    char port[8];
+    char path[CONF_PATH];
+} hook_url;
+/* http://HOST[:PORT][/PATH] (port 80 by default; HOST a name, an IPv4
+ * address or [IPv6]): 0, or -1 with why (https and other schemes are
+ * refused). */
+int hook_url_parse(const char *url, hook_url *out, char *err, size_t errsz);
+/* Starts the delivery threads: 0 or -1. */
+int hook_start(mcd *d);
+/* Loop thread: job id has ended (its state is in the store): a note is
+ * queued when its user has a --notify-url. Never blocks. */
+void hook_job_ended(mcd *d, uint64_t id);
+/* After the loop: the threads stop (a delivery in progress ends within
+ * HOOK_TIMEOUT_S); notes still queued are dropped, counted in the log. */
+void hook_stop(void);
 
 /* ---- notify_ -------------------------------------------------------------- */
 void notify_ready(mcd *d);        /* READY=1 and the first STATUS=; starts the timer */
