@@ -46,6 +46,9 @@ static struct {
 
 static void tell_ended(mcd *d, uint64_t id)
 {
+    store_job j;
+    if (store_get(d->store, id, &j) == 0 && j.start_ms && j.end_ms >= j.start_ms)
+        snap_job_ended(d, (double)(j.end_ms - j.start_ms) / 1000);
     if (J.l.ended)
         J.l.ended(d, id);
     hook_job_ended(d, id);
@@ -132,7 +135,11 @@ void job_close(mcd *d)
 
 void job_running(mcd *d, uint64_t id, long pid)
 {
-    if (store_set_running(d->store, id, store_now_ms(), pid))
+    int64_t now = store_now_ms();
+    store_job j;
+    if (store_get(d->store, id, &j) == 0 && j.submit_ms && now >= j.submit_ms)
+        snap_job_started(d, (double)(now - j.submit_ms) / 1000);
+    if (store_set_running(d->store, id, now, pid))
         dlog(DLOG_ERROR, "job %llu: cannot record it RUNNING (the store is failing)", (unsigned long long)id);
     tell_queue(d);
 }

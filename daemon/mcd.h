@@ -394,6 +394,9 @@ int64_t sched_ahead(const sched *s, uint64_t id);
 /* The pending jobs in the order they start (ids[i] has i jobs ahead of
  * it), at most max of them: their number (0 also when out of memory). */
 uint32_t sched_order(const sched *s, uint64_t *ids, uint32_t max);
+/* The i-th user the scheduler knows: 0 with its name and counts, -1 past
+ * the last. */
+int sched_user_at(const sched *s, uint32_t i, const char **name, uint32_t *pending, uint32_t *running);
 uint32_t sched_user_pending(const sched *s, const char *user);
 uint32_t sched_user_running(const sched *s, const char *user);
 
@@ -414,6 +417,21 @@ typedef struct snap_slot {
     double eta_s;                 /* its seconds left; NaN not known */
 } snap_slot;
 
+/* Histograms of seconds (job durations, queue waits): counts per bucket of
+ * SNAP_BUCKETS upper bounds, the last bucket above them all (+Inf). */
+#define SNAP_NBUCKETS 10
+#define SNAP_BUCKETS {0.1, 1, 5, 15, 60, 300, 900, 3600, 14400, 86400}
+typedef struct snap_hist {
+    uint64_t bucket[SNAP_NBUCKETS + 1];   /* not cumulative */
+    uint64_t count;
+    double sum;
+} snap_hist;
+#define SNAP_MAX_USERS 64         /* users whose queue the snapshot carries */
+typedef struct snap_user {
+    char name[AUTH_MAX_USER];
+    uint32_t pending, running;
+} snap_user;
+
 typedef struct mcd_snapshot {
     uint32_t seq;                 /* published snapshots so far (wraps) */
     uint32_t uptime_s;            /* since the daemon started */
@@ -421,6 +439,10 @@ typedef struct mcd_snapshot {
     uint64_t completed, failed, cancelled;
     uint32_t nslots;              /* the backend's slots: workers or slurm-max-jobs */
     snap_slot *slots;             /* nslots, owned by whoever allocated the snapshot */
+    snap_hist duration;           /* ended runs: start to end (since the daemon started) */
+    snap_hist wait;               /* started runs: submit to start */
+    uint32_t nusers;              /* users with pending or running jobs, at most SNAP_MAX_USERS */
+    snap_user users[SNAP_MAX_USERS];
     uint32_t nqueue;              /* pending jobs in start order (the web's queue positions), */
     uint64_t queue[SNAP_MAX_QUEUE]; /* at most SNAP_MAX_QUEUE of them */
 } mcd_snapshot;
@@ -437,6 +459,10 @@ int snap_init(mcd *d, char *err, size_t errsz);
 void snap_collect(mcd *d, mcd_snapshot *out);
 /* Loop thread: a worker's progress record (kept for its slot's figures). */
 void snap_progress(mcd *d, const proto_progress *p);
+/* Loop thread: a run started after waiting wait_s since its submit; a job
+ * ran run_s from its start to its end (the histograms). */
+void snap_job_started(mcd *d, double wait_s);
+void snap_job_ended(mcd *d, double run_s);
 void snap_close(mcd *d);          /* stops the timer (the loop can end) */
 void snap_free(snap *s);          /* after the readers are stopped; NULL ok */
 /* Any thread: a copy of the latest published snapshot; out->slots holds

@@ -55,8 +55,47 @@ static void slot_family(FILE *fp, const mcd_snapshot *s, const char *name, const
     }
 }
 
+static void histogram(FILE *fp, const char *name, const char *help, const snap_hist *h)
+{
+    static const double bounds[SNAP_NBUCKETS] = SNAP_BUCKETS;
+    family(fp, name, "histogram", help);
+    uint64_t cum = 0;
+    for (int b = 0; b < SNAP_NBUCKETS; b++) {
+        cum += h->bucket[b];
+        fprintf(fp, "%s_bucket{le=\"%g\"} %llu\n", name, bounds[b], (unsigned long long)cum);
+    }
+    fprintf(fp, "%s_bucket{le=\"+Inf\"} %llu\n", name, (unsigned long long)h->count);
+    fprintf(fp, "%s_sum ", name);
+    value(fp, h->sum);
+    fprintf(fp, "%s_count %llu\n", name, (unsigned long long)h->count);
+}
+
+/* A label value as the text format escapes it: backslash, quote, newline. */
+static void label_value(FILE *fp, const char *v)
+{
+    for (; *v; v++)
+        if (*v == '\\' || *v == '"')
+            fprintf(fp, "\\%c", *v);
+        else if (*v == '\n')
+            fputs("\\n", fp);
+        else
+            fputc(*v, fp);
+}
+
+static void user_family(FILE *fp, const mcd_snapshot *s, const char *name, const char *help, int running)
+{
+    family(fp, name, "gauge", help);
+    for (uint32_t i = 0; i < s->nusers; i++) {
+        fprintf(fp, "%s{user=\"", name);
+        label_value(fp, s->users[i].name);
+        fprintf(fp, "\"} %u\n", running ? s->users[i].running : s->users[i].pending);
+    }
+}
+
 void metrics_format(FILE *fp, const mcd_snapshot *s)
 {
+    family(fp, "meshcorr_build_info", "gauge", "The build of meshcorrd: always 1, its version as a label.");
+    fprintf(fp, "meshcorr_build_info{version=\"%s\"} 1\n", MC_VERSION);
     family(fp, "meshcorr_queue_depth", "gauge", "Jobs pending in the queue.");
     fprintf(fp, "meshcorr_queue_depth %u\n", s->queued);
     family(fp, "meshcorr_running_jobs", "gauge", "Worker slots running a job.");
@@ -83,4 +122,10 @@ void metrics_format(FILE *fp, const mcd_snapshot *s)
                 "Seconds the job has left, from the time its share done took (NaN not known).", F_ETA);
     slot_family(fp, s, "meshcorr_slot_energy", "Total energy of the latest progress (both directions summed).", F_ENERGY);
     slot_family(fp, s, "meshcorr_slot_beta", "Mismatch weight beta of the latest progress.", F_BETA);
+    user_family(fp, s, "meshcorr_user_queue_depth", "Jobs of one user pending in the queue (users with jobs).", 0);
+    user_family(fp, s, "meshcorr_user_running_jobs", "Jobs of one user running (users with jobs).", 1);
+    histogram(fp, "meshcorr_job_duration_seconds",
+              "Runs from their start to their end, by how long they took (since meshcorrd started).", &s->duration);
+    histogram(fp, "meshcorr_job_queue_wait_seconds",
+              "Runs from their job's submit to their start (since meshcorrd started).", &s->wait);
 }

@@ -190,6 +190,16 @@ uint32_t sched_queued(const sched *s)
     return (uint32_t)s->nq;
 }
 
+int sched_user_at(const sched *s, uint32_t i, const char **name, uint32_t *pending, uint32_t *running)
+{
+    if (i >= s->nusers)
+        return -1;
+    *name = s->users[i].name;
+    *pending = s->users[i].pending;
+    *running = s->users[i].running;
+    return 0;
+}
+
 uint32_t sched_user_pending(const sched *s, const char *user)
 {
     int u = find_user(s, user);

@@ -578,7 +578,7 @@ static int parse_metrics(char *text, sample *out, int max)
             continue;
         }
         if (sscanf(line, "# TYPE %127s %31s", name, kind) == 2) {
-            CHECK(!strcmp(kind, "gauge") || !strcmp(kind, "counter"));
+            CHECK(!strcmp(kind, "gauge") || !strcmp(kind, "counter") || !strcmp(kind, "histogram"));
             CHECK(nt < 64);
             snprintf(type[nt++], 128, "%s", name);
             continue;
@@ -607,11 +607,22 @@ static int parse_metrics(char *text, sample *out, int max)
         s->value = strtod(rest + 1, &end);
         if (end == rest + 1 || *end != '\0' || !isfinite(s->value))
             FAILF("sample value not numeric: %s", line);
+        /* a histogram's samples are its family's name with _bucket, _sum, _count */
+        char fam[128];
+        snprintf(fam, sizeof fam, "%s", s->name);
+        static const char *const parts[] = {"_bucket", "_sum", "_count"};
+        for (int p = 0; p < 3; p++) {
+            size_t fl = strlen(fam), pl = strlen(parts[p]);
+            if (fl > pl && !strcmp(fam + fl - pl, parts[p]) && strstr(fam, "_seconds")) {
+                fam[fl - pl] = '\0';
+                break;
+            }
+        }
         int h = 0, t = 0;
         for (int i = 0; i < nh; i++)
-            h |= !strcmp(help[i], s->name);
+            h |= !strcmp(help[i], s->name) || !strcmp(help[i], fam);
         for (int i = 0; i < nt; i++)
-            t |= !strcmp(type[i], s->name);
+            t |= !strcmp(type[i], s->name) || !strcmp(type[i], fam);
         if (!h || !t)
             FAILF("%s has no # HELP or # TYPE before it", s->name);
     }
@@ -734,7 +745,9 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
              " --expect meshcorr_slot_state --expect meshcorr_slot_elapsed_seconds --expect meshcorr_slot_stage"
              " --expect meshcorr_slot_outer_iteration --expect meshcorr_slot_total_iterations"
              " --expect meshcorr_slot_progress_ratio --expect meshcorr_slot_eta_seconds"
-             " --expect meshcorr_slot_energy --expect meshcorr_slot_beta",
+             " --expect meshcorr_slot_energy --expect meshcorr_slot_beta --expect meshcorr_build_info"
+             " --expect meshcorr_user_queue_depth --expect meshcorr_user_running_jobs"
+             " --expect meshcorr_job_duration_seconds --expect meshcorr_job_queue_wait_seconds",
              files[0], files[1]);
     int rc = promcheck(args, report, sizeof report);
     if (rc != 0)
@@ -756,6 +769,10 @@ TEST(promcheck_refuses_texts_that_break_the_conventions)
         {"# HELP meshcorr_slot_state S.\n# TYPE meshcorr_slot_state gauge\nmeshcorr_slot_state{job=\"1\"} 1\n",
          "label 'job'"},
         {"# HELP meshcorr_workers W.\n# TYPE meshcorr_workers gauge\nmeshcorr_workers one\n", "parser refuses"},
+        {"# HELP meshcorr_wait_seconds W.\n# TYPE meshcorr_wait_seconds histogram\n"
+         "meshcorr_wait_seconds_bucket{le=\"1\"} 3\nmeshcorr_wait_seconds_bucket{le=\"+Inf\"} 2\n"
+         "meshcorr_wait_seconds_sum 1\nmeshcorr_wait_seconds_count 2\n", "not cumulative"},
+        {"# HELP meshcorr_workers W.\n# TYPE meshcorr_workers gauge\nmeshcorr_workers{le=\"1\"} 1\n", "label 'le'"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         int rc = promcheck(testfile_text("bad.prom", bad[i].text), report, sizeof report);
@@ -763,7 +780,10 @@ TEST(promcheck_refuses_texts_that_break_the_conventions)
             FAILF("promcheck.py on\n%s: exit %d, wanted 1 and \"%s\":\n%s", bad[i].text, rc, bad[i].finding, report);
     }
     const char *good = "# HELP meshcorr_jobs_total Jobs.\n# TYPE meshcorr_jobs_total counter\n"
-                       "meshcorr_jobs_total{state=\"failed\"} 0\n";
+                       "meshcorr_jobs_total{state=\"failed\"} 0\n"
+                       "# HELP meshcorr_wait_seconds W.\n# TYPE meshcorr_wait_seconds histogram\n"
+                       "meshcorr_wait_seconds_bucket{le=\"1\"} 1\nmeshcorr_wait_seconds_bucket{le=\"+Inf\"} 2\n"
+                       "meshcorr_wait_seconds_sum 3.5\nmeshcorr_wait_seconds_count 2\n";
     int rc = promcheck(testfile_text("good.prom", good), report, sizeof report);
     if (rc != 0)
         FAILF("promcheck.py refused a good text (exit %d):\n%s", rc, report);
