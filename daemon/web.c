@@ -572,7 +572,6 @@ int web_job(web *w, const web_req *r, uint64_t id, store_job *j, char *params, s
 
 const char *web_job_stage(web *w, const store_job *j, int64_t *position)
 {
-    (void)w;
     *position = -1;
     const mcd_snapshot *s = w->copy;      /* the copy web_snapshot took for this request */
     if (j->state == PROTO_STATE_PENDING) {

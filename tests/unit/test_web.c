@@ -8,7 +8,8 @@
  * and maps, bob's job 404 on the page and the API, no resource from
  * anywhere but the daemon, a cancel. Its screenshots land in build/web-shots/.
  * Here: the failed login is in the daemon's log with the address, the
- * cancel reached the store, and the daemon exits cleanly. Skipped without
+ * cancel reached the store, a token taken out of the tokens file (SIGHUP)
+ * no longer logs in, and the daemon exits cleanly. Skipped without
  * chromium, chromedriver or selenium (deploy/install-deps.sh installs them). */
 #include "support/harness.h"
 #include "support/testdaemon.h"
@@ -35,6 +36,28 @@ static int free_port(void)
         FAILF("free port: %s", strerror(errno));
     close(fd);
     return ntohs(a.sin_port);
+}
+
+/* GET path from 127.0.0.1:port with a Bearer token: the HTTP status. */
+static int api_status(int port, const char *path, const char *token)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {0};
+    a.sin_family = AF_INET;
+    a.sin_port = htons((uint16_t)port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a))
+        FAILF("connect to --http: %s", strerror(errno));
+    char req[512], resp[4096];
+    int n = snprintf(req, sizeof req, "GET %s HTTP/1.0\r\nAuthorization: Bearer %s\r\n\r\n", path, token);
+    CHECK(send(fd, req, (size_t)n, MSG_NOSIGNAL) == n);
+    ssize_t got = read(fd, resp, sizeof resp - 1);
+    close(fd);
+    CHECK(got > 12);
+    resp[got] = '\0';
+    int status = 0;
+    CHECK(sscanf(resp, "HTTP/1.%*d %d", &status) == 1);
+    return status;
 }
 
 static void need_browser(void)
@@ -80,6 +103,18 @@ TEST_T(browser_logs_in_sees_own_jobs_plot_result_and_cancels, 300)
     CHECK(testdaemon_log_has(&d, "login from 127.0.0.1 refused: unknown token (client 'web')"));
     CHECK(testdaemon_log_has(&d, "web login: alice from 127.0.0.1"));
     CHECK_INT(testdaemon_wait_state(alice, running, MC_CANCELLED, 30), MC_CANCELLED);
+
+    /* a token taken out of the tokens file (and a SIGHUP) logs its web user out */
+    CHECK_INT(api_status(port, "/api/v1/jobs", TESTDAEMON_ALICE), 200);
+    char tokens[640], line[256];
+    snprintf(tokens, sizeof tokens, "%s/tokens", d.dir);
+    testdaemon_token_line(TESTDAEMON_BOB, "bob", 0, line, sizeof line);
+    testdaemon_write_tokens(tokens, line);
+    CHECK(kill(d.pid, SIGHUP) == 0);
+    for (int i = 0; i < 100 && !testdaemon_log_has(&d, "reload: tokens read"); i++)
+        testdaemon_sleep_ms(50);
+    CHECK_INT(api_status(port, "/api/v1/jobs", TESTDAEMON_ALICE), 401);
+    CHECK_INT(api_status(port, "/api/v1/jobs", TESTDAEMON_BOB), 200);
     mc_close(alice);
     mc_close(bob);
     testdaemon_stop(&d, SIGTERM);
