@@ -4,8 +4,8 @@
  * JSON API (web.c). Nothing here touches the daemon's loop-owned state: the
  * metrics format a copy of the published snapshot (snap_read), and web.c
  * reads the job store through a read-only SQLite connection of its own.
- * MHD bounds what clients can hold: MHD_OPTION_CONNECTION_LIMIT
- * connections, each closed after MHD_OPTION_CONNECTION_TIMEOUT idle
+ * MHD bounds what clients can hold: HTTP_MAX_CONNECTIONS connections,
+ * HTTP_MAX_PER_ADDRESS of one address, each closed after HTTP_TIMEOUT_S idle
  * seconds, and a request body over WEB_MAX_BODY bytes is answered 413.
  * With --tls-cert/--tls-key it is HTTPS only (MHD_USE_TLS, the same
  * certificate, key and TLS versions as the tls: listeners); a SIGHUP that
@@ -22,7 +22,12 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#define HTTP_MAX_CONNECTIONS 64
+/* Connections, each a thread: libmicrohttpd counts a finished connection
+ * until its thread is reaped, so the cap leaves room for those beside the
+ * live ones (a lower cap held new connections back at 50 polling browsers). */
+#define HTTP_MAX_CONNECTIONS 256
+#define HTTP_MAX_PER_ADDRESS 128   /* of one client address */
+#define HTTP_THREAD_STACK (512u << 10)
 #define HTTP_TIMEOUT_S 10
 
 struct http {
@@ -133,10 +138,14 @@ static struct MHD_Daemon *serve(http *h, const char *cert, const char *key)
     if (!cert)
         return MHD_start_daemon(flags, 0, NULL, NULL, on_request, h, MHD_OPTION_LISTEN_SOCKET, h->fd,
                                 MHD_OPTION_CONNECTION_LIMIT, (unsigned)HTTP_MAX_CONNECTIONS,
+                                MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)HTTP_MAX_PER_ADDRESS,
+                                MHD_OPTION_THREAD_STACK_SIZE, (size_t)HTTP_THREAD_STACK,
                                 MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)HTTP_TIMEOUT_S,
                                 MHD_OPTION_NOTIFY_COMPLETED, on_completed, NULL, MHD_OPTION_END);
     return MHD_start_daemon(flags | MHD_USE_TLS, 0, NULL, NULL, on_request, h, MHD_OPTION_LISTEN_SOCKET, h->fd,
                             MHD_OPTION_CONNECTION_LIMIT, (unsigned)HTTP_MAX_CONNECTIONS,
+                            MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)HTTP_MAX_PER_ADDRESS,
+                            MHD_OPTION_THREAD_STACK_SIZE, (size_t)HTTP_THREAD_STACK,
                             MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)HTTP_TIMEOUT_S,
                             MHD_OPTION_NOTIFY_COMPLETED, on_completed, NULL,
                             MHD_OPTION_HTTPS_MEM_CERT, cert, MHD_OPTION_HTTPS_MEM_KEY, key,
