@@ -43,7 +43,9 @@
  * servers, which read the published snapshot (snap_read) and, for the web
  * pages, the job store through a read-only SQLite connection of their own
  * in their own threads; a cancel from the web goes to the loop through a
- * uv_async (web_cancel.c). dlog may be called from any thread. */
+ * uv_async (web_cancel.c); a map's picture is drawn by a worker process a
+ * thread of web_picture.c waits for; job-end notes go out from hook.c's
+ * threads. dlog and throttle_ may be called from any thread. */
 #ifndef MCD_H
 #define MCD_H
 #include <stddef.h>

@@ -2,7 +2,7 @@
  * worker slots, each running job's latest progress, the queue's order
  * (positions for the web pages), each user's pending and running jobs and
  * the histograms of run durations and queue waits, computed in one
- * place (snap_collect) for STATS and for the dashboards (mbus.c, metrics.c).
+ * place (snap_collect) for STATS and for the dashboards (mbus.c, http.c).
  *
  * DESIGN: the loop thread owns the daemon's state; the dashboard servers run
  * in threads of their own and must never touch it. Every SNAP_PERIOD_MS the
