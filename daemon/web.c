@@ -430,7 +430,8 @@ static enum MHD_Result login_page(web_req *r, unsigned status, const char *msg)
                 fputc(*p, fp);
         fputs("</p>", fp);
     }
-    fputs(at + strlen(mark), fp);
+    const char *rest = at + strlen(mark);   /* the asset has no terminating NUL */
+    fwrite(rest, 1, a->len - (size_t)(rest - (const char *)a->data), fp);
     if (fclose(fp) != 0) {
         free(buf);
         return MHD_NO;
