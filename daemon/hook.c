@@ -310,7 +310,7 @@ void hook_job_ended(mcd *d, uint64_t id)
     int over = ftell(fp) >= (long)sizeof n->body - 1;
     fclose(fp);
     if (over) {
-        dlog(DLOG_WARN, "job %llu: its end note is over %d bytes: not sent", (unsigned long long)id, HOOK_MAX_BODY);
+        dlog(DLOG_WARN, "job %llu: its end note is over %u bytes: not sent", (unsigned long long)id, HOOK_MAX_BODY);
         free(n);
         return;
     }

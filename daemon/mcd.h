@@ -669,7 +669,7 @@ int dev_list(const mcd *d, const char **out, int max);
 #define HOOK_FIRST_RETRY_S 1      /* waits between attempts: 1, 2, 4, 8 s */
 #define HOOK_THREADS 4            /* deliveries at once: a dead listener holds one */
 #define HOOK_MAX_QUEUED 1024      /* notes waiting; past it the oldest is dropped (logged) */
-#define HOOK_MAX_BODY 2048
+#define HOOK_MAX_BODY (6 * (2 * PROTO_MAX_STRING + AUTH_MAX_USER) + 512) /* a note, every string escaped at worst */
 typedef struct hook_url {
     char host[CONF_HOST];
     char port[8];
