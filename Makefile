@@ -72,7 +72,8 @@ CLI_C   := $(wildcard client-c/cli/*.c)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
 
 # The CLI's pictures (client-c/render/: rasteriser and PNG writer): linked
-# into the CLI and the tests only, so libmeshcorr.so never needs libpng.
+# into the CLI, the worker (--picture, for the web UI) and the tests only,
+# so libmeshcorr.so never needs libpng.
 RENDER_C    := $(wildcard client-c/render/*.c)
 RENDER_OBJ  := $(RENDER_C:%.c=$(BUILD)/obj/%.o)
 RENDER_LIB  := $(BUILD)/libmcrender.a
@@ -125,6 +126,20 @@ $(BUILD)/gen/ener_ocl_src.h: $(OCL_SRC)
 	  xxd -i < $$s; echo ", 0};"; done > $@.tmp; mv $@.tmp $@
 $(BUILD)/obj/workers/ener/ener_ocl.o: $(BUILD)/gen/ener_ocl_src.h
 
+# The web UI's pages, scripts and style sheet (daemon/web/), embedded as C
+# arrays and a table of them by file name (web.c includes it): the daemon
+# serves them from its binary.
+WEB_ASSETS := $(sort $(wildcard daemon/web/*.html daemon/web/*.js daemon/web/*.css))
+$(BUILD)/gen/web_assets.h: $(WEB_ASSETS)
+	@mkdir -p $(dir $@)
+	set -e; for s in $(WEB_ASSETS); do echo "static const unsigned char web__$$(basename $$s | tr .- __)[] = {"; \
+	  xxd -i < $$s; echo "};"; done > $@.tmp; \
+	echo "static const struct web_asset web__assets[] = {" >> $@.tmp; \
+	for s in $(WEB_ASSETS); do n=$$(basename $$s); v=web__$$(echo $$n | tr .- __); \
+	  echo "    {\"$$n\", $$v, sizeof $$v},"; done >> $@.tmp; \
+	echo "};" >> $@.tmp; mv $@.tmp $@
+$(BUILD)/obj/daemon/web.o: $(BUILD)/gen/web_assets.h
+
 $(ENGINE_LIB): $(ENGINE_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
@@ -163,8 +178,8 @@ $(BUILD)/meshcorr: $(CLI_OBJ) $(RENDER_LIB) $(CLIENT_LIB) $(ENGINE_LIB) $(PROTO_
 $(BUILD)/meshcorrd: $(BUILD)/obj/daemon/main.o $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -o $@ $< $(DAEMON_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(DAEMON_LIBS) $(LDLIBS)
 
-$(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
-	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)
+$(BUILD)/meshcorr-worker: $(WORKER_OBJ) $(RENDER_LIB) $(ENGINE_LIB) $(PROTO_LIB)
+	$(CC) $(CFLAGS) -o $@ $(WORKER_OBJ) $(RENDER_LIB) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS) $(RENDER_LIBS)
 
 $(BUILD)/meshcorr-validate: $(VALIDATE_OBJ) $(ENGINE_LIB) $(PROTO_LIB)
 	$(CC) $(CFLAGS) -Wl,--as-needed -o $@ $(VALIDATE_OBJ) $(ENGINE_LIB) $(PROTO_LIB) $(LDLIBS)

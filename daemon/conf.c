@@ -14,7 +14,7 @@
 static int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz);
 #include <unistd.h>
 
-enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT, K_FLAG };
+enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT, K_FLAG, K_NOTIFY };
 
 #define OFF(f) offsetof(mcd_conf, f)
 static const struct option_def {
@@ -25,7 +25,7 @@ static const struct option_def {
     const char *help;
 } options[] = {
     {"listen", K_LISTEN, 0, 0, 0, "unix:PATH | tls:HOST:PORT | tcp:HOST:PORT (repeatable; PORT 0 = any free port; tcp: loopback only)"},
-    {"tls-cert", K_PATH, OFF(tls_cert), 0, 0, "FILE PEM certificate chain for tls: listeners and HTTPS --metrics"},
+    {"tls-cert", K_PATH, OFF(tls_cert), 0, 0, "FILE PEM certificate chain for tls: listeners and HTTPS --http"},
     {"tls-key", K_PATH, OFF(tls_key), 0, 0, "FILE PEM private key of --tls-cert"},
     {"insecure-tcp", K_FLAG, OFF(insecure_tcp), 0, 1, "let a tcp: listener bind a non-loopback address (tokens in clear)"},
     {"state-dir", K_PATH, OFF(state_dir), 0, 0, "DIR: jobs.db and spool/ (required)"},
@@ -65,7 +65,9 @@ static const struct option_def {
     {"port-file", K_PATH, OFF(port_file), 0, 0, "FILE to write the bound tcp: and tls:HOST:PORT addresses to"},
     {"log-level", K_LEVEL, OFF(log_level), 0, 0, "error|warn|info|debug (default info)"},
     {"modbus", K_ENDPOINT, OFF(modbus), 0, 0, "[HOST:]PORT Modbus TCP status registers (off; 1502 suits; host 127.0.0.1)"},
-    {"metrics", K_ENDPOINT, OFF(metrics), 0, 0, "[HOST:]PORT Prometheus GET /metrics over HTTP, HTTPS with --tls-cert (off; host 127.0.0.1)"},
+    {"http", K_ENDPOINT, OFF(http), 0, 0, "[HOST:]PORT web UI, JSON API and Prometheus /metrics over HTTP, HTTPS with --tls-cert (off; host 127.0.0.1)"},
+    {"metrics", K_ENDPOINT, OFF(http), 0, 0, "[HOST:]PORT the same as --http"},
+    {"notify-url", K_NOTIFY, 0, 0, 0, "USER=http://HOST[:PORT]/PATH: POST a JSON note there when a job of USER ends (repeatable)"},
     {"backend", K_PATH, OFF(backend), 0, 0, "local|slurm: where jobs run (default local)"},
     {"slurm-partition", K_PATH, OFF(slurm_partition), 0, 0, "NAME sbatch --partition (default: Slurm's)"},
     {"slurm-account", K_PATH, OFF(slurm_account), 0, 0, "NAME sbatch --account"},
@@ -110,7 +112,7 @@ void conf_init(mcd_conf *c)
     c->idle_timeout_s = CONF_DEFAULT_IDLE_TIMEOUT_S;
     c->admin_uid = -1;
     c->log_level = DLOG_INFO;
-    c->modbus.port = c->metrics.port = -1;
+    c->modbus.port = c->http.port = -1;
     strcpy(c->backend, "local");
     c->slurm_cpus = 1;
     c->slurm_max_jobs = CONF_DEFAULT_SLURM_MAX_JOBS;
@@ -178,6 +180,25 @@ int conf_set(mcd_conf *c, const char *key, const char *v, char *err, size_t errs
         if (strncmp(v, "unix:", 5) != 0 && strncmp(v, "tcp:", 4) != 0 && strncmp(v, "tls:", 4) != 0)
             return errbuf_set(err, errsz, -1, "--listen: '%s' is not unix:PATH, tls:HOST:PORT or tcp:HOST:PORT", v);
         return set_path(c->listen[c->nlisten++], o->name, v, err, errsz);
+    case K_NOTIFY: {
+        if (c->nnotify == CONF_MAX_NOTIFY)
+            return errbuf_set(err, errsz, -1, "--notify-url: more than %d users", CONF_MAX_NOTIFY);
+        const char *eq = strchr(v, '=');
+        char user[AUTH_MAX_USER], why[256];
+        hook_url u;
+        if (!eq || (size_t)(eq - v) >= sizeof user)
+            return errbuf_set(err, errsz, -1, "--notify-url: '%s' is not USER=URL", v);
+        memcpy(user, v, (size_t)(eq - v));
+        user[eq - v] = '\0';
+        if (auth_user_ok(user, why, sizeof why))
+            return errbuf_set(err, errsz, -1, "--notify-url: user '%s': %s", user, why);
+        if (hook_url_parse(eq + 1, &u, why, sizeof why))
+            return errbuf_set(err, errsz, -1, "--notify-url %s: %s", v, why);
+        for (int i = 0; i < c->nnotify; i++)
+            if (!strncmp(c->notify[i], v, (size_t)(eq - v) + 1))
+                return errbuf_set(err, errsz, -1, "--notify-url: user '%s' has a URL already", user);
+        return set_path(c->notify[c->nnotify++], o->name, v, err, errsz);
+    }
     case K_CONFIG:
         return conf_load_file(c, v, err, errsz);
     case K_ENDPOINT:

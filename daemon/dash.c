@@ -1,5 +1,5 @@
 /* dash.c — the listening sockets of the dashboard servers (--modbus,
- * --metrics): HOST as the user gave it (a name or a numeric address, v4 or
+ * --http): HOST as the user gave it (a name or a numeric address, v4 or
  * v6), bound in the main thread before the loop starts, so a taken port
  * stops the daemon at start-up with a message. Close-on-exec: the workers
  * meshcorrd spawns must not inherit them. Serves nothing itself. */
@@ -57,5 +57,5 @@ static void keep_endpoint(const conf_endpoint *o, conf_endpoint *n, const char *
 void dash_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz)
 {
     keep_endpoint(&o->modbus, &n->modbus, "modbus", changed, sz);
-    keep_endpoint(&o->metrics, &n->metrics, "metrics", changed, sz);
+    keep_endpoint(&o->http, &n->http, "http", changed, sz);
 }

@@ -24,6 +24,7 @@ static void check(mcd *d)
     bk_close(d);
     job_close(d);
     snap_close(d);
+    web_cancel_close(d);
     uv_close((uv_handle_t *)&d->sigterm, NULL);
     uv_close((uv_handle_t *)&d->sigint, NULL);
     /* closing them put back the default action: another SIGTERM now (an

@@ -6,7 +6,7 @@
  * (SIGTERM/SIGINT: drain.c; SIGHUP: reload.c), READY=1 to the service
  * manager, then the loop; or `meshcorrd token ...` (token.c) alone. The loop ends once the drain has closed every
  * handle; only then the store closes (no store_submit can be running) and
- * the dashboard threads (--modbus, --metrics) stop. Holds no request, job or
+ * the dashboard threads (--modbus, --http) stop. Holds no request, job or
  * shutdown logic. */
 #include "backend.h"
 #include "mcd.h"
@@ -86,14 +86,19 @@ int main(int argc, char **argv)
     job_init(&d);
     req_init(&d);
     /* the TLS key is read while root is still at hand, with the binds */
+    if (web_cancel_init(&d) || hook_start(&d)) {
+        dlog(DLOG_ERROR, "out of memory");
+        goto done;
+    }
     if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
         priv_bind_begin(&priv, err, sizeof err) || tls_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
-        (d.conf.metrics.port > 0 && metrics_start(&d.conf.metrics, d.tls, d.snap, &d.metrics, err, sizeof err)) ||
+        (d.conf.http.port > 0 && http_start(&d, &d.conf.http, d.tls, &d.http, err, sizeof err)) ||
         priv_drop(&priv, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }
+    http_set_tokens(d.http, d.tokens);
     srv_note_tokens(&d);
     job_sweep_start(&d);
     uv_signal_init(d.loop, &d.sigterm);
@@ -117,13 +122,16 @@ done:
         bk_close(&d);
         job_close(&d);
         snap_close(&d);
+        web_cancel_close(&d);
         uv_run(d.loop, UV_RUN_NOWAIT);
     }
     mbus_stop(d.mbus);
-    metrics_stop(d.metrics);
+    http_stop(d.http);
+    hook_stop();
     tls_close(&d);
     snap_free(d.snap);
     uv_loop_close(d.loop);
+    web_cancel_free(d.web_cancel);
     store_close(d.store);
     sched_free(d.sched);
     auth_tokens_free(d.tokens);

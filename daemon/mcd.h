@@ -22,8 +22,11 @@
  *   snap.c   snap_   the status snapshot: STATS and the dashboards read it
  *   dash.c   dash_   listening sockets of the dashboard servers
  *   mbus.c   mbus_   Modbus TCP input registers, in a thread of their own
- *   metrics.c metrics_ Prometheus text over HTTP (libmicrohttpd's thread)
+ *   http.c   http_   the HTTP endpoint (--http): libmicrohttpd's thread, TLS, dispatch
+ *   metrics.c metrics_ Prometheus text format of the snapshot (GET /metrics)
+ *   web.c, web_*.c web_ the web UI and the JSON API (web.h), sessions, cancel hand-off
  *   notify.c notify_ sd_notify: READY, STATUS, RELOADING, STOPPING
+ *   hook.c   hook_   --notify-url: a job's end POSTed to its user's URL (threads of its own)
  *   drain.c  drain_  SIGTERM/SIGINT: the graceful shutdown
  *   reload.c reload_ SIGHUP: options and tokens read again
  *   priv.c   priv_   started as root: bind, then run as --user for good
@@ -36,9 +39,13 @@
  *
  * Threads: everything runs in the libuv loop thread except store_submit
  * and the read of a result.frame, which req.c runs in libuv's thread pool
- * (their after callbacks are back on the loop), and the Modbus and metrics
- * servers, which read the published snapshot (snap_read) in their own
- * threads. dlog may be called from any thread. */
+ * (their after callbacks are back on the loop), and the Modbus and HTTP
+ * servers, which read the published snapshot (snap_read) and, for the web
+ * pages, the job store through a read-only SQLite connection of their own
+ * in their own threads; a cancel from the web goes to the loop through a
+ * uv_async (web_cancel.c); a map's picture is drawn by a worker process a
+ * thread of web_picture.c waits for; job-end notes go out from hook.c's
+ * threads. dlog and throttle_ may be called from any thread. */
 #ifndef MCD_H
 #define MCD_H
 #include <stddef.h>
@@ -86,8 +93,9 @@
 #define CONF_FD_RESERVE_BASE 32                   /* --fd-reserve 0: this many ... */
 #define CONF_FD_RESERVE_PER_SLOT 4                /* ... plus this many per backend slot */
 
+#define CONF_MAX_NOTIFY 64        /* --notify-url users */
 #define CONF_HOST 256
-/* A dashboard server's address (--modbus, --metrics); port -1 = off. */
+/* A dashboard server's address (--modbus, --http); port -1 = off. */
 typedef struct conf_endpoint {
     char host[CONF_HOST];         /* as the user gave it; 127.0.0.1 when only a port was */
     int port;
@@ -96,7 +104,7 @@ typedef struct conf_endpoint {
 typedef struct mcd_conf {
     char listen[CONF_MAX_LISTEN][CONF_PATH]; /* "unix:PATH", "tcp:HOST:PORT" or "tls:HOST:PORT" */
     int nlisten;
-    char tls_cert[CONF_PATH];     /* PEM certificate chain of tls: listeners and --metrics; "" = none */
+    char tls_cert[CONF_PATH];     /* PEM certificate chain of tls: listeners and --http; "" = none */
     char tls_key[CONF_PATH];      /* its private key */
     int insecure_tcp;             /* a tcp: listener may bind a non-loopback address */
     char state_dir[CONF_PATH];
@@ -126,7 +134,9 @@ typedef struct mcd_conf {
     long admin_uid;               /* Unix-socket uid treated as admin; -1 none (root always) */
     int log_level;                /* DLOG_* */
     conf_endpoint modbus;         /* Modbus TCP input registers (MODBUS.md) */
-    conf_endpoint metrics;        /* Prometheus text over HTTP, GET /metrics */
+    conf_endpoint http;           /* web UI, JSON API and GET /metrics (--http; --metrics is its alias) */
+    char notify[CONF_MAX_NOTIFY][CONF_PATH]; /* "USER=http://HOST:PORT/PATH" (--notify-url) */
+    int nnotify;
     /* where jobs run (backend.h): "local" worker slots or "slurm" */
     char backend[CONF_PATH];
     char slurm_partition[CONF_PATH], slurm_account[CONF_PATH];
@@ -229,13 +239,14 @@ int auth_peer_user(int fd, long admin_uid, char user[AUTH_MAX_USER], int *admin,
                    char *err, size_t errsz);
 
 /* ---- throttle_: failed logins per address (throttle.c) ---------------------- */
+/* HELLOs and web logins alike. */
 #define THROTTLE_FREE_FAILS 5         /* failed HELLOs an address may make in a row, */
 #define THROTTLE_REFILL_S 12          /* one more for every this many quiet seconds; */
 #define THROTTLE_BASE_BLOCK_S 2       /* then its HELLOs are refused this long, doubling */
 #define THROTTLE_MAX_BLOCK_S 600      /* with each further failure up to this */
 #define THROTTLE_LOG_PERIOD_S 10      /* at most one line per address in this time */
 #define THROTTLE_MAX_ADDRS 4096       /* addresses followed at once; the quietest go first */
-/* Loop thread, now_ms: the loop's clock. 0 when peer may try a token now;
+/* Any thread, now_ms: the loop's clock (uv_hrtime in ms). 0 when peer may try a token now;
  * else the seconds it must wait (the HELLO is refused unchecked, counted). */
 uint32_t throttle_check(const char *peer, uint64_t now_ms);
 /* A HELLO from peer failed (why: "unknown token"): counted, and logged
@@ -349,6 +360,9 @@ void store_counters(store *s, uint64_t *completed, uint64_t *failed, uint64_t *c
 /* <dir>/spool/<id>[/file] into buf. */
 const char *store_spool_path(const store *s, uint64_t id, const char *file, char *buf, size_t sz);
 int store_is_terminal(int state);
+/* A state as the jobs table spells it (its Slurm name) back to enum
+ * proto_state; FAILED for a name it does not know. */
+int store_state_of(const char *name);
 
 /* ---- wlock_ --------------------------------------------------------------- */
 #define WLOCK_HELD 1
@@ -378,12 +392,19 @@ uint32_t sched_queued(const sched *s);              /* pending, all users */
 /* Jobs that start before pending job id in the order as it stands (the
  * running counts and last starts as they are now); -1 when id is not queued. */
 int64_t sched_ahead(const sched *s, uint64_t id);
+/* The pending jobs in the order they start (ids[i] has i jobs ahead of
+ * it), at most max of them: their number (0 also when out of memory). */
+uint32_t sched_order(const sched *s, uint64_t *ids, uint32_t max);
+/* The i-th user the scheduler knows: 0 with its name and counts, -1 past
+ * the last. */
+int sched_user_at(const sched *s, uint32_t i, const char **name, uint32_t *pending, uint32_t *running);
 uint32_t sched_user_pending(const sched *s, const char *user);
 uint32_t sched_user_running(const sched *s, const char *user);
 
 /* ---- snap_ ---------------------------------------------------------------- */
 /* The daemon's state in figures: the one place they are computed (STATS,
  * the Modbus registers and /metrics all come from snap_collect). */
+#define SNAP_MAX_QUEUE 1024       /* queue positions a snapshot carries */
 typedef struct snap_slot {
     uint64_t job_id;              /* 0 = idle */
     uint8_t state;                /* PROTO_SLOT_* */
@@ -397,6 +418,21 @@ typedef struct snap_slot {
     double eta_s;                 /* its seconds left; NaN not known */
 } snap_slot;
 
+/* Histograms of seconds (job durations, queue waits): counts per bucket of
+ * SNAP_BUCKETS upper bounds, the last bucket above them all (+Inf). */
+#define SNAP_NBUCKETS 10
+#define SNAP_BUCKETS {0.1, 1, 5, 15, 60, 300, 900, 3600, 14400, 86400}
+typedef struct snap_hist {
+    uint64_t bucket[SNAP_NBUCKETS + 1];   /* not cumulative */
+    uint64_t count;
+    double sum;
+} snap_hist;
+#define SNAP_MAX_USERS 64         /* users whose queue the snapshot carries */
+typedef struct snap_user {
+    char name[AUTH_MAX_USER];
+    uint32_t pending, running;
+} snap_user;
+
 typedef struct mcd_snapshot {
     uint32_t seq;                 /* published snapshots so far (wraps) */
     uint32_t uptime_s;            /* since the daemon started */
@@ -404,6 +440,12 @@ typedef struct mcd_snapshot {
     uint64_t completed, failed, cancelled;
     uint32_t nslots;              /* the backend's slots: workers or slurm-max-jobs */
     snap_slot *slots;             /* nslots, owned by whoever allocated the snapshot */
+    snap_hist duration;           /* ended runs: start to end (since the daemon started) */
+    snap_hist wait;               /* started runs: submit to start */
+    uint32_t nusers;              /* users with pending or running jobs, at most SNAP_MAX_USERS */
+    snap_user users[SNAP_MAX_USERS];
+    uint32_t nqueue;              /* pending jobs in start order (the web's queue positions), */
+    uint64_t queue[SNAP_MAX_QUEUE]; /* at most SNAP_MAX_QUEUE of them */
 } mcd_snapshot;
 
 typedef struct snap snap;
@@ -418,6 +460,10 @@ int snap_init(mcd *d, char *err, size_t errsz);
 void snap_collect(mcd *d, mcd_snapshot *out);
 /* Loop thread: a worker's progress record (kept for its slot's figures). */
 void snap_progress(mcd *d, const proto_progress *p);
+/* Loop thread: a run started after waiting wait_s since its submit; a job
+ * ran run_s from its start to its end (the histograms). */
+void snap_job_started(mcd *d, double wait_s);
+void snap_job_ended(mcd *d, double run_s);
 void snap_close(mcd *d);          /* stops the timer (the loop can end) */
 void snap_free(snap *s);          /* after the readers are stopped; NULL ok */
 /* Any thread: a copy of the latest published snapshot; out->slots holds
@@ -431,7 +477,7 @@ void snap_release(mcd_snapshot *m);          /* NULL ok */
 /* A listening TCP socket (close-on-exec, non-blocking) on e: the fd, or -1
  * with the detail in err. */
 int dash_listen(const conf_endpoint *e, const char *what, char *err, size_t errsz);
-/* SIGHUP: keeps n's dashboard endpoints (modbus, metrics) at the running o. */
+/* SIGHUP: keeps n's dashboard endpoints (modbus, http) at the running o. */
 void dash_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 
 /* ---- mbus_ ---------------------------------------------------------------- */
@@ -501,13 +547,34 @@ int tls_conn_bye(tls_conn *t);
 const char *tls_conn_desc(const tls_conn *t, char *buf, size_t sz);
 
 /* ---- metrics_ ------------------------------------------------------------- */
-typedef struct metrics metrics;
-/* Serves HTTPS with tls's certificate and key when tls is not NULL. */
-int metrics_start(const conf_endpoint *e, const tls_creds *tls, snap *s, metrics **out, char *err, size_t errsz);
+/* The snapshot in Prometheus text format (version 0.0.4) into fp. */
+void metrics_format(FILE *fp, const mcd_snapshot *s);
+
+/* ---- http_ ---------------------------------------------------------------- */
+typedef struct http http;
+typedef struct web_cancel web_cancel;
+/* Binds e and serves it (HTTPS with tls's certificate and key when tls is
+ * not NULL): /metrics, the web pages and /api/v1/. d is read only for what
+ * does not change while it runs (the state directory, the store's spool
+ * paths, the tokens through http_set_tokens). 0, or -1 with err. */
+int http_start(mcd *d, const conf_endpoint *e, const tls_creds *tls, http **out, char *err, size_t errsz);
 /* SIGHUP: new connections get tls's certificate (the listening socket
  * stays); 0, or -1 with err (the running one goes on). */
-int metrics_set_tls(metrics *m, const tls_creds *tls, char *err, size_t errsz);
-void metrics_stop(metrics *m);    /* NULL ok */
+int http_set_tls(http *h, const tls_creds *tls, char *err, size_t errsz);
+/* Loop thread: the tokens the web logins check from now on (the caller
+ * frees the previous table only after this returns). NULL h ok. */
+void http_set_tokens(http *h, const auth_tokens *t);
+void http_stop(http *h);          /* NULL ok */
+
+/* ---- web_cancel_: cancels from the web, run on the loop (web_cancel.c) ---- */
+#define WEB_CANCEL_MAX_QUEUED 64  /* requests waiting for the loop; more are refused (503) */
+/* Loop thread, at start: the queue and its uv_async. 0 or -1. */
+int web_cancel_init(mcd *d);
+/* Any thread: asks the loop to cancel job id for user (admin: any job's).
+ * 0, or -1 when the queue is full. */
+int web_cancel_request(web_cancel *w, uint64_t id, const char *user, int admin);
+void web_cancel_close(mcd *d);    /* loop thread: closes the handle (drain) */
+void web_cancel_free(web_cancel *w);   /* after the loop ended; NULL ok */
 
 /* ---- the daemon ------------------------------------------------------------ */
 typedef struct conn conn;
@@ -536,7 +603,8 @@ struct mcd {
     int draining;                 /* shutdown started: no new work */
     snap *snap;                   /* the status snapshot */
     mbus *mbus;                   /* NULL unless --modbus */
-    metrics *metrics;             /* NULL unless --metrics */
+    http *http;                   /* NULL unless --http */
+    web_cancel *web_cancel;       /* cancels from the web, handed to the loop */
     tls_creds *tls;               /* NULL unless --tls-cert and --tls-key */
     const bk_ops *bk;             /* the backend (backend.h) */
     int argc;                     /* the command line, parsed again on SIGHUP */
@@ -582,6 +650,10 @@ int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz);
 /* A pending job (not handed to a backend) is cancelled: out of the queue,
  * CANCELLED in the store, END to its watchers. 0 or PROTO_ESTORAGE. */
 int job_cancel_pending(mcd *d, uint64_t id);
+/* Cancels job j as it is in the store: a running one (or one queued in
+ * Slurm) is stopped by its backend, a pending one ends CANCELLED here. 0,
+ * PROTO_ESTORAGE, or PROTO_EBAD_STATE when it has ended already. */
+int job_cancel(mcd *d, const store_job *j);
 
 /* ---- dev_: the devices a worker sees, asked once of the worker program ---- */
 /* Runs `meshcorr-worker --list-devices` in the background; until it answers
@@ -589,6 +661,31 @@ int job_cancel_pending(mcd *d, uint64_t id);
 void dev_probe(mcd *d);
 /* The device lines into out (at most max); their number. */
 int dev_list(const mcd *d, const char **out, int max);
+
+/* ---- hook_: word to a URL when a job ends (hook.c) ------------------------- */
+#define HOOK_TIMEOUT_S 5          /* connect, send and the answer's status line, each attempt */
+#define HOOK_ATTEMPTS 5           /* then the note is dropped (logged) */
+#define HOOK_FIRST_RETRY_S 1      /* waits between attempts: 1, 2, 4, 8 s */
+#define HOOK_THREADS 4            /* deliveries at once: a dead listener holds one */
+#define HOOK_MAX_QUEUED 1024      /* notes waiting; past it the oldest is dropped (logged) */
+#define HOOK_MAX_BODY (6 * (2 * PROTO_MAX_STRING + AUTH_MAX_USER) + 512) /* a note, every string escaped at worst */
+typedef struct hook_url {
+    char host[CONF_HOST];
+    char port[8];
+    char path[CONF_PATH];
+} hook_url;
+/* http://HOST[:PORT][/PATH] (port 80 by default; HOST a name, an IPv4
+ * address or [IPv6]): 0, or -1 with why (https and other schemes are
+ * refused). */
+int hook_url_parse(const char *url, hook_url *out, char *err, size_t errsz);
+/* Starts the delivery threads: 0 or -1. */
+int hook_start(mcd *d);
+/* Loop thread: job id has ended (its state is in the store): a note is
+ * queued when its user has a --notify-url. Never blocks. */
+void hook_job_ended(mcd *d, uint64_t id);
+/* After the loop: the threads stop (a delivery in progress ends within
+ * HOOK_TIMEOUT_S); notes still queued are dropped, counted in the log. */
+void hook_stop(void);
 
 /* ---- notify_ -------------------------------------------------------------- */
 void notify_ready(mcd *d);        /* READY=1 and the first STATUS=; starts the timer */
@@ -650,6 +747,11 @@ typedef struct conn_auth {
     int by_token;                 /* logged in with a token: its hash follows (SIGHUP checks it) */
     uint8_t token_hash[AUTH_HASH_LEN];
 } conn_auth;
+/* A TCP peer's name for logs and the per-address counts (conn_auth.peer):
+ * the IPv4 address, or an IPv6 address's /64; "?" for another family.
+ * Any thread. */
+struct sockaddr;
+void srv_peer_name(const struct sockaddr *sa, char out[SRV_MAX_PEER]);
 conn_auth *srv_conn_auth(conn *c);
 mcd *srv_conn_daemon(conn *c);
 int srv_conn_fd(conn *c);

@@ -2,7 +2,7 @@
  * USER: it resolves USER first, creates the state directory for USER (or
  * takes over an empty one), opens the job store and sets the backend up
  * with USER as its effective user (so every file it creates is USER's),
- * binds its listeners (--listen, --modbus, --metrics) as root, then drops
+ * binds its listeners (--listen, --modbus, --http) as root, then drops
  * to USER for good (setgroups, setgid, setuid) and checks that root cannot
  * be regained. Everything after that, the workers and validators it starts
  * included, runs as USER. Started as anyone else it runs as that user;

@@ -76,15 +76,17 @@ static void on_sighup(uv_signal_t *h, int sig)
         dlog_set_level(d->conf.log_level);
         job_sweep_start(d);   /* result-ttl may have changed: sweep now, then at its period */
         dlog(DLOG_INFO, "reload: options applied");
-        if (tls_reload(d) && d->metrics && metrics_set_tls(d->metrics, d->tls, err, sizeof err) != 0)
-            dlog(DLOG_ERROR, "reload: %s: --metrics keeps the running certificate", err);
+        if (tls_reload(d) && d->http && http_set_tls(d->http, d->tls, err, sizeof err) != 0)
+            dlog(DLOG_ERROR, "reload: %s: --http keeps the running certificate", err);
     }
     auth_tokens *t = NULL;
     if (auth_tokens_load(d->conf.tokens, &t, err, sizeof err) != 0) {
         dlog(DLOG_ERROR, "reload: %s: keeping the previous tokens", err);
     } else {
-        auth_tokens_free(d->tokens);
+        auth_tokens *old = d->tokens;
         d->tokens = t;
+        http_set_tokens(d->http, t);      /* the web's logins stop reading the old table */
+        auth_tokens_free(old);
         dlog(DLOG_INFO, "reload: tokens read from %s", auth_tokens_path(t)[0] ? auth_tokens_path(t) : "(none)");
         srv_note_tokens(d);
     }

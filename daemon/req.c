@@ -748,16 +748,13 @@ static void on_cancel(conn *c, const proto_msg *m)
     store_job j;
     if (visible_job(c, m->request_id, m->u.cancel.job_id, &j))
         return;
-    if (!store_is_terminal(j.state) && bk_cancel(d, j.id) == 0) {
-        /* the backend has it (running, or queued in Slurm) and stops it */
-        dlog(DLOG_INFO, "job %llu: cancel requested from the %s backend", (unsigned long long)j.id, bk_name(d));
-    } else if (j.state == PROTO_STATE_PENDING) {
-        if (job_cancel_pending(d, j.id)) {
-            srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure cancelling job %llu",
-                           (unsigned long long)j.id);
-            return;
-        }
-    } else {
+    int rc = job_cancel(d, &j);
+    if (rc == PROTO_ESTORAGE) {
+        srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure cancelling job %llu",
+                       (unsigned long long)j.id);
+        return;
+    }
+    if (rc) {
         srv_send_error(c, m->request_id, PROTO_EBAD_STATE, "job %llu is %s: nothing to cancel",
                        (unsigned long long)j.id, proto_state_name(j.state));
         return;

@@ -154,6 +154,30 @@ int64_t sched_ahead(const sched *s, uint64_t id)
     return n;
 }
 
+static int order_cmp(const void *x, const void *y, void *ctx)
+{
+    const sched *s = ctx;
+    const sched_entry *a = x, *b = y;
+    return before(s, a, b) ? -1 : before(s, b, a) ? 1 : 0;
+}
+
+/* before() is a lexicographic order (priority, the user's running count
+ * and last start, id), so a job's index in the sorted queue is its
+ * sched_ahead. */
+uint32_t sched_order(const sched *s, uint64_t *ids, uint32_t max)
+{
+    sched_entry *tmp = s->nq ? malloc(s->nq * sizeof *tmp) : NULL;
+    if (!tmp)
+        return 0;
+    memcpy(tmp, s->q, s->nq * sizeof *tmp);
+    qsort_r(tmp, s->nq, sizeof *tmp, order_cmp, (void *)s);
+    uint32_t n = s->nq < max ? (uint32_t)s->nq : max;
+    for (uint32_t i = 0; i < n; i++)
+        ids[i] = tmp[i].id;
+    free(tmp);
+    return n;
+}
+
 void sched_done(sched *s, const char *user)
 {
     int u = find_user(s, user);
@@ -164,6 +188,16 @@ void sched_done(sched *s, const char *user)
 uint32_t sched_queued(const sched *s)
 {
     return (uint32_t)s->nq;
+}
+
+int sched_user_at(const sched *s, uint32_t i, const char **name, uint32_t *pending, uint32_t *running)
+{
+    if (i >= s->nusers)
+        return -1;
+    *name = s->users[i].name;
+    *pending = s->users[i].pending;
+    *running = s->users[i].running;
+    return 0;
 }
 
 uint32_t sched_user_pending(const sched *s, const char *user)

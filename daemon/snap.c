@@ -1,6 +1,8 @@
 /* snap.c — the status snapshot: queue depth, running jobs, end counters,
- * worker slots and each running job's latest progress, computed in one
- * place (snap_collect) for STATS and for the dashboards (mbus.c, metrics.c).
+ * worker slots, each running job's latest progress, the queue's order
+ * (positions for the web pages), each user's pending and running jobs and
+ * the histograms of run durations and queue waits, computed in one
+ * place (snap_collect) for STATS and for the dashboards (mbus.c, http.c).
  *
  * DESIGN: the loop thread owns the daemon's state; the dashboard servers run
  * in threads of their own and must never touch it. Every SNAP_PERIOD_MS the
@@ -35,6 +37,7 @@ struct snap {
     mcd_snapshot *scratch;
     uv_timer_t timer;
     int timer_open;
+    snap_hist duration, wait;
     struct timespec t0;
     uint32_t seq;
     /* shared: under mu */
@@ -132,6 +135,19 @@ void snap_collect(mcd *d, mcd_snapshot *out)
     out->workers = n;
     out->running = running;
     out->queued = sched_queued(d->sched);
+    out->nqueue = sched_order(d->sched, out->queue, SNAP_MAX_QUEUE);
+    out->duration = d->snap->duration;
+    out->wait = d->snap->wait;
+    out->nusers = 0;
+    const char *name;
+    uint32_t pending, run;
+    for (uint32_t i = 0; out->nusers < SNAP_MAX_USERS && sched_user_at(d->sched, i, &name, &pending, &run) == 0; i++)
+        if (pending || run) {
+            snap_user *u = &out->users[out->nusers++];
+            snprintf(u->name, sizeof u->name, "%s", name);
+            u->pending = pending;
+            u->running = run;
+        }
     store_counters(d->store, &out->completed, &out->failed, &out->cancelled);
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -181,6 +197,29 @@ int snap_init(mcd *d, char *err, size_t errsz)
     s->timer_open = 1;
     uv_timer_start(&s->timer, on_timer, SNAP_PERIOD_MS, SNAP_PERIOD_MS);
     return 0;
+}
+
+static void observe(snap_hist *h, double s)
+{
+    static const double bounds[SNAP_NBUCKETS] = SNAP_BUCKETS;
+    int b = 0;
+    while (b < SNAP_NBUCKETS && s > bounds[b])
+        b++;
+    h->bucket[b]++;
+    h->count++;
+    h->sum += s;
+}
+
+void snap_job_started(mcd *d, double wait_s)
+{
+    if (d->snap)
+        observe(&d->snap->wait, wait_s);
+}
+
+void snap_job_ended(mcd *d, double run_s)
+{
+    if (d->snap)
+        observe(&d->snap->duration, run_s);
 }
 
 void snap_close(mcd *d)

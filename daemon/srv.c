@@ -670,12 +670,17 @@ static void peer_of(conn *c)
     }
     struct sockaddr_storage sa;
     int len = sizeof sa;
-    if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) != 0)
-        return;
-    if (sa.ss_family == AF_INET) {
-        inet_ntop(AF_INET, &((struct sockaddr_in *)&sa)->sin_addr, out, SRV_MAX_PEER);
-    } else if (sa.ss_family == AF_INET6) {
-        struct in6_addr a = ((struct sockaddr_in6 *)&sa)->sin6_addr;
+    if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) == 0)
+        srv_peer_name((const struct sockaddr *)&sa, out);
+}
+
+void srv_peer_name(const struct sockaddr *sa, char out[SRV_MAX_PEER])
+{
+    snprintf(out, SRV_MAX_PEER, "?");
+    if (sa->sa_family == AF_INET) {
+        inet_ntop(AF_INET, &((const struct sockaddr_in *)sa)->sin_addr, out, SRV_MAX_PEER);
+    } else if (sa->sa_family == AF_INET6) {
+        struct in6_addr a = ((const struct sockaddr_in6 *)sa)->sin6_addr;
         if (IN6_IS_ADDR_V4MAPPED(&a)) {
             inet_ntop(AF_INET, &a.s6_addr[12], out, SRV_MAX_PEER);
             return;

@@ -142,7 +142,7 @@ int store_is_terminal(int state)
     return state != PROTO_STATE_PENDING && state != PROTO_STATE_RUNNING;
 }
 
-static int state_from_name(const char *s)
+int store_state_of(const char *s)
 {
     for (int i = 0; i <= PROTO_STATE_LAST; i++)
         if (strcmp(s, proto_state_name(i)) == 0)
@@ -674,7 +674,7 @@ static void read_job(sqlite3_stmt *st, store_job *j)
     snprintf(j->user, sizeof j->user, "%s", (const char *)sqlite3_column_text(st, 1));
     snprintf(j->label, sizeof j->label, "%s", (const char *)sqlite3_column_text(st, 2));
     j->priority = (int32_t)sqlite3_column_int64(st, 3);
-    j->state = state_from_name((const char *)sqlite3_column_text(st, 4));
+    j->state = store_state_of((const char *)sqlite3_column_text(st, 4));
     snprintf(j->reason, sizeof j->reason, "%s", (const char *)sqlite3_column_text(st, 5));
     j->submit_ms = sqlite3_column_int64(st, 6);
     j->start_ms = sqlite3_column_int64(st, 7);

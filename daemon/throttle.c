@@ -8,16 +8,19 @@
  * HELLO is answered without looking at its token, so while an address
  * waits it learns nothing, however fast it asks. A successful login resets
  * nothing: one good account does not buy more guesses. Other addresses are
- * never affected.
+ * never affected. The web UI's logins (web.c) count and wait in the same
+ * table as HELLOs.
  *
  * The log names the address: the first failure of a burst at once, then
  * one line per THROTTLE_LOG_PERIOD_S summing up what came since, so a
  * flood costs a line every few seconds, not one per try. State is a fixed
- * table in this file (one loop thread); an address nobody needs to
+ * table in this file under a mutex (the loop thread and the HTTP server's
+ * thread both call in); an address nobody needs to
  * remember any more (bucket full, not refused, nothing to log) leaves it,
  * and a full table forgets the quietest address first. */
 #include "mcd.h"
 
+#include <pthread.h>
 #include <string.h>
 
 typedef struct entry {
@@ -34,6 +37,7 @@ typedef struct entry {
 } entry;
 
 static entry table[THROTTLE_MAX_ADDRS];
+static pthread_mutex_t mu = PTHREAD_MUTEX_INITIALIZER;
 
 static void refill(entry *e, uint64_t now)
 {
@@ -84,12 +88,12 @@ static void write_line(entry *e, uint64_t now)
         return;
     char wait[96] = "";
     if (e->blocked_until_ms > now)
-        snprintf(wait, sizeof wait, "; its HELLOs are refused for %llu s more",
+        snprintf(wait, sizeof wait, "; its logins are refused for %llu s more",
                  (unsigned long long)((e->blocked_until_ms - now + 999) / 1000));
     if (n == 1 && e->failed == 1)
-        dlog(DLOG_WARN, "HELLO from %s refused: %s (client '%s')%s", e->peer, e->why, e->client, wait);
+        dlog(DLOG_WARN, "login from %s refused: %s (client '%s')%s", e->peer, e->why, e->client, wait);
     else
-        dlog(DLOG_WARN, "%u failed HELLOs from %s in the last %.0f s (%u token(s) checked and wrong, %u refused "
+        dlog(DLOG_WARN, "%u failed logins from %s in the last %.0f s (%u token(s) checked and wrong, %u refused "
              "unchecked: too many failed logins; first client '%s')%s", n, e->peer,
              e->logged_ms ? (double)(now - e->logged_ms) / 1000.0 : 0.0, e->failed, e->refused, e->client, wait);
     e->logged_ms = now;
@@ -107,16 +111,21 @@ static void note(entry *e, uint64_t now)
 
 uint32_t throttle_check(const char *peer, uint64_t now_ms)
 {
+    pthread_mutex_lock(&mu);
+    uint32_t wait = 0;
     entry *e = find(peer);
-    if (!e || e->blocked_until_ms <= now_ms)
-        return 0;
-    e->refused++;
-    note(e, now_ms);
-    return (uint32_t)((e->blocked_until_ms - now_ms + 999) / 1000);
+    if (e && e->blocked_until_ms > now_ms) {
+        e->refused++;
+        note(e, now_ms);
+        wait = (uint32_t)((e->blocked_until_ms - now_ms + 999) / 1000);
+    }
+    pthread_mutex_unlock(&mu);
+    return wait;
 }
 
 void throttle_fail(const char *peer, const char *client, const char *why, uint64_t now_ms)
 {
+    pthread_mutex_lock(&mu);
     entry *e = find(peer);
     if (!e)
         e = add(peer, now_ms);
@@ -138,10 +147,12 @@ void throttle_fail(const char *peer, const char *client, const char *why, uint64
         snprintf(e->why, sizeof e->why, "%s", why);
     }
     note(e, now_ms);
+    pthread_mutex_unlock(&mu);
 }
 
 void throttle_sweep(uint64_t now_ms)
 {
+    pthread_mutex_lock(&mu);
     for (int i = 0; i < THROTTLE_MAX_ADDRS; i++) {
         entry *e = &table[i];
         if (!e->peer[0])
@@ -152,4 +163,5 @@ void throttle_sweep(uint64_t now_ms)
         if (e->tokens >= THROTTLE_FREE_FAILS && e->blocked_until_ms <= now_ms && e->failed + e->refused == 0)
             e->peer[0] = '\0';
     }
+    pthread_mutex_unlock(&mu);
 }

@@ -22,6 +22,7 @@ libsystemd-dev systemd
 libgnutls28-dev gnutls-bin
 libseccomp-dev
 mandoc man-db python3-prometheus-client
+chromium chromium-driver python3-selenium python3-yaml
 libpng-dev
 python3 python3-numpy python3-setuptools python3-pip python3-venv python3-wheel
 "

@@ -14,6 +14,7 @@
 #define SPOOL_SECRET_FILE   "progress.secret"  /* the Slurm worker's progress secret (daemon, 0600) */
 #define SPOOL_SLURM_OUT     "slurm.out"        /* the Slurm job's output */
 #define SPOOL_WORKER_LOCK   "worker.lock"      /* flock held by the job's worker process (local daemon) */
+#define SPOOL_PICTURE       "map.png"          /* the picture of a completed job's map (meshcorr-worker --picture, for the web) */
 #define SPOOL_TMP_SUFFIX    ".tmp"             /* NAME.tmp, fsynced, renamed to NAME */
 
 /* the worker's exit statuses */

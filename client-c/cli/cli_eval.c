@@ -110,66 +110,22 @@ out:
     return rc;
 }
 
-/* What the picture shows, for its captions: the files, the map's quality
- * and (gt_points > 0) its mean geodesic error. */
-typedef struct png_words {
-    const char *spath, *tpath, *ppath;
-    double flipped, collapsed, gt_mean;
-    int gt_points, folds;
-} png_words;
-
-/* The last part of a path: captions name files, not folders. */
 static const char *base_name(const char *path)
 {
     const char *s = strrchr(path, '/');
     return s && s[1] ? s + 1 : path;
 }
 
-/* FILE: the source coloured through P beside the target coloured by
- * position (render_map_picture), the source turned to face as its images
- * P·X̃ do, with captions saying which side is which, which map and how
- * good it is; folds: hatch P's flipped and collapsed source faces. */
-static int write_png(const char *path, const mesh *S, const mesh *T, const bmap *P, const png_words *w)
+/* FILE: render_map_png's picture of P, captioned with the files' names. */
+static int write_png(const char *path, const mesh *S, const mesh *T, const bmap *P, render_map_words *w)
 {
     char err[1024];
-    int rc = RENDER_ENOMEM;
-    unsigned char *trgb = malloc(3 * (size_t)T->nv + 1), *srgb = malloc(3 * (size_t)S->nv + 1);
-    unsigned char *kind = w->folds ? malloc((size_t)S->nf + 1) : NULL;
-    double *img = malloc(sizeof(double) * 3 * (size_t)S->nv + 1);
-    render_image *im = NULL, *pic = NULL;
-    if (!trgb || !srgb || !img || (w->folds && (!kind || metric_fold_faces(S, T, P, kind) < 0)))
-        goto fail;
-    viz_position_colors(T, trgb);
-    viz_pull_colors(P, T->f, trgb, srgb);
-    bmap_apply(P, T->f, T->v, 3, img);
-    if ((rc = render_map_picture(S, srgb, kind, img, T, trgb, EVAL_PNG_PANEL, &pic)))
-        goto fail;
-    char src[600], tgt[600], map[600], quality[200], error[200] = "";
-    snprintf(src, sizeof src, "source: %s", base_name(w->spath));
-    snprintf(tgt, sizeof tgt, "target: %s", base_name(w->tpath));
-    snprintf(map, sizeof map, "map: %s", base_name(w->ppath));
-    snprintf(quality, sizeof quality, "source triangles flipped %.2f %%, collapsed %.2f %%%s", 100 * w->flipped,
-             100 * w->collapsed, w->folds ? " (hatched)" : "");
-    if (w->gt_points > 0)
-        snprintf(error, sizeof error, "geodesic error: mean %.4f of sqrt(area), %d points", w->gt_mean,
-                 w->gt_points);
-    render_caption cap = {{src, "coloured through the map"}, {tgt, "coloured by position"},
-                          {map, quality, w->gt_points > 0 ? error : "top: the target's widest side; bottom: from behind",
-                           w->gt_points > 0 ? "top: the target's widest side; bottom: from behind" : NULL}};
-    if ((rc = render_captioned(pic, &cap, &im)))
-        goto fail;
-    if ((rc = render_png_write(im, path, err, sizeof err)))
+    w->source = base_name(w->source);
+    w->target = base_name(w->target);
+    w->map = base_name(w->map);
+    int rc = render_map_png(path, S, T, P, w, EVAL_PNG_PANEL, err, sizeof err);
+    if (rc)
         fprintf(stderr, "meshcorr eval: %s\n", err);
-    goto out;
-fail:
-    fprintf(stderr, "meshcorr eval: %s: %s\n", path, render_strerror(rc));
-out:
-    render_image_free(pic);
-    render_image_free(im);
-    free(img);
-    free(kind);
-    free(trgb);
-    free(srgb);
     return rc;
 }
 
@@ -318,7 +274,7 @@ int cli_eval(int argc, char **argv)
             gsrc[k] = k;
     }
     double curves[EVAL_MAX_MAPS][EVAL_CURVE_STEPS], gmean[EVAL_MAX_MAPS];
-    png_words words = {spath, tpath, ppaths[0], NAN, NAN, NAN, 0, folds};
+    render_map_words words = {spath, tpath, ppaths[0], NAN, NAN, NAN, 0, folds};
     if (gt) {
         if (geod_solver_new(T, 0, &gs, err, sizeof err)) {
             fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);

@@ -1,9 +1,10 @@
 /* render.h — offscreen pictures of meshes for a person to open anywhere: a
  * small z-buffered rasteriser (orthographic, flat two-sided Lambert shading
  * of per-vertex colours, supersampled) and a PNG writer (libpng). This is
- * the CLI's concern, not the engine's: the module is linked into `meshcorr`
- * and the tests only, never into libmeshcorr, so libpng stays out of the
- * client library's dependencies.
+ * the CLI's concern, not the engine's: the module is linked into `meshcorr`,
+ * into `meshcorr-worker` (its --picture for the web UI) and the tests only,
+ * never into libmeshcorr, so libpng stays out of the client library's
+ * dependencies.
  *
  * Images are h rows of w RGB pixels (3 bytes each), top row first.
  * Ownership: render_image_new and render_map_picture return an image the
@@ -13,6 +14,7 @@
 #ifndef RENDER_H
 #define RENDER_H
 #include <stddef.h>
+#include "map/bmap.h"
 #include "mesh/mesh.h"
 
 #define RENDER_MAX_SIDE 8192      /* pixels per image side */
@@ -127,5 +129,22 @@ int render_caption_bottom(int w);
 /* Writes im as an 8-bit RGB PNG. RENDER_EPNG with the file and libpng's
  * message in err. */
 int render_png_write(const render_image *im, const char *path, char *err, size_t errsz);
+
+/* What a map picture's captions say (render_map_png): the names of the
+ * source, target and map, the map's flipped and collapsed fractions (NaN:
+ * not known), and, gt_points > 0, its mean geodesic error; folds: P's
+ * flipped and collapsed source faces are hatched. */
+
+typedef struct render_map_words {
+    const char *source, *target, *map;
+    double flipped, collapsed, gt_mean;
+    int gt_points, folds;
+} render_map_words;
+/* path: S coloured through P beside T coloured by position
+ * (render_map_picture with panel pixels per panel side), captioned
+ * (render_captioned), as a PNG. 0, or a RENDER_E* code with the file and
+ * why in err. */
+int render_map_png(const char *path, const mesh *S, const mesh *T, const bmap *P, const render_map_words *w,
+                   int panel, char *err, size_t errsz);
 
 #endif

@@ -83,10 +83,10 @@ TEST_T(a_token_guessing_loop_is_slowed_to_a_few_tries_and_logged_with_its_addres
 
     /* the log names the address: the first failure at once, then a sum,
      * never a line per try */
-    CHECK(testdaemon_log_has(&d, "HELLO from 127.0.0.1 refused: unknown token (client 'guesser')"));
-    for (int i = 0; i < 750 && !testdaemon_log_has(&d, "failed HELLOs from 127.0.0.1 in the last"); i++)
+    CHECK(testdaemon_log_has(&d, "login from 127.0.0.1 refused: unknown token (client 'guesser')"));
+    for (int i = 0; i < 750 && !testdaemon_log_has(&d, "failed logins from 127.0.0.1 in the last"); i++)
         testdaemon_sleep_ms(20);
-    CHECK(testdaemon_log_has(&d, "failed HELLOs from 127.0.0.1 in the last"));
+    CHECK(testdaemon_log_has(&d, "failed logins from 127.0.0.1 in the last"));
     int lines = log_count(&d, "127.0.0.1");
     printf("  %d log lines (debug lines aside) name 127.0.0.1\n", lines);
     CHECK(lines <= 6);

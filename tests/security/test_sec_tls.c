@@ -621,16 +621,15 @@ TEST(certificate_and_key_errors_stop_the_start_naming_the_file)
     CHECK_STR_HAS(out, "does not belong to the certificate in --tls-cert");
 }
 
-/* GET /metrics over TLS from 127.0.0.1:port, trusting ca for localhost:
- * the handshake's result, and the response into resp. */
-static int https_get(int port, const char *ca, char *resp, size_t sz)
+/* req (a whole HTTP request) over TLS to 127.0.0.1:port, trusting ca for
+ * localhost: the handshake's result, and the response into resp. */
+static int https_ask(int port, const char *ca, const char *req, char *resp, size_t sz)
 {
     dial t;
     resp[0] = '\0';
     int rc = tls_dial(&t, port, "NORMAL", ca, "localhost");
     if (rc == 0) {
-        static const char req[] = "GET /metrics HTTP/1.0\r\nHost: localhost\r\n\r\n";
-        CHECK(gnutls_record_send(t.s, req, sizeof req - 1) == (ssize_t)sizeof req - 1);
+        CHECK(gnutls_record_send(t.s, req, strlen(req)) == (ssize_t)strlen(req));
         size_t n = 0;
         ssize_t r;
         while (n + 1 < sz && (r = gnutls_record_recv(t.s, resp + n, sz - 1 - n)) > 0)
@@ -641,7 +640,13 @@ static int https_get(int port, const char *ca, char *resp, size_t sz)
     return rc;
 }
 
-TEST(metrics_are_served_over_https_with_the_same_certificate)
+/* GET /metrics over TLS (https_ask). */
+static int https_get(int port, const char *ca, char *resp, size_t sz)
+{
+    return https_ask(port, ca, "GET /metrics HTTP/1.0\r\nHost: localhost\r\n\r\n", resp, sz);
+}
+
+TEST(metrics_and_web_logins_are_served_over_https_with_the_same_certificate)
 {
     testtls t;
     testtls_make(&t, "certs");
@@ -667,6 +672,14 @@ TEST(metrics_are_served_over_https_with_the_same_certificate)
     CHECK(n >= 0);
     resp[n] = '\0';
     CHECK(strstr(resp, "meshcorr_queue_depth") == NULL);
+    /* the web's login over HTTPS: its session cookie is Secure */
+    char login[256];
+    snprintf(login, sizeof login, "POST /login HTTP/1.0\r\nHost: localhost\r\nContent-Length: %zu\r\n\r\ntoken=%s",
+             strlen("token=") + strlen(TESTDAEMON_ALICE), TESTDAEMON_ALICE);
+    CHECK_INT(https_ask(mport, t.ca, login, resp, sizeof resp), 0);
+    CHECK_STR_HAS(resp, "HTTP/1.1 303");
+    CHECK_STR_HAS(resp, "mc_session=");
+    CHECK_STR_HAS(resp, "HttpOnly; SameSite=Strict; Secure");
     testdaemon_stop(&d, SIGTERM);
 }
 
@@ -712,7 +725,7 @@ TEST_T(sighup_serves_a_renewed_certificate_and_keeps_the_old_one_when_the_new_is
     replace_file(key, key2);
     kill(d.pid, SIGHUP);
     wait_log(&d, "reload: TLS certificate and key read again");
-    wait_log(&d, "reload: metrics serve the new certificate");
+    wait_log(&d, "reload: --http serves the new certificate");
     expect_tls_refusal(addr, t.ca, "not trusted");       /* new connections get the renewed one */
     mc_client *after = tls_client(addr, t.other_ca);
     CHECK_INT(mc_ping(after), 0);

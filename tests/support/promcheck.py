@@ -5,7 +5,9 @@ prometheus_client.parser.text_string_to_metric_families) and against the
 naming conventions: every family has HELP and TYPE, counters end in _total
 and gauges do not, times are _seconds and sizes _bytes, names and labels are
 snake_case under the meshcorr_ prefix, no label Prometheus reserves (job,
-instance, __*), no series twice, values numbers (counters finite, >= 0).
+instance, __*; le only on a histogram's buckets), no series twice, values
+numbers (counters finite, >= 0), histograms' buckets cumulative with +Inf
+equal to their _count.
 
 usage: promcheck.py FILE... [--expect NAME]...
 Prints one line per problem on stderr; exit 0 when there is none, 1 when
@@ -66,8 +68,8 @@ def check_text(path, text, problems, seen_families):
         if fam.type in ("untyped", "unknown"):
             bad("%s has no TYPE (or samples outside their family)" % name)
             continue
-        if fam.type not in ("counter", "gauge"):
-            bad("%s has type %s, not counter or gauge" % (name, fam.type))
+        if fam.type not in ("counter", "gauge", "histogram"):
+            bad("%s has type %s, not counter, gauge or histogram" % (name, fam.type))
         if name not in declared and fam.type == "counter":
             bad("counter %s does not end in _total" % fam.name)
         elif name not in declared:
@@ -85,10 +87,15 @@ def check_text(path, text, problems, seen_families):
         if any(w in words for w in SIZE_WORDS) and not name.endswith(
                 ("_bytes", "_bytes_total")):
             bad("%s is a size but does not end in _bytes" % name)
+        if fam.type == "histogram":
+            check_histogram(name, fam.samples, bad)
         for s in fam.samples:
-            if s.name != name:
+            hist = fam.type == "histogram"
+            if s.name != name and not (hist and s.name in (name + "_bucket", name + "_sum", name + "_count")):
                 bad("sample %s in family %s" % (s.name, name))
             for k in s.labels:
+                if hist and k == "le" and s.name == name + "_bucket":
+                    continue
                 if k in RESERVED_LABELS or k.startswith("__") or not LABEL.match(k):
                     bad("%s: label %r is reserved by Prometheus or not snake_case"
                         % (name, k))
@@ -100,6 +107,27 @@ def check_text(path, text, problems, seen_families):
                 bad("%s: value %r is not a number" % (s.name, s.value))
             elif fam.type == "counter" and (not math.isfinite(s.value) or s.value < 0):
                 bad("counter %s has value %r" % (s.name, s.value))
+
+
+def check_histogram(name, samples, bad):
+    """Buckets in increasing le, counts cumulative, +Inf last and equal to
+    _count; _sum and _count present."""
+    buckets = [(s.labels.get("le"), s.value) for s in samples if s.name == name + "_bucket"]
+    count = [s.value for s in samples if s.name == name + "_count"]
+    if not buckets or buckets[-1][0] != "+Inf":
+        bad("histogram %s has no +Inf bucket last" % name)
+        return
+    if len(count) != 1 or not [s for s in samples if s.name == name + "_sum"]:
+        bad("histogram %s lacks _sum or _count" % name)
+        return
+    bounds = [float(le) for le, _ in buckets]
+    if bounds != sorted(bounds):
+        bad("histogram %s: buckets not in increasing le" % name)
+    values = [v for _, v in buckets]
+    if values != sorted(values):
+        bad("histogram %s: bucket counts not cumulative" % name)
+    if values[-1] != count[0]:
+        bad("histogram %s: +Inf bucket %r differs from _count %r" % (name, values[-1], count[0]))
 
 
 def main(argv):

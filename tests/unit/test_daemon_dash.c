@@ -541,7 +541,7 @@ TEST_T(modbus_refuses_writes_and_junk_and_keeps_serving, 60)
 /* ---- /metrics --------------------------------------------------------------- */
 
 /* GET (or method) path over a raw socket: the status code; the body into body. */
-static int http(int port, const char *method, const char *path, char *body, size_t bsz)
+static int http_ask(int port, const char *method, const char *path, char *body, size_t bsz)
 {
     int fd = tcp_connect(port);
     char req[256];
@@ -578,7 +578,7 @@ static int parse_metrics(char *text, sample *out, int max)
             continue;
         }
         if (sscanf(line, "# TYPE %127s %31s", name, kind) == 2) {
-            CHECK(!strcmp(kind, "gauge") || !strcmp(kind, "counter"));
+            CHECK(!strcmp(kind, "gauge") || !strcmp(kind, "counter") || !strcmp(kind, "histogram"));
             CHECK(nt < 64);
             snprintf(type[nt++], 128, "%s", name);
             continue;
@@ -607,11 +607,22 @@ static int parse_metrics(char *text, sample *out, int max)
         s->value = strtod(rest + 1, &end);
         if (end == rest + 1 || *end != '\0' || !isfinite(s->value))
             FAILF("sample value not numeric: %s", line);
+        /* a histogram's samples are its family's name with _bucket, _sum, _count */
+        char fam[128];
+        snprintf(fam, sizeof fam, "%s", s->name);
+        static const char *const parts[] = {"_bucket", "_sum", "_count"};
+        for (int p = 0; p < 3; p++) {
+            size_t fl = strlen(fam), pl = strlen(parts[p]);
+            if (fl > pl && !strcmp(fam + fl - pl, parts[p]) && strstr(fam, "_seconds")) {
+                fam[fl - pl] = '\0';
+                break;
+            }
+        }
         int h = 0, t = 0;
         for (int i = 0; i < nh; i++)
-            h |= !strcmp(help[i], s->name);
+            h |= !strcmp(help[i], s->name) || !strcmp(help[i], fam);
         for (int i = 0; i < nt; i++)
-            t |= !strcmp(type[i], s->name);
+            t |= !strcmp(type[i], s->name) || !strcmp(type[i], fam);
         if (!h || !t)
             FAILF("%s has no # HELP or # TYPE before it", s->name);
     }
@@ -638,7 +649,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
     static char body[1 << 16];
     static sample s[256];
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     mc_server_stats st;
     CHECK_INT(mc_stats(x.c, &st), 0);
     int n = parse_metrics(body, s, 256);
@@ -672,7 +683,7 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(mc_cancel(x.c, x.job), 0);
     testdaemon_wait_state(x.c, x.job, MC_CANCELLED, 30);
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     CHECK_INT(mc_stats(x.c, &st), 0);
     n = parse_metrics(body, s, 256);
     CHECK_INT(st.cancelled, 2);
@@ -682,11 +693,12 @@ TEST_T(metrics_endpoint_is_prometheus_text_matching_stats, 90)
     CHECK_INT(metric(s, n, "meshcorr_slot_state", "slot=\"0\",job_id=\"0\""), 0);
     mc_stats_free(&st);
 
-    /* other paths and methods */
-    CHECK_INT(http(x.metrics, "GET", "/", body, sizeof body), 404);
-    CHECK_INT(http(x.metrics, "GET", "/metricsx", body, sizeof body), 404);
-    CHECK_INT(http(x.metrics, "POST", "/metrics", body, sizeof body), 405);
-    CHECK_INT(http(x.metrics, "DELETE", "/metrics", body, sizeof body), 405);
+    /* other paths and methods: / is the web UI, which sends a browser
+     * without a session to its login page */
+    CHECK_INT(http_ask(x.metrics, "GET", "/", body, sizeof body), 303);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metricsx", body, sizeof body), 404);
+    CHECK_INT(http_ask(x.metrics, "POST", "/metrics", body, sizeof body), 405);
+    CHECK_INT(http_ask(x.metrics, "DELETE", "/metrics", body, sizeof body), 405);
     mc_close(x.c);
     testdaemon_stop(&x.d, SIGTERM);
 }
@@ -705,7 +717,7 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
     dash x;
     dash_start(&x, "promparse");
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     snprintf(files[0], sizeof files[0], "%s", testfile_text("idle.prom", body));
 
     x.job = testdaemon_submit_ok(x.c, 1000, 1, 0);      /* runs until cancelled */
@@ -720,7 +732,7 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
     }
     CHECK(st.has_progress && st.progress.stage == PROTO_STAGE_ECTM);
     testdaemon_sleep_ms(2 * SNAP_PERIOD_MS);
-    CHECK_INT(http(x.metrics, "GET", "/metrics", body, sizeof body), 200);
+    CHECK_INT(http_ask(x.metrics, "GET", "/metrics", body, sizeof body), 200);
     snprintf(files[1], sizeof files[1], "%s", testfile_text("running.prom", body));
     CHECK_STR_HAS(body, "meshcorr_slot_energy{");
     CHECK_INT(mc_cancel(x.c, x.job), 0);
@@ -733,7 +745,9 @@ TEST_T(metrics_pass_prometheus_own_parser_idle_and_running, 120)
              " --expect meshcorr_slot_state --expect meshcorr_slot_elapsed_seconds --expect meshcorr_slot_stage"
              " --expect meshcorr_slot_outer_iteration --expect meshcorr_slot_total_iterations"
              " --expect meshcorr_slot_progress_ratio --expect meshcorr_slot_eta_seconds"
-             " --expect meshcorr_slot_energy --expect meshcorr_slot_beta",
+             " --expect meshcorr_slot_energy --expect meshcorr_slot_beta --expect meshcorr_build_info"
+             " --expect meshcorr_user_queue_depth --expect meshcorr_user_running_jobs"
+             " --expect meshcorr_job_duration_seconds --expect meshcorr_job_queue_wait_seconds",
              files[0], files[1]);
     int rc = promcheck(args, report, sizeof report);
     if (rc != 0)
@@ -755,6 +769,10 @@ TEST(promcheck_refuses_texts_that_break_the_conventions)
         {"# HELP meshcorr_slot_state S.\n# TYPE meshcorr_slot_state gauge\nmeshcorr_slot_state{job=\"1\"} 1\n",
          "label 'job'"},
         {"# HELP meshcorr_workers W.\n# TYPE meshcorr_workers gauge\nmeshcorr_workers one\n", "parser refuses"},
+        {"# HELP meshcorr_wait_seconds W.\n# TYPE meshcorr_wait_seconds histogram\n"
+         "meshcorr_wait_seconds_bucket{le=\"1\"} 3\nmeshcorr_wait_seconds_bucket{le=\"+Inf\"} 2\n"
+         "meshcorr_wait_seconds_sum 1\nmeshcorr_wait_seconds_count 2\n", "not cumulative"},
+        {"# HELP meshcorr_workers W.\n# TYPE meshcorr_workers gauge\nmeshcorr_workers{le=\"1\"} 1\n", "label 'le'"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         int rc = promcheck(testfile_text("bad.prom", bad[i].text), report, sizeof report);
@@ -762,7 +780,10 @@ TEST(promcheck_refuses_texts_that_break_the_conventions)
             FAILF("promcheck.py on\n%s: exit %d, wanted 1 and \"%s\":\n%s", bad[i].text, rc, bad[i].finding, report);
     }
     const char *good = "# HELP meshcorr_jobs_total Jobs.\n# TYPE meshcorr_jobs_total counter\n"
-                       "meshcorr_jobs_total{state=\"failed\"} 0\n";
+                       "meshcorr_jobs_total{state=\"failed\"} 0\n"
+                       "# HELP meshcorr_wait_seconds W.\n# TYPE meshcorr_wait_seconds histogram\n"
+                       "meshcorr_wait_seconds_bucket{le=\"1\"} 1\nmeshcorr_wait_seconds_bucket{le=\"+Inf\"} 2\n"
+                       "meshcorr_wait_seconds_sum 3.5\nmeshcorr_wait_seconds_count 2\n";
     int rc = promcheck(testfile_text("good.prom", good), report, sizeof report);
     if (rc != 0)
         FAILF("promcheck.py refused a good text (exit %d):\n%s", rc, report);
@@ -774,14 +795,16 @@ TEST(dashboard_options_parse_host_and_port)
     char err[256];
     conf_init(&c);
     CHECK_INT(c.modbus.port, -1);
-    CHECK_INT(c.metrics.port, -1);
+    CHECK_INT(c.http.port, -1);
     CHECK_INT(conf_set(&c, "modbus", "1502", err, sizeof err), 0);
     CHECK_STR_HAS(c.modbus.host, "127.0.0.1");
     CHECK_INT(c.modbus.port, 1502);
     CHECK_INT(conf_set(&c, "metrics", "0.0.0.0:9101", err, sizeof err), 0);
-    CHECK(!strcmp(c.metrics.host, "0.0.0.0") && c.metrics.port == 9101);
+    CHECK(!strcmp(c.http.host, "0.0.0.0") && c.http.port == 9101);
     CHECK_INT(conf_set(&c, "metrics", "[::1]:9102", err, sizeof err), 0);
-    CHECK(!strcmp(c.metrics.host, "::1") && c.metrics.port == 9102);
+    CHECK(!strcmp(c.http.host, "::1") && c.http.port == 9102);
+    CHECK_INT(conf_set(&c, "http", "9103", err, sizeof err), 0);     /* --metrics is its alias */
+    CHECK(!strcmp(c.http.host, "127.0.0.1") && c.http.port == 9103);
     CHECK(conf_set(&c, "modbus", "host:", err, sizeof err) != 0);
     CHECK(conf_set(&c, "modbus", ":1502", err, sizeof err) != 0);
     CHECK(conf_set(&c, "modbus", "70000", err, sizeof err) != 0);

@@ -53,16 +53,22 @@ typedef struct wrk_job {
 int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *job,
                         char *err, size_t errsz);
 void wrk_job_close(wrk_job *job);
+/* A map from the wire (a SUBMIT's initial map, a RESULT's P or Q) checked
+ * against its meshes (one row per vertex of from, faces of to, weights of a
+ * point on the face): *out NULL when w is absent; else 0, or BAD_MAP's wire
+ * code naming name and the row. */
+int wrk_map_of(const proto_map *w, const char *name, const mesh *from, const mesh *to, bmap **out, char *err,
+               size_t errsz);
 /* The job as corr_run's input (pointers into job; the meshes named
  * "source mesh" and "target mesh", as in every message of a job). */
 void wrk_job_input(const wrk_job *job, corr_input *in);
 
 /* worker_io.c — the spool files. wrk_frame_read reads path whole and decodes
- * one frame filling it exactly (*buf holds the payload m borrows from; free
+ * one frame of the given type (enum proto_type) filling it exactly (*buf holds the payload m borrows from; free
  * it after proto_msg_free). I/O errors are PROTO_ESTORAGE. wrk_frame_write
  * encodes m and writes dir/name atomically: name.tmp, fsync, rename, fsync
  * of dir; the .tmp is removed on failure. */
-int wrk_frame_read(const char *path, unsigned char **buf, proto_msg *m, char *err, size_t errsz);
+int wrk_frame_read(const char *path, int type, unsigned char **buf, proto_msg *m, char *err, size_t errsz);
 int wrk_frame_write(const char *dir, const char *name, const proto_msg *m, char *err, size_t errsz);
 
 /* worker_progress.c — PROGRESS frames (request id 0) on a pipe, or on a TCP
@@ -98,6 +104,13 @@ typedef struct wrk_result {
 int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
                      double elapsed, wrk_result *r, char *err, size_t errsz);
 void wrk_result_close(wrk_result *r);
+
+/* worker_picture.c — `--picture FILE`: the picture of a finished job's map
+ * P (render_map_png, as `meshcorr eval --out-png` draws it) from DIR's
+ * job.frame and result.frame, for the web UI's job page. The meshes are
+ * decoded in the sandbox, as for a run; FILE is written as FILE.tmp, then
+ * renamed. The exit status: SPOOL_EXIT_OK, or 1 with the reason on stderr. */
+int wrk_picture(const char *dir, uint64_t job_id, const wrk_limits *lim, const char *out);
 
 /* The limits the worker sets whatever the daemon passes (WORKER.md,
  * "Sandbox"): its largest file is one frame (result.frame), it needs few

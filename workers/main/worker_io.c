@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-int wrk_frame_read(const char *path, unsigned char **buf, proto_msg *m, char *err, size_t errsz)
+int wrk_frame_read(const char *path, int type, unsigned char **buf, proto_msg *m, char *err, size_t errsz)
 {
     *buf = NULL;
     memset(m, 0, sizeof *m);
@@ -58,9 +58,9 @@ int wrk_frame_read(const char *path, unsigned char **buf, proto_msg *m, char *er
     } else if (used != len) {
         rc = errbuf_set(err, errsz, PROTO_ETRAILING, "%s: %zu bytes after the frame",
                         path, len - used);
-    } else if (m->type != PROTO_MSG_SUBMIT) {
-        rc = errbuf_set(err, errsz, PROTO_EUNEXPECTED, "%s: holds a %s message, not SUBMIT",
-                        path, proto_type_name(m->type));
+    } else if (m->type != type) {
+        rc = errbuf_set(err, errsz, PROTO_EUNEXPECTED, "%s: holds a %s message, not %s",
+                        path, proto_type_name(m->type), proto_type_name(type));
     }
 done:
     close(fd);

@@ -99,8 +99,8 @@ done:
     return rc;
 }
 
-static int map_map(const proto_map *w, const char *name, const mesh *from, const mesh *to,
-                   bmap **out, char *err, size_t errsz)
+int wrk_map_of(const proto_map *w, const char *name, const mesh *from, const mesh *to, bmap **out, char *err,
+               size_t errsz)
 {
     *out = NULL;
     if (w->n == 0)
@@ -143,8 +143,8 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
         (rc = load_mesh(&s->source, "source mesh", lim, &job->S, err, errsz)) ||
         (rc = load_mesh(&s->target, "target mesh", lim, &job->T, err, errsz)) ||
         (rc = map_landmarks(s, job->S, job->T, &job->L, err, errsz)) ||
-        (rc = map_map(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
-        (rc = map_map(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
+        (rc = wrk_map_of(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
+        (rc = wrk_map_of(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
         (rc = check_stages(s, err, errsz)) ||
         (rc = check_sizes(job, err, errsz))) {
         wrk_job_close(job);

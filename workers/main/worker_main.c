@@ -39,10 +39,14 @@ static void usage(void)
         "usage: meshcorr-worker --job DIR --job-id ID [--progress-fd N] [--threads N]\n"
         "                       [--max-vertices N] [--max-faces N] [--max-memory-mb N] [--max-cpu-s N]\n"
         "                       [--progress-tcp HOST:PORT --secret-file PATH]\n"
+        "       meshcorr-worker --job DIR --job-id ID --picture FILE [--max-vertices N] [--max-faces N]\n"
+        "                       [--max-memory-mb N] [--max-cpu-s N]\n"
         "       meshcorr-worker --list-devices [--threads N]\n"
         "       meshcorr-worker --version\n"
         "Runs the job in DIR/job.frame; writes DIR/result.frame (exit 0) or DIR/error.frame\n"
         "(exit 1, or 3 when cancelled by SIGTERM). Exit 2: bad usage; 4: neither could be written.\n"
+        "--picture: the finished job's map P drawn into FILE (PNG) from DIR's job.frame and\n"
+        "result.frame, as meshcorr eval --out-png draws it (exit 0, else 1).\n"
         "See workers/WORKER.md.\n");
 }
 
@@ -89,10 +93,10 @@ int main(int argc, char **argv)
         {"progress-tcp", required_argument, 0, 'c'}, {"secret-file", required_argument, 0, 's'},
         {"max-memory-mb", required_argument, 0, 'm'}, {"list-devices", no_argument, 0, 'L'},
         {"max-cpu-s", required_argument, 0, 'C'},    {"help", no_argument, 0, 'h'},
-        {"version", no_argument, 0, 'V'},
+        {"version", no_argument, 0, 'V'},          {"picture", required_argument, 0, 'P'},
         {0, 0, 0, 0}};
     const char *progress_tcp = NULL, *secret_file = NULL;
-    const char *dir = NULL;
+    const char *dir = NULL, *picture = NULL;
     uint64_t job_id = 0;
     int have_id = 0, progress_fd = -1, bad = 0, list_devices = 0;
     unsigned long long max_memory_mb = 0, max_cpu_s = 0;
@@ -125,6 +129,7 @@ int main(int argc, char **argv)
         case 'c': progress_tcp = optarg; break;
         case 's': secret_file = optarg; break;
         case 'L': list_devices = 1; break;
+        case 'P': picture = optarg; break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
         case 'V': printf(PROG " %s\n", MC_VERSION); return 0;
         default: bad = 1;
@@ -160,6 +165,8 @@ int main(int argc, char **argv)
         usage();
         return SPOOL_EXIT_USAGE;
     }
+    if (picture)
+        return wrk_picture(dir, job_id, &lim, picture);
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -184,7 +191,7 @@ int main(int argc, char **argv)
     memset(&res, 0, sizeof res);
     memset(&out, 0, sizeof out);
     snprintf(path, sizeof path, "%s/%s", dir, SPOOL_JOB_FRAME);
-    int rc = wrk_frame_read(path, &frame, &sub, err, sizeof err);
+    int rc = wrk_frame_read(path, PROTO_MSG_SUBMIT, &frame, &sub, err, sizeof err);
     if (rc) {
         status = fail(dir, job_id, rc, err);
         goto done;
