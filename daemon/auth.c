@@ -72,22 +72,6 @@ void auth_hash_hex(const uint8_t h[AUTH_HASH_LEN], char hex[2 * AUTH_HASH_LEN + 
     hex[2 * AUTH_HASH_LEN] = '\0';
 }
 
-int auth_user_ok(const char *user, char *err, size_t errsz)
-{
-    size_t n = strlen(user);
-    if (n == 0 || n >= AUTH_MAX_USER)
-        return errbuf_set(err, errsz, -1, "a user name has 1 to %d bytes", AUTH_MAX_USER - 1);
-    for (size_t i = 0; i < n; i++) {
-        unsigned char c = (unsigned char)user[i];
-        if (c <= ' ' || c >= 0x7F || c == '#')
-            return errbuf_set(err, errsz, -1, "a user name is printable ASCII without blanks or '#' (byte %zu is "
-                              "0x%02x)", i, c);
-    }
-    if (strcmp(user, PROTO_LIST_ALL_USERS) == 0)
-        return errbuf_set(err, errsz, -1, "the user name %s means every user in LIST", PROTO_LIST_ALL_USERS);
-    return 0;
-}
-
 int auth_token_new(char tok[AUTH_NEW_TOKEN_LEN + 1], char *err, size_t errsz)
 {
     static const char b64url[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_";

@@ -1,6 +1,7 @@
 /* backend.c — the bk_ dispatch (backend.h): picks the configured backend's
- * operations once at start and forwards to them. Knows nothing about how a
- * backend runs a job. */
+ * operations once at start and forwards to them, and the one cancel rule
+ * (the backend stops what it has, the queue drops what it does not).
+ * Knows nothing about how a backend runs a job. */
 #include "backend.h"
 
 #include <string.h>
@@ -22,6 +23,18 @@ void bk_drain(mcd *d, mcd_idle_fn idle) { ops_of(d)->drain(d, idle); }
 int bk_busy(const mcd *d) { return ops_of(d)->busy(d); }
 int bk_nslots(const mcd *d) { return ops_of(d)->nslots(d); }
 const char *bk_name(const mcd *d) { return ops_of(d)->name; }
+
+int bk_cancel_job(mcd *d, const store_job *j)
+{
+    if (!store_is_terminal(j->state) && bk_cancel(d, j->id) == 0) {
+        /* the backend has it (running, or queued in Slurm) and stops it */
+        dlog(DLOG_INFO, "job %llu: cancel requested from the %s backend", (unsigned long long)j->id, bk_name(d));
+        return 0;
+    }
+    if (j->state == PROTO_STATE_PENDING)
+        return job_cancel_pending(d, j->id);
+    return PROTO_EBAD_STATE;
+}
 
 void bk_slot_info(const mcd *d, int i, uint8_t *state, uint64_t *job_id)
 {

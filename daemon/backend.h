@@ -41,6 +41,11 @@ extern const bk_ops bk_local, bk_slurm;
 int bk_init(mcd *d, char *err, size_t errsz);
 void bk_schedule(mcd *d);
 int bk_cancel(mcd *d, uint64_t id);
+/* Cancels job j as it is in the store (the protocol's CANCEL and the web's
+ * cancel): a running one (or one queued in Slurm) is stopped by its
+ * backend, a pending one ends CANCELLED (job_cancel_pending). 0,
+ * PROTO_ESTORAGE, or PROTO_EBAD_STATE when it has ended already. */
+int bk_cancel_job(mcd *d, const store_job *j);
 void bk_drain(mcd *d, mcd_idle_fn idle);
 int bk_busy(const mcd *d);
 int bk_nslots(const mcd *d);

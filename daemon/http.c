@@ -79,7 +79,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     r.body_len = b->len;
     const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
     if (ci && ci->client_addr)
-        srv_peer_name(ci->client_addr, r.peer);
+        peer_name(ci->client_addr, r.peer);
     else
         snprintf(r.peer, sizeof r.peer, "?");
     if (b->too_big)
@@ -162,6 +162,7 @@ int http_start(mcd *d, const conf_endpoint *e, const tls_creds *tls, http **out,
         free(h);
         return errbuf_set(err, errsz, -1, "http: out of memory");
     }
+    web_picture_init(d);
     h->snap = d->snap;
     h->fd = dash_listen(e, "http", err, errsz);
     if (h->fd < 0) {

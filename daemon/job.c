@@ -2,8 +2,8 @@
  * progress and its end are recorded here and nowhere else (the backends
  * decide from what their worker left and call these; backend.h), a pending
  * job's cancel too (a running one's is handed to its backend); and its last step, the deletion of a finished job
- * result-ttl after its end (the expiry sweep). It calls only the store, the
- * scheduler and, for a cancel, the backend; who tells the watchers (req.c) listens (job_listen), so no
+ * result-ttl after its end (the expiry sweep). It calls only the store and the
+ * scheduler; who tells the watchers (req.c) listens (job_listen), so no
  * call goes back up; an end is also queued for its user's --notify-url (hook.c).
  *
  * DESIGN: a job's end is recorded before anyone is told. job_ended writes
@@ -42,13 +42,31 @@ static struct {
     uv_timer_t sweep;             /* result expiry */
     uint64_t progress_failed;     /* job whose progress the store refused (logged once) */
     job_listener l;               /* who tells the watchers (req.c) */
+    snap_hist duration, wait;     /* runs: start to end; submit to start */
 } J;
+
+static void observe(snap_hist *h, double s)
+{
+    static const double bounds[SNAP_NBUCKETS] = SNAP_BUCKETS;
+    int b = 0;
+    while (b < SNAP_NBUCKETS && s > bounds[b])
+        b++;
+    h->bucket[b]++;
+    h->count++;
+    h->sum += s;
+}
+
+void job_times(snap_hist *duration, snap_hist *wait)
+{
+    *duration = J.duration;
+    *wait = J.wait;
+}
 
 static void tell_ended(mcd *d, uint64_t id)
 {
     store_job j;
     if (store_get(d->store, id, &j) == 0 && j.start_ms && j.end_ms >= j.start_ms)
-        snap_job_ended(d, (double)(j.end_ms - j.start_ms) / 1000);
+        observe(&J.duration, (double)(j.end_ms - j.start_ms) / 1000);
     if (J.l.ended)
         J.l.ended(d, id);
     hook_job_ended(d, id);
@@ -138,7 +156,7 @@ void job_running(mcd *d, uint64_t id, long pid)
     int64_t now = store_now_ms();
     store_job j;
     if (store_get(d->store, id, &j) == 0 && j.submit_ms && now >= j.submit_ms)
-        snap_job_started(d, (double)(now - j.submit_ms) / 1000);
+        observe(&J.wait, (double)(now - j.submit_ms) / 1000);
     if (store_set_running(d->store, id, now, pid))
         dlog(DLOG_ERROR, "job %llu: cannot record it RUNNING (the store is failing)", (unsigned long long)id);
     tell_queue(d);
@@ -298,18 +316,6 @@ int job_cancel_pending(mcd *d, uint64_t id)
     tell_ended(d, id);
     tell_queue(d);
     return 0;
-}
-
-int job_cancel(mcd *d, const store_job *j)
-{
-    if (!store_is_terminal(j->state) && bk_cancel(d, j->id) == 0) {
-        /* the backend has it (running, or queued in Slurm) and stops it */
-        dlog(DLOG_INFO, "job %llu: cancel requested from the %s backend", (unsigned long long)j->id, bk_name(d));
-        return 0;
-    }
-    if (j->state == PROTO_STATE_PENDING)
-        return job_cancel_pending(d, j->id);
-    return PROTO_EBAD_STATE;
 }
 
 /* A worker's error.frame at path: its protocol error code and message

@@ -85,11 +85,18 @@ int main(int argc, char **argv)
     }
     job_init(&d);
     req_init(&d);
-    /* the TLS key is read while root is still at hand, with the binds */
     if (web_cancel_init(&d) || hook_start(&d)) {
         dlog(DLOG_ERROR, "out of memory");
         goto done;
     }
+    /* Before the port file and the sockets exist: a SIGTERM sent as soon as
+     * they do is a drain once the loop runs, never the default death. */
+    uv_signal_init(d.loop, &d.sigterm);
+    uv_signal_init(d.loop, &d.sigint);
+    d.sigterm.data = d.sigint.data = &d;
+    uv_signal_start(&d.sigterm, on_signal, SIGTERM);
+    uv_signal_start(&d.sigint, on_signal, SIGINT);
+    /* the TLS key is read while root is still at hand, with the binds */
     if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
         priv_bind_begin(&priv, err, sizeof err) || tls_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
         (d.conf.modbus.port > 0 && mbus_start(&d.conf.modbus, d.snap, &d.mbus, err, sizeof err)) ||
@@ -101,11 +108,6 @@ int main(int argc, char **argv)
     http_set_tokens(d.http, d.tokens);
     srv_note_tokens(&d);
     job_sweep_start(&d);
-    uv_signal_init(d.loop, &d.sigterm);
-    uv_signal_init(d.loop, &d.sigint);
-    d.sigterm.data = d.sigint.data = &d;
-    uv_signal_start(&d.sigterm, on_signal, SIGTERM);
-    uv_signal_start(&d.sigint, on_signal, SIGINT);
     reload_init(&d, argc, argv);
     dlog(DLOG_INFO, "meshcorrd ready: %s backend, %u job(s) pending, state in %s", bk_name(&d),
          sched_queued(d.sched), d.conf.state_dir);
@@ -118,6 +120,10 @@ int main(int argc, char **argv)
 done:
     if (status) {
         /* a start-up failure: close whatever was opened */
+        if (uv_is_active((uv_handle_t *)&d.sigterm)) {
+            uv_close((uv_handle_t *)&d.sigterm, NULL);
+            uv_close((uv_handle_t *)&d.sigint, NULL);
+        }
         srv_stop_listening(&d);
         bk_close(&d);
         job_close(&d);

@@ -460,10 +460,6 @@ int snap_init(mcd *d, char *err, size_t errsz);
 void snap_collect(mcd *d, mcd_snapshot *out);
 /* Loop thread: a worker's progress record (kept for its slot's figures). */
 void snap_progress(mcd *d, const proto_progress *p);
-/* Loop thread: a run started after waiting wait_s since its submit; a job
- * ran run_s from its start to its end (the histograms). */
-void snap_job_started(mcd *d, double wait_s);
-void snap_job_ended(mcd *d, double run_s);
 void snap_close(mcd *d);          /* stops the timer (the loop can end) */
 void snap_free(snap *s);          /* after the readers are stopped; NULL ok */
 /* Any thread: a copy of the latest published snapshot; out->slots holds
@@ -650,10 +646,9 @@ int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz);
 /* A pending job (not handed to a backend) is cancelled: out of the queue,
  * CANCELLED in the store, END to its watchers. 0 or PROTO_ESTORAGE. */
 int job_cancel_pending(mcd *d, uint64_t id);
-/* Cancels job j as it is in the store: a running one (or one queued in
- * Slurm) is stopped by its backend, a pending one ends CANCELLED here. 0,
- * PROTO_ESTORAGE, or PROTO_EBAD_STATE when it has ended already. */
-int job_cancel(mcd *d, const store_job *j);
+/* Loop thread: the histograms of the runs so far (since the daemon
+ * started): start to end of the ended ones, submit to start of the started. */
+void job_times(snap_hist *duration, snap_hist *wait);
 
 /* ---- dev_: the devices a worker sees, asked once of the worker program ---- */
 /* Runs `meshcorr-worker --list-devices` in the background; until it answers
@@ -751,7 +746,7 @@ typedef struct conn_auth {
  * the IPv4 address, or an IPv6 address's /64; "?" for another family.
  * Any thread. */
 struct sockaddr;
-void srv_peer_name(const struct sockaddr *sa, char out[SRV_MAX_PEER]);
+void peer_name(const struct sockaddr *sa, char out[SRV_MAX_PEER]);
 conn_auth *srv_conn_auth(conn *c);
 mcd *srv_conn_daemon(conn *c);
 int srv_conn_fd(conn *c);

@@ -748,7 +748,7 @@ static void on_cancel(conn *c, const proto_msg *m)
     store_job j;
     if (visible_job(c, m->request_id, m->u.cancel.job_id, &j))
         return;
-    int rc = job_cancel(d, &j);
+    int rc = bk_cancel_job(d, &j);
     if (rc == PROTO_ESTORAGE) {
         srv_send_error(c, m->request_id, PROTO_ESTORAGE, "job store failure cancelling job %llu",
                        (unsigned long long)j.id);

@@ -37,7 +37,6 @@ struct snap {
     mcd_snapshot *scratch;
     uv_timer_t timer;
     int timer_open;
-    snap_hist duration, wait;
     struct timespec t0;
     uint32_t seq;
     /* shared: under mu */
@@ -136,8 +135,7 @@ void snap_collect(mcd *d, mcd_snapshot *out)
     out->running = running;
     out->queued = sched_queued(d->sched);
     out->nqueue = sched_order(d->sched, out->queue, SNAP_MAX_QUEUE);
-    out->duration = d->snap->duration;
-    out->wait = d->snap->wait;
+    job_times(&out->duration, &out->wait);
     out->nusers = 0;
     const char *name;
     uint32_t pending, run;
@@ -197,29 +195,6 @@ int snap_init(mcd *d, char *err, size_t errsz)
     s->timer_open = 1;
     uv_timer_start(&s->timer, on_timer, SNAP_PERIOD_MS, SNAP_PERIOD_MS);
     return 0;
-}
-
-static void observe(snap_hist *h, double s)
-{
-    static const double bounds[SNAP_NBUCKETS] = SNAP_BUCKETS;
-    int b = 0;
-    while (b < SNAP_NBUCKETS && s > bounds[b])
-        b++;
-    h->bucket[b]++;
-    h->count++;
-    h->sum += s;
-}
-
-void snap_job_started(mcd *d, double wait_s)
-{
-    if (d->snap)
-        observe(&d->snap->wait, wait_s);
-}
-
-void snap_job_ended(mcd *d, double run_s)
-{
-    if (d->snap)
-        observe(&d->snap->duration, run_s);
 }
 
 void snap_close(mcd *d)

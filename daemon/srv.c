@@ -671,25 +671,7 @@ static void peer_of(conn *c)
     struct sockaddr_storage sa;
     int len = sizeof sa;
     if (uv_tcp_getpeername(&c->u.tcp, (struct sockaddr *)&sa, &len) == 0)
-        srv_peer_name((const struct sockaddr *)&sa, out);
-}
-
-void srv_peer_name(const struct sockaddr *sa, char out[SRV_MAX_PEER])
-{
-    snprintf(out, SRV_MAX_PEER, "?");
-    if (sa->sa_family == AF_INET) {
-        inet_ntop(AF_INET, &((const struct sockaddr_in *)sa)->sin_addr, out, SRV_MAX_PEER);
-    } else if (sa->sa_family == AF_INET6) {
-        struct in6_addr a = ((const struct sockaddr_in6 *)sa)->sin6_addr;
-        if (IN6_IS_ADDR_V4MAPPED(&a)) {
-            inet_ntop(AF_INET, &a.s6_addr[12], out, SRV_MAX_PEER);
-            return;
-        }
-        memset(&a.s6_addr[8], 0, 8);
-        char ip[INET6_ADDRSTRLEN];
-        inet_ntop(AF_INET6, &a, ip, sizeof ip);
-        snprintf(out, SRV_MAX_PEER, "%s/64", ip);
-    }
+        peer_name((const struct sockaddr *)&sa, out);
 }
 
 /* What the accept decides on, c itself not counted. */

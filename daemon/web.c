@@ -79,7 +79,6 @@ web *web_new(mcd *d, int tls)
     w->snap = d->snap;
     w->tls = tls;
     w->cancels = d->web_cancel;
-    web_picture_init(d);
     snprintf(w->db_path, sizeof w->db_path, "%s/jobs.db", d->conf.state_dir);
     snprintf(w->backend, sizeof w->backend, "%s", d->conf.backend);
     return w;
@@ -394,7 +393,7 @@ static const char *type_of(const char *name)
     return "text/html; charset=utf-8";
 }
 
-static enum MHD_Result page(web_req *r, unsigned status, const char *name)
+enum MHD_Result web_page(web_req *r, unsigned status, const char *name)
 {
     const struct web_asset *a = asset(name);
     if (!a)
@@ -404,7 +403,7 @@ static enum MHD_Result page(web_req *r, unsigned status, const char *name)
 
 /* The login page with msg (plain text, escaped for HTML) where it has its
  * <!--msg--> mark. */
-static enum MHD_Result login_page(web_req *r, unsigned status, const char *msg)
+enum MHD_Result web_login_page(web_req *r, unsigned status, const char *msg)
 {
     const struct web_asset *a = asset("login.html");
     const char *mark = "<!--msg-->";
@@ -462,7 +461,7 @@ static int form_field(const char *body, const char *name, char *out, size_t sz)
     return -1;
 }
 
-static enum MHD_Result do_login(web *w, web_req *r)
+enum MHD_Result web_login(web *w, web_req *r)
 {
     char token[AUTH_MAX_LINE + 1];
     if (form_field(r->body, "token", token, sizeof token))
@@ -474,14 +473,14 @@ static enum MHD_Result do_login(web *w, web_req *r)
     if (wait) {
         char msg[128];
         snprintf(msg, sizeof msg, "Too many failed logins from %s: retry in %u s.", r->peer, wait);
-        return login_page(r, MHD_HTTP_TOO_MANY_REQUESTS, msg);
+        return web_login_page(r, MHD_HTTP_TOO_MANY_REQUESTS, msg);
     }
     if (rc)
-        return login_page(r, MHD_HTTP_UNAUTHORIZED, "Unknown token.");
+        return web_login_page(r, MHD_HTTP_UNAUTHORIZED, "Unknown token.");
     session *s = session_new(w, r->user, hash, store_now_ms());
     if (!s) {
         dlog(DLOG_WARN, "web login of %s from %s refused: %d sessions open", r->user, r->peer, WEB_MAX_SESSIONS);
-        return login_page(r, MHD_HTTP_SERVICE_UNAVAILABLE, "Too many sessions open: try again later.");
+        return web_login_page(r, MHD_HTTP_SERVICE_UNAVAILABLE, "Too many sessions open: try again later.");
     }
     dlog(DLOG_INFO, "web login: %s%s from %s", r->user, r->admin ? " (admin)" : "", r->peer);
     char cookie[256];
@@ -498,7 +497,7 @@ int web_csrf_ok(const web_req *r)
     return t && same_secret(t, r->csrf);
 }
 
-static enum MHD_Result do_logout(web *w, web_req *r)
+enum MHD_Result web_logout(web *w, web_req *r)
 {
     enum MHD_Result res;
     if (web_auth(w, r, &res))
@@ -587,60 +586,4 @@ const char *web_job_stage(web *w, const store_job *j, int64_t *position)
         if (s->slots[i].job_id == j->id)
             return s->slots[i].has_progress ? proto_stage_name(s->slots[i].stage) : "start";
     return "start";
-}
-
-/* ---- dispatch ---- */
-
-static enum MHD_Result handle(web *w, web_req *r)
-{
-    int get = !strcmp(r->method, MHD_HTTP_METHOD_GET), post = !strcmp(r->method, MHD_HTTP_METHOD_POST);
-    const char *u = r->url;
-    if (!strncmp(u, "/api/v1/", 8) || !strcmp(u, "/api/v1"))
-        return web_api(w, r, u + 7);
-    if (!strncmp(u, "/static/", 8)) {
-        if (!get)
-            return web_reply_text(r, MHD_HTTP_METHOD_NOT_ALLOWED, "GET only\n");
-        return page(r, MHD_HTTP_OK, u + 8);
-    }
-    if (!strcmp(u, "/login")) {
-        if (post)
-            return do_login(w, r);
-        if (!get)
-            return web_reply_text(r, MHD_HTTP_METHOD_NOT_ALLOWED, "GET or POST only\n");
-        return login_page(r, MHD_HTTP_OK, "");
-    }
-    if (!strcmp(u, "/logout")) {
-        if (!post)
-            return web_reply_text(r, MHD_HTTP_METHOD_NOT_ALLOWED, "POST only\n");
-        return do_logout(w, r);
-    }
-    const char *name = !strcmp(u, "/") ? "index.html" : !strcmp(u, "/workers") ? "workers.html"
-                     : !strncmp(u, "/jobs/", 6) ? "job.html" : NULL;
-    if (!name)
-        return web_reply_text(r, MHD_HTTP_NOT_FOUND, "not found: the pages are /, /jobs/ID and /workers; "
-                              "the metrics /metrics; the API /api/v1/\n");
-    if (!get)
-        return web_reply_text(r, MHD_HTTP_METHOD_NOT_ALLOWED, "GET only\n");
-    enum MHD_Result res;
-    if (web_auth(w, r, &res))
-        return res;
-    if (!strcmp(name, "job.html")) {
-        char *end;
-        errno = 0;
-        unsigned long long id = strtoull(u + 6, &end, 10);
-        store_job j;
-        if (errno || *end || end == u + 6 || web_job(w, r, id, &j, NULL, 0))
-            return web_reply_text(r, MHD_HTTP_NOT_FOUND, "no such job\n");
-    }
-    return page(r, MHD_HTTP_OK, name);
-}
-
-enum MHD_Result web_handle(web *w, web_req *r)
-{
-    web_lock(w);
-    web_snapshot(w);
-    enum MHD_Result rc = handle(w, r);
-    web_unlock(w);
-    explicit_bzero(r->csrf, sizeof r->csrf);
-    return rc;
 }

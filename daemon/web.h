@@ -30,7 +30,7 @@ typedef struct web_req {
     const char *url, *method;
     const char *body;             /* NUL-terminated; body_len bytes */
     size_t body_len;
-    char peer[SRV_MAX_PEER];      /* srv_peer_name: logs and the login throttle */
+    char peer[SRV_MAX_PEER];      /* peer_name: logs and the login throttle */
     /* set by web_auth */
     char user[AUTH_MAX_USER];
     int admin;
@@ -45,7 +45,8 @@ void web_free(web *w);            /* NULL ok */
 void web_set_tokens(web *w, const auth_tokens *t);   /* takes the lock */
 void web_lock(web *w);
 void web_unlock(web *w);
-/* Answers r: the pages, /login, /logout, static assets and /api/v1/. */
+/* web_route.c: answers r (the pages, /login, /logout, static assets and
+ * /api/v1/) under the web's lock. */
 enum MHD_Result web_handle(web *w, web_req *r);
 
 /* Replies. Every one carries the Content-Security-Policy and no-cache
@@ -60,7 +61,18 @@ enum MHD_Result web_reply_error(web_req *r, unsigned status, const char *fmt, ..
 /* The text fp (an open_memstream of *buf, *len) holds, closed, as JSON. */
 enum MHD_Result web_reply_json(web_req *r, unsigned status, FILE *fp, char **buf, size_t *len);
 
-/* ---- web.c, for web_api.c ---- */
+/* ---- web.c, for the router (web_route.c) ---- */
+/* The embedded asset name (index.html, job.html, ...) with status; 404
+ * for a name that is not one. */
+enum MHD_Result web_page(web_req *r, unsigned status, const char *name);
+/* The login form with msg above it (empty: none). */
+enum MHD_Result web_login_page(web_req *r, unsigned status, const char *msg);
+/* POST /login: a session for the form's token, or the form again with why. */
+enum MHD_Result web_login(web *w, web_req *r);
+/* POST /logout: the session ends (CSRF-checked). */
+enum MHD_Result web_logout(web *w, web_req *r);
+
+/* ---- web.c, for the API, the streams and the pictures ---- */
 /* Logged in by a Bearer token or a session cookie: 0 with r->user and
  * r->admin set; else the reply already queued in *res (401, 429). */
 int web_auth(web *w, web_req *r, enum MHD_Result *res);
@@ -90,13 +102,6 @@ const char *web_job_stage(web *w, const store_job *j, int64_t *position);
 /* path is r->url after "/api/v1". */
 enum MHD_Result web_api(web *w, web_req *r, const char *path);
 
-/* Job id's progress records after record `after`, at most max, written to
- * fp: as the elements of a JSON array (comma-separated), or with sse as
- * server-sent events (`id: RECORD`, `event: progress`, `data: {...}`). The
- * last record's number (after when there was none), or -1 when the store
- * cannot be read. */
-int64_t web_points(web *w, uint64_t id, uint64_t after, int max, FILE *fp, int sse);
-
 /* ---- web_events.c ---- */
 #define WEB_MAX_STREAMS 32          /* event streams open at once, all users */
 #define WEB_MAX_STREAMS_PER_USER 4  /* of one user; past either cap a new one is refused (503) */
@@ -109,6 +114,12 @@ enum MHD_Result web_events(web *w, web_req *r, const store_job *j);
 /* The streams of the MHD daemon that is being replaced (a TLS reload) end,
  * so that its stop does not wait for them (EventSource reconnects). */
 void web_streams_end(web *w);
+/* Job id's progress records after record `after`, at most max, written to
+ * fp: as the elements of a JSON array (comma-separated), or with sse as
+ * server-sent events (`id: RECORD`, `event: progress`, `data: {...}`). The
+ * last record's number (after when there was none), or -1 when the store
+ * cannot be read. */
+int64_t web_points(web *w, uint64_t id, uint64_t after, int max, FILE *fp, int sse);
 
 /* ---- web_picture.c ---- */
 /* At start: the worker program and the limits a drawing runs with. */

@@ -1,10 +1,11 @@
 /* web_cancel.c — a cancel asked on the web, carried out on the loop: the
  * HTTP thread queues (job, user, admin) under a mutex and wakes the loop
  * with a uv_async; the loop takes the queue and cancels each job the way a
- * CANCEL request does (job_cancel), after checking again, on the store as
+ * CANCEL request does (bk_cancel_job), after checking again, on the store as
  * it is now, that the job is the user's (or the user an admin) and has not
  * ended. The queue is bounded (WEB_CANCEL_MAX_QUEUED): past it a request is
  * refused, never waited for, so the HTTP thread never blocks on the loop. */
+#include "backend.h"
 #include "mcd.h"
 
 #include <pthread.h>
@@ -44,7 +45,7 @@ static void on_async(uv_async_t *a)
                  q[i].user);
             continue;
         }
-        int rc = job_cancel(w->d, &j);
+        int rc = bk_cancel_job(w->d, &j);
         if (rc == PROTO_ESTORAGE)
             dlog(DLOG_ERROR, "job %llu: job store failure cancelling it (web, %s)", (unsigned long long)j.id,
                  q[i].user);

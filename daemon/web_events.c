@@ -17,6 +17,7 @@
 #include "web.h"
 
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -215,4 +216,45 @@ enum MHD_Result web_events(web *w, web_req *r, const store_job *j)
     enum MHD_Result rc = MHD_queue_response(r->conn, MHD_HTTP_OK, res);
     MHD_destroy_response(res);
     return rc;
+}
+
+/* The history's one reader: the stream and GET .../history share it. */
+int64_t web_points(web *w, uint64_t id, uint64_t after, int max, FILE *fp, int sse)
+{
+    sqlite3 *db = web_db(w);
+    sqlite3_stmt *st = NULL;
+    if (!db || sqlite3_prepare_v2(db, "SELECT rowid, stage, outer_it, total,"
+                                  " membrane0 + coalesce(membrane1, 0), bending0 + coalesce(bending1, 0),"
+                                  " mismatch0 + coalesce(mismatch1, 0), reverse0 + coalesce(reverse1, 0),"
+                                  " energy0 + coalesce(energy1, 0), beta, gamma, elapsed_s, fraction"
+                                  " FROM history WHERE job = ? AND rowid > ? ORDER BY rowid LIMIT ?",
+                                  -1, &st, NULL) != SQLITE_OK) {
+        sqlite3_finalize(st);
+        return -1;
+    }
+    sqlite3_bind_int64(st, 1, (sqlite3_int64)id);
+    sqlite3_bind_int64(st, 2, (sqlite3_int64)after);
+    sqlite3_bind_int(st, 3, max);
+    static const char *const keys[] = {"membrane", "bending", "mismatch", "reverse", "energy", "beta", "gamma",
+                                       "elapsed_s", "fraction"};
+    int64_t next = (int64_t)after;
+    int n = 0;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+        next = sqlite3_column_int64(st, 0);
+        int stage = sqlite3_column_int(st, 1);
+        if (sse)
+            fprintf(fp, "id: %lld\nevent: progress\ndata: ", (long long)next);
+        else if (n)
+            fputc(',', fp);
+        n++;
+        fprintf(fp, "{\"stage\":\"%s\",\"outer\":%d,\"total\":%d", proto_stage_name(stage),
+                sqlite3_column_int(st, 2), sqlite3_column_int(st, 3));
+        for (int k = 0; k < 9; k++) {
+            fprintf(fp, ",\"%s\":", keys[k]);
+            web_json_num(fp, sqlite3_column_type(st, 4 + k) == SQLITE_NULL ? NAN : sqlite3_column_double(st, 4 + k));
+        }
+        fputs(sse ? "}\n\n" : "}", fp);
+    }
+    sqlite3_finalize(st);
+    return next;
 }

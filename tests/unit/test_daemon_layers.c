@@ -20,18 +20,21 @@
  * snapshots beside snap, and token is a command beside main. */
 static const struct { const char *mod; int floor; } floors[] = {
     {"store", 0}, {"sched", 0}, {"wlock", 0}, {"priv", 0}, {"tls", 0}, {"conf", 0},
-    {"auth", 0}, {"throttle", 0}, {"fds", 0}, {"dlog", 0},
-    {"job", 1},
+    {"auth", 0}, {"auth_user", 0}, {"throttle", 0}, {"fds", 0}, {"dlog", 0}, {"hook_url", 0}, {"peer", 0},
+    {"web_json", 0},
+    {"job", 1}, {"hook", 1},
     {"backend", 2}, {"wsup", 2}, {"bk_slurm", 2}, {"bk_prog", 2}, {"bk_cmd", 2},
     {"notify", 3}, {"snap", 3}, {"devices", 3}, {"val", 3},
     {"dash", 3}, {"metrics", 3}, {"mbus", 3}, {"mbus_regs", 3},
+    {"http", 3}, {"web_route", 3}, {"web", 3}, {"web_api", 3}, {"web_events", 3}, {"web_picture", 3},
+    {"web_cancel", 3},
     {"srv", 4}, {"req", 4},
     {"drain", 5}, {"reload", 5},
     {"main", 6}, {"token", 6},
 };
 static const char *floor_names[] = {
-    "store, sched, wlock, priv, tls, conf, auth, throttle, fds, dlog",
-    "job",
+    "store, sched, wlock, priv, tls, conf, auth, throttle, fds, dlog and the pure helpers",
+    "job, hook",
     "backend, wsup, bk_slurm, bk_prog, bk_cmd",
     "notify, snap, devices, val and the dashboards",
     "srv, req",
