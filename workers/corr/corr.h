@@ -5,7 +5,7 @@
  *   then the chosen stages, always in this order (corr_stages):
  *   DDM denoising of the uploaded P (and Q): the map's functional map
  *     C = Psi1^T M1 P Psi2, deblurred to a precise map (ddm.h, thesis §2.5)
- *   RHM: from landmarks (a start map, rhm.h) or from the uploaded or
+ *   RHM: from landmarks (a start map, start.h) or from the uploaded or
  *     denoised maps (rhm_run_from_maps, anchored to them: rhm.h's
  *     RHM_ANCHORS), giving P and Q, whose folds are
  *     then repaired (corr_repair, fold.h)
