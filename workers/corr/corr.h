@@ -191,7 +191,7 @@ int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
  * is queued. */
 int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
 
-/* RHM from the landmarks as the pipeline runs it: rhm_run from rp, then
+/* RHM from the landmarks as the pipeline runs it: start_run from rp, then
  * the fold repair of its maps (corr_repair, rep). Start auto (the
  * default): from the distances start, and when the repaired maps are still
  * folded (metric_verdict: over 5 % of either map's triangles flipped or
@@ -203,7 +203,7 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
  * failure of the second run
  * leaves the first maps; a cancel cancels. raw (may be NULL): a copy of
  * the kept forward map before its repair (for benchmarks). progress:
- * rhm_run's, the second run's reports from iteration 0 again. */
+ * start_run's, the second run's reports from iteration 0 again. */
 int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
              rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz);
 
