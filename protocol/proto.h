@@ -136,7 +136,7 @@ enum proto_slot_state {
 
 /* values of the ENUM parameters model, start, stages and ddm_mode (their names: proto_params.h) */
 enum proto_model { PROTO_MODEL_BIJECTIVE = 0, PROTO_MODEL_INJECTIVE = 1 };
-/* RHM's start map from the landmarks (workers/rhm/rhm.h) */
+/* RHM's start map from the landmarks (workers/start/start.h) */
 enum proto_start { PROTO_START_DISTANCES = 0, PROTO_START_VORONOI = 1, PROTO_START_FMAP = 2 };
 /* The chains of stages a job can run: the values of the ENUM parameter
  * stages, named as PROTO_PARAMS lists them ("ddm,ectm"); the engine's

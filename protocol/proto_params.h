@@ -40,7 +40,7 @@
 #define PROTO_MAX_DEVICE    127      /* bytes of ":DEVICE" in backend, the colon excluded */
 #define PROTO_RHM_MAX_DIM   64       /* rhm_dim's max: the embedding's (EMBED_MAX_DIM) */
 #define PROTO_DDM_MAX_K     300      /* ddm_k's max: the eigenpairs' (LBO_MAX_K) */
-#define PROTO_ZOOMOUT_MIN   51       /* zoomout's min besides 0 (off): RHM_FMAP_K + 1 */
+#define PROTO_ZOOMOUT_MIN   51       /* zoomout's min besides 0 (off): START_FMAP_K + 1 */
 #define PROTO_ZOOMOUT_MAX   300      /* zoomout's max: the eigenpairs' (LBO_MAX_K) */
 #define PROTO_COARSE_MIN    500      /* coarse's min besides 0 (off) */
 #define PROTO_COARSE_MAX    10000000 /* coarse's max */

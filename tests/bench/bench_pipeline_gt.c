@@ -5,7 +5,7 @@
  * TOSCA_r isometric cat0->cat1 (about 100 units across: the engine is
  * scale-invariant), and the cartoon pairs homerA->homerB and headA->headB.
  *
- * Stages: the start map RHM begins with (rhm.h: by default start auto,
+ * Stages: the start map RHM begins with (start.h: by default start auto,
  * whose first start is the geodesic distances to the landmarks, rebuilt
  * here; --start=voronoi for the thesis' Voronoi cells), RHM with
  * rhm_params_init's values (start auto: from the functional-map start too
@@ -13,7 +13,8 @@
  * ectm_params_init's values from RHM's two maps: meshcorr match's
  * defaults. RHM and ECTM run through corr_run (stages rhm, then stages ectm
  * from RHM's P and Q: the same calls as stages all); the start map is
- * rebuilt by the RHM internals (rhm__init_start) that rhm_run begins with.
+ * rebuilt by the RHM internals (rhm__start with start_maps) that start_run
+ * begins with.
  *
  * Per pair and stage, with both meshes at unit area: mean geodesic error /
  * sqrt(target area) against the direct ground truth, and where a symmetric
@@ -54,6 +55,7 @@
 #include "metric/metric.h"
 #include "proto.h"
 #include "rhm/rhm__problem.h"
+#include "start/start.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -230,7 +232,7 @@ static void run_pair(const void *arg, void *out)
         goto out;
     const corr_input *ri = coarse ? &cc.in : &in;
     if (rhm__problem_new(ri->S, ri->T, ri->L, &rp, &pb, err, sizeof err) ||
-        rhm__init_start(pb, err, sizeof err))
+        rhm__start(pb, start_maps, err, sizeof err))
         goto out;
     if (coarse) {
         printf("  %s: coarse to fine, stages on %d -> %d vertices\n", ps->label, ri->S->nv,

@@ -6,7 +6,7 @@
  * time. */
 #include "support/harness.h"
 #include "support/testgt.h"
-#include "rhm/rhm.h"
+#include "start/start.h"
 
 TEST_T(rhm_200_iterations_on_faust_5k, 1200)
 {
@@ -17,7 +17,7 @@ TEST_T(rhm_200_iterations_on_faust_5k, 1200)
     p.stop_change = 0;
     rhm_result r;
     char err[512];
-    if (rhm_run(g.S, g.T, &g.L, &p, NULL, NULL, &r, err, sizeof err))
+    if (start_run(g.S, g.T, &g.L, &p, NULL, NULL, &r, err, sizeof err))
         FAILF("%s", err);
     const rhm_report *q = &r.last;
     printf("rhm FAUST 000 -> 001 (%d -> %d vertices), %d iterations: %.1f s "

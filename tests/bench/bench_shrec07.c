@@ -57,6 +57,7 @@
 #include "corr/corr.h"
 #include "metric/metric.h"
 #include "rhm/rhm__problem.h"
+#include "start/start.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -250,7 +251,7 @@ static void run_pair(const void *arg, void *out)
         fflush(stdout);
     }
     if (rhm__problem_new(ri->S, ri->T, ri->L, &rp, &pb, err, sizeof err) ||
-        rhm__init_start(pb, err, sizeof err))
+        rhm__start(pb, start_maps, err, sizeof err))
         goto out;
     fig->secs[START] = now() - t0;
     const bmap *maps[NSTAGES] = { pb->side[0].P, NULL, NULL, NULL };

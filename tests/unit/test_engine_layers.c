@@ -22,8 +22,8 @@ static const struct { const char *mod; int floor; } floors[] = {
     {"geo", 2}, {"map", 2}, {"lmk", 2}, {"proj", 2},
     {"lbo", 3}, {"geod", 3}, {"ener", 3}, {"viz", 3}, {"ctf", 3},
     {"desc", 4}, {"embed", 4}, {"metric", 4}, {"ddm", 4}, {"ectm", 4},
-    {"fmap", 5}, {"fold", 5},
-    {"rhm", 6},
+    {"fmap", 5}, {"fold", 5}, {"rhm", 5},
+    {"start", 6},
     {"corr", 7},
     {"main", 8},
 };
@@ -33,8 +33,8 @@ static const char *floor_names[] = {
     "geo, map, lmk, proj",
     "lbo, geod, ener, viz, ctf",
     "desc, embed, metric, ddm, ectm",
-    "fmap, fold",
-    "rhm",
+    "fmap, fold, rhm",
+    "start",
     "corr",
     "main",
 };

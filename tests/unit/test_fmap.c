@@ -607,7 +607,7 @@ TEST_T(orientation_operator_is_antisymmetric_and_mirror_odd, 30)
     mesh_free(m);
 }
 
-/* The functional-map start of rhm_init.c (k = 50; WKS + landmark WKM,
+/* The functional-map start of start_fmap.c (k = 50; WKS + landmark WKM,
  * Δ + D_N commutativity, the orientation term at weight mu_o on
  * FMAP_ORIENT_ENERGIES energies per block; DDM deblurring onto the target)
  * from SHREC'07 plier 203 to T = the plier mirrored (testmesh_mirrored:

@@ -11,6 +11,7 @@
 #include "metric/metric.h"
 #include "proto.h"
 #include "rhm/rhm__problem.h"
+#include "start/start.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -57,10 +58,10 @@ static void faust_pipeline(int start, double ge[3], metric_summary ms[3])
     p.start = start;
     rhm__problem *pb = NULL;
     if (rhm__problem_new(g.S, g.T, &g.L, &p, &pb, err, sizeof err) ||
-        rhm__init_start(pb, err, sizeof err))
+        rhm__start(pb, start_maps, err, sizeof err))
         FAILF("%s", err);
     rhm_result res;
-    if (rhm_run(g.S, g.T, &g.L, &p, print_progress, NULL, &res, err, sizeof err))
+    if (start_run(g.S, g.T, &g.L, &p, print_progress, NULL, &res, err, sizeof err))
         FAILF("%s", err);
     char name[32];
     printf("  start %s; RHM: %d iterations, %.1f ms per iteration\n",
@@ -175,7 +176,7 @@ TEST_T(zoomout_lowers_the_fmap_starts_error_on_faust, 1200)
             if (rhm__problem_new(g.S, g.T, &g.L, &p, &pb, err, sizeof err))
                 FAILF("%s", err);
             double t1 = now_s();
-            if (rhm__init_start(pb, err, sizeof err))
+            if (rhm__start(pb, start_maps, err, sizeof err))
                 FAILF("%s", err);
             t[z] = now_s() - t1;
             (void)t0;
@@ -205,7 +206,7 @@ static rhm__problem *faust_problem_from(testgt *g, int iters, int start)
     p.start = start;
     rhm__problem *pb = NULL;
     if (rhm__problem_new(g->S, g->T, &g->L, &p, &pb, err, sizeof err) ||
-        rhm__init_start(pb, err, sizeof err))
+        rhm__start(pb, start_maps, err, sizeof err))
         FAILF("%s", err);
     for (int k = 1; k <= iters; k++)
         for (int i = 0; i < 2; i++) {
@@ -222,7 +223,7 @@ static rhm__problem *faust_problem(testgt *g, int iters)
 
 /* The distances start: every row a point of the other side whose
  * description (scaled distances to the landmarks, then the weighted sines
- * of rhm__problem.h) is the closest (checked against brute force on a
+ * of start.h) is the closest (checked against brute force on a
  * sample of rows), each landmark mapped near its partner, and
  * X_ij = P_ij X_j. */
 static double *description(rhm__side *a, int nl, int dd, double *D)
@@ -237,7 +238,7 @@ static double *description(rhm__side *a, int nl, int dd, double *D)
         CHECK(geo_gradient_sine(a->m, D + (size_t)r * a->n, 1, D + (size_t)((r + 1) % nl) * a->n,
                                 1, o) == 0);
         for (int v = 0; v < a->n; v++)
-            Z[(size_t)v * dd + nl + r] = RHM__ORIENT_WEIGHT * o[v];
+            Z[(size_t)v * dd + nl + r] = START_ORIENT_WEIGHT * o[v];
     }
     free(o);
     return Z;
@@ -540,7 +541,7 @@ TEST(run_stops_when_progress_returns_nonzero)
     rhm_result res;
     char err[256];
     int last = -1;
-    CHECK_INT(rhm_run(g.S, g.T, &g.L, &p, cancel_at_2, &last, &res, err, sizeof err), RHM_ECANCELED);
+    CHECK_INT(start_run(g.S, g.T, &g.L, &p, cancel_at_2, &last, &res, err, sizeof err), RHM_ECANCELED);
     CHECK_INT(last, 2);
     CHECK(res.P12 == NULL && res.P21 == NULL);
     CHECK_STR_HAS(err, "iteration 2");
@@ -555,13 +556,13 @@ TEST(refuses_too_few_landmarks_and_bad_parameters)
     rhm_params_init(&p);
     rhm_result res;
     char err[256];
-    CHECK_INT(rhm_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_ELANDMARKS);
+    CHECK_INT(start_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_ELANDMARKS);
     CHECK_STR_HAS(err, "at least 3");
     L.n = 3;
     L.src = (int[]){0, 5, 9};
     L.tgt = (int[]){0, 5, 9};
     p.alpha = 1;
-    CHECK_INT(rhm_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_EPARAM);
+    CHECK_INT(start_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_EPARAM);
     CHECK_STR_HAS(err, "alpha");
     mesh_free(m);
 }
@@ -606,7 +607,7 @@ TEST_T(sphere_to_retessellated_sphere_is_found_from_eight_landmarks, 120)
     rhm_params_init(&p);
     rhm_result r;
     char err[256];
-    if (rhm_run(S, T, &L, &p, NULL, NULL, &r, err, sizeof err))
+    if (start_run(S, T, &L, &p, NULL, NULL, &r, err, sizeof err))
         FAILF("%s", err);
     int *id = malloc(sizeof(int) * (size_t)S->nv);
     double *ge = malloc(sizeof(double) * (size_t)S->nv);
@@ -666,14 +667,14 @@ TEST_T(start_and_rhm_keep_a_thin_shape_the_right_way_round, 240)
     rhm_params p;
     rhm_params_init(&p);
     rhm__problem *pb = NULL;
-    if (rhm__problem_new(S, T, L, &p, &pb, err, sizeof err) || rhm__init_start(pb, err, sizeof err))
+    if (rhm__problem_new(S, T, L, &p, &pb, err, sizeof err) || rhm__start(pb, start_maps, err, sizeof err))
         FAILF("%s", err);
     metric_summary ms;
     CHECK_INT(metric_summarize(S, T, pb->side[0].P, &ms), 0);
     printf("  start: %.1f %% flipped\n", 100 * ms.flipped_fraction);
     CHECK(ms.flipped_fraction < 0.25);
     rhm_result res;
-    if (rhm_run(S, T, L, &p, NULL, NULL, &res, err, sizeof err))
+    if (start_run(S, T, L, &p, NULL, NULL, &res, err, sizeof err))
         FAILF("%s", err);
     CHECK_INT(metric_summarize(S, T, res.P12, &ms), 0);
     printf("  RHM: %.1f %% flipped\n", 100 * ms.flipped_fraction);

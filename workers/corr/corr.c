@@ -8,6 +8,7 @@
 #include "corr/corr__plan.h"
 #include "mesh/mesh_check.h"
 #include "metric/metric.h"
+#include "start/start.h"
 #include "util/errbuf.h"
 
 #include <string.h>
@@ -141,7 +142,7 @@ static int rhm_repaired(const corr_input *in, const rhm_params *q, relay *rl,
                         rhm_progress_fn progress, void *ctx, rhm_result *out, bmap **raw,
                         fold_report rep[2], char *err, size_t errsz)
 {
-    int rc = rhm_run(in->S, in->T, in->L, q, progress, ctx, out, err, errsz);
+    int rc = start_run(in->S, in->T, in->L, q, progress, ctx, out, err, errsz);
     if (rc)
         return corr_from_rhm(rc);
     if (raw) {
@@ -164,16 +165,15 @@ static int rhm_chain(const corr_input *in, const rhm_params *rp, relay *rl,
         *raw = NULL;
     rhm_params q = *rp;
     int autos = q.start == RHM_START_AUTO;
-    if (autos)
-        q.start = RHM_START_DISTANCES;
+    q.start = start_first(rp->start);
     int rc = rhm_repaired(in, &q, rl, progress, ctx, out, raw, rep, err, errsz);
     double bad = rc ? 2 : folded(in, out);
-    int again = !rc && autos && metric_verdict(bad, 0) != METRIC_VERDICT_OK;
+    int again = !rc && start_second(rp->start, bad) >= 0;
     if (rl && rl->plan && autos && !rc)
         corr__plan_rerun(rl->plan, again);
     if (!again)
         return rc;
-    q.start = RHM_START_FMAP;
+    q.start = start_second(rp->start, bad);
     rhm_result alt;
     bmap *raw2 = NULL;
     fold_report rep2[2];
@@ -184,7 +184,7 @@ static int rhm_chain(const corr_input *in, const rhm_params *rp, relay *rl,
         bmap_free(raw2);
         return errbuf_set(err, errsz, rc, "%s", why);
     }
-    if (rc == CORR_OK && folded(in, &alt) < bad) {     /* keep the functional map's */
+    if (rc == CORR_OK && start_keep_second(bad, folded(in, &alt))) {  /* keep the second map */
         rhm_result t = *out;
         *out = alt;
         alt = t;

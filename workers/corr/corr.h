@@ -5,7 +5,7 @@
  *   then the chosen stages, always in this order (corr_chain):
  *   DDM denoising of the uploaded P (and Q): the map's functional map
  *     C = Psi1^T M1 P Psi2, deblurred to a precise map (ddm.h, thesis §2.5)
- *   RHM: from landmarks (a start map, rhm.h) or from the uploaded or
+ *   RHM: from landmarks (a start map, start.h) or from the uploaded or
  *     denoised maps (rhm_run_from_maps, anchored to them: rhm.h's
  *     RHM_ANCHORS), giving P and Q, whose folds are
  *     then repaired (corr_repair, fold.h)
@@ -190,7 +190,7 @@ int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
  * is queued. */
 int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
 
-/* RHM from the landmarks as the pipeline runs it: rhm_run from rp, then
+/* RHM from the landmarks as the pipeline runs it: start_run from rp, then
  * the fold repair of its maps (corr_repair, rep). Start auto (the
  * default): from the distances start, and when the repaired maps are still
  * folded (metric_verdict: over 5 % of either map's triangles flipped or
@@ -202,7 +202,7 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
  * failure of the second run
  * leaves the first maps; a cancel cancels. raw (may be NULL): a copy of
  * the kept forward map before its repair (for benchmarks). progress:
- * rhm_run's, the second run's reports from iteration 0 again. */
+ * start_run's, the second run's reports from iteration 0 again. */
 int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
              rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz);
 

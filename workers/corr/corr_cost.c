@@ -10,7 +10,7 @@
  * workers and holds the estimate above their peak and within a small
  * factor of it); the terms that grow with the landmarks are the engine's
  * own arrays, counted from the code that allocates them:
- *   - the distances start (rhm_init.c, start_distances): both sides'
+ *   - the distances start (start_distances.c): both sides'
  *     descriptions, nv by 2·nl doubles each, then either the principal
  *     axes of R^(2nl) (four dd by dd matrices: covariance, eigenvectors and
  *     LAPACK's copies) or one projection's boxes in R^(2nl) (proj_closest:
@@ -35,6 +35,7 @@
  * links none of their libraries. */
 #include "corr/corr.h"
 #include "fmap/fmap.h"
+#include "start/start.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -121,7 +122,7 @@ double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, s
             double dist = 8 * dd * n2 + max2(max2(8 * nl * nmax, 4 * 8 * dd * dd), 8 * 2 * dd * 1.25 * fmax);
             /* fmap: descriptors and the wave-kernel maps' work arrays of
              * both sides, the orientation operators, ZoomOut's bases */
-            double k = RHM_FMAP_K, kz = r->zoomout;
+            double k = START_FMAP_K, kz = r->zoomout;
             double fmap = 8 * FMAP_ENERGIES_DEFAULT * (2 * nl + 1) * n2 +
                           2 * 8 * k * k * FMAP_ORIENT_ENERGIES * (nl + 1) + 8 * 2 * kz * n2;
             double vor = 8 * nl * ns;   /* Voronoi: every source vertex's distance to every landmark */

@@ -19,26 +19,10 @@
  * mass; s_i: total area. All in the meshes' own units (the energy is
  * scale-invariant as written).
  *
- * Start from the landmarks (p_r on M1, q_r on M2, r = 1..nl), three kinds
- * and a rule among them:
- *  - distances: every vertex described by its geodesic
- *    distances to the landmarks of its side, divided by √(area); P12 row v
- *    = the closest point to v's description on M2 with M2's descriptions as
- *    vertex coordinates (an exact projection in R^nl, proj.h), P21 the same
- *    the other way; X_ij = P_ij X_j. Not the thesis' start: it is ours,
- *    because the Voronoi start below collapses every cell to a point and a
- *    limb's turn about its axis is then left to chance (docs/decisions.md,
- *    "RHM's start: distances, then the functional map").
- *  - voronoi (§3.3.2): P12 sends every vertex of a geodesic Voronoi cell of
- *    M1 (centres: source landmarks) to the cell's target landmark; P21
- *    sends every vertex v of M2 to the source landmark whose target
- *    landmark is nearest to v in M2's embedding (the nearest neighbour of v
- *    among the images T12(V1), which are exactly the target landmarks; ties
- *    to the lower landmark index); X_ij = P_ij X_j.
- *  - fmap: a functional map from the landmarks' descriptors (Δ + D_N
- *    commutativity, fmap.h), made precise by DDM's deblurring.
- *  - auto (the default): a rule of the pipeline, which repairs RHM's
- *    maps (corr_rhm, corr.h); rhm_run runs the distances start for it.
+ * Start: the maps P12, P21 from which the iterations begin, X_ij = P_ij X_j.
+ * From landmarks they come from the start module (start.h: distances,
+ * Voronoi or functional-map maps, the kind p.start), through rhm_run_start,
+ * which takes the start as a function; from given maps, rhm_run_from_maps.
  *
  * Iteration k = 1..K (Algorithm 3.1), β_k = beta_step·min(k, beta_ramp):
  * for i = 1, 2: P_ij <- projection, X_ij <- sparse linear solve. Each block
@@ -52,11 +36,12 @@
  * distances start keeps most parts the right way round, and landmarks on both
  * sides of such parts help either way.
  *
- * This module reads no files. rhm_run reports the initial map (iteration 0)
+ * This module reads no files. rhm_run_start reports the initial map (iteration 0)
  * and every iteration through a callback whose non-zero return cancels. */
 #ifndef RHM_H
 #define RHM_H
 #include <stddef.h>
+#include "geod/geod.h"
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -77,17 +62,12 @@ enum rhm_error {
 #undef RHM_ENUM
 };
 
-/* Basis size of the functional-map start (the k of fmap's tests and
- * figures), capped by what a small mesh has; ZoomOut (rhm_params.zoomout)
- * grows it from there. */
-#define RHM_FMAP_K 50
-
 typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
     RHM_START_VORONOI = 1,     /* the thesis' geodesic Voronoi map          */
     RHM_START_FMAP = 2,        /* functional map (Δ + D_N) deblurred by DDM */
-    RHM_START_AUTO = 3         /* the pipeline's rule (corr_rhm); rhm_run
-                                  runs distances for it                    */
+    RHM_START_AUTO = 3         /* the pipeline's rule (start.h, corr_rhm);
+                                  a single run starts from distances       */
 } rhm_start;
 /* Their names are the values of start in PROTO_PARAMS (proto_params.h):
  * proto_param_value_name, proto_param_parse. */
@@ -107,7 +87,8 @@ typedef struct rhm_params {
     int min_iterations;    /* no early stop before this iteration  (>= 1)   */
     double stop_change;    /* relative energy change to stop; 0 = never     */
     int threads;           /* OpenMP threads; 0: all cores                  */
-    int zoomout;           /* start fmap: ZoomOut's final basis size; 0 off */
+    int zoomout;           /* start fmap: ZoomOut's final basis size; 0 off
+                              (start.h: from START_FMAP_K + 1)              */
     int coarse;            /* coarse to fine's vertices (corr.h); 0 off     */
     double anchor;         /* from given maps: weight δ of the anchor term
                               Ē_A (rhm_run_from_maps); 0: off       (>= 0)  */
@@ -131,8 +112,7 @@ typedef struct rhm_params {
  * start: auto (ours, see above); anchor RHM_ANCHOR_WEIGHT on RHM_ANCHORS
  * (given maps only). */
 void rhm_params_init(rhm_params *p);
-/* 0 or RHM_EPARAM with the offending field named in err (zoomout from 1 to
- * RHM_FMAP_K: ZoomOut only grows the start's basis). */
+/* 0 or RHM_EPARAM with the offending field named in err. */
 int rhm_params_check(const rhm_params *p, char *err, size_t errsz);
 double rhm_beta(const rhm_params *p, int k);
 
@@ -149,7 +129,7 @@ typedef struct rhm_report {
     double beta;
     rhm_terms dir[2];
     double energy;         /* sum of the eight terms                        */
-    double elapsed;        /* seconds since rhm_run started                 */
+    double elapsed;        /* seconds since the run started                 */
     double t_setup;        /* seconds in geodesics, embeddings, operators   */
     double t_project, t_solve; /* cumulated seconds in P-steps, X-steps     */
 } rhm_report;
@@ -160,20 +140,42 @@ typedef struct rhm_result {
     bmap *P12;             /* M1 -> M2 (ECTM's P0)                          */
     bmap *P21;             /* M2 -> M1 (ECTM's Q0)                          */
     rhm_report last;
-    int start;             /* the start the maps came from (rhm_run: auto
+    int start;             /* the start the maps came from (start_run: auto
                               is distances; corr_rhm: the one kept); -1
-                              from given maps                             */
+                              from given maps and from rhm_run_start       */
 } rhm_result;
 void rhm_result_close(rhm_result *r);
 
+/* What a start from landmarks sees of side i (0: S = M1, 1: T = M2) and
+ * fills: P, the map from side i to the other side, allocated by RHM (n
+ * rows onto the other side's faces, to be set row by row). The rest is
+ * RHM's set-up, borrowed for the start's duration. */
+typedef struct rhm_side {
+    const mesh *m;         /* the side's mesh                               */
+    int n;                 /* its vertices                                  */
+    double area;           /* its total area                                */
+    const double *X;       /* n by dim: its embedding (row-major)           */
+    int dim;               /* the embedding's dimension m                   */
+    geod_solver *geod;     /* its heat-method solver (Laplacian and mass)   */
+    int *lmk;              /* nl landmark vertices on this side (read only) */
+    int nl;                /* landmark pairs                                */
+    bmap *P;               /* to fill: side i -> side 1 − i                 */
+} rhm_side;
+
+/* Fills side[0].P (P12) and side[1].P (P21) for the parameters p; RHM_OK
+ * or an RHM_* error with its detail in err. */
+typedef int (*rhm_start_fn)(const rhm_params *p, rhm_side side[2], char *err, size_t errsz);
+
 /* Runs RHM from the landmark pairs L (L->src on S = M1, L->tgt on T = M2,
- * at least PROTO_MIN_LANDMARKS), from p->start (auto: distances). The
- * meshes must be validated (manifold,
+ * at least PROTO_MIN_LANDMARKS): the set-up, the start maps by start (the
+ * start module's start_maps from p->start: start_run), X_ij = P_ij X_j,
+ * then the iterations. The meshes must be validated (manifold,
  * connected, no degenerate face). Errors: RHM_EPARAM, RHM_ELANDMARKS,
- * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC; detail in err. */
-int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
-            rhm_progress_fn progress, void *ctx, rhm_result *out,
-            char *err, size_t errsz);
+ * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC, or start's; detail
+ * in err. out->start is -1 (start_run sets it). */
+int rhm_run_start(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+                  rhm_start_fn start, rhm_progress_fn progress, void *ctx, rhm_result *out,
+                  char *err, size_t errsz);
 
 /* RHM from given maps instead of a start from landmarks (thesis §3.3.2
  * lists a given map as an RHM input): P12 (S -> T, required) and P21
@@ -183,10 +185,10 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
  * the anchors (p->anchor, p->anchors: a farthest-point sample of each
  * side's embedding, the first at vertex 0, each held by the anchor term to
  * its start X_ij = P_ij X_j), then
- * the iterations of rhm_run. L may be NULL or hold any number of pairs:
+ * the iterations of rhm_run_start. L may be NULL or hold any number of pairs:
  * landmarks serve only the weak landmark term, so p->gamma > 0 needs at
  * least one. p->start is unused. The maps are copied, not kept. Errors as
- * rhm_run; RHM_EMAP for maps sized for other meshes or with a face
+ * rhm_run_start; RHM_EMAP for maps sized for other meshes or with a face
  * out of range. */
 int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap *P12,
                       const bmap *P21, const rhm_params *p, rhm_progress_fn progress, void *ctx,

@@ -1,7 +1,7 @@
 /* rhm__problem.h — internal (rhm__): the state of one RHM job and its block
- * steps, shared by rhm_problem.c (set-up), rhm_init.c (start from
- * landmarks), rhm_given.c (start from given maps), rhm_step.c (P-step,
- * X-step, energy) and rhm_run.c (the loop); the tests drive the steps one
+ * steps, shared by rhm_problem.c (set-up), rhm_given.c (start from given
+ * maps), rhm_step.c (P-step, X-step, energy) and rhm_run.c (the start from
+ * landmarks through an rhm_start_fn, the loop); the tests drive the steps one
  * by one. Not part of the public rhm_ API.
  *
  * Index convention: side i = 0 is M1 (the source), 1 is M2; direction i is
@@ -44,7 +44,7 @@ typedef struct rhm__problem {
 } rhm__problem;
 
 /* Builds geodesic solvers, embeddings, operators, trees and the X-step
- * symbolic factorisations; the maps are left NULL (rhm__init_start sets
+ * symbolic factorisations; the maps are left NULL (rhm__start sets
  * them). Errors as rhm_run. */
 int rhm__problem_new(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
                      rhm__problem **out, char *err, size_t errsz);
@@ -67,17 +67,10 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
                  rhm_result *out, char *err, size_t errsz);
 double rhm__now(void);   /* monotonic seconds */
 
-/* The distances start describes a vertex by its distances to the
- * landmarks / √area and, for r = 0..nl−1, RHM__ORIENT_WEIGHT times the sine
- * of the angle from ∇d_r to ∇d_{(r+1) mod nl} (geo_orient.h): the features
- * a mirrored match negates. The weight is about a quarter of a typical
- * distance at unit area: enough to tell a shape's front from its back when the
- * distances cannot, small enough to leave
- * the distances in charge elsewhere. */
-#define RHM__ORIENT_WEIGHT 0.25
-
-/* The start (rhm.h) of kind p.start: P12, P21, X_ij = P_ij X_j. */
-int rhm__init_start(rhm__problem *pb, char *err, size_t errsz);
+/* The start from landmarks (rhm.h, rhm_run_start): allocates P12, P21,
+ * fills them by start through the sides' rhm_side view, sets X_ij =
+ * P_ij X_j. */
+int rhm__start(rhm__problem *pb, rhm_start_fn start, char *err, size_t errsz);
 
 /* P_ij <- argmin over maps of (1−α)Ē_R(P, X_ji) + βĒ_Q(P, X_ij), row by row
  * (closest point in R^{2m}, exact, seeded with the current P_ij). why: the

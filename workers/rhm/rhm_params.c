@@ -2,7 +2,6 @@
  * the β schedule), error strings and the result's destructor. */
 #include "rhm/rhm.h"
 #include "embed/embed.h"
-#include "lbo/lbo.h"
 #include "proto.h"
 #include "util/errbuf.h"
 
@@ -14,8 +13,6 @@
 #define RHM_ROW_RHM(x) x
 #define RHM_ROW_ECTM(x)
 #define RHM_ROW_NONE(x)
-_Static_assert(PROTO_ZOOMOUT_MAX <= LBO_MAX_K, "zoomout's range must fit the eigenpairs'");
-_Static_assert(PROTO_ZOOMOUT_MIN == RHM_FMAP_K + 1, "ZoomOut grows the fmap start's basis");
 _Static_assert(EMBED_MAX_DIM == PROTO_RHM_MAX_DIM, "rhm_dim's max in PROTO_PARAMS is EMBED_MAX_DIM");
 _Static_assert((int)RHM_START_VORONOI == (int)PROTO_START_VORONOI &&
                    (int)RHM_START_FMAP == (int)PROTO_START_FMAP, "start values");

@@ -1,6 +1,7 @@
-/* rhm_run.c — the RHM loop (rhm.h): set-up, the start map, block coordinate
- * descent with the β schedule and the stopping rule, progress and
- * cancellation. The numerics are rhm_step.c's. */
+/* rhm_run.c — the RHM loop (rhm.h): set-up, the start map from landmarks
+ * through the caller's rhm_start_fn, block coordinate descent with the β
+ * schedule and the stopping rule, progress and cancellation. The numerics
+ * are rhm_step.c's. */
 #include "rhm/rhm__problem.h"
 #include "util/errbuf.h"
 
@@ -65,11 +66,35 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
     return RHM_OK;
 }
 
-int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
-            rhm_progress_fn progress, void *ctx, rhm_result *out,
-            char *err, size_t errsz)
+int rhm__start(rhm__problem *pb, rhm_start_fn start, char *err, size_t errsz)
+{
+    rhm__side *a = &pb->side[0], *b = &pb->side[1];
+    bmap_free(a->P);
+    bmap_free(b->P);
+    a->P = bmap_new(a->n, b->n);
+    b->P = bmap_new(b->n, a->n);
+    if (!a->P || !b->P)
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    rhm_side view[2];
+    for (int i = 0; i < 2; i++) {
+        const rhm__side *sd = &pb->side[i];
+        view[i] = (rhm_side){ .m = sd->m, .n = sd->n, .area = sd->s, .X = sd->X, .dim = pb->dim,
+                              .geod = sd->geod, .lmk = sd->lmk, .nl = pb->nl, .P = sd->P };
+    }
+    int rc = start(&pb->p, view, err, errsz);
+    if (rc)
+        return rc;
+    bmap_apply(a->P, b->m->f, b->X, pb->dim, a->Xij);
+    bmap_apply(b->P, a->m->f, a->X, pb->dim, b->Xij);
+    return RHM_OK;
+}
+
+int rhm_run_start(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
+                  rhm_start_fn start, rhm_progress_fn progress, void *ctx, rhm_result *out,
+                  char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
+    out->start = -1;
     double t0 = rhm__now();
     if (p->threads > 0)
         omp_set_num_threads(p->threads);
@@ -77,10 +102,8 @@ int rhm_run(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
     int rc = rhm__problem_new(S, T, L, p, &pb, err, errsz);
     if (rc)
         return rc;
-    if (!(rc = rhm__init_start(pb, err, errsz)))
+    if (!(rc = rhm__start(pb, start, err, errsz)))
         rc = rhm__iterate(pb, t0, progress, ctx, out, err, errsz);
-    if (!rc)
-        out->start = p->start == RHM_START_AUTO ? RHM_START_DISTANCES : p->start;
     rhm__problem_free(pb);
     return rc;
 }
