@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <suitesparse/cholmod.h>
 
 const char *geod_strerror(int code)
 {
@@ -32,12 +33,9 @@ void geod_solver_free(geod_solver *s)
 {
     if (!s)
         return;
-    if (s->cc_started) {
-        cholmod_free_factor(&s->heat, &s->cc);
-        cholmod_free_factor(&s->heat_dir, &s->cc);
-        cholmod_free_factor(&s->poisson, &s->cc);
-        cholmod_finish(&s->cc);
-    }
+    chol_free(s->heat);
+    chol_free(s->heat_dir);
+    chol_free(s->poisson);
     free(s->f);
     geo_csr_free(s->L);
     free(s->mass);
@@ -79,15 +77,19 @@ static void face_gradients(const geod__idt *T, double *grad, double *area)
  * of the intrinsic triangulation. L as CSR with both triangles: CHOLMOD
  * sorts the triplets and sums duplicate edges; loops (an edge from a vertex
  * to itself) are dropped, they add nothing to x^T L x. */
-static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass,
-                              cholmod_common *cc)
+static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass)
 {
+    cholmod_common common, *cc = &common;
+    cholmod_start(cc);
+    cc->print = 0;
     cholmod_triplet *tr = cholmod_allocate_triplet((size_t)nv, (size_t)nv,
                                                    12 * (size_t)T->nf + (size_t)nv, 0, CHOLMOD_REAL, cc);
     cholmod_sparse *A = NULL;
     geo_csr *L = NULL;
-    if (!tr)
+    if (!tr) {
+        cholmod_finish(cc);
         return NULL;
+    }
     int *ti = tr->i, *tj = tr->j;
     double *tx = tr->x;
     size_t n = 0;
@@ -120,6 +122,7 @@ static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, do
     }
     cholmod_free_sparse(&A, cc);
     cholmod_free_triplet(&tr, cc);
+    cholmod_finish(cc);
     return L;
 }
 
@@ -152,59 +155,41 @@ static int components(const geo_edges *e, int nv, int *comp)
     return n;
 }
 
-/* The upper triangle of a * L + diag(d) restricted to the vertices keep
- * (ascending, or NULL for all; remap: vertex -> row or -1), as a CHOLMOD
- * symmetric (stype 1) matrix. A row with a zero diagonal (a vertex without
- * a non-degenerate face) gets 1: it is decoupled, and the system stays
- * definite. */
-static cholmod_sparse *assemble(const geo_csr *L, double a, const double *d,
-                                const int *keep, int nkeep, const int *remap,
-                                cholmod_common *cc)
+/* *out = the factorised a * L + diag(d) restricted to the vertices keep
+ * (ascending, or NULL for all; remap: vertex -> row or -1). A row with a
+ * zero diagonal (a vertex without a non-degenerate face) gets 1: it is
+ * decoupled, and the system stays definite. AMD ordering only: the
+ * factors are the same whatever METIS would do. GEOD_OK, GEOD_ENOMEM or
+ * GEOD_EFACTOR, naming what in err. */
+static int factor(const geo_csr *L, double a, const double *d, const int *keep, int nkeep,
+                  const int *remap, const char *what, chol **out, char *err, size_t errsz)
 {
+    char detail[256] = "";
     size_t nnz = 0;
     for (int r = 0; r < nkeep; r++) {
         int j = keep ? keep[r] : r;
-        for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++)
-            nnz += L->col[p] <= j && (!remap || remap[L->col[p]] >= 0);
+        nnz += (size_t)(L->row_start[j + 1] - L->row_start[j]);
     }
-    cholmod_sparse *A = cholmod_allocate_sparse(nkeep, nkeep, nnz, 1, 1, 1,
-                                                CHOLMOD_REAL, cc);
-    if (!A)
-        return NULL;
-    int *cp = A->p, *ri = A->i;
-    double *x = A->x;
-    size_t at = 0;
-    for (int r = 0; r < nkeep; r++) {
+    double *dk = malloc((size_t)nkeep * sizeof *dk);
+    int rc = dk ? chol_new(nkeep, nnz, CHOL_ORDER_AMD, out, detail, sizeof detail) : CHOL_ENOMEM;
+    for (int r = 0; rc == CHOL_OK && r < nkeep; r++) {
         int j = keep ? keep[r] : r;
-        cp[r] = (int)at;
+        dk[r] = d[j];
         for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++) {
             int c = L->col[p];
-            if (c > j || (remap && remap[c] < 0))
-                continue;
-            ri[at] = remap ? remap[c] : c;
-            x[at] = a * L->val[p];
-            if (c == j) {
-                x[at] += d[j];
-                if (!(x[at] != 0))
-                    x[at] = 1;
-            }
-            at++;
+            if (c <= j && (!remap || remap[c] >= 0))
+                chol_add(*out, remap ? remap[c] : c, r, a * L->val[p]);
         }
     }
-    cp[nkeep] = (int)at;
-    return A;
-}
-
-static cholmod_factor *factorise(cholmod_sparse *A, cholmod_common *cc,
-                                 const char *what, char *err, size_t errsz)
-{
-    cholmod_factor *F = cholmod_analyze(A, cc);
-    if (F && cholmod_factorize(A, F, cc) && cc->status == CHOLMOD_OK)
-        return F;
-    errbuf_set(err, errsz, GEOD_EFACTOR, "factorising %s failed (CHOLMOD status %d)",
-               what, cc->status);
-    cholmod_free_factor(&F, cc);
-    return NULL;
+    if (rc == CHOL_OK && (rc = chol_assemble(*out, CHOL_DIAG_SHIFT_UNIT, dk, detail, sizeof detail)) == CHOL_OK)
+        rc = chol_factorise(*out, detail, sizeof detail);
+    free(dk);
+    if (rc == CHOL_OK)
+        return GEOD_OK;
+    chol_free(*out);
+    *out = NULL;
+    return errbuf_set(err, errsz, rc == CHOL_ENOMEM ? GEOD_ENOMEM : GEOD_EFACTOR, "%s: %s", what,
+                      detail[0] ? detail : "out of memory");
 }
 
 int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err, size_t errsz)
@@ -217,7 +202,6 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     geo_csr *L = NULL;
     double *mass = NULL, *d = NULL;
     int *remap = NULL;
-    cholmod_sparse *A = NULL;
     int ok = 0;
     if (!m || m->nv < 1 || m->nf < 1) {
         return errbuf_set(err, errsz, GEOD_EMESH, "geodesics need a mesh with faces");
@@ -248,13 +232,7 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     }
     s->flips = idt.flips;
     face_gradients(&idt, s->grad, s->area);
-    cholmod_start(&s->cc);
-    s->cc_started = 1;
-    s->cc.print = 0;
-    s->cc.nmethods = 1; /* AMD only: deterministic, no METIS */
-    s->cc.method[0].ordering = CHOLMOD_AMD;
-    s->cc.postorder = 1;
-    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass, &s->cc))) {
+    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass))) {
         code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex Laplacian", m->nv);
         goto out;
     }
@@ -290,16 +268,18 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
 
     for (int i = 0; i < m->nv; i++)
         d[i] = mass[i];
-    if (!(A = assemble(L, s->t, d, NULL, m->nv, NULL, &s->cc)) ||
-        !(s->heat = factorise(A, &s->cc, "M + t L", err, errsz)))
-        goto fail_cholmod;
-    cholmod_free_sparse(&A, &s->cc);
+    if ((rc = factor(L, s->t, d, NULL, m->nv, NULL, "factorising M + t L", &s->heat, err,
+                     errsz)) != GEOD_OK) {
+        code = rc;
+        goto out;
+    }
     for (int i = 0; i < m->nv; i++)
         d[i] = eps * mass[i];
-    if (!(A = assemble(L, 1.0, d, NULL, m->nv, NULL, &s->cc)) ||
-        !(s->poisson = factorise(A, &s->cc, "L + eps M", err, errsz)))
-        goto fail_cholmod;
-    cholmod_free_sparse(&A, &s->cc);
+    if ((rc = factor(L, 1.0, d, NULL, m->nv, NULL, "factorising L + eps M", &s->poisson, err,
+                     errsz)) != GEOD_OK) {
+        code = rc;
+        goto out;
+    }
 
     if (geo_edges_boundary_count(&e) > 0) {
         if (!(remap = malloc((size_t)m->nv * sizeof *remap)) ||
@@ -320,27 +300,17 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
         for (int i = 0; i < m->nv; i++)
             d[i] = mass[i];
         if (s->n_interior > 0 &&
-            (!(A = assemble(L, s->t, d, s->interior, s->n_interior, remap, &s->cc)) ||
-             !(s->heat_dir = factorise(A, &s->cc, "the interior block of M + t L",
-                                       err, errsz))))
-            goto fail_cholmod;
+            (rc = factor(L, s->t, d, s->interior, s->n_interior, remap,
+                         "factorising the interior block of M + t L", &s->heat_dir, err,
+                         errsz)) != GEOD_OK) {
+            code = rc;
+            goto out;
+        }
     } else {
         s->n_interior = m->nv;
     }
     ok = 1;
-    goto out;
-
-fail_cholmod:
-    if (s->cc.status == CHOLMOD_OUT_OF_MEMORY)
-        code = errbuf_set(err, errsz, GEOD_ENOMEM, "CHOLMOD ran out of memory (%d vertices)", m->nv);
-    else if (!A)
-        code = errbuf_set(err, errsz, GEOD_EFACTOR, "CHOLMOD could not build a matrix (status %d)",
-                          s->cc.status);
-    else
-        code = GEOD_EFACTOR;   /* factorise said which */
 out:
-    if (s && s->cc_started)
-        cholmod_free_sparse(&A, &s->cc);
     free(d);
     free(remap);
     geod__idt_close(&idt);
