@@ -310,13 +310,7 @@ static void start_later(mcd *d, uint64_t id, const char *user, const char *why)
     char reason[PROTO_MAX_STRING + 1];
     snprintf(reason, sizeof reason, "waiting to start: %s (retried in %.1f s)", why, (double)R.delay_ms / 1000);
     dlog(DLOG_WARN, "job %llu: %s", (unsigned long long)id, reason);
-    sched_done(d->sched, user);
-    store_job j;
-    if (store_get(d->store, id, &j) == 0 && sched_add(d->sched, id, user, j.priority) == 0)
-        store_set_reason(d->store, id, reason);
-    else
-        dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue (it runs after the next restart)",
-             (unsigned long long)id);
+    job_requeue(d, id, user, 1, reason);
     pause_starts();
 }
 
