@@ -372,11 +372,11 @@ void store_close(store *s)
     free(s);
 }
 
-/* No worker a previous daemon started survives it: each job's worker lock
- * (wlock.c) is held by whatever process of that job still runs, recorded
- * in the row or not (a daemon killed between the spawn and the row's update
- * left it PENDING). */
-int store_kill_orphan_workers(store *s, char *err, size_t errsz)
+/* Calls fn for each entry of spool/ but . and .. (name: the entry's name,
+ * id: its job id, 0 when the name is not one). 0, or PROTO_ESTORAGE with
+ * err when spool/ cannot be read. */
+static int each_spool_entry(store *s, void (*fn)(store *s, const char *name, uint64_t id, void *ctx),
+                            void *ctx, char *err, size_t errsz)
 {
     char spool[CONF_PATH + 16];
     snprintf(spool, sizeof spool, "%s/spool", s->dir);
@@ -385,19 +385,39 @@ int store_kill_orphan_workers(store *s, char *err, size_t errsz)
         return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
     struct dirent *de;
     while ((de = readdir(dp))) {
-        char *e, path[CONF_PATH + 64];
-        unsigned long long id = strtoull(de->d_name, &e, 10);
-        if (de->d_name[0] == '.' || *e != '\0' || id == 0)
+        if (strcmp(de->d_name, ".") == 0 || strcmp(de->d_name, "..") == 0)
             continue;
-        int n = wlock_kill_holders(store_spool_path(s, id, SPOOL_WORKER_LOCK, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
-        if (n > 0)
-            dlog(DLOG_WARN, "store: job %llu: killed %d worker process(es) a previous daemon left running", id, n);
-        else if (n < 0)
-            dlog(DLOG_ERROR, "store: job %llu: a process still holds %s after %d ms: the job starts once it"
-                 " lets go", id, path, WLOCK_RECOVER_WAIT_MS);
+        char *e;
+        unsigned long long id = strtoull(de->d_name, &e, 10);
+        fn(s, de->d_name, de->d_name[0] != '.' && *e == '\0' ? id : 0, ctx);
     }
     closedir(dp);
     return 0;
+}
+
+static void kill_holders(store *s, const char *name, uint64_t id, void *ctx)
+{
+    (void)name;
+    (void)ctx;
+    char path[CONF_PATH + 64];
+    if (!id)
+        return;
+    int n = wlock_kill_holders(store_spool_path(s, id, SPOOL_WORKER_LOCK, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
+    if (n > 0)
+        dlog(DLOG_WARN, "store: job %llu: killed %d worker process(es) a previous daemon left running",
+             (unsigned long long)id, n);
+    else if (n < 0)
+        dlog(DLOG_ERROR, "store: job %llu: a process still holds %s after %d ms: the job starts once it"
+             " lets go", (unsigned long long)id, path, WLOCK_RECOVER_WAIT_MS);
+}
+
+/* No worker a previous daemon started survives it: each job's worker lock
+ * (wlock.c) is held by whatever process of that job still runs, recorded
+ * in the row or not (a daemon killed between the spawn and the row's update
+ * left it PENDING). */
+int store_kill_orphan_workers(store *s, char *err, size_t errsz)
+{
+    return each_spool_entry(s, kill_holders, NULL, err, errsz);
 }
 
 int store_set_pending(store *s, uint64_t id)
@@ -407,37 +427,30 @@ int store_set_pending(store *s, uint64_t id)
                   " WHERE id = ?", "i", (int64_t)id);
 }
 
+/* A spool entry without a committed row: a SUBMIT cut off before its row
+ * was inserted (.new-*), or a job's directory whose row is gone. */
+static void remove_orphan(store *s, const char *name, uint64_t id, void *ctx)
+{
+    int *removed = ctx;
+    store_job j;
+    if (strncmp(name, SPOOL_NEW_PREFIX, strlen(SPOOL_NEW_PREFIX)) == 0) {
+        char dir[CONF_PATH + 300];
+        snprintf(dir, sizeof dir, "%s/spool/%s", s->dir, name);
+        remove_dir(dir);
+        (*removed)++;
+    } else if (id && store_get(s, id, &j) == PROTO_ENOT_FOUND) {
+        spool_remove(s, id);
+        (*removed)++;
+    }
+}
+
 int store_tidy_spool(store *s, int *removed, int *dropped, char *err, size_t errsz)
 {
     sqlite3_stmt *st;
     *removed = *dropped = 0;
-    /* spool directories without a committed row */
-    char spool[CONF_PATH + 16];
-    snprintf(spool, sizeof spool, "%s/spool", s->dir);
-    DIR *dp = opendir(spool);
-    if (!dp)
-        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
-    struct dirent *de;
-    while ((de = readdir(dp))) {
-        if (strncmp(de->d_name, SPOOL_NEW_PREFIX, strlen(SPOOL_NEW_PREFIX)) == 0) {
-            /* a SUBMIT cut off before its row was inserted */
-            char dir[CONF_PATH + 300];
-            snprintf(dir, sizeof dir, "%s/%s", spool, de->d_name);
-            remove_dir(dir);
-            (*removed)++;
-            continue;
-        }
-        char *e;
-        unsigned long long id = strtoull(de->d_name, &e, 10);
-        if (de->d_name[0] == '.' || *e != '\0' || id == 0)
-            continue;
-        store_job j;
-        if (store_get(s, id, &j) == PROTO_ENOT_FOUND) {
-            spool_remove(s, id);
-            (*removed)++;
-        }
-    }
-    closedir(dp);
+    int rc = each_spool_entry(s, remove_orphan, removed, err, errsz);
+    if (rc)
+        return rc;
     /* ended jobs that did not complete hold no input (store_set_state
      * removes it after its commit; a daemon killed in between left it):
      * their missing job.frame is how it should be, not a loss */
@@ -900,41 +913,38 @@ int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_i
     return each_job(s, st, fn, ctx);
 }
 
+/* The jobs the condition where selects (one ? at most: bound to arg), in
+ * id order. */
+static int each_where(store *s, const char *where, int64_t arg, store_job_fn fn, void *ctx)
+{
+    char sql[512];
+    sqlite3_stmt *st;
+    snprintf(sql, sizeof sql, "SELECT " JOB_COLS " FROM jobs WHERE %s ORDER BY id", where);
+    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    if (strchr(where, '?'))
+        sqlite3_bind_int64(st, 1, arg);
+    return each_job(s, st, fn, ctx);
+}
+
 int store_each_pending(store *s, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state = 'PENDING' AND slurm_id = ''"
-                           " ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state = 'PENDING' AND slurm_id = ''", 0, fn, ctx);
 }
 
 int store_each_unfinished(store *s, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state IN ('PENDING', 'RUNNING')"
-                           " ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state IN ('PENDING', 'RUNNING')", 0, fn, ctx);
 }
 
 int store_each_slurm(store *s, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state IN ('PENDING', 'RUNNING')"
-                           " AND slurm_id != '' ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state IN ('PENDING', 'RUNNING') AND slurm_id != ''", 0, fn, ctx);
 }
 
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state NOT IN ('PENDING', 'RUNNING')"
-                           " AND end_ms < ? ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    sqlite3_bind_int64(st, 1, before_ms);
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state NOT IN ('PENDING', 'RUNNING') AND end_ms < ?", before_ms, fn, ctx);
 }
 
 int store_delete(store *s, uint64_t id)
