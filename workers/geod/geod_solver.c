@@ -155,13 +155,13 @@ static int components(const geo_edges *e, int nv, int *comp)
     return n;
 }
 
-/* *out = the factorised a * L + diag(d) restricted to the vertices keep
+/* *out = the factorised a * L + c * M (M = diag(mass)) restricted to the vertices keep
  * (ascending, or NULL for all; remap: vertex -> row or -1). A row with a
  * zero diagonal (a vertex without a non-degenerate face) gets 1: it is
  * decoupled, and the system stays definite. AMD ordering only: the
  * factors are the same whatever METIS would do. GEOD_OK, GEOD_ENOMEM or
  * GEOD_EFACTOR, naming what in err. */
-static int factor(const geo_csr *L, double a, const double *d, const int *keep, int nkeep,
+static int factor(const geo_csr *L, double a, double c, const double *mass, const int *keep, int nkeep,
                   const int *remap, const char *what, chol **out, char *err, size_t errsz)
 {
     char detail[256] = "";
@@ -174,11 +174,11 @@ static int factor(const geo_csr *L, double a, const double *d, const int *keep, 
     int rc = dk ? chol_new(nkeep, nnz, CHOL_ORDER_AMD, out, detail, sizeof detail) : CHOL_ENOMEM;
     for (int r = 0; rc == CHOL_OK && r < nkeep; r++) {
         int j = keep ? keep[r] : r;
-        dk[r] = d[j];
+        dk[r] = c * mass[j];
         for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++) {
-            int c = L->col[p];
-            if (c <= j && (!remap || remap[c] >= 0))
-                chol_add(*out, remap ? remap[c] : c, r, a * L->val[p]);
+            int col = L->col[p];
+            if (col <= j && (!remap || remap[col] >= 0))
+                chol_add(*out, remap ? remap[col] : col, r, a * L->val[p]);
         }
     }
     if (rc == CHOL_OK && (rc = chol_assemble(*out, CHOL_DIAG_SHIFT_UNIT, dk, detail, sizeof detail)) == CHOL_OK)
@@ -192,6 +192,69 @@ static int factor(const geo_csr *L, double a, const double *d, const int *keep, 
                       detail[0] ? detail : "out of memory");
 }
 
+/* The heat time's scale h (the mean extrinsic edge length) and the
+ * Poisson regularisation eps = GEOD_POISSON_REG * mean(L_ii) / mean(M_ii)
+ * over the vertices with mass. GEOD_OK, or GEOD_EMESH for a degenerate
+ * mesh. */
+static int operator_scales(const mesh *m, const geo_edges *e, const geo_csr *L, const double *mass,
+                           double *h_out, double *eps, char *err, size_t errsz)
+{
+    double h = 0, msum = 0, lsum = 0;
+    int nmass = 0;
+    for (int k = 0; k < e->ne; k++) {
+        double v[3];
+        geo__sub(m->v + 3 * (size_t)e->ev[2 * k], m->v + 3 * (size_t)e->ev[2 * k + 1], v);
+        h += sqrt(geo__dot(v, v));
+    }
+    h /= e->ne;
+    for (int i = 0; i < m->nv; i++)
+        if (mass[i] > 0) {
+            msum += mass[i];
+            lsum += geo_csr_get(L, i, i);
+            nmass++;
+        }
+    if (!(h > 0) || !isfinite(h) || nmass == 0 || !(msum > 0) || !(lsum > 0) ||
+        !isfinite(msum) || !isfinite(lsum))
+        return errbuf_set(err, errsz, GEOD_EMESH, "degenerate mesh: mean edge length %g, total area %g",
+                          h, msum);
+    *h_out = h;
+    *eps = GEOD_POISSON_REG * lsum / msum;
+    return GEOD_OK;
+}
+
+/* On a mesh with boundary: s->interior (the vertices on no boundary edge)
+ * and the factorised interior block of M + t L (none when every vertex is
+ * on the boundary); on a closed mesh every vertex is interior and there is
+ * no block. GEOD_OK, GEOD_ENOMEM or GEOD_EFACTOR. */
+static int factor_interior(geod_solver *s, const geo_edges *e, char *err, size_t errsz)
+{
+    if (geo_edges_boundary_count(e) == 0) {
+        s->n_interior = s->nv;
+        return GEOD_OK;
+    }
+    int *remap = malloc((size_t)s->nv * sizeof *remap);   /* vertex -> interior row, or -1 */
+    if (!remap || !(s->interior = malloc((size_t)s->nv * sizeof *s->interior))) {
+        free(remap);
+        return errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the interior list");
+    }
+    for (int i = 0; i < s->nv; i++)
+        remap[i] = 0;
+    for (int k = 0; k < e->ne; k++)
+        if (e->ef[2 * k + 1] < 0)
+            remap[e->ev[2 * k]] = remap[e->ev[2 * k + 1]] = -1;
+    for (int i = 0; i < s->nv; i++)
+        if (remap[i] == 0) {
+            remap[i] = s->n_interior;
+            s->interior[s->n_interior++] = i;
+        }
+    int rc = s->n_interior > 0
+           ? factor(s->L, s->t, 1.0, s->mass, s->interior, s->n_interior, remap,
+                    "factorising the interior block of M + t L", &s->heat_dir, err, errsz)
+           : GEOD_OK;
+    free(remap);
+    return rc;
+}
+
 int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err, size_t errsz)
 {
     geod_solver *s = NULL;
@@ -200,9 +263,7 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     geo_edges e = {0};
     geod__idt idt = {0};
     geo_csr *L = NULL;
-    double *mass = NULL, *d = NULL;
-    int *remap = NULL;
-    int ok = 0;
+    double *mass = NULL, h = 0, eps = 0;
     if (!m || m->nv < 1 || m->nf < 1) {
         return errbuf_set(err, errsz, GEOD_EMESH, "geodesics need a mesh with faces");
     }
@@ -216,8 +277,7 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     }
     s = calloc(1, sizeof *s);
     mass = malloc((size_t)m->nv * sizeof *mass);
-    d = malloc((size_t)m->nv * sizeof *d);
-    if (!s || !mass || !d ||
+    if (!s || !mass ||
         !(s->grad = malloc(6 * (size_t)m->nf * sizeof *s->grad)) ||
         !(s->area = malloc((size_t)m->nf * sizeof *s->area)) ||
         !(s->comp = malloc((size_t)m->nv * sizeof *s->comp))) {
@@ -241,85 +301,23 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     s->L = L;
     s->mass = mass;
     s->ncomp = components(&e, m->nv, s->comp);
-
-    double h = 0, msum = 0, lsum = 0;
-    int nmass = 0;
-    for (int k = 0; k < e.ne; k++) {
-        double v[3];
-        geo__sub(m->v + 3 * (size_t)e.ev[2 * k], m->v + 3 * (size_t)e.ev[2 * k + 1], v);
-        h += sqrt(geo__dot(v, v));
-    }
-    h /= e.ne;
-    for (int i = 0; i < m->nv; i++)
-        if (mass[i] > 0) {
-            msum += mass[i];
-            lsum += geo_csr_get(L, i, i);
-            nmass++;
-        }
-    if (!(h > 0) || !isfinite(h) || nmass == 0 || !(msum > 0) || !(lsum > 0) ||
-        !isfinite(msum) || !isfinite(lsum)) {
-        code = errbuf_set(err, errsz, GEOD_EMESH,
-                          "degenerate mesh: mean edge length %g, total area %g", h, msum);
+    if ((code = operator_scales(m, &e, L, mass, &h, &eps, err, errsz)) != GEOD_OK)
         goto out;
-    }
     s->t = t_factor * h * h;
-    double eps = GEOD_POISSON_REG * lsum / msum;
-
-
-    for (int i = 0; i < m->nv; i++)
-        d[i] = mass[i];
-    if ((rc = factor(L, s->t, d, NULL, m->nv, NULL, "factorising M + t L", &s->heat, err,
-                     errsz)) != GEOD_OK) {
-        code = rc;
+    if ((code = factor(L, s->t, 1.0, mass, NULL, m->nv, NULL, "factorising M + t L", &s->heat, err,
+                       errsz)) != GEOD_OK ||
+        (code = factor(L, 1.0, eps, mass, NULL, m->nv, NULL, "factorising L + eps M", &s->poisson, err,
+                       errsz)) != GEOD_OK ||
+        (code = factor_interior(s, &e, err, errsz)) != GEOD_OK)
         goto out;
-    }
-    for (int i = 0; i < m->nv; i++)
-        d[i] = eps * mass[i];
-    if ((rc = factor(L, 1.0, d, NULL, m->nv, NULL, "factorising L + eps M", &s->poisson, err,
-                     errsz)) != GEOD_OK) {
-        code = rc;
-        goto out;
-    }
-
-    if (geo_edges_boundary_count(&e) > 0) {
-        if (!(remap = malloc((size_t)m->nv * sizeof *remap)) ||
-            !(s->interior = malloc((size_t)m->nv * sizeof *s->interior))) {
-            code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the interior list");
-            goto out;
-        }
-        for (int i = 0; i < m->nv; i++)
-            remap[i] = 0;
-        for (int k = 0; k < e.ne; k++)
-            if (e.ef[2 * k + 1] < 0)
-                remap[e.ev[2 * k]] = remap[e.ev[2 * k + 1]] = -1;
-        for (int i = 0; i < m->nv; i++)
-            if (remap[i] == 0) {
-                remap[i] = s->n_interior;
-                s->interior[s->n_interior++] = i;
-            }
-        for (int i = 0; i < m->nv; i++)
-            d[i] = mass[i];
-        if (s->n_interior > 0 &&
-            (rc = factor(L, s->t, d, s->interior, s->n_interior, remap,
-                         "factorising the interior block of M + t L", &s->heat_dir, err,
-                         errsz)) != GEOD_OK) {
-            code = rc;
-            goto out;
-        }
-    } else {
-        s->n_interior = m->nv;
-    }
-    ok = 1;
 out:
-    free(d);
-    free(remap);
     geod__idt_close(&idt);
     if (!s || !s->L) {   /* not handed over to the solver */
         geo_csr_free(L);
         free(mass);
     }
     geo_edges_close(&e);
-    if (!ok) {
+    if (code != GEOD_OK) {
         geod_solver_free(s);
         return code;
     }
