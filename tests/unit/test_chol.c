@@ -273,6 +273,5 @@ TEST_T(misuse_is_refused, 10)
     CHECK_INT(chol_solve(c, x, 0, x, err, sizeof err), CHOL_EINVAL);
     CHECK_INT(chol_solve(c, x, 1, x, err, sizeof err), CHOL_OK);
     CHECK(x[0] == 3 && x[1] == 4);
-    CHECK(strcmp(chol_strerror(CHOL_ENOTPD), "matrix not positive definite") == 0);
     chol_free(c);
 }

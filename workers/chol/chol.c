@@ -16,16 +16,6 @@ struct chol {
     int factorised;                 /* F holds the current values' factor */
 };
 
-const char *chol_strerror(int code)
-{
-    switch (code) {
-#define CHOL_STR(name, val, msg, kind) case name: return msg;
-        CHOL_ERRORS(CHOL_STR)
-#undef CHOL_STR
-    }
-    return "unknown sparse solver error";
-}
-
 int chol_new(int n, size_t cap, enum chol_order order, chol **out, char *err, size_t errsz)
 {
     *out = NULL;

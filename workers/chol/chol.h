@@ -30,7 +30,6 @@ enum chol_error {
     CHOL_ERRORS(CHOL_ENUM)
 #undef CHOL_ENUM
 };
-const char *chol_strerror(int code);
 
 /* The fill-reducing ordering. AMD alone is deterministic whatever METIS
  * would do; CHOLMOD's own choice tries AMD and may fall back to METIS on
