@@ -624,6 +624,40 @@ static int moved_far(const ctx *c, const taken *r)
     return far > FOLD__MAX_MOVE * FOLD__MAX_MOVE * diam2;
 }
 
+/* Per taken region, the mode whose re-map leaves it least bad, kept when
+ * better than before (its rows into c->R, its faces' kinds into knew):
+ * per placement the dragged landmarks unless the free ones do better and
+ * stay near their images, then the tube's on a tie. km: each mode's
+ * kinds, nf apart. */
+static void keep_best(ctx *c, taken *tk, int ntaken, const unsigned char *kind,
+                      const unsigned char *km, unsigned char *knew, fold_report *rep)
+{
+    int nf = c->S->nf;
+    for (int k = 0; k < ntaken; k++) {
+        taken *r = tk + k;
+        long before = badness(&r->p, kind), v[MODES];
+        for (int md = 0; md < MODES; md++)   /* a remap that moved good parts far never wins */
+            v[md] = r->far[md] && md < MODE_TUBE_DRAGGED ? LONG_MAX : badness(&r->p, km + (size_t)md * nf);
+        int disk = v[MODE_DISK_DRAGGED] <= v[MODE_DISK_FREE] ||
+                           r->shift[MODE_DISK_FREE] > FOLD__MAX_SHIFT ? MODE_DISK_DRAGGED : MODE_DISK_FREE;
+        int tube = v[MODE_TUBE_DRAGGED] <= v[MODE_TUBE_FREE] ||
+                           r->shift[MODE_TUBE_FREE] > FOLD__MAX_SHIFT ? MODE_TUBE_DRAGGED : MODE_TUBE_FREE;
+        int tubed = 0;
+        for (int i = r->p.nb; i < r->p.nv && !tubed; i++)
+            tubed = c->tubed[r->p.verts[i]];
+        int won = v[tube] <= v[disk] || r->tube || tubed ? tube : disk;
+        if (v[won] < before) {
+            rows(c->R, &r->p, r->mface[won], r->mw[won], 0);
+            for (int i = r->p.nb; i < r->p.nv && won >= MODE_TUBE_DRAGGED; i++)
+                c->tubed[r->p.verts[i]] = 1;
+            rep->regions++;
+            rep->region += r->p.nv - r->p.nb;
+            for (int q = 0; q < r->p.nf; q++)
+                knew[r->p.faces[q]] = km[(size_t)won * nf + r->p.faces[q]];
+        }
+    }
+}
+
 /* One pass with regions grown by `rings`: returns the new number of bad
  * faces (kind updated), or -1 when out of memory. */
 static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *rep)
@@ -704,31 +738,7 @@ static int pass(ctx *c, int rings, unsigned char *kind, int bad, fold_report *re
     }
     unsigned char *knew = km + (size_t)MODES * nf;
     memcpy(knew, kind, (size_t)nf);
-    for (int k = 0; k < ntaken; k++) {
-        taken *r = tk + k;
-        long before = badness(&r->p, kind), v[MODES];
-        for (int md = 0; md < MODES; md++)   /* a remap that moved good parts far never wins */
-            v[md] = r->far[md] && md < MODE_TUBE_DRAGGED ? LONG_MAX : badness(&r->p, km + (size_t)md * nf);
-        /* per placement, the dragged landmarks unless the free ones do
-         * better and stay near their images; then the tube's on a tie */
-        int disk = v[MODE_DISK_DRAGGED] <= v[MODE_DISK_FREE] ||
-                           r->shift[MODE_DISK_FREE] > FOLD__MAX_SHIFT ? MODE_DISK_DRAGGED : MODE_DISK_FREE;
-        int tube = v[MODE_TUBE_DRAGGED] <= v[MODE_TUBE_FREE] ||
-                           r->shift[MODE_TUBE_FREE] > FOLD__MAX_SHIFT ? MODE_TUBE_DRAGGED : MODE_TUBE_FREE;
-        int tubed = 0;
-        for (int i = r->p.nb; i < r->p.nv && !tubed; i++)
-            tubed = c->tubed[r->p.verts[i]];
-        int won = v[tube] <= v[disk] || r->tube || tubed ? tube : disk;
-        if (v[won] < before) {
-            rows(c->R, &r->p, r->mface[won], r->mw[won], 0);
-            for (int i = r->p.nb; i < r->p.nv && won >= MODE_TUBE_DRAGGED; i++)
-                c->tubed[r->p.verts[i]] = 1;
-            rep->regions++;
-            rep->region += r->p.nv - r->p.nb;
-            for (int q = 0; q < r->p.nf; q++)
-                knew[r->p.faces[q]] = km[(size_t)won * nf + r->p.faces[q]];
-        }
-    }
+    keep_best(c, tk, ntaken, kind, km, knew, rep);
     bad = 0;
     for (int t = 0; t < nf; t++)
         bad += (kind[t] = knew[t]) != 0;
