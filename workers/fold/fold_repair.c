@@ -405,6 +405,72 @@ static int tube_like(const mesh *S, const fold__patch *p, const double *depth)
     return deepest > FOLD__TUBE_DEPTH * len / (2 * M_PI);
 }
 
+/* Mirrors the chart uvT of pT (corner: its faces' corners as chart
+ * indices) when its faces have negative area in all: oriented as T. */
+static void orient_chart(const fold__patch *pT, const int *corner, double *uvT)
+{
+    double sa = 0;
+    for (int q = 0; q < pT->nf; q++)
+        sa += area2(uvT + 2 * corner[3 * q], uvT + 2 * corner[3 * q + 1], uvT + 2 * corner[3 * q + 2]);
+    if (sa < 0)
+        for (int i = 0; i < pT->nv; i++)
+            uvT[2 * i + 1] = -uvT[2 * i + 1];
+}
+
+/* The images of pS's vertices in the chart uvT (c->tloc: T's vertex ->
+ * chart index) into uv (an inner vertex's outside it at 0), and which are
+ * pinned there (the boundary and the kept holes) into pin. 1 when a
+ * pinned vertex or a dragged landmark has its image outside the chart,
+ * else 0. */
+static int images_in_chart(ctx *c, const fold__patch *pS, const double *uvT, double *uv,
+                           unsigned char *pin)
+{
+    const mesh *T = c->T;
+    for (int i = 0; i < pS->nv; i++) {
+        int v = pS->verts[i], f = c->R->face[v];
+        uv[2 * i] = uv[2 * i + 1] = 0;
+        pin[i] = c->tube ? i < pS->nb : pinned(c, pS, i);
+        /* the image's corners in the chart, by their weights (an image
+         * on a face across the chart's edge: its corners inside,
+         * renormalised; none inside: outside the chart) */
+        double win = 0;
+        for (int k = 0; k < 3; k++) {
+            int j = c->tloc[T->f[3 * f + k]];
+            if (j < 0)
+                continue;
+            win += c->R->w[3 * v + k];
+            uv[2 * i] += c->R->w[3 * v + k] * uvT[2 * j];
+            uv[2 * i + 1] += c->R->w[3 * v + k] * uvT[2 * j + 1];
+        }
+        if (win > 0) {
+            uv[2 * i] /= win;
+            uv[2 * i + 1] /= win;
+            continue;
+        }
+        if (pin[i] || (c->drag_landmarks && c->fixed[v]))
+            return 1;
+    }
+    return 0;
+}
+
+/* The inner vertices of pS (not pinned, not fixed) back through the chart:
+ * their new faces and weights in c->R where uv lies in a chart face. */
+static void read_back(ctx *c, const fold__patch *pS, const unsigned char *pin, const fold__patch *pT,
+                      const int *corner, const double *uvT, const double *uv)
+{
+    for (int i = 0; i < pS->nv; i++) {
+        int v = pS->verts[i];
+        if (pin[i] || c->fixed[v])
+            continue;
+        double bw[3];
+        int bf = locate(pT, corner, uvT, uv + 2 * i, bw);
+        if (bf < 0)
+            continue;
+        c->R->face[v] = pT->faces[bf];
+        memcpy(c->R->w + 3 * v, bw, sizeof bw);
+    }
+}
+
 /* Re-maps the inner vertices of region pS (see fold.h) in c->R. Returns 0,
  * 1 when it cannot (no chart), -1 when out of memory. */
 static int remap(ctx *c, const fold__patch *pS)
@@ -447,45 +513,14 @@ static int remap(ctx *c, const fold__patch *pS)
     for (int q = 0; q < pT.nf; q++)
         for (int k = 0; k < 3; k++)
             corner[3 * q + k] = c->tloc[T->f[3 * pT.faces[q] + k]];
-    /* the chart is oriented as T when its faces have positive area */
-    double sa = 0;
-    for (int q = 0; q < pT.nf; q++)
-        sa += area2(uvT + 2 * corner[3 * q], uvT + 2 * corner[3 * q + 1], uvT + 2 * corner[3 * q + 2]);
-    if (sa < 0)
-        for (int i = 0; i < pT.nv; i++)
-            uvT[2 * i + 1] = -uvT[2 * i + 1];
-    /* the images in the chart (an inner vertex's outside it starts at 0);
-     * the boundary and the kept holes pinned there */
-    for (int i = 0; i < pS->nv; i++) {
-        int v = pS->verts[i], f = c->R->face[v];
-        uv[2 * i] = uv[2 * i + 1] = 0;
-        pin[i] = c->tube ? i < pS->nb : pinned(c, pS, i);
-        /* the image's corners in the chart, by their weights (an image
-         * on a face across the chart's edge: its corners inside,
-         * renormalised; none inside: outside the chart) */
-        double win = 0;
-        for (int k = 0; k < 3; k++) {
-            int j = c->tloc[T->f[3 * f + k]];
-            if (j < 0)
-                continue;
-            win += c->R->w[3 * v + k];
-            uv[2 * i] += c->R->w[3 * v + k] * uvT[2 * j];
-            uv[2 * i + 1] += c->R->w[3 * v + k] * uvT[2 * j + 1];
-        }
-        if (win > 0) {
-            uv[2 * i] /= win;
-            uv[2 * i + 1] /= win;
-            continue;
-        }
-        if (pin[i] || (c->drag_landmarks && c->fixed[v])) {   /* outside the chart */
-            rc = 1;
-            for (int j = 0; j < pT.nv; j++)
-                c->tloc[pT.verts[j]] = -1;
-            goto out;
-        }
-    }
+    orient_chart(&pT, corner, uvT);
+    int outside = images_in_chart(c, pS, uvT, uv, pin);
     for (int i = 0; i < pT.nv; i++)
         c->tloc[pT.verts[i]] = -1;
+    if (outside) {
+        rc = 1;
+        goto out;
+    }
     memcpy(lm, uv, sizeof(double) * 2 * (size_t)pS->nv);
     if (c->tube) {
         /* the region's own tube chart, fitted inside its boundary's images */
@@ -505,18 +540,7 @@ static int remap(ctx *c, const fold__patch *pS)
     for (int i = 0; i < pS->nv; i++)
         if (!pin[i] && c->fixed[pS->verts[i]])
             c->shift = fmax(c->shift, hypot(uv[2 * i] - lm[2 * i], uv[2 * i + 1] - lm[2 * i + 1]));
-    /* read the inner vertices back through the chart */
-    for (int i = 0; i < pS->nv; i++) {
-        int v = pS->verts[i];
-        if (pin[i] || c->fixed[v])
-            continue;
-        double bw[3];
-        int bf = locate(&pT, corner, uvT, uv + 2 * i, bw);
-        if (bf < 0)
-            continue;
-        c->R->face[v] = pT.faces[bf];
-        memcpy(c->R->w + 3 * v, bw, sizeof bw);
-    }
+    read_back(c, pS, pin, &pT, corner, uvT, uv);
     rc = 0;
 out:
     free(uv);
