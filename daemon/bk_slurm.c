@@ -490,11 +490,7 @@ static void on_sbatch(void *ctx, int status, const char *out, const char *err)
         snprintf(st, sizeof st, "%d", status);
         set_err(S.err_sbatch, sizeof S.err_sbatch, "sbatch failed (exit %s): %s", st,
                 err[0] ? err : out[0] ? out : "no output");
-        store_job row;
-        if (j->counted)
-            sched_done(S.d->sched, j->user);
-        if (store_get(S.d->store, id, &row) == 0)
-            sched_add(S.d->sched, id, j->user, row.priority);
+        job_requeue(S.d, id, j->user, j->counted, NULL);
         drop_job(j);
         return;                    /* no step(): wait for the timer */
     }
@@ -525,10 +521,7 @@ static int submit(uint64_t id, const char *user)
     store_clear_run(d->store, id);
     if (write_secret(j, err, sizeof err)) {
         set_err(S.err_spool, sizeof S.err_spool, "cannot write the job's secret: %s%s", err, "");
-        sched_done(d->sched, user);
-        store_job row;
-        if (store_get(d->store, id, &row) == 0)
-            sched_add(d->sched, id, user, row.priority);
+        job_requeue(d, id, user, 1, NULL);
         drop_job(j);
         return -1;
     }

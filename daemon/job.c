@@ -15,9 +15,14 @@
  * does not have. A daemon that stops first loses nothing: the next start's
  * recovery adopts the run's result.frame or runs the job again. What the
  * files of a run say (result.frame; error.frame: FAILED, OUT_OF_MEMORY for
- * NOMEM, CANCELLED for CANCELLED) is read here for both backends. */
+ * NOMEM, CANCELLED for CANCELLED) is read here for both backends.
+ *
+ * The way back to the queue is one (job_requeue), whoever sends a job
+ * back; and what becomes of the jobs a stopped daemon left unfinished is
+ * decided here too (job_recover), the store doing the writing. */
 #include "backend.h"
 #include "mcd.h"
+#include "util/errbuf.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -280,13 +285,7 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
     if (counted)
         sched_done(d->sched, user);
     if (!store_is_terminal(state)) {
-        /* runs again: the scheduler has it even if the store cannot say so */
-        store_job j;
-        if (store_set_state(d->store, id, PROTO_STATE_PENDING, reason))
-            dlog(DLOG_ERROR, "job %llu: cannot record it PENDING again", (unsigned long long)id);
-        if (store_get(d->store, id, &j) != 0 || sched_add(d->sched, id, user, j.priority) != 0)
-            dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue: it runs after the next restart",
-                 (unsigned long long)id);
+        job_requeue(d, id, user, 0, reason);
         tell_queue(d);
         return;
     }
@@ -305,6 +304,22 @@ void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, co
         free(q);
     }
     record_end(d, id, state, reason);
+}
+
+int job_requeue(mcd *d, uint64_t id, const char *user, int counted, const char *reason)
+{
+    if (counted)
+        sched_done(d->sched, user);
+    /* the scheduler has it even if the store cannot say so */
+    if (reason && store_set_state(d->store, id, PROTO_STATE_PENDING, reason))
+        dlog(DLOG_ERROR, "job %llu: cannot record it PENDING again", (unsigned long long)id);
+    store_job j;
+    if (store_get(d->store, id, &j) != 0 || sched_add(d->sched, id, user, j.priority) != 0) {
+        dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue: it runs after the next restart",
+             (unsigned long long)id);
+        return -1;
+    }
+    return 0;
 }
 
 int job_cancel_pending(mcd *d, uint64_t id)
@@ -360,4 +375,124 @@ int job_error_end(mcd *d, uint64_t id, char *reason, size_t rsz)
     snprintf(reason, rsz, "%s: %s", proto_err_name(code), emsg);
     return code == PROTO_ENOMEM ? PROTO_STATE_OUT_OF_MEMORY
          : code == PROTO_ECANCELLED ? PROTO_STATE_CANCELLED : PROTO_STATE_FAILED;
+}
+
+/* ---- recovery after a restart ------------------------------------------- */
+
+typedef struct left_job {
+    uint64_t id;
+    int state;
+    int slurm;                    /* has a Slurm job id */
+} left_job;
+
+typedef struct left_jobs {
+    left_job *j;
+    size_t n;
+    int nomem;
+} left_jobs;
+
+static int collect_left(void *ctx, const store_job *j)
+{
+    left_jobs *l = ctx;
+    left_job *t = realloc(l->j, (l->n + 1) * sizeof *t);
+    if (!t) {
+        l->nomem = 1;
+        return 1;
+    }
+    l->j = t;
+    l->j[l->n++] = (left_job){j->id, j->state, j->slurm_id[0] != '\0'};
+    return 0;
+}
+
+/* A worker finished job id while no daemon watched: its result.frame is
+ * complete (written atomically) and, when it decodes, the job's answer;
+ * running the job again would only redo the work. 1 adopted, 0 not (no
+ * usable result), -1 when the store cannot record it. */
+static int adopt_result(store *s, uint64_t id)
+{
+    char path[CONF_PATH + 64], why[256];
+    if (access(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), F_OK) != 0)
+        return 0;
+    proto_msg m;
+    uint8_t *buf;
+    if (store_result_read(s, id, &m, &buf, why, sizeof why)) {
+        dlog(DLOG_WARN, "store: job %llu: result.frame left by a worker is not usable (%s): runs again",
+             (unsigned long long)id, why);
+        return 0;
+    }
+    int verdict;
+    double flipped, collapsed;
+    store_result_quality(&m, &verdict, &flipped, &collapsed);
+    proto_msg_free(&m);
+    free(buf);
+    if (verdict >= 0)
+        store_set_quality(s, id, verdict, flipped, collapsed);
+    if (store_set_state(s, id, PROTO_STATE_COMPLETED, "finished while the daemon was down: result adopted"))
+        return -1;
+    dlog(DLOG_INFO, "store: job %llu: COMPLETED: its worker finished while the daemon was down; result adopted",
+         (unsigned long long)id);
+    return 1;
+}
+
+int job_recover(store *s, int keep_slurm, char *err, size_t errsz)
+{
+    int rc = store_kill_orphan_workers(s, err, errsz);
+    if (rc)
+        return rc;
+    left_jobs l = {0};
+    if (store_each_unfinished(s, collect_left, &l) || l.nomem) {
+        free(l.j);
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot read the unfinished jobs%s",
+                          l.nomem ? " (out of memory)" : "");
+    }
+    int unslurmed = 0, adopted = 0, requeued = 0, lost = 0;
+    for (size_t i = 0; i < l.n && !rc; i++) {
+        left_job *j = &l.j[i];
+        char path[CONF_PATH + 64];
+        if (j->slurm && !keep_slurm) {      /* Slurm runs without the Slurm backend: they run here again */
+            if (store_set_pending(s, j->id)) {
+                rc = errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot re-queue Slurm jobs");
+                break;
+            }
+            j->slurm = 0;
+            j->state = PROTO_STATE_PENDING;
+            unslurmed++;
+        }
+        if (!j->slurm) {
+            int a = adopt_result(s, j->id);
+            if (a < 0)
+                rc = errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot record job %llu's adopted result",
+                                (unsigned long long)j->id);
+            adopted += a > 0;
+            if (a)
+                continue;
+            if (j->state == PROTO_STATE_RUNNING) {   /* the run was cut off by the daemon's end */
+                if (store_set_pending(s, j->id)) {
+                    rc = errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot re-queue running jobs");
+                    break;
+                }
+                j->state = PROTO_STATE_PENDING;
+                requeued++;
+            }
+        }
+        /* a Slurm run goes on without us and is re-attached by the backend;
+         * any job still to start needs its input */
+        if (j->state == PROTO_STATE_PENDING &&
+            access(store_spool_path(s, j->id, SPOOL_JOB_FRAME, path, sizeof path), R_OK) != 0) {
+            dlog(DLOG_WARN, "store: job %llu has no spool/job.frame: FAILED", (unsigned long long)j->id);
+            store_set_state(s, j->id, PROTO_STATE_FAILED, "spool file job.frame missing after restart");
+            lost++;
+        }
+    }
+    free(l.j);
+    if (unslurmed)
+        dlog(DLOG_WARN, "store: %d job(s) handed to Slurm by an earlier run go back to the queue"
+             " (backend is not slurm)", unslurmed);
+    int removed, dropped;
+    if (rc || (rc = store_tidy_spool(s, &removed, &dropped, err, errsz)))
+        return rc;
+    dlog(DLOG_INFO, "store: recovered: %d result(s) adopted, %d running job(s) re-queued, %d orphan spool"
+         " dir(s) removed, %d job(s) without spool failed, %d ended job(s)' input removed", adopted, requeued,
+         removed, lost, dropped);
+    return 0;
 }

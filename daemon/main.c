@@ -75,7 +75,7 @@ int main(int argc, char **argv)
     if (priv_become(&priv, d.conf.state_dir, err, sizeof err) ||
         auth_tokens_load(d.conf.tokens, &d.tokens, err, sizeof err) ||
         store_open(d.conf.state_dir, &d.store, err, sizeof err) ||
-        store_recover(d.store, strcmp(d.conf.backend, "slurm") == 0, err, sizeof err)) {
+        job_recover(d.store, strcmp(d.conf.backend, "slurm") == 0, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
         goto done;
     }

@@ -297,15 +297,17 @@ int store_open(const char *dir, store **out, char *err, size_t errsz);
 void store_keep_on_reload(const mcd_conf *o, mcd_conf *n, char *changed, size_t sz);
 /* NULL ok; never while a store_submit runs. */
 void store_close(store *s);
-/* After a restart: every worker a previous daemon left running is killed
- * (found by its job's worker lock, wlock_), an unfinished local job whose
- * worker had written a valid result.frame is COMPLETED with it (adopted, not
- * run again), other RUNNING jobs go back to PENDING, spool dirs without a
- * row are removed, unfinished rows without job.frame become FAILED, and
- * ended jobs that did not complete lose a job.frame left behind.
- * Unfinished jobs with a Slurm job id are left as they are with keep_slurm
- * (the Slurm backend re-attaches), else they go back to PENDING too. */
-int store_recover(store *s, int keep_slurm, char *err, size_t errsz);
+/* After a restart (job_recover decides what becomes of each job): kills
+ * every worker a previous daemon left running, found by its job's worker
+ * lock (wlock_), so that the spool stays as they left it. */
+int store_kill_orphan_workers(store *s, char *err, size_t errsz);
+/* Job id back to PENDING with its run forgotten (start, pid, progress,
+ * Slurm job id); its reason stays. Recovery only: a running daemon's
+ * requeue is job_requeue. */
+int store_set_pending(store *s, uint64_t id);
+/* After a restart: removes spool dirs without a row (*removed) and the
+ * job.frame left behind by ended jobs that did not complete (*dropped). */
+int store_tidy_spool(store *s, int *removed, int *dropped, char *err, size_t errsz);
 /* Durable insert: spool/<id>/job.frame (fsynced) and the row, committed
  * together; *id is the committed row's. Any thread (it blocks on the disk:
  * the daemon calls it from libuv's thread pool); frame is only read. */
@@ -348,6 +350,8 @@ int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_i
 int store_each_pending(store *s, store_job_fn fn, void *ctx);
 /* PENDING or RUNNING jobs that have a Slurm job id. */
 int store_each_slurm(store *s, store_job_fn fn, void *ctx);
+/* PENDING or RUNNING jobs, local or Slurm's. */
+int store_each_unfinished(store *s, store_job_fn fn, void *ctx);
 /* Terminal jobs that ended before before_ms. */
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx);
 int store_delete(store *s, uint64_t id);
@@ -637,8 +641,24 @@ void job_running(mcd *d, uint64_t id, long pid);
 int job_progress_take(mcd *d, uint64_t id, proto_buf *in);
 /* A run of job id (user's; counted: the scheduler counts it as running)
  * ended in state: terminal, recorded (retried while the store refuses it),
- * then END to the watchers; or PENDING: back to the scheduler. */
+ * then END to the watchers; or PENDING: back to the queue (job_requeue). */
 void job_ended(mcd *d, uint64_t id, const char *user, int counted, int state, const char *reason);
+/* Job id (user's), taken from the queue, goes back to it to run (again):
+ * the scheduler stops counting it as running when counted, the row says
+ * PENDING with reason (NULL: the row is left as it is), and the scheduler
+ * holds it at the row's priority. 0, or -1 (logged) when the queue cannot
+ * take it: it then runs after the next restart. The one way back to the
+ * queue for both backends. */
+int job_requeue(mcd *d, uint64_t id, const char *user, int counted, const char *reason);
+/* After a restart, before the queue is built from the store: what each
+ * job a previous daemon left unfinished becomes. Its workers are killed
+ * first; a local job whose worker wrote a valid result.frame is COMPLETED
+ * with it (adopted, not run again); other RUNNING local jobs go back to
+ * PENDING; a PENDING job without job.frame is FAILED. Jobs with a Slurm
+ * job id are left as they are with keep_slurm (the Slurm backend
+ * re-attaches), else they become local PENDING jobs first. Then the spool
+ * is tidied (store_tidy_spool). 0 or PROTO_ESTORAGE with err. */
+int job_recover(store *s, int keep_slurm, char *err, size_t errsz);
 /* What the run's files say: result.frame is there; the state its
  * error.frame gives (reason "CODE: message"), or -1 without one. */
 int job_has_result(mcd *d, uint64_t id);

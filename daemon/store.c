@@ -7,7 +7,7 @@
  * row, renames the directory to spool/<id> (fsync spool/) and commits; the
  * caller answers SUBMIT_OK only after it returned 0, with the id of the
  * committed row. A crash before the commit leaves a spool/.new-* directory
- * or a spool/<id> without a row, which store_recover removes (the client
+ * or a spool/<id> without a row, which recovery (job_recover) removes (the client
  * never heard of that job). Ids come from AUTOINCREMENT and are never
  * reused.
  *
@@ -26,7 +26,7 @@
  * on the loop (WAL keeps the file consistent); it becomes durable with the
  * next FULL commit (any state change) or checkpoint. After a power loss the
  * last records of a job that was running may be missing; that job runs
- * again from the start anyway (store_recover). That keeps an fsync per record
+ * again from the start anyway (job_recover). That keeps an fsync per record
  * off the loop (docs/decisions.md, "PROGRESS records without an fsync").
  *
  * Tables: jobs (one row per job; state as its Slurm name; the latest outer
@@ -372,183 +372,101 @@ void store_close(store *s)
     free(s);
 }
 
+/* Calls fn for each entry of spool/ but . and .. (name: the entry's name,
+ * id: its job id, 0 when the name is not one). 0, or PROTO_ESTORAGE with
+ * err when spool/ cannot be read. */
+static int each_spool_entry(store *s, void (*fn)(store *s, const char *name, uint64_t id, void *ctx),
+                            void *ctx, char *err, size_t errsz)
+{
+    char spool[CONF_PATH + 16];
+    snprintf(spool, sizeof spool, "%s/spool", s->dir);
+    DIR *dp = opendir(spool);
+    if (!dp)
+        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
+    struct dirent *de;
+    while ((de = readdir(dp))) {
+        if (strcmp(de->d_name, ".") == 0 || strcmp(de->d_name, "..") == 0)
+            continue;
+        char *e;
+        unsigned long long id = strtoull(de->d_name, &e, 10);
+        fn(s, de->d_name, de->d_name[0] != '.' && *e == '\0' ? id : 0, ctx);
+    }
+    closedir(dp);
+    return 0;
+}
+
+static void kill_holders(store *s, const char *name, uint64_t id, void *ctx)
+{
+    (void)name;
+    (void)ctx;
+    char path[CONF_PATH + 64];
+    if (!id)
+        return;
+    int n = wlock_kill_holders(store_spool_path(s, id, SPOOL_WORKER_LOCK, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
+    if (n > 0)
+        dlog(DLOG_WARN, "store: job %llu: killed %d worker process(es) a previous daemon left running",
+             (unsigned long long)id, n);
+    else if (n < 0)
+        dlog(DLOG_ERROR, "store: job %llu: a process still holds %s after %d ms: the job starts once it"
+             " lets go", (unsigned long long)id, path, WLOCK_RECOVER_WAIT_MS);
+}
+
 /* No worker a previous daemon started survives it: each job's worker lock
  * (wlock.c) is held by whatever process of that job still runs, recorded
  * in the row or not (a daemon killed between the spawn and the row's update
  * left it PENDING). */
-static int kill_orphan_workers(store *s, char *err, size_t errsz)
+int store_kill_orphan_workers(store *s, char *err, size_t errsz)
 {
-    char spool[CONF_PATH + 16];
-    snprintf(spool, sizeof spool, "%s/spool", s->dir);
-    DIR *dp = opendir(spool);
-    if (!dp)
-        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
-    struct dirent *de;
-    while ((de = readdir(dp))) {
-        char *e, path[CONF_PATH + 64];
-        unsigned long long id = strtoull(de->d_name, &e, 10);
-        if (de->d_name[0] == '.' || *e != '\0' || id == 0)
-            continue;
-        int n = wlock_kill_holders(store_spool_path(s, id, SPOOL_WORKER_LOCK, path, sizeof path), WLOCK_RECOVER_WAIT_MS);
-        if (n > 0)
-            dlog(DLOG_WARN, "store: job %llu: killed %d worker process(es) a previous daemon left running", id, n);
-        else if (n < 0)
-            dlog(DLOG_ERROR, "store: job %llu: a process still holds %s after %d ms: the job starts once it"
-                 " lets go", id, path, WLOCK_RECOVER_WAIT_MS);
-    }
-    closedir(dp);
-    return 0;
+    return each_spool_entry(s, kill_holders, NULL, err, errsz);
 }
 
-/* Unfinished local jobs whose worker finished while no daemon watched: the
- * result is complete (the worker writes it atomically) and valid, so it is
- * the job's answer; running the job again would only redo the work. */
-static int adopt_results(store *s, int *adopted, char *err, size_t errsz)
+int store_set_pending(store *s, uint64_t id)
 {
-    sqlite3_stmt *st;
-    *adopted = 0;
-    if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs WHERE state IN ('PENDING', 'RUNNING') AND slurm_id = ''",
-                           -1, &st, NULL) != SQLITE_OK)
-        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
-    uint64_t *ids = NULL;
-    size_t n = 0;
-    while (sqlite3_step(st) == SQLITE_ROW) {
-        uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
-        char path[CONF_PATH + 64];
-        if (access(store_spool_path(s, id, SPOOL_RESULT_FRAME, path, sizeof path), F_OK) != 0)
-            continue;
-        uint64_t *l = realloc(ids, (n + 1) * sizeof *l);
-        if (l) {
-            ids = l;
-            ids[n++] = id;
-        }
-    }
-    sqlite3_finalize(st);
-    for (size_t i = 0; i < n; i++) {
-        char why[256];
-        proto_msg m;
-        uint8_t *buf;
-        if (store_result_read(s, ids[i], &m, &buf, why, sizeof why)) {
-            dlog(DLOG_WARN, "store: job %llu: result.frame left by a worker is not usable (%s): runs again",
-                 (unsigned long long)ids[i], why);
-            continue;
-        }
-        int verdict;
-        double flipped, collapsed;
-        store_result_quality(&m, &verdict, &flipped, &collapsed);
-        proto_msg_free(&m);
-        free(buf);
-        if (verdict >= 0)
-            store_set_quality(s, ids[i], verdict, flipped, collapsed);
-        if (store_set_state(s, ids[i], PROTO_STATE_COMPLETED, "finished while the daemon was down: result adopted")) {
-            free(ids);
-            return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: cannot record job %llu's adopted result",
-                              (unsigned long long)ids[i]);
-        }
-        dlog(DLOG_INFO, "store: job %llu: COMPLETED: its worker finished while the daemon was down; result adopted",
-             (unsigned long long)ids[i]);
-        (*adopted)++;
-    }
-    free(ids);
-    return 0;
+    return exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
+                  " energy = NULL, fraction = NULL, eta_s = NULL, slurm_id = '', progress_off = 0"
+                  " WHERE id = ?", "i", (int64_t)id);
 }
 
-int store_recover(store *s, int keep_slurm, char *err, size_t errsz)
+/* A spool entry without a committed row: a SUBMIT cut off before its row
+ * was inserted (.new-*), or a job's directory whose row is gone. */
+static void remove_orphan(store *s, const char *name, uint64_t id, void *ctx)
+{
+    int *removed = ctx;
+    store_job j;
+    if (strncmp(name, SPOOL_NEW_PREFIX, strlen(SPOOL_NEW_PREFIX)) == 0) {
+        char dir[CONF_PATH + 300];
+        snprintf(dir, sizeof dir, "%s/spool/%s", s->dir, name);
+        remove_dir(dir);
+        (*removed)++;
+    } else if (id && store_get(s, id, &j) == PROTO_ENOT_FOUND) {
+        spool_remove(s, id);
+        (*removed)++;
+    }
+}
+
+int store_tidy_spool(store *s, int *removed, int *dropped, char *err, size_t errsz)
 {
     sqlite3_stmt *st;
-    int rc = 0;
-    /* 0. Slurm runs without the Slurm backend: they run here again. */
-    if (!keep_slurm) {
-        if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
-                         " energy = NULL, fraction = NULL, eta_s = NULL, slurm_id = '', progress_off = 0"
-                         " WHERE state IN ('PENDING', 'RUNNING') AND slurm_id != ''", NULL)))
-            return errbuf_set(err, errsz, rc, "recover: cannot re-queue Slurm jobs");
-        if (sqlite3_changes(s->db))
-            dlog(DLOG_WARN, "store: %d job(s) handed to Slurm by an earlier run go back to the queue"
-                 " (backend is not slurm)", sqlite3_changes(s->db));
-    }
-    /* 1. no worker of the previous daemon runs on; the results they
-     * finished are adopted; other RUNNING jobs go back to PENDING (the run
-     * was cut off by the daemon's end). Slurm runs go on without us and are
-     * re-attached by the backend. */
-    int adopted;
-    if ((rc = kill_orphan_workers(s, err, errsz)) || (rc = adopt_results(s, &adopted, err, errsz)))
+    *removed = *dropped = 0;
+    int rc = each_spool_entry(s, remove_orphan, removed, err, errsz);
+    if (rc)
         return rc;
-    if ((rc = exec_v(s->db, "UPDATE jobs SET state = 'PENDING', start_ms = 0, pid = 0, outer_it = 0,"
-                     " energy = NULL, fraction = NULL, eta_s = NULL"
-                     " WHERE state = 'RUNNING' AND slurm_id = ''", NULL)))
-        return errbuf_set(err, errsz, rc, "recover: cannot re-queue running jobs");
-    int requeued = sqlite3_changes(s->db);
-    /* 2. spool directories without a committed row. */
-    char spool[CONF_PATH + 16];
-    snprintf(spool, sizeof spool, "%s/spool", s->dir);
-    DIR *dp = opendir(spool);
-    if (!dp)
-        return errbuf_set(err, errsz, PROTO_ESTORAGE, "%s: %s", spool, strerror(errno));
-    struct dirent *de;
-    int removed = 0;
-    while ((de = readdir(dp))) {
-        if (strncmp(de->d_name, SPOOL_NEW_PREFIX, strlen(SPOOL_NEW_PREFIX)) == 0) {
-            /* a SUBMIT cut off before its row was inserted */
-            char dir[CONF_PATH + 300];
-            snprintf(dir, sizeof dir, "%s/%s", spool, de->d_name);
-            remove_dir(dir);
-            removed++;
-            continue;
-        }
-        char *e;
-        unsigned long long id = strtoull(de->d_name, &e, 10);
-        if (de->d_name[0] == '.' || *e != '\0' || id == 0)
-            continue;
-        store_job j;
-        if (store_get(s, id, &j) == PROTO_ENOT_FOUND) {
-            spool_remove(s, id);
-            removed++;
-        }
-    }
-    closedir(dp);
-    /* 3. unfinished rows whose job.frame is gone. */
-    if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs WHERE state = 'PENDING'", -1, &st, NULL) != SQLITE_OK)
-        return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
-    uint64_t *lost = NULL;
-    size_t nlost = 0;
-    while (sqlite3_step(st) == SQLITE_ROW) {
-        uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
-        char path[CONF_PATH + 64];
-        if (access(store_spool_path(s, id, SPOOL_JOB_FRAME, path, sizeof path), R_OK) != 0) {
-            uint64_t *l = realloc(lost, (nlost + 1) * sizeof *l);
-            if (l) {
-                lost = l;
-                lost[nlost++] = id;
-            }
-        }
-    }
-    sqlite3_finalize(st);
-    for (size_t i = 0; i < nlost; i++) {
-        dlog(DLOG_WARN, "store: job %llu has no spool/job.frame: FAILED", (unsigned long long)lost[i]);
-        store_set_state(s, lost[i], PROTO_STATE_FAILED, "spool file job.frame missing after restart");
-    }
-    free(lost);
-    /* 4. ended jobs that did not complete hold no input (store_set_state
+    /* ended jobs that did not complete hold no input (store_set_state
      * removes it after its commit; a daemon killed in between left it):
      * their missing job.frame is how it should be, not a loss */
     if (sqlite3_prepare_v2(s->db, "SELECT id FROM jobs WHERE state NOT IN ('PENDING', 'RUNNING', 'COMPLETED')",
                            -1, &st, NULL) != SQLITE_OK)
         return errbuf_set(err, errsz, PROTO_ESTORAGE, "recover: %s", sqlite3_errmsg(s->db));
-    int dropped = 0;
     while (sqlite3_step(st) == SQLITE_ROW) {
         uint64_t id = (uint64_t)sqlite3_column_int64(st, 0);
         char path[CONF_PATH + 64];
         if (access(store_spool_path(s, id, SPOOL_JOB_FRAME, path, sizeof path), F_OK) == 0) {
             drop_input(s, id);
             recount_bytes(s, id);
-            dropped++;
+            (*dropped)++;
         }
     }
     sqlite3_finalize(st);
-    dlog(DLOG_INFO, "store: recovered: %d result(s) adopted, %d running job(s) re-queued, %d orphan spool"
-         " dir(s) removed, %zu job(s) without spool failed, %d ended job(s)' input removed", adopted, requeued,
-         removed, nlost, dropped);
     return 0;
 }
 
@@ -995,32 +913,38 @@ int store_list(store *s, const char *user, uint32_t state_mask, uint64_t after_i
     return each_job(s, st, fn, ctx);
 }
 
+/* The jobs the condition where selects (one ? at most: bound to arg), in
+ * id order. */
+static int each_where(store *s, const char *where, int64_t arg, store_job_fn fn, void *ctx)
+{
+    char sql[512];
+    sqlite3_stmt *st;
+    snprintf(sql, sizeof sql, "SELECT " JOB_COLS " FROM jobs WHERE %s ORDER BY id", where);
+    if (sqlite3_prepare_v2(s->db, sql, -1, &st, NULL) != SQLITE_OK)
+        return PROTO_ESTORAGE;
+    if (strchr(where, '?'))
+        sqlite3_bind_int64(st, 1, arg);
+    return each_job(s, st, fn, ctx);
+}
+
 int store_each_pending(store *s, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state = 'PENDING' AND slurm_id = ''"
-                           " ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state = 'PENDING' AND slurm_id = ''", 0, fn, ctx);
+}
+
+int store_each_unfinished(store *s, store_job_fn fn, void *ctx)
+{
+    return each_where(s, "state IN ('PENDING', 'RUNNING')", 0, fn, ctx);
 }
 
 int store_each_slurm(store *s, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state IN ('PENDING', 'RUNNING')"
-                           " AND slurm_id != '' ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state IN ('PENDING', 'RUNNING') AND slurm_id != ''", 0, fn, ctx);
 }
 
 int store_each_expired(store *s, int64_t before_ms, store_job_fn fn, void *ctx)
 {
-    sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(s->db, "SELECT " JOB_COLS " FROM jobs WHERE state NOT IN ('PENDING', 'RUNNING')"
-                           " AND end_ms < ? ORDER BY id", -1, &st, NULL) != SQLITE_OK)
-        return PROTO_ESTORAGE;
-    sqlite3_bind_int64(st, 1, before_ms);
-    return each_job(s, st, fn, ctx);
+    return each_where(s, "state NOT IN ('PENDING', 'RUNNING') AND end_ms < ?", before_ms, fn, ctx);
 }
 
 int store_delete(store *s, uint64_t id)

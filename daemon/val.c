@@ -62,6 +62,58 @@ static int write_all(int fd, const void *p, size_t n)
     return 0;
 }
 
+/* The validator's answer from fd (its stdout) into reply, up to
+ * VAL_MAX_REPLY bytes; the bytes read. */
+static size_t read_reply(int fd, uint8_t *reply)
+{
+    size_t got = 0;
+    for (;;) {
+        ssize_t r = read(fd, reply + got, VAL_MAX_REPLY - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            break;
+        got += (size_t)r;
+        if (got == VAL_MAX_REPLY)
+            break;
+    }
+    return got;
+}
+
+/* What the validator's wait status st and its answer reply (got bytes)
+ * say: 0 (the meshes can run), the ERROR it wrote, BAD_MESH for a mesh
+ * that crashed it or ran out of CPU time, else INTERNAL; msg says why. */
+static int verdict(const val_conf *vc, int st, const uint8_t *reply, size_t got, char *msg, size_t msz)
+{
+    int rc = PROTO_EINTERNAL;
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 0)
+        return 0;
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 1) {
+        proto_msg m;
+        size_t used;
+        char derr[256];
+        if (proto_decode(reply, got, VAL_MAX_REPLY, &m, &used, derr, sizeof derr) == PROTO_READY &&
+            m.type == PROTO_MSG_ERROR) {
+            rc = m.u.error.code;
+            snprintf(msg, msz, "%s", m.u.error.message);
+            proto_msg_free(&m);
+        } else {
+            snprintf(msg, msz, "the meshes cannot be checked: the validator's answer does not decode");
+        }
+    } else if (WIFSIGNALED(st) && (WTERMSIG(st) == SIGXCPU || WTERMSIG(st) == SIGKILL)) {
+        rc = PROTO_EBAD_MESH;
+        snprintf(msg, msz, "the meshes could not be decoded and checked within %u s of CPU time",
+                 vc->max_cpu_s);
+    } else if (WIFSIGNALED(st)) {
+        rc = PROTO_EBAD_MESH;        /* Draco aborted or crashed on these bytes */
+        snprintf(msg, msz, "a mesh crashed the decoder (%s) while it was checked", strsignal(WTERMSIG(st)));
+    } else {
+        snprintf(msg, msz, "the meshes cannot be checked: %s exited %d", vc->validator,
+                 WIFEXITED(st) ? WEXITSTATUS(st) : -1);
+    }
+    return rc;
+}
+
 int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, double *cpu_ms, char *msg,
                size_t msz)
 {
@@ -113,17 +165,7 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
     close(in[1]);
     in[1] = -1;
     uint8_t reply[VAL_MAX_REPLY];
-    size_t got = 0;
-    for (;;) {
-        ssize_t r = read(out[0], reply + got, sizeof reply - got);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0)
-            break;
-        got += (size_t)r;
-        if (got == sizeof reply)
-            break;
-    }
+    size_t got = read_reply(out[0], reply);
     int st = 0;
     struct rusage ru;
     memset(&ru, 0, sizeof ru);
@@ -132,31 +174,7 @@ int val_submit(const val_conf *vc, const void *frame, size_t len, double *ms, do
     if (cpu_ms)
         *cpu_ms = 1e3 * (double)(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
                   1e-3 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-    if (WIFEXITED(st) && WEXITSTATUS(st) == 0) {
-        rc = 0;
-    } else if (WIFEXITED(st) && WEXITSTATUS(st) == 1) {
-        proto_msg m;
-        size_t used;
-        char derr[256];
-        if (proto_decode(reply, got, VAL_MAX_REPLY, &m, &used, derr, sizeof derr) == PROTO_READY &&
-            m.type == PROTO_MSG_ERROR) {
-            rc = m.u.error.code;
-            snprintf(msg, msz, "%s", m.u.error.message);
-            proto_msg_free(&m);
-        } else {
-            snprintf(msg, msz, "the meshes cannot be checked: the validator's answer does not decode");
-        }
-    } else if (WIFSIGNALED(st) && (WTERMSIG(st) == SIGXCPU || WTERMSIG(st) == SIGKILL)) {
-        rc = PROTO_EBAD_MESH;
-        snprintf(msg, msz, "the meshes could not be decoded and checked within %u s of CPU time",
-                 vc->max_cpu_s);
-    } else if (WIFSIGNALED(st)) {
-        rc = PROTO_EBAD_MESH;        /* Draco aborted or crashed on these bytes */
-        snprintf(msg, msz, "a mesh crashed the decoder (%s) while it was checked", strsignal(WTERMSIG(st)));
-    } else {
-        snprintf(msg, msz, "the meshes cannot be checked: %s exited %d", vc->validator,
-                 WIFEXITED(st) ? WEXITSTATUS(st) : -1);
-    }
+    rc = verdict(vc, st, reply, got, msg, msz);
 done:
     for (int i = 0; i < 2; i++) {
         if (in[i] >= 0)

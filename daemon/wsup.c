@@ -310,13 +310,7 @@ static void start_later(mcd *d, uint64_t id, const char *user, const char *why)
     char reason[PROTO_MAX_STRING + 1];
     snprintf(reason, sizeof reason, "waiting to start: %s (retried in %.1f s)", why, (double)R.delay_ms / 1000);
     dlog(DLOG_WARN, "job %llu: %s", (unsigned long long)id, reason);
-    sched_done(d->sched, user);
-    store_job j;
-    if (store_get(d->store, id, &j) == 0 && sched_add(d->sched, id, user, j.priority) == 0)
-        store_set_reason(d->store, id, reason);
-    else
-        dlog(DLOG_ERROR, "job %llu: cannot put it back in the queue (it runs after the next restart)",
-             (unsigned long long)id);
+    job_requeue(d, id, user, 1, reason);
     pause_starts();
 }
 
@@ -350,6 +344,78 @@ static int take_worker_lock(mcd *d, uint64_t id, const char *user, int *fd)
         snprintf(why, sizeof why, "cannot lock %.900s: %s", path, strerror(-rc));
     start_later(d, id, user, why);
     return 1;
+}
+
+/* The worker's command line for job id in dir; the strings live in *wa. */
+typedef struct worker_args {
+    char *argv[20];                /* 17 at most, and the NULL */
+    char wbuf[PATH_MAX], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16], cpu[24];
+} worker_args;
+
+static char **worker_argv(mcd *d, uint64_t id, char *dir, worker_args *wa)
+{
+    char **argv = wa->argv;
+    snprintf(wa->sid, sizeof wa->sid, "%llu", (unsigned long long)id);
+    snprintf(wa->fd, sizeof wa->fd, "%d", SPOOL_PROGRESS_FD);
+    snprintf(wa->thr, sizeof wa->thr, "%d", d->conf.threads_per_worker);
+    snprintf(wa->maxv, sizeof wa->maxv, "%u", d->conf.max_vertices);
+    snprintf(wa->maxf, sizeof wa->maxf, "%llu", conf_max_faces(&d->conf));
+    int k = 0;
+    argv[k++] = (char *)conf_worker_path(&d->conf, wa->wbuf, sizeof wa->wbuf);
+    argv[k++] = "--job";         argv[k++] = dir;
+    argv[k++] = "--job-id";      argv[k++] = wa->sid;
+    argv[k++] = "--progress-fd"; argv[k++] = wa->fd;
+    argv[k++] = "--max-vertices"; argv[k++] = wa->maxv;
+    argv[k++] = "--max-faces";   argv[k++] = wa->maxf;
+    if (d->conf.threads_per_worker > 0) {
+        argv[k++] = "--threads";
+        argv[k++] = wa->thr;
+    }
+    uint32_t mem_mb = conf_worker_memory_mb(&d->conf, d->conf.workers);
+    if (mem_mb > 0) {
+        snprintf(wa->mem, sizeof wa->mem, "%u", mem_mb);
+        argv[k++] = "--max-memory-mb";
+        argv[k++] = wa->mem;
+    }
+    snprintf(wa->cpu, sizeof wa->cpu, "%llu", wsup_cpu_limit_s(d));
+    argv[k++] = "--max-cpu-s";
+    argv[k++] = wa->cpu;
+    argv[k] = NULL;
+    return argv;
+}
+
+/* Spawns argv on slot s: its output joins the daemon's log, its progress
+ * comes through s->pipe, and it inherits the job's lock lock_fd (closed
+ * here: the worker holds it alone). uv_spawn's code. */
+static int spawn(wsup_slot *s, char **argv, int lock_fd)
+{
+    mcd *d = s->d;
+    uv_pipe_init(d->loop, &s->pipe, 0);
+    s->pipe.data = s;
+    s->proc.data = s;
+    s->open_handles = 2;
+    uv_stdio_container_t stdio[SPOOL_LOCK_FD + 1];
+    stdio[0].flags = UV_IGNORE;
+    stdio[1].flags = UV_INHERIT_FD;    /* the worker's output joins our log */
+    stdio[1].data.fd = 2;
+    stdio[2].flags = UV_INHERIT_FD;
+    stdio[2].data.fd = 2;
+    stdio[SPOOL_PROGRESS_FD].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
+    stdio[SPOOL_PROGRESS_FD].data.stream = (uv_stream_t *)&s->pipe;
+    stdio[SPOOL_LOCK_FD].flags = UV_INHERIT_FD;   /* the job's lock, held from the fork on */
+    stdio[SPOOL_LOCK_FD].data.fd = lock_fd;
+    uv_process_options_t opt;
+    memset(&opt, 0, sizeof opt);
+    opt.file = argv[0];
+    opt.args = argv;
+    opt.exit_cb = on_exit_cb;
+    opt.stdio = stdio;
+    opt.stdio_count = SPOOL_LOCK_FD + 1;
+    int rc = uv_spawn(d->loop, &s->proc, &opt);
+    if (rc == 0)
+        wlock_note_pid(lock_fd, (long)s->proc.pid);
+    close(lock_fd);                    /* the worker holds the lock now, alone */
+    return rc;
 }
 
 /* Starts job id on slot s: 0 when the slot took it (or it ended at once),
@@ -387,60 +453,10 @@ static int slot_start(wsup_slot *s, uint64_t id, const char *user)
     proto_buf_reset(&s->in);
     store_clear_run(d->store, id);
 
-    char wbuf[PATH_MAX], sid[32], fd[8], thr[16], maxv[16], maxf[16], mem[16], cpu[24];
-    snprintf(sid, sizeof sid, "%llu", (unsigned long long)id);
-    snprintf(fd, sizeof fd, "%d", SPOOL_PROGRESS_FD);
-    snprintf(thr, sizeof thr, "%d", d->conf.threads_per_worker);
-    snprintf(maxv, sizeof maxv, "%u", d->conf.max_vertices);
-    snprintf(maxf, sizeof maxf, "%llu", conf_max_faces(&d->conf));
-    char *argv[16];
-    int k = 0;
-    argv[k++] = (char *)conf_worker_path(&d->conf, wbuf, sizeof wbuf);
-    argv[k++] = "--job";         argv[k++] = dir;
-    argv[k++] = "--job-id";      argv[k++] = sid;
-    argv[k++] = "--progress-fd"; argv[k++] = fd;
-    argv[k++] = "--max-vertices"; argv[k++] = maxv;
-    argv[k++] = "--max-faces";   argv[k++] = maxf;
-    if (d->conf.threads_per_worker > 0) {
-        argv[k++] = "--threads";
-        argv[k++] = thr;
-    }
-    uint32_t mem_mb = conf_worker_memory_mb(&d->conf, d->conf.workers);
-    if (mem_mb > 0) {
-        snprintf(mem, sizeof mem, "%u", mem_mb);
-        argv[k++] = "--max-memory-mb";
-        argv[k++] = mem;
-    }
-    snprintf(cpu, sizeof cpu, "%llu", wsup_cpu_limit_s(d));
-    argv[k++] = "--max-cpu-s";
-    argv[k++] = cpu;
-    argv[k] = NULL;
+    worker_args wa;
+    char **argv = worker_argv(d, id, dir, &wa);
 
-    uv_pipe_init(d->loop, &s->pipe, 0);
-    s->pipe.data = s;
-    s->proc.data = s;
-    s->open_handles = 2;
-    uv_stdio_container_t stdio[SPOOL_LOCK_FD + 1];
-    stdio[0].flags = UV_IGNORE;
-    stdio[1].flags = UV_INHERIT_FD;    /* the worker's output joins our log */
-    stdio[1].data.fd = 2;
-    stdio[2].flags = UV_INHERIT_FD;
-    stdio[2].data.fd = 2;
-    stdio[SPOOL_PROGRESS_FD].flags = UV_CREATE_PIPE | UV_WRITABLE_PIPE;
-    stdio[SPOOL_PROGRESS_FD].data.stream = (uv_stream_t *)&s->pipe;
-    stdio[SPOOL_LOCK_FD].flags = UV_INHERIT_FD;   /* the job's lock, held from the fork on */
-    stdio[SPOOL_LOCK_FD].data.fd = lock_fd;
-    uv_process_options_t opt;
-    memset(&opt, 0, sizeof opt);
-    opt.file = argv[0];
-    opt.args = argv;
-    opt.exit_cb = on_exit_cb;
-    opt.stdio = stdio;
-    opt.stdio_count = SPOOL_LOCK_FD + 1;
-    int rc = uv_spawn(d->loop, &s->proc, &opt);
-    if (rc == 0)
-        wlock_note_pid(lock_fd, (long)s->proc.pid);
-    close(lock_fd);                    /* the worker holds the lock now, alone */
+    int rc = spawn(s, argv, lock_fd);
     if (rc) {
         dlog(DLOG_ERROR, "job %llu: cannot start %s: %s", (unsigned long long)id, argv[0], uv_strerror(rc));
         /* no process: the slot is idle once both handles are closed */

@@ -363,6 +363,112 @@ static void io_params(io *c, proto_params *p)
 #define SLOT_MIN    (8 + 1)
 #define DEVICE_MIN  5
 
+static void io_hello_ok(io *c, proto_hello_ok *h)
+{
+    io_u16(c, &h->version);
+    io_str(c, &h->user, "user");
+    io_enum(c, &h->admin, 1, "admin");
+    io_u32(c, &h->limits.max_frame);
+    io_u32(c, &h->limits.max_vertices);
+    io_u32(c, &h->limits.max_landmarks);
+    io_u32(c, &h->limits.max_jobs_per_user);
+    io_u32(c, &h->limits.max_queue);
+    io_u32(c, &h->limits.max_wall_s);
+}
+
+static void io_submit(io *c, proto_submit *s)
+{
+    io_blob(c, &s->source, "source mesh");
+    io_blob(c, &s->target, "target mesh");
+    io_landmarks(c, &s->landmarks, &s->nlandmarks);
+    io_map(c, &s->p, "initial map P");
+    io_map(c, &s->q, "initial map Q");
+    io_params(c, &s->params);
+    io_i32(c, &s->priority);
+    io_str(c, &s->label, "label");
+}
+
+static void io_status_ok(io *c, proto_status_ok *s)
+{
+    io_u64(c, &s->job_id);
+    io_enum(c, &s->state, PROTO_STATE_LAST, "job state");
+    io_i32(c, &s->priority);
+    io_str(c, &s->user, "user");
+    io_str(c, &s->label, "label");
+    io_str(c, &s->reason, "reason");
+    io_i64(c, &s->submit_ms);
+    io_i64(c, &s->start_ms);
+    io_i64(c, &s->end_ms);
+    io_enum(c, &s->has_progress, 1, "has_progress");
+    if (s->has_progress)
+        io_progress(c, &s->progress);
+    io_quality(c, &s->quality);
+}
+
+static void io_job_summary(io *c, proto_job_summary *j)
+{
+    io_u64(c, &j->job_id);
+    io_enum(c, &j->state, PROTO_STATE_LAST, "job state");
+    io_i32(c, &j->priority);
+    io_i64(c, &j->submit_ms);
+    io_str(c, &j->user, "user");
+    io_str(c, &j->label, "label");
+    io_u32(c, &j->outer);
+    io_u32(c, &j->total);
+    io_quality(c, &j->quality);
+    io_share(c, &j->fraction, &j->eta_s);
+    io_u32(c, &j->ahead);
+}
+
+static void io_list_ok(io *c, proto_list_ok *l)
+{
+    io_count(c, &l->n, PROTO_MAX_LIST, "PROTO_MAX_LIST", SUMMARY_MIN, "job list");
+    if (c->dec)
+        l->jobs = io_alloc(c, l->n, sizeof *l->jobs);
+    for (uint32_t i = 0; i < l->n && !c->err; i++)
+        io_job_summary(c, &l->jobs[i]);
+}
+
+static void io_result_ok(io *c, proto_result_ok *r)
+{
+    io_u64(c, &r->job_id);
+    io_map(c, &r->p, "map P");
+    io_map(c, &r->q, "map Q");
+    io_blob(c, &r->deformed, "deformed mesh");
+    io_count(c, &r->nmetrics, PROTO_MAX_METRICS, "PROTO_MAX_METRICS", METRIC_MIN, "metrics");
+    if (c->dec)
+        r->metrics = io_alloc(c, r->nmetrics, sizeof *r->metrics);
+    for (uint32_t i = 0; i < r->nmetrics && !c->err; i++) {
+        io_str(c, &r->metrics[i].key, "metric key");
+        io_f64(c, &r->metrics[i].value);
+    }
+}
+
+static void io_stats_ok(io *c, proto_stats_ok *s)
+{
+    io_u32(c, &s->queued);
+    io_u32(c, &s->running);
+    io_u32(c, &s->workers);
+    io_u64(c, &s->completed);
+    io_u64(c, &s->failed);
+    io_u64(c, &s->cancelled);
+    io_count(c, &s->nslots, PROTO_MAX_SLOTS, "PROTO_MAX_SLOTS", SLOT_MIN, "worker slots");
+    if (c->dec)
+        s->slots = io_alloc(c, s->nslots, sizeof *s->slots);
+    for (uint32_t i = 0; i < s->nslots && !c->err; i++) {
+        io_u64(c, &s->slots[i].job_id);
+        io_enum(c, &s->slots[i].state, PROTO_SLOT_LAST, "slot state");
+    }
+    io_count(c, &s->ndevices, PROTO_MAX_DEVICES, "PROTO_MAX_DEVICES", DEVICE_MIN, "devices");
+    if (c->dec)
+        s->devices = io_alloc(c, s->ndevices, sizeof *s->devices);
+    for (uint32_t i = 0; i < s->ndevices && !c->err; i++)
+        io_str(c, &s->devices[i], "device name");
+    io_str(c, &s->backend, "backend name");
+    io_u8(c, &s->backend_ok);
+    io_str(c, &s->backend_status, "backend status");
+}
+
 /* The payload of message m, in both directions. */
 static void io_payload(io *c, proto_msg *m)
 {
@@ -374,53 +480,20 @@ static void io_payload(io *c, proto_msg *m)
         io_str(c, &h->client, "client name");
         break;
     }
-    case PROTO_MSG_HELLO_OK: {
-        proto_hello_ok *h = &m->u.hello_ok;
-        io_u16(c, &h->version);
-        io_str(c, &h->user, "user");
-        io_enum(c, &h->admin, 1, "admin");
-        io_u32(c, &h->limits.max_frame);
-        io_u32(c, &h->limits.max_vertices);
-        io_u32(c, &h->limits.max_landmarks);
-        io_u32(c, &h->limits.max_jobs_per_user);
-        io_u32(c, &h->limits.max_queue);
-        io_u32(c, &h->limits.max_wall_s);
+    case PROTO_MSG_HELLO_OK:
+        io_hello_ok(c, &m->u.hello_ok);
         break;
-    }
-    case PROTO_MSG_SUBMIT: {
-        proto_submit *s = &m->u.submit;
-        io_blob(c, &s->source, "source mesh");
-        io_blob(c, &s->target, "target mesh");
-        io_landmarks(c, &s->landmarks, &s->nlandmarks);
-        io_map(c, &s->p, "initial map P");
-        io_map(c, &s->q, "initial map Q");
-        io_params(c, &s->params);
-        io_i32(c, &s->priority);
-        io_str(c, &s->label, "label");
+    case PROTO_MSG_SUBMIT:
+        io_submit(c, &m->u.submit);
         break;
-    }
     case PROTO_MSG_SUBMIT_OK: case PROTO_MSG_STATUS: case PROTO_MSG_CANCEL:
     case PROTO_MSG_OK: case PROTO_MSG_DELETE:
         /* all five union members are the same proto_job_ref */
         io_u64(c, &m->u.ok.job_id);
         break;
-    case PROTO_MSG_STATUS_OK: {
-        proto_status_ok *s = &m->u.status_ok;
-        io_u64(c, &s->job_id);
-        io_enum(c, &s->state, PROTO_STATE_LAST, "job state");
-        io_i32(c, &s->priority);
-        io_str(c, &s->user, "user");
-        io_str(c, &s->label, "label");
-        io_str(c, &s->reason, "reason");
-        io_i64(c, &s->submit_ms);
-        io_i64(c, &s->start_ms);
-        io_i64(c, &s->end_ms);
-        io_enum(c, &s->has_progress, 1, "has_progress");
-        if (s->has_progress)
-            io_progress(c, &s->progress);
-        io_quality(c, &s->quality);
+    case PROTO_MSG_STATUS_OK:
+        io_status_ok(c, &m->u.status_ok);
         break;
-    }
     case PROTO_MSG_LIST: {
         proto_list *l = &m->u.list;
         io_u32(c, &l->state_mask);
@@ -431,27 +504,9 @@ static void io_payload(io *c, proto_msg *m)
             io_fail(c, PROTO_EBAD_FRAME, "state mask 0x%x has bits past the last state", l->state_mask);
         break;
     }
-    case PROTO_MSG_LIST_OK: {
-        proto_list_ok *l = &m->u.list_ok;
-        io_count(c, &l->n, PROTO_MAX_LIST, "PROTO_MAX_LIST", SUMMARY_MIN, "job list");
-        if (c->dec)
-            l->jobs = io_alloc(c, l->n, sizeof *l->jobs);
-        for (uint32_t i = 0; i < l->n && !c->err; i++) {
-            proto_job_summary *j = &l->jobs[i];
-            io_u64(c, &j->job_id);
-            io_enum(c, &j->state, PROTO_STATE_LAST, "job state");
-            io_i32(c, &j->priority);
-            io_i64(c, &j->submit_ms);
-            io_str(c, &j->user, "user");
-            io_str(c, &j->label, "label");
-            io_u32(c, &j->outer);
-            io_u32(c, &j->total);
-            io_quality(c, &j->quality);
-            io_share(c, &j->fraction, &j->eta_s);
-            io_u32(c, &j->ahead);
-        }
+    case PROTO_MSG_LIST_OK:
+        io_list_ok(c, &m->u.list_ok);
         break;
-    }
     case PROTO_MSG_WATCH:
         io_u64(c, &m->u.watch.job_id);
         io_u32(c, &m->u.watch.from_outer);
@@ -470,46 +525,12 @@ static void io_payload(io *c, proto_msg *m)
         if (!c->err && (m->u.result.what & ~PROTO_WANT_ALL))
             io_fail(c, PROTO_EBAD_FRAME, "RESULT what 0x%x has unknown bits", m->u.result.what);
         break;
-    case PROTO_MSG_RESULT_OK: {
-        proto_result_ok *r = &m->u.result_ok;
-        io_u64(c, &r->job_id);
-        io_map(c, &r->p, "map P");
-        io_map(c, &r->q, "map Q");
-        io_blob(c, &r->deformed, "deformed mesh");
-        io_count(c, &r->nmetrics, PROTO_MAX_METRICS, "PROTO_MAX_METRICS", METRIC_MIN, "metrics");
-        if (c->dec)
-            r->metrics = io_alloc(c, r->nmetrics, sizeof *r->metrics);
-        for (uint32_t i = 0; i < r->nmetrics && !c->err; i++) {
-            io_str(c, &r->metrics[i].key, "metric key");
-            io_f64(c, &r->metrics[i].value);
-        }
+    case PROTO_MSG_RESULT_OK:
+        io_result_ok(c, &m->u.result_ok);
         break;
-    }
-    case PROTO_MSG_STATS_OK: {
-        proto_stats_ok *s = &m->u.stats_ok;
-        io_u32(c, &s->queued);
-        io_u32(c, &s->running);
-        io_u32(c, &s->workers);
-        io_u64(c, &s->completed);
-        io_u64(c, &s->failed);
-        io_u64(c, &s->cancelled);
-        io_count(c, &s->nslots, PROTO_MAX_SLOTS, "PROTO_MAX_SLOTS", SLOT_MIN, "worker slots");
-        if (c->dec)
-            s->slots = io_alloc(c, s->nslots, sizeof *s->slots);
-        for (uint32_t i = 0; i < s->nslots && !c->err; i++) {
-            io_u64(c, &s->slots[i].job_id);
-            io_enum(c, &s->slots[i].state, PROTO_SLOT_LAST, "slot state");
-        }
-        io_count(c, &s->ndevices, PROTO_MAX_DEVICES, "PROTO_MAX_DEVICES", DEVICE_MIN, "devices");
-        if (c->dec)
-            s->devices = io_alloc(c, s->ndevices, sizeof *s->devices);
-        for (uint32_t i = 0; i < s->ndevices && !c->err; i++)
-            io_str(c, &s->devices[i], "device name");
-        io_str(c, &s->backend, "backend name");
-        io_u8(c, &s->backend_ok);
-        io_str(c, &s->backend_status, "backend status");
+    case PROTO_MSG_STATS_OK:
+        io_stats_ok(c, &m->u.stats_ok);
         break;
-    }
     case PROTO_MSG_ERROR:
         io_i32(c, &m->u.error.code);
         io_str(c, &m->u.error.message, "error message");

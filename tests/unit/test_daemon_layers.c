@@ -8,7 +8,7 @@
  * bk_drain and req_quiesce take. A daemon object with no floor in the
  * table fails too: a new file is placed in it (and in the README) when it
  * is added. Also: only job.c records a job's state (store_set_state,
- * store_set_running). */
+ * store_set_running, store_set_pending). */
 #include "support/harness.h"
 
 #include <glob.h>
@@ -176,8 +176,8 @@ TEST(the_only_call_cycle_is_the_listed_exception)
 TEST(only_the_job_module_records_a_jobs_state)
 {
     read_objects();
-    const char *writers[] = {"store_set_state", "store_set_running"};
-    for (size_t w = 0; w < 2; w++)
+    const char *writers[] = {"store_set_state", "store_set_running", "store_set_pending"};
+    for (size_t w = 0; w < sizeof writers / sizeof writers[0]; w++)
         for (int u = 0; u < nuses; u++)
             if (strcmp(uses[u].name, writers[w]) == 0 && strcmp(mods[uses[u].mod], "job") != 0)
                 FAILF("%s calls %s: a job's state is recorded by job.c alone", mods[uses[u].mod],

@@ -18,7 +18,7 @@
 
 static const struct { const char *mod; int floor; } floors[] = {
     {"util", 0}, {"opt", 0},
-    {"mesh", 1}, {"sandbox", 1},
+    {"mesh", 1}, {"sandbox", 1}, {"chol", 1},
     {"geo", 2}, {"map", 2}, {"lmk", 2}, {"proj", 2},
     {"lbo", 3}, {"geod", 3}, {"ener", 3}, {"viz", 3}, {"ctf", 3},
     {"desc", 4}, {"embed", 4}, {"metric", 4}, {"ddm", 4}, {"ectm", 4},
@@ -29,7 +29,7 @@ static const struct { const char *mod; int floor; } floors[] = {
 };
 static const char *floor_names[] = {
     "util, opt",
-    "mesh, sandbox",
+    "mesh, sandbox, chol",
     "geo, map, lmk, proj",
     "lbo, geod, ener, viz, ctf",
     "desc, embed, metric, ddm, ectm",

@@ -67,6 +67,108 @@ static double triangle_min(const face_pre *f, double D, double E, double F, doub
     return best;
 }
 
+/* fp[f] for every face of T with corners in A (n2 by d). */
+static void faces_pre(const double *A, int d, const mesh *T, face_pre *fp)
+{
+    for (int f = 0; f < T->nf; f++) {
+        const double *a0 = A + (size_t)T->f[3 * f] * d, *a1 = A + (size_t)T->f[3 * f + 1] * d;
+        const double *a2 = A + (size_t)T->f[3 * f + 2] * d;
+        double a = 0, h = 0, c = 0, p1 = 0, p2 = 0;
+        for (int j = 0; j < d; j++) {
+            double e1 = a1[j] - a0[j], e2 = a2[j] - a0[j];
+            a += e1 * e1;
+            h += e1 * e2;
+            c += e2 * e2;
+            p1 += e1 * a0[j];
+            p2 += e2 * a0[j];
+        }
+        double l = fmax(fmax(a, c), a + c - 2 * h);
+        fp[f] = (face_pre){a, h, c, p1, p2, sqrt(fmax(l, 0))};
+    }
+}
+
+/* For the DDM__ROWS rows of B from i0 (nr of them real, the block padded
+ * with row i0): g[r n2 + j] = B_r . A_j and d2[...] = |B_r - A_j|^2
+ * (clamped at 0), in one pass over A (each A_j read once for the block,
+ * the block's columns in registers). bt: d by DDM__ROWS scratch, 16-byte
+ * aligned. */
+static void block_products(const double *A, int d, int n2, const double *norm2, const double *B,
+                           int i0, int nr, double *bt, double *g, double *d2)
+{
+    double bb[DDM__ROWS];
+    for (int r = 0; r < DDM__ROWS; r++) {  /* B's rows transposed, the block padded */
+        const double *b = B + (size_t)(i0 + (r < nr ? r : 0)) * d;
+        bb[r] = dot(b, b, d);
+        for (int c = 0; c < d; c++)
+            bt[(size_t)c * DDM__ROWS + r] = b[c];
+    }
+    const ddm__v2 *bv = (const ddm__v2 *)bt;
+    for (int j = 0; j < n2; j++) {
+        const double *aj = A + (size_t)j * d;
+        _Static_assert(DDM__ROWS == 8, "the four accumulators below");
+        ddm__v2 acc[DDM__ROWS / 2] = {{0, 0}};   /* 4 registers, not memory */
+        for (int c = 0; c < d; c++) {
+            ddm__v2 a = {aj[c], aj[c]};
+            acc[0] += a * bv[4 * c];
+            acc[1] += a * bv[4 * c + 1];
+            acc[2] += a * bv[4 * c + 2];
+            acc[3] += a * bv[4 * c + 3];
+        }
+        for (int r = 0; r < DDM__ROWS; r++) {
+            double x = acc[r / 2][r % 2], e = norm2[j] - 2 * x + bb[r];
+            g[(size_t)r * n2 + j] = x;
+            d2[(size_t)r * n2 + j] = e > 0 ? e : 0;
+        }
+    }
+}
+
+/* Row i's nearest point of T from its products gi and squared distances
+ * di with every vertex: the nearest vertex, then every face the bound
+ * (App. A.2) cannot rule out. Writes P's row i; returns the squared
+ * distance, and adds the faces solved to *solved. */
+static double nearest_on_faces(const mesh *T, const face_pre *fp, const int *vface, const double *gi,
+                               const double *di, int i, bmap *P, long long *solved)
+{
+    int n2 = T->nv, nf = T->nf;
+    double best = INFINITY;
+    int vbest = 0;
+    for (int j = 0; j < n2; j++)
+        if (di[j] < best && vface[j] >= 0) {
+            best = di[j];
+            vbest = j;
+        }
+    /* the nearest vertex (Delta_min), as a point of its lowest face */
+    int bf = vface[vbest] / 3, corner = vface[vbest] % 3;
+    double bw[3] = {corner == 0, corner == 1, corner == 2};
+    double rbest = sqrt(best);
+    for (int f = 0; f < nf; f++) {   /* the bound, squared: dmin^2 > (rbest + lmax)^2 */
+        const int *fv = T->f + 3 * f;
+        double x0 = di[fv[0]], x1 = di[fv[1]], x2 = di[fv[2]];
+        double dmin2 = x0 < x1 ? x0 : x1, rr = rbest + fp[f].lmax;   /* d2 has no NaN */
+        dmin2 = x2 < dmin2 ? x2 : dmin2;
+        if (dmin2 > rr * rr)
+            continue;
+        (*solved)++;
+        double D = fp[f].p1 - (gi[fv[1]] - gi[fv[0]]), E = fp[f].p2 - (gi[fv[2]] - gi[fv[0]]);
+        double ss = 0, tt = 0, v = triangle_min(fp + f, D, E, di[fv[0]], &ss, &tt);
+        if (v < best) {
+            best = fmax(v, 0);
+            rbest = sqrt(best);
+            bf = f;
+            bw[0] = 1 - ss - tt;
+            bw[1] = ss;
+            bw[2] = tt;
+        }
+    }
+    P->face[i] = bf;
+    double ws = 0;
+    for (int q = 0; q < 3; q++)
+        ws += bw[q] = bw[q] < 0 ? 0 : bw[q];
+    for (int q = 0; q < 3; q++)
+        P->w[3 * i + q] = bw[q] / ws;
+    return best;
+}
+
 int ddm_nearest_points(const double *A, int d, const mesh *T, const double *B, int n1,
                        const double *m1, bmap *P, ddm_stats *stats, char *err, size_t errsz)
 {
@@ -98,26 +200,9 @@ int ddm_nearest_points(const double *A, int d, const mesh *T, const double *B, i
     for (int f = nf - 1; f >= 0; f--)            /* lowest face with corner j, and which corner */
         for (int q = 0; q < 3; q++)
             vface[T->f[3 * f + q]] = 3 * f + q;
-    for (int f = 0; f < nf; f++) {
-        const double *a0 = A + (size_t)T->f[3 * f] * d, *a1 = A + (size_t)T->f[3 * f + 1] * d;
-        const double *a2 = A + (size_t)T->f[3 * f + 2] * d;
-        double a = 0, h = 0, c = 0, p1 = 0, p2 = 0;
-        for (int j = 0; j < d; j++) {
-            double e1 = a1[j] - a0[j], e2 = a2[j] - a0[j];
-            a += e1 * e1;
-            h += e1 * e2;
-            c += e2 * e2;
-            p1 += e1 * a0[j];
-            p2 += e2 * a0[j];
-        }
-        double l = fmax(fmax(a, c), a + c - 2 * h);
-        fp[f] = (face_pre){a, h, c, p1, p2, sqrt(fmax(l, 0))};
-    }
+    faces_pre(A, d, T, fp);
 #pragma omp parallel reduction(+ : solved, cost)
     {
-        /* DDM__ROWS rows at a time: their products with every A_j in one
-         * pass over A (each A_j read once for the block, the block's
-         * columns in registers) */
         double *g = malloc((size_t)n2 * DDM__ROWS * sizeof *g);
         double *d2 = malloc((size_t)n2 * DDM__ROWS * sizeof *d2);
         double *bt = aligned_alloc(16, (size_t)d * DDM__ROWS * sizeof *bt);
@@ -130,72 +215,12 @@ int ddm_nearest_points(const double *A, int d, const mesh *T, const double *B, i
             if (!g || !d2 || !bt)
                 continue;
             int nr = n1 - i0 < DDM__ROWS ? n1 - i0 : DDM__ROWS;
-            double bb[DDM__ROWS];
-            for (int r = 0; r < DDM__ROWS; r++) {  /* B's rows transposed, the block padded */
-                const double *b = B + (size_t)(i0 + (r < nr ? r : 0)) * d;
-                bb[r] = dot(b, b, d);
-                for (int c = 0; c < d; c++)
-                    bt[(size_t)c * DDM__ROWS + r] = b[c];
-            }
-            const ddm__v2 *bv = (const ddm__v2 *)bt;
-            for (int j = 0; j < n2; j++) {
-                const double *aj = A + (size_t)j * d;
-                _Static_assert(DDM__ROWS == 8, "the four accumulators below");
-                ddm__v2 acc[DDM__ROWS / 2] = {{0, 0}};   /* 4 registers, not memory */
-                for (int c = 0; c < d; c++) {
-                    ddm__v2 a = {aj[c], aj[c]};
-                    acc[0] += a * bv[4 * c];
-                    acc[1] += a * bv[4 * c + 1];
-                    acc[2] += a * bv[4 * c + 2];
-                    acc[3] += a * bv[4 * c + 3];
-                }
-                for (int r = 0; r < DDM__ROWS; r++) {
-                    double x = acc[r / 2][r % 2], e = norm2[j] - 2 * x + bb[r];
-                    g[(size_t)r * n2 + j] = x;
-                    d2[(size_t)r * n2 + j] = e > 0 ? e : 0;
-                }
-            }
+            block_products(A, d, n2, norm2, B, i0, nr, bt, g, d2);
             for (int r = 0; r < nr; r++) {
-                int i = i0 + r;
-                const double *gi = g + (size_t)r * n2, *di = d2 + (size_t)r * n2;
-                double best = INFINITY;
-                int vbest = 0;
-                for (int j = 0; j < n2; j++)
-                    if (di[j] < best && vface[j] >= 0) {
-                        best = di[j];
-                        vbest = j;
-                    }
-                /* the nearest vertex (Delta_min), as a point of its lowest face */
-                int bf = vface[vbest] / 3, corner = vface[vbest] % 3;
-                double bw[3] = {corner == 0, corner == 1, corner == 2};
-                double rbest = sqrt(best);
-                for (int f = 0; f < nf; f++) {   /* the bound, squared: dmin^2 > (rbest + lmax)^2 */
-                    const int *fv = T->f + 3 * f;
-                    double x0 = di[fv[0]], x1 = di[fv[1]], x2 = di[fv[2]];
-                    double dmin2 = x0 < x1 ? x0 : x1, rr = rbest + fp[f].lmax;   /* d2 has no NaN */
-                    dmin2 = x2 < dmin2 ? x2 : dmin2;
-                    if (dmin2 > rr * rr)
-                        continue;
-                    solved++;
-                    double D = fp[f].p1 - (gi[fv[1]] - gi[fv[0]]), E = fp[f].p2 - (gi[fv[2]] - gi[fv[0]]);
-                    double ss = 0, tt = 0, v = triangle_min(fp + f, D, E, di[fv[0]], &ss, &tt);
-                    if (v < best) {
-                        best = fmax(v, 0);
-                        rbest = sqrt(best);
-                        bf = f;
-                        bw[0] = 1 - ss - tt;
-                        bw[1] = ss;
-                        bw[2] = tt;
-                    }
-                }
-                P->face[i] = bf;
-                double ws = 0;
-                for (int q = 0; q < 3; q++)
-                    ws += bw[q] = bw[q] < 0 ? 0 : bw[q];
-                for (int q = 0; q < 3; q++)
-                    P->w[3 * i + q] = bw[q] / ws;
+                double best = nearest_on_faces(T, fp, vface, g + (size_t)r * n2, d2 + (size_t)r * n2,
+                                               i0 + r, P, &solved);
                 if (m1)
-                    cost += m1[i] * best;
+                    cost += m1[i0 + r] * best;
             }
         }
         free(g);

@@ -463,6 +463,81 @@ static double *unscaled(const double *Y, int nv, const geo_scaling *f)
     return out;
 }
 
+/* The sides' maps from the start P0 (and Q0, or the reverse by nearest
+ * point when bijective), their pins and Y ← P X̃ (Ỹ ← Q X). ECTM_OK,
+ * ECTM_ENOMEM or reverse_by_nearest's code. */
+static int pair_start(pair *pr, const bmap *P0, const bmap *Q0, const ectm_landmarks *L,
+                      char *err, size_t errsz)
+{
+    side *a = &pr->s[0], *b = &pr->s[1];
+    int rc;
+    a->Zt = malloc(sizeof(double) * ((size_t)a->X->nv * 6 + 1));
+    b->Zt = malloc(sizeof(double) * ((size_t)b->X->nv * 6 + 1));
+    a->P = bmap_new(a->X->nv, b->X->nv);
+    b->P = bmap_new(b->X->nv, a->X->nv);
+    if (!a->Zt || !b->Zt || !a->P || !b->P)
+        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+    if (L && L->n > 0 &&
+        (side_pins(a, b, L->src, L->tgt, L->n) ||
+         (pr->bijective && side_pins(b, a, L->tgt, L->src, L->n))))
+        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+    memcpy(a->P->face, P0->face, sizeof(int) * (size_t)a->X->nv);
+    memcpy(a->P->w, P0->w, sizeof(double) * 3 * (size_t)a->X->nv);
+    bmap_apply(a->P, b->X->f, b->X->v, 3, a->PX);
+    memcpy(a->Y, a->PX, sizeof(double) * 3 * (size_t)a->X->nv);   /* Y ← P X̃ */
+    if (!pr->bijective)
+        return ECTM_OK;
+    if (Q0) {
+        memcpy(b->P->face, Q0->face, sizeof(int) * (size_t)b->X->nv);
+        memcpy(b->P->w, Q0->w, sizeof(double) * 3 * (size_t)b->X->nv);
+    } else if ((rc = reverse_by_nearest(a, b, err, errsz))) {
+        return rc;
+    }
+    bmap_apply(b->P, a->X->f, a->X->v, 3, b->PX);
+    memcpy(b->Y, b->PX, sizeof(double) * 3 * (size_t)b->X->nv);   /* Ỹ ← Q X */
+    if (side_transpose(a, b) || side_transpose(b, a))
+        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+    return ECTM_OK;
+}
+
+/* Outer iteration k at β = beta (scaled): per direction the P-step then
+ * the Y-step, then the energies into r. ECTM_OK or the failing step's
+ * code, named in err. */
+static int outer_iteration(pair *pr, int k, double beta, ectm_report *r, double *scratch,
+                           char *err, size_t errsz)
+{
+    const ectm_params *p = &pr->p;
+    side *a = &pr->s[0], *b = &pr->s[1];
+    for (int dir = 0; dir < (pr->bijective ? 2 : 1); dir++) {
+        side *u = &pr->s[dir], *v = &pr->s[1 - dir];
+        /* P ← projection (Q for dir 1), then Y ← L-BFGS (Ỹ for dir 1) */
+        double tp = now();
+        pstep(u, v, beta, p->gamma, pr->bijective);
+        if (pr->bijective && side_transpose(v, u))
+            return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+        double ts = now();
+        r->t_project += ts - tp;
+        int rc = solve_y(pr, dir, beta, &r->dir[dir], scratch);
+        r->t_solve += now() - ts;
+        const char *be = ener_backend_error(u->def);
+        if (rc && be)
+            rc = ECTM_EBACKEND;
+        if (rc)
+            return errbuf_set(err, errsz, rc, "%s in the %s Y-step at outer iteration %d%s%s",
+                              ectm_strerror(rc), dir ? "target" : "source", k, be ? ": " : "",
+                              be ? be : "");
+    }
+    if (pr->bijective) {
+        /* The source's γ term changed with the new Q: report it current. */
+        ystep st0 = { .a = a, .b = b, .beta = beta, .gamma = p->gamma, .bijective = 1 };
+        ystep_eval(&st0, a->Y, scratch, a->X->nv * 3);
+        r->dir[0].mismatch = st0.mismatch;
+        r->dir[0].reverse = st0.reverse;
+    }
+    total_energy(pr, r);
+    return ECTM_OK;
+}
+
 int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
              const ectm_landmarks *L, const ectm_params *p, ectm_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz)
@@ -500,41 +575,13 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
     if ((rc = side_open(&pr.s[1], T, p->partial, &dp, p, "target", err, errsz)))
         goto done;
     side *a = &pr.s[0], *b = &pr.s[1];
-    a->Zt = malloc(sizeof(double) * ((size_t)a->X->nv * 6 + 1));
-    b->Zt = malloc(sizeof(double) * ((size_t)b->X->nv * 6 + 1));
-    a->P = bmap_new(a->X->nv, b->X->nv);
-    b->P = bmap_new(b->X->nv, a->X->nv);
     int nmax = a->X->nv > b->X->nv ? a->X->nv : b->X->nv;
-    scratch = malloc(sizeof(double) * ((size_t)nmax * 3 + 1));
-    if (!a->Zt || !b->Zt || !a->P || !b->P || !scratch) {
+    if (!(scratch = malloc(sizeof(double) * ((size_t)nmax * 3 + 1)))) {
         rc = errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
         goto done;
     }
-    if (L && L->n > 0 &&
-        (side_pins(a, b, L->src, L->tgt, L->n) ||
-         (pr.bijective && side_pins(b, a, L->tgt, L->src, L->n)))) {
-        rc = errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+    if ((rc = pair_start(&pr, P0, Q0, L, err, errsz)))
         goto done;
-    }
-    memcpy(a->P->face, P0->face, sizeof(int) * (size_t)a->X->nv);
-    memcpy(a->P->w, P0->w, sizeof(double) * 3 * (size_t)a->X->nv);
-    bmap_apply(a->P, b->X->f, b->X->v, 3, a->PX);
-    memcpy(a->Y, a->PX, sizeof(double) * 3 * (size_t)a->X->nv);   /* Y ← P X̃ */
-    if (pr.bijective) {
-        if (Q0) {
-            memcpy(b->P->face, Q0->face, sizeof(int) * (size_t)b->X->nv);
-            memcpy(b->P->w, Q0->w, sizeof(double) * 3 * (size_t)b->X->nv);
-        } else if ((rc = reverse_by_nearest(a, b, err, errsz))) {
-            goto done;
-        }
-        bmap_apply(b->P, a->X->f, a->X->v, 3, b->PX);
-        memcpy(b->Y, b->PX, sizeof(double) * 3 * (size_t)b->X->nv);   /* Ỹ ← Q X */
-    }
-
-    if (pr.bijective && (side_transpose(a, b) || side_transpose(b, a))) {
-        rc = errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
-        goto done;
-    }
     ectm_report r;
     memset(&r, 0, sizeof r);
     r.total = p->iterations;
@@ -544,37 +591,8 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         double beta = ectm_beta(p, k) * beta_scale;
         r.outer = k;
         r.beta = ectm_beta(p, k);
-        for (int dir = 0; dir < (pr.bijective ? 2 : 1); dir++) {
-            side *u = &pr.s[dir], *v = &pr.s[1 - dir];
-            /* P ← projection (Q for dir 1), then Y ← L-BFGS (Ỹ for dir 1) */
-            double tp = now();
-            pstep(u, v, beta, p->gamma, pr.bijective);
-            if (pr.bijective && side_transpose(v, u)) {
-                rc = errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
-                goto done;
-            }
-            double ts = now();
-            r.t_project += ts - tp;
-            rc = solve_y(&pr, dir, beta, &r.dir[dir], scratch);
-            r.t_solve += now() - ts;
-            const char *be = ener_backend_error(u->def);
-            if (rc && be)
-                rc = ECTM_EBACKEND;
-            if (rc) {
-                errbuf_set(err, errsz, rc, "%s in the %s Y-step at outer iteration %d%s%s",
-                           ectm_strerror(rc), dir ? "target" : "source", k, be ? ": " : "",
-                           be ? be : "");
-                goto done;
-            }
-        }
-        if (pr.bijective) {
-            /* The source's γ term changed with the new Q: report it current. */
-            ystep st0 = { .a = a, .b = b, .beta = beta, .gamma = p->gamma, .bijective = 1 };
-            ystep_eval(&st0, a->Y, scratch, a->X->nv * 3);
-            r.dir[0].mismatch = st0.mismatch;
-            r.dir[0].reverse = st0.reverse;
-        }
-        total_energy(&pr, &r);
+        if ((rc = outer_iteration(&pr, k, beta, &r, scratch, err, errsz)))
+            goto done;
         r.elapsed = now() - t0;
         out->last = r;
         if (!isfinite(r.energy)) {

@@ -1,14 +1,14 @@
 /* embed_biharmonic.c — the smooth extension of an embedding known at a few
  * vertices to the whole mesh: the minimiser of the discrete biharmonic
  * energy tr(Zᵀ L M⁻¹ L Z) with those rows fixed (one sparse SPD solve,
- * CHOLMOD); see embed.h. Takes the operators as given (geod.h's
+ * chol.h); see embed.h. Takes the operators as given (geod.h's
  * intrinsic Delaunay L and M); computes no distance. */
 #include "embed/embed.h"
+#include "chol/chol.h"
 #include "util/errbuf.h"
 
 #include <stdlib.h>
 #include <string.h>
-#include <suitesparse/cholmod.h>
 
 static int cmp_int(const void *a, const void *b)
 {
@@ -23,12 +23,9 @@ int embed_biharmonic(const geo_csr *L, const double *mass, const int *fixed, int
     int *row = malloc((size_t)n * sizeof *row);      /* vertex -> free row, or -1 - fixed index */
     double *acc = calloc((size_t)n, sizeof *acc);    /* one row of K, scattered */
     int *mark = malloc((size_t)n * sizeof *mark), *cols = malloc((size_t)n * sizeof *cols);
-    cholmod_common cc;
-    cholmod_start(&cc);
-    cc.print = 0;
-    cholmod_sparse *A = NULL;
-    cholmod_dense *B = NULL, *X = NULL;
-    cholmod_factor *F = NULL;
+    chol *A = NULL;
+    double *bx = NULL;   /* right-hand sides, then the solution: nf by dim, column-major */
+    char detail[256] = "";
     if (!row || !acc || !mark || !cols) {
         errbuf_set(err, errsz, rc, "out of memory");
         goto out;
@@ -55,15 +52,12 @@ int embed_biharmonic(const geo_csr *L, const double *mass, const int *fixed, int
             int l = L->col[p];
             cap += (size_t)(L->row_start[l + 1] - L->row_start[l]);
         }
-    A = cholmod_allocate_sparse((size_t)nf, (size_t)nf, cap, 1, 1, 1, CHOLMOD_REAL, &cc);
-    B = cholmod_zeros((size_t)nf, (size_t)dim, CHOLMOD_REAL, &cc);
-    if (!A || !B) {
+    /* CHOLMOD's own choice of ordering */
+    if (!(bx = calloc((size_t)nf * dim, sizeof *bx)) ||
+        chol_new(nf, cap, CHOL_ORDER_CHOLMOD, &A, detail, sizeof detail) != CHOL_OK) {
         errbuf_set(err, errsz, rc, "out of memory for the %d-row biharmonic system", nf);
         goto out;
     }
-    int *ap = A->p, *ai = A->i;
-    double *ax = A->x, *bx = B->x;
-    size_t at = 0;
     for (int v = 0; v < n; v++) {
         if (row[v] < 0)
             continue;
@@ -83,14 +77,11 @@ int embed_biharmonic(const geo_csr *L, const double *mass, const int *fixed, int
         }
         qsort(cols, (size_t)nc, sizeof *cols, cmp_int);
         int c = row[v];
-        ap[c] = (int)at;
         for (int q = 0; q < nc; q++) {
             int u = cols[q];
             if (row[u] >= 0) {
-                if (row[u] <= c) {
-                    ai[at] = row[u];
-                    ax[at++] = acc[u];
-                }
+                if (row[u] <= c)
+                    chol_add(A, row[u], c, acc[u]);
             } else {
                 const double *y = Y + (size_t)(-1 - row[u]) * dim;
                 for (int d = 0; d < dim; d++)
@@ -98,26 +89,23 @@ int embed_biharmonic(const geo_csr *L, const double *mass, const int *fixed, int
             }
         }
     }
-    ap[nf] = (int)at; /* rows sorted: row[] numbers free vertices in vertex order */
-    if (!(F = cholmod_analyze(A, &cc)) || !cholmod_factorize(A, F, &cc) ||
-        cc.status != CHOLMOD_OK || !(X = cholmod_solve(CHOLMOD_A, F, B, &cc))) {
-        rc = errbuf_set(err, errsz, cc.status == CHOLMOD_OUT_OF_MEMORY ? EMBED_ENOMEM : EMBED_ESOLVE,
-                        "biharmonic extension: CHOLMOD status %d (is every component sampled?)",
-                        cc.status);
+    int crc = chol_assemble(A, CHOL_DIAG_KEEP, NULL, detail, sizeof detail);
+    if (crc == CHOL_OK && (crc = chol_factorise(A, detail, sizeof detail)) == CHOL_OK)
+        crc = chol_solve(A, bx, dim, bx, detail, sizeof detail);
+    if (crc != CHOL_OK) {
+        rc = errbuf_set(err, errsz, crc == CHOL_ENOMEM ? EMBED_ENOMEM : EMBED_ESOLVE,
+                        "biharmonic extension: %s (is every component sampled?)", detail);
         goto out;
     }
-    const double *x = X->x;
+    const double *x = bx;
     for (int v = 0; v < n; v++)
         if (row[v] >= 0)
             for (int d = 0; d < dim; d++)
                 Z[(size_t)v * dim + d] = x[(size_t)d * nf + row[v]];
     rc = EMBED_OK;
 out:
-    cholmod_free_sparse(&A, &cc);
-    cholmod_free_dense(&B, &cc);
-    cholmod_free_dense(&X, &cc);
-    cholmod_free_factor(&F, &cc);
-    cholmod_finish(&cc);
+    chol_free(A);
+    free(bx);
     free(row);
     free(acc);
     free(mark);

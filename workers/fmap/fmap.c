@@ -321,6 +321,79 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
                                           k2, mu, mu_n, 0, C, iterations, err, errsz);
 }
 
+/* The Jacobi preconditioner Jd = 1 / diag(H), H(E_ac) at E_ac = e_a e_c^T:
+ * G_cc + mu D_ac + w (|N1 e_a|^2 + |e_c^T N2|^2 - 2 N1_aa N2_cc) + the
+ * same for each O_d (their columns and rows need not be symmetric); 1
+ * where the diagonal is not positive. */
+static void jacobi_diagonal(const normal_system *ns, double *Jd)
+{
+    int k1 = ns->k1, k2 = ns->k2;
+    for (int a = 0; a < k1; a++)
+        for (int c = 0; c < k2; c++) {
+            double h = ns->G[(size_t)c * k2 + c] + ns->mu * ns->D[(size_t)a * k2 + c];
+            for (int d = -1; d < ns->no; d++) {
+                const double *X1 = d < 0 ? ns->N1 : ns->O1 + (size_t)d * k1 * k1;
+                const double *X2 = d < 0 ? ns->N2 : ns->O2 + (size_t)d * k2 * k2;
+                double wd = d < 0 ? ns->w : ns->wo[d], s1 = 0, s2 = 0;
+                if (wd == 0)
+                    continue;
+                for (int q = 0; q < k1; q++)
+                    s1 += X1[(size_t)q * k1 + a] * X1[(size_t)q * k1 + a];
+                for (int q = 0; q < k2; q++)
+                    s2 += X2[(size_t)c * k2 + q] * X2[(size_t)c * k2 + q];
+                h += wd * (s1 + s2 - 2 * X1[(size_t)a * k1 + a] * X2[(size_t)c * k2 + c]);
+            }
+            Jd[(size_t)a * k2 + c] = h > 0 ? 1 / h : 1;
+        }
+}
+
+/* H C = B by conjugate gradients preconditioned with Jd, from the C given
+ * (the Laplacian-only map); r, p, Hp: k1 k2 scratch. FMAP_OK, or
+ * FMAP_ESOLVE when H is not positive definite along a direction or the
+ * residual stays above FMAP_CG_TOL. */
+static int pcg(const normal_system *ns, const double *Jd, const double *B, double *C, double *r,
+               double *p, double *Hp, int *iterations, char *err, size_t errsz)
+{
+    int n = ns->k1 * ns->k2;
+    normal_apply(ns, C, Hp);
+    double rr = 0, rz = 0, bnorm = frob(B, n);
+    for (int q = 0; q < n; q++) {
+        r[q] = B[q] - Hp[q];
+        p[q] = Jd[q] * r[q];
+        rr += r[q] * r[q];
+        rz += r[q] * p[q];
+    }
+    int it = 0;
+    while (sqrt(rr) > FMAP_CG_TOL * bnorm && it < FMAP_CG_MAX_ITER) {
+        normal_apply(ns, p, Hp);
+        double pHp = 0;
+        for (int q = 0; q < n; q++)
+            pHp += p[q] * Hp[q];
+        if (!(pHp > 0))
+            return errbuf_set(err, errsz, FMAP_ESOLVE,
+                              "functional map with D_N: the system is not positive definite");
+        double alpha = rz / pHp, rr2 = 0, rz2 = 0;
+        for (int q = 0; q < n; q++) {
+            C[q] += alpha * p[q];
+            r[q] -= alpha * Hp[q];
+            rr2 += r[q] * r[q];
+            rz2 += r[q] * Jd[q] * r[q];
+        }
+        for (int q = 0; q < n; q++)
+            p[q] = Jd[q] * r[q] + rz2 / rz * p[q];
+        rr = rr2;
+        rz = rz2;
+        it++;
+    }
+    if (iterations)
+        *iterations = it;
+    if (sqrt(rr) > FMAP_CG_TOL * bnorm)
+        return errbuf_set(err, errsz, FMAP_ESOLVE,
+                          "functional map with D_N: %d conjugate-gradient steps left residual %.3g",
+                          it, sqrt(rr) / bnorm);
+    return FMAP_OK;
+}
+
 int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const double *F1,
                                    const double *N1, const double *O1, const lbo_basis *b2,
                                    const double *m2, const double *F2, const double *N2,
@@ -366,67 +439,8 @@ int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const 
         wo[d] = on > 0 ? mu_o / no / on : 0;
     }
     normal_system ns = {k1, k2, no, G, D, N1, N2, O1, O2, wo, mu, nn > 0 ? mu_n / nn : 0, t1, t2};
-    /* Jacobi preconditioner: H's diagonal, H(E_ac) at E_ac = e_a e_c^T:
-     * G_cc + mu D_ac + w (|N1 e_a|^2 + |e_c^T N2|^2 - 2 N1_aa N2_cc) + the
-     * same for each O_d (their columns and rows need not be symmetric) */
-    for (int a = 0; a < k1; a++)
-        for (int c = 0; c < k2; c++) {
-            double h = G[(size_t)c * k2 + c] + mu * D[(size_t)a * k2 + c];
-            for (int d = -1; d < no; d++) {
-                const double *X1 = d < 0 ? N1 : O1 + (size_t)d * k1 * k1;
-                const double *X2 = d < 0 ? N2 : O2 + (size_t)d * k2 * k2;
-                double wd = d < 0 ? ns.w : wo[d], s1 = 0, s2 = 0;
-                if (wd == 0)
-                    continue;
-                for (int q = 0; q < k1; q++)
-                    s1 += X1[(size_t)q * k1 + a] * X1[(size_t)q * k1 + a];
-                for (int q = 0; q < k2; q++)
-                    s2 += X2[(size_t)c * k2 + q] * X2[(size_t)c * k2 + q];
-                h += wd * (s1 + s2 - 2 * X1[(size_t)a * k1 + a] * X2[(size_t)c * k2 + c]);
-            }
-            Jd[(size_t)a * k2 + c] = h > 0 ? 1 / h : 1;
-        }
-    normal_apply(&ns, C, Hp);   /* preconditioned conjugate gradients from the Laplacian-only C */
-    double rr = 0, rz = 0, bnorm = frob(B, n);
-    for (int q = 0; q < n; q++) {
-        r[q] = B[q] - Hp[q];
-        p[q] = Jd[q] * r[q];
-        rr += r[q] * r[q];
-        rz += r[q] * p[q];
-    }
-    int it = 0;
-    while (sqrt(rr) > FMAP_CG_TOL * bnorm && it < FMAP_CG_MAX_ITER) {
-        normal_apply(&ns, p, Hp);
-        double pHp = 0;
-        for (int q = 0; q < n; q++)
-            pHp += p[q] * Hp[q];
-        if (!(pHp > 0)) {
-            rc = errbuf_set(err, errsz, FMAP_ESOLVE,
-                            "functional map with D_N: the system is not positive definite");
-            goto out;
-        }
-        double alpha = rz / pHp, rr2 = 0, rz2 = 0;
-        for (int q = 0; q < n; q++) {
-            C[q] += alpha * p[q];
-            r[q] -= alpha * Hp[q];
-            rr2 += r[q] * r[q];
-            rz2 += r[q] * Jd[q] * r[q];
-        }
-        for (int q = 0; q < n; q++)
-            p[q] = Jd[q] * r[q] + rz2 / rz * p[q];
-        rr = rr2;
-        rz = rz2;
-        it++;
-    }
-    if (iterations)
-        *iterations = it;
-    if (sqrt(rr) > FMAP_CG_TOL * bnorm) {
-        rc = errbuf_set(err, errsz, FMAP_ESOLVE,
-                        "functional map with D_N: %d conjugate-gradient steps left residual %.3g",
-                        it, sqrt(rr) / bnorm);
-        goto out;
-    }
-    rc = FMAP_OK;
+    jacobi_diagonal(&ns, Jd);
+    rc = pcg(&ns, Jd, B, C, r, p, Hp, iterations, err, errsz);
 out:
     free(Jd);
     free(wo);

@@ -88,20 +88,13 @@ static void solve(int n, const int *start, const int *col, const double *w, cons
     }
 }
 
-int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
-                   const unsigned char *pin, const double *scale, int *loc, double *uv)
+/* The patch's edges into list (room for 3 per face), one entry each in
+ * edge order: the sum of its faces' cotangent halves, of their scales
+ * (1 without scale) and their count; the number of edges. */
+static int edge_weights(const mesh *m, const geo_edges *E, const fold__patch *p, const double *scale,
+                        ew *list)
 {
-    int nv = p->nv, ne = 0, rc = -1;
-    ew *list = malloc(sizeof(ew) * ((size_t)p->nf * 3 + 1));
-    int *id = malloc(sizeof(int) * ((size_t)nv + 1));
-    int *start = calloc((size_t)nv + 2, sizeof(int));
-    int *col = NULL;
-    double *w = NULL, *diag = calloc((size_t)nv + 1, sizeof(double)), *work = NULL;
-    int *ea = NULL;
-    if (!list || !id || !start || !diag)
-        goto out;
-    for (int i = 0; i < nv; i++)
-        loc[p->verts[i]] = i;
+    int ne = 0;
     for (int q = 0; q < p->nf; q++) {
         int t = p->faces[q];
         const int *f = m->f + 3 * t;
@@ -122,6 +115,24 @@ int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
         } else
             list[ne++] = list[i];
     }
+    return ne;
+}
+
+int fold__harmonic(const mesh *m, const geo_edges *E, const fold__patch *p,
+                   const unsigned char *pin, const double *scale, int *loc, double *uv)
+{
+    int nv = p->nv, ne = 0, rc = -1;
+    ew *list = malloc(sizeof(ew) * ((size_t)p->nf * 3 + 1));
+    int *id = malloc(sizeof(int) * ((size_t)nv + 1));
+    int *start = calloc((size_t)nv + 2, sizeof(int));
+    int *col = NULL;
+    double *w = NULL, *diag = calloc((size_t)nv + 1, sizeof(double)), *work = NULL;
+    int *ea = NULL;
+    if (!list || !id || !start || !diag)
+        goto out;
+    for (int i = 0; i < nv; i++)
+        loc[p->verts[i]] = i;
+    ne = edge_weights(m, E, p, scale, list);
     /* the free vertices' rows: neighbours that are free (col) or pinned (rhs) */
     int nfree = 0;
     for (int i = 0; i < nv; i++)

@@ -4,9 +4,8 @@
 #ifndef GEOD__SOLVER_H
 #define GEOD__SOLVER_H
 #include "geod/geod.h"
+#include "chol/chol.h"
 #include "geo/geo_csr.h"
-
-#include <suitesparse/cholmod.h>
 
 struct geod_solver {
     int nv, nf;
@@ -22,11 +21,9 @@ struct geod_solver {
     int ncomp;
     int n_interior;          /* vertices not on the boundary (all when closed) */
     int *interior;           /* n_interior: their vertex indices, ascending; NULL when closed */
-    cholmod_common cc;
-    int cc_started;
-    cholmod_factor *heat;    /* M + t L */
-    cholmod_factor *heat_dir;/* interior block of M + t L; NULL when closed */
-    cholmod_factor *poisson; /* L + eps M */
+    chol *heat;              /* M + t L, factorised */
+    chol *heat_dir;          /* interior block of M + t L; NULL when closed */
+    chol *poisson;           /* L + eps M */
 };
 
 #endif

@@ -29,12 +29,11 @@ static void divergence(const geod_solver *s, const double *u, double *b)
     }
 }
 
-static cholmod_dense *solve(geod_solver *s, cholmod_factor *F, cholmod_dense *B)
+/* x = F^-1 b for ncol columns; GEOD_OK, GEOD_ENOMEM or GEOD_EFACTOR. */
+static int solve(chol *F, const double *b, int ncol, double *x)
 {
-    cholmod_dense *X = cholmod_solve(CHOLMOD_A, F, B, &s->cc);
-    if (X && s->cc.status != CHOLMOD_OK)
-        cholmod_free_dense(&X, &s->cc);
-    return X;
+    int rc = chol_solve(F, b, ncol, x, NULL, 0);
+    return rc == CHOL_OK ? GEOD_OK : rc == CHOL_ENOMEM ? GEOD_ENOMEM : GEOD_EFACTOR;
 }
 
 /* ncol fields; column c starts heat at src[start[c] .. start[c+1]).
@@ -42,29 +41,29 @@ static cholmod_dense *solve(geod_solver *s, cholmod_factor *F, cholmod_dense *B)
 static int fields(geod_solver *s, const int *src, const int *start, int ncol,
                   double *dist)
 {
-    int nv = s->nv, rc = GEOD_ENOMEM;
-    cholmod_dense *B = NULL, *U = NULL, *Bd = NULL, *Ud = NULL, *Phi = NULL;
-    int *seen = NULL;
-    double *sum = NULL;
-    if (!(B = cholmod_zeros(nv, ncol, CHOLMOD_REAL, &s->cc)))
+    int nv = s->nv, ni = s->n_interior, rc = GEOD_ENOMEM;
+    /* column-major nv (B, U, Phi) or ni (Bd, Ud) by ncol */
+    double *b = calloc((size_t)nv * ncol, sizeof *b), *u = malloc((size_t)nv * ncol * sizeof *u);
+    double *phi = malloc((size_t)nv * ncol * sizeof *phi), *bd = NULL, *ud = NULL;
+    int *seen = malloc((size_t)s->ncomp * sizeof *seen);
+    double *sum = malloc((size_t)s->ncomp * sizeof *sum);
+    if (!b || !u || !phi || !seen || !sum)
         goto out;
-    double *b = B->x;
     for (int c = 0; c < ncol; c++)
         for (int p = start[c]; p < start[c + 1]; p++)
             b[src[p] + (size_t)c * nv] = 1;
-    if (!(U = solve(s, s->heat, B)))
-        goto fail;
+    if ((rc = solve(s->heat, b, ncol, u)) != GEOD_OK)
+        goto out;
     if (s->heat_dir) { /* average with the Dirichlet solution (0 on the boundary) */
-        int ni = s->n_interior;
-        if (!(Bd = cholmod_zeros(ni, ncol, CHOLMOD_REAL, &s->cc)))
+        rc = GEOD_ENOMEM;
+        if (!(bd = malloc((size_t)ni * ncol * sizeof *bd)) ||
+            !(ud = malloc((size_t)ni * ncol * sizeof *ud)))
             goto out;
-        double *bd = Bd->x;
         for (int c = 0; c < ncol; c++)
             for (int r = 0; r < ni; r++)
                 bd[r + (size_t)c * ni] = b[s->interior[r] + (size_t)c * nv];
-        if (!(Ud = solve(s, s->heat_dir, Bd)))
-            goto fail;
-        double *u = U->x, *ud = Ud->x;
+        if ((rc = solve(s->heat_dir, bd, ncol, ud)) != GEOD_OK)
+            goto out;
         for (int c = 0; c < ncol; c++) {
             double *uc = u + (size_t)c * nv;
             for (int i = 0; i < nv; i++)
@@ -73,19 +72,13 @@ static int fields(geod_solver *s, const int *src, const int *start, int ncol,
                 uc[s->interior[r]] += 0.5 * ud[r + (size_t)c * ni];
         }
     }
-    const double *u = U->x;
 #pragma omp parallel for schedule(static)
     for (int c = 0; c < ncol; c++)
         divergence(s, u + (size_t)c * nv, b + (size_t)c * nv);
-    if (!(Phi = solve(s, s->poisson, B)))
-        goto fail;
+    if ((rc = solve(s->poisson, b, ncol, phi)) != GEOD_OK)
+        goto out;
 
     /* shift per component by the mean over its sources, clamp, pin sources */
-    seen = malloc((size_t)s->ncomp * sizeof *seen);
-    sum = malloc((size_t)s->ncomp * sizeof *sum);
-    if (!seen || !sum)
-        goto out;
-    const double *phi = Phi->x;
     for (int c = 0; c < ncol; c++) {
         const double *pc = phi + (size_t)c * nv;
         double *dc = dist + (size_t)c * nv;
@@ -104,15 +97,12 @@ static int fields(geod_solver *s, const int *src, const int *start, int ncol,
             dc[src[p]] = 0;
     }
     rc = GEOD_OK;
-    goto out;
-fail:
-    rc = s->cc.status == CHOLMOD_OUT_OF_MEMORY ? GEOD_ENOMEM : GEOD_EFACTOR;
 out:
-    cholmod_free_dense(&B, &s->cc);
-    cholmod_free_dense(&U, &s->cc);
-    cholmod_free_dense(&Bd, &s->cc);
-    cholmod_free_dense(&Ud, &s->cc);
-    cholmod_free_dense(&Phi, &s->cc);
+    free(b);
+    free(u);
+    free(phi);
+    free(bd);
+    free(ud);
     free(seen);
     free(sum);
     return rc;

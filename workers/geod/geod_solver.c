@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <suitesparse/cholmod.h>
 
 const char *geod_strerror(int code)
 {
@@ -32,12 +33,9 @@ void geod_solver_free(geod_solver *s)
 {
     if (!s)
         return;
-    if (s->cc_started) {
-        cholmod_free_factor(&s->heat, &s->cc);
-        cholmod_free_factor(&s->heat_dir, &s->cc);
-        cholmod_free_factor(&s->poisson, &s->cc);
-        cholmod_finish(&s->cc);
-    }
+    chol_free(s->heat);
+    chol_free(s->heat_dir);
+    chol_free(s->poisson);
     free(s->f);
     geo_csr_free(s->L);
     free(s->mass);
@@ -79,15 +77,19 @@ static void face_gradients(const geod__idt *T, double *grad, double *area)
  * of the intrinsic triangulation. L as CSR with both triangles: CHOLMOD
  * sorts the triplets and sums duplicate edges; loops (an edge from a vertex
  * to itself) are dropped, they add nothing to x^T L x. */
-static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass,
-                              cholmod_common *cc)
+static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, double *mass)
 {
+    cholmod_common common, *cc = &common;
+    cholmod_start(cc);
+    cc->print = 0;
     cholmod_triplet *tr = cholmod_allocate_triplet((size_t)nv, (size_t)nv,
                                                    12 * (size_t)T->nf + (size_t)nv, 0, CHOLMOD_REAL, cc);
     cholmod_sparse *A = NULL;
     geo_csr *L = NULL;
-    if (!tr)
+    if (!tr) {
+        cholmod_finish(cc);
         return NULL;
+    }
     int *ti = tr->i, *tj = tr->j;
     double *tx = tr->x;
     size_t n = 0;
@@ -120,6 +122,7 @@ static geo_csr *idt_laplacian(const geod__idt *T, int nv, const double *area, do
     }
     cholmod_free_sparse(&A, cc);
     cholmod_free_triplet(&tr, cc);
+    cholmod_finish(cc);
     return L;
 }
 
@@ -152,59 +155,104 @@ static int components(const geo_edges *e, int nv, int *comp)
     return n;
 }
 
-/* The upper triangle of a * L + diag(d) restricted to the vertices keep
- * (ascending, or NULL for all; remap: vertex -> row or -1), as a CHOLMOD
- * symmetric (stype 1) matrix. A row with a zero diagonal (a vertex without
- * a non-degenerate face) gets 1: it is decoupled, and the system stays
- * definite. */
-static cholmod_sparse *assemble(const geo_csr *L, double a, const double *d,
-                                const int *keep, int nkeep, const int *remap,
-                                cholmod_common *cc)
+/* *out = the factorised a * L + c * M (M = diag(mass)) restricted to the vertices keep
+ * (ascending, or NULL for all; remap: vertex -> row or -1). A row with a
+ * zero diagonal (a vertex without a non-degenerate face) gets 1: it is
+ * decoupled, and the system stays definite. AMD ordering only: the
+ * factors are the same whatever METIS would do. GEOD_OK, GEOD_ENOMEM or
+ * GEOD_EFACTOR, naming what in err. */
+static int factor(const geo_csr *L, double a, double c, const double *mass, const int *keep, int nkeep,
+                  const int *remap, const char *what, chol **out, char *err, size_t errsz)
 {
+    char detail[256] = "";
     size_t nnz = 0;
     for (int r = 0; r < nkeep; r++) {
         int j = keep ? keep[r] : r;
-        for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++)
-            nnz += L->col[p] <= j && (!remap || remap[L->col[p]] >= 0);
+        nnz += (size_t)(L->row_start[j + 1] - L->row_start[j]);
     }
-    cholmod_sparse *A = cholmod_allocate_sparse(nkeep, nkeep, nnz, 1, 1, 1,
-                                                CHOLMOD_REAL, cc);
-    if (!A)
-        return NULL;
-    int *cp = A->p, *ri = A->i;
-    double *x = A->x;
-    size_t at = 0;
-    for (int r = 0; r < nkeep; r++) {
+    double *dk = malloc((size_t)nkeep * sizeof *dk);
+    int rc = dk ? chol_new(nkeep, nnz, CHOL_ORDER_AMD, out, detail, sizeof detail) : CHOL_ENOMEM;
+    for (int r = 0; rc == CHOL_OK && r < nkeep; r++) {
         int j = keep ? keep[r] : r;
-        cp[r] = (int)at;
+        dk[r] = c * mass[j];
         for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++) {
-            int c = L->col[p];
-            if (c > j || (remap && remap[c] < 0))
-                continue;
-            ri[at] = remap ? remap[c] : c;
-            x[at] = a * L->val[p];
-            if (c == j) {
-                x[at] += d[j];
-                if (!(x[at] != 0))
-                    x[at] = 1;
-            }
-            at++;
+            int col = L->col[p];
+            if (col <= j && (!remap || remap[col] >= 0))
+                chol_add(*out, remap ? remap[col] : col, r, a * L->val[p]);
         }
     }
-    cp[nkeep] = (int)at;
-    return A;
+    if (rc == CHOL_OK && (rc = chol_assemble(*out, CHOL_DIAG_SHIFT_UNIT, dk, detail, sizeof detail)) == CHOL_OK)
+        rc = chol_factorise(*out, detail, sizeof detail);
+    free(dk);
+    if (rc == CHOL_OK)
+        return GEOD_OK;
+    chol_free(*out);
+    *out = NULL;
+    return errbuf_set(err, errsz, rc == CHOL_ENOMEM ? GEOD_ENOMEM : GEOD_EFACTOR, "%s: %s", what,
+                      detail[0] ? detail : "out of memory");
 }
 
-static cholmod_factor *factorise(cholmod_sparse *A, cholmod_common *cc,
-                                 const char *what, char *err, size_t errsz)
+/* The heat time's scale h (the mean extrinsic edge length) and the
+ * Poisson regularisation eps = GEOD_POISSON_REG * mean(L_ii) / mean(M_ii)
+ * over the vertices with mass. GEOD_OK, or GEOD_EMESH for a degenerate
+ * mesh. */
+static int operator_scales(const mesh *m, const geo_edges *e, const geo_csr *L, const double *mass,
+                           double *h_out, double *eps, char *err, size_t errsz)
 {
-    cholmod_factor *F = cholmod_analyze(A, cc);
-    if (F && cholmod_factorize(A, F, cc) && cc->status == CHOLMOD_OK)
-        return F;
-    errbuf_set(err, errsz, GEOD_EFACTOR, "factorising %s failed (CHOLMOD status %d)",
-               what, cc->status);
-    cholmod_free_factor(&F, cc);
-    return NULL;
+    double h = 0, msum = 0, lsum = 0;
+    int nmass = 0;
+    for (int k = 0; k < e->ne; k++) {
+        double v[3];
+        geo__sub(m->v + 3 * (size_t)e->ev[2 * k], m->v + 3 * (size_t)e->ev[2 * k + 1], v);
+        h += sqrt(geo__dot(v, v));
+    }
+    h /= e->ne;
+    for (int i = 0; i < m->nv; i++)
+        if (mass[i] > 0) {
+            msum += mass[i];
+            lsum += geo_csr_get(L, i, i);
+            nmass++;
+        }
+    if (!(h > 0) || !isfinite(h) || nmass == 0 || !(msum > 0) || !(lsum > 0) ||
+        !isfinite(msum) || !isfinite(lsum))
+        return errbuf_set(err, errsz, GEOD_EMESH, "degenerate mesh: mean edge length %g, total area %g",
+                          h, msum);
+    *h_out = h;
+    *eps = GEOD_POISSON_REG * lsum / msum;
+    return GEOD_OK;
+}
+
+/* On a mesh with boundary: s->interior (the vertices on no boundary edge)
+ * and the factorised interior block of M + t L (none when every vertex is
+ * on the boundary); on a closed mesh every vertex is interior and there is
+ * no block. GEOD_OK, GEOD_ENOMEM or GEOD_EFACTOR. */
+static int factor_interior(geod_solver *s, const geo_edges *e, char *err, size_t errsz)
+{
+    if (geo_edges_boundary_count(e) == 0) {
+        s->n_interior = s->nv;
+        return GEOD_OK;
+    }
+    int *remap = malloc((size_t)s->nv * sizeof *remap);   /* vertex -> interior row, or -1 */
+    if (!remap || !(s->interior = malloc((size_t)s->nv * sizeof *s->interior))) {
+        free(remap);
+        return errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the interior list");
+    }
+    for (int i = 0; i < s->nv; i++)
+        remap[i] = 0;
+    for (int k = 0; k < e->ne; k++)
+        if (e->ef[2 * k + 1] < 0)
+            remap[e->ev[2 * k]] = remap[e->ev[2 * k + 1]] = -1;
+    for (int i = 0; i < s->nv; i++)
+        if (remap[i] == 0) {
+            remap[i] = s->n_interior;
+            s->interior[s->n_interior++] = i;
+        }
+    int rc = s->n_interior > 0
+           ? factor(s->L, s->t, 1.0, s->mass, s->interior, s->n_interior, remap,
+                    "factorising the interior block of M + t L", &s->heat_dir, err, errsz)
+           : GEOD_OK;
+    free(remap);
+    return rc;
 }
 
 int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err, size_t errsz)
@@ -215,10 +263,7 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     geo_edges e = {0};
     geod__idt idt = {0};
     geo_csr *L = NULL;
-    double *mass = NULL, *d = NULL;
-    int *remap = NULL;
-    cholmod_sparse *A = NULL;
-    int ok = 0;
+    double *mass = NULL, h = 0, eps = 0;
     if (!m || m->nv < 1 || m->nf < 1) {
         return errbuf_set(err, errsz, GEOD_EMESH, "geodesics need a mesh with faces");
     }
@@ -232,8 +277,7 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     }
     s = calloc(1, sizeof *s);
     mass = malloc((size_t)m->nv * sizeof *mass);
-    d = malloc((size_t)m->nv * sizeof *d);
-    if (!s || !mass || !d ||
+    if (!s || !mass ||
         !(s->grad = malloc(6 * (size_t)m->nf * sizeof *s->grad)) ||
         !(s->area = malloc((size_t)m->nf * sizeof *s->area)) ||
         !(s->comp = malloc((size_t)m->nv * sizeof *s->comp))) {
@@ -248,13 +292,7 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     }
     s->flips = idt.flips;
     face_gradients(&idt, s->grad, s->area);
-    cholmod_start(&s->cc);
-    s->cc_started = 1;
-    s->cc.print = 0;
-    s->cc.nmethods = 1; /* AMD only: deterministic, no METIS */
-    s->cc.method[0].ordering = CHOLMOD_AMD;
-    s->cc.postorder = 1;
-    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass, &s->cc))) {
+    if (!(L = idt_laplacian(&idt, m->nv, s->area, mass))) {
         code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for a %d-vertex Laplacian", m->nv);
         goto out;
     }
@@ -263,93 +301,23 @@ int geod_solver_new(const mesh *m, double t_factor, geod_solver **out, char *err
     s->L = L;
     s->mass = mass;
     s->ncomp = components(&e, m->nv, s->comp);
-
-    double h = 0, msum = 0, lsum = 0;
-    int nmass = 0;
-    for (int k = 0; k < e.ne; k++) {
-        double v[3];
-        geo__sub(m->v + 3 * (size_t)e.ev[2 * k], m->v + 3 * (size_t)e.ev[2 * k + 1], v);
-        h += sqrt(geo__dot(v, v));
-    }
-    h /= e.ne;
-    for (int i = 0; i < m->nv; i++)
-        if (mass[i] > 0) {
-            msum += mass[i];
-            lsum += geo_csr_get(L, i, i);
-            nmass++;
-        }
-    if (!(h > 0) || !isfinite(h) || nmass == 0 || !(msum > 0) || !(lsum > 0) ||
-        !isfinite(msum) || !isfinite(lsum)) {
-        code = errbuf_set(err, errsz, GEOD_EMESH,
-                          "degenerate mesh: mean edge length %g, total area %g", h, msum);
+    if ((code = operator_scales(m, &e, L, mass, &h, &eps, err, errsz)) != GEOD_OK)
         goto out;
-    }
     s->t = t_factor * h * h;
-    double eps = GEOD_POISSON_REG * lsum / msum;
-
-
-    for (int i = 0; i < m->nv; i++)
-        d[i] = mass[i];
-    if (!(A = assemble(L, s->t, d, NULL, m->nv, NULL, &s->cc)) ||
-        !(s->heat = factorise(A, &s->cc, "M + t L", err, errsz)))
-        goto fail_cholmod;
-    cholmod_free_sparse(&A, &s->cc);
-    for (int i = 0; i < m->nv; i++)
-        d[i] = eps * mass[i];
-    if (!(A = assemble(L, 1.0, d, NULL, m->nv, NULL, &s->cc)) ||
-        !(s->poisson = factorise(A, &s->cc, "L + eps M", err, errsz)))
-        goto fail_cholmod;
-    cholmod_free_sparse(&A, &s->cc);
-
-    if (geo_edges_boundary_count(&e) > 0) {
-        if (!(remap = malloc((size_t)m->nv * sizeof *remap)) ||
-            !(s->interior = malloc((size_t)m->nv * sizeof *s->interior))) {
-            code = errbuf_set(err, errsz, GEOD_ENOMEM, "out of memory for the interior list");
-            goto out;
-        }
-        for (int i = 0; i < m->nv; i++)
-            remap[i] = 0;
-        for (int k = 0; k < e.ne; k++)
-            if (e.ef[2 * k + 1] < 0)
-                remap[e.ev[2 * k]] = remap[e.ev[2 * k + 1]] = -1;
-        for (int i = 0; i < m->nv; i++)
-            if (remap[i] == 0) {
-                remap[i] = s->n_interior;
-                s->interior[s->n_interior++] = i;
-            }
-        for (int i = 0; i < m->nv; i++)
-            d[i] = mass[i];
-        if (s->n_interior > 0 &&
-            (!(A = assemble(L, s->t, d, s->interior, s->n_interior, remap, &s->cc)) ||
-             !(s->heat_dir = factorise(A, &s->cc, "the interior block of M + t L",
-                                       err, errsz))))
-            goto fail_cholmod;
-    } else {
-        s->n_interior = m->nv;
-    }
-    ok = 1;
-    goto out;
-
-fail_cholmod:
-    if (s->cc.status == CHOLMOD_OUT_OF_MEMORY)
-        code = errbuf_set(err, errsz, GEOD_ENOMEM, "CHOLMOD ran out of memory (%d vertices)", m->nv);
-    else if (!A)
-        code = errbuf_set(err, errsz, GEOD_EFACTOR, "CHOLMOD could not build a matrix (status %d)",
-                          s->cc.status);
-    else
-        code = GEOD_EFACTOR;   /* factorise said which */
+    if ((code = factor(L, s->t, 1.0, mass, NULL, m->nv, NULL, "factorising M + t L", &s->heat, err,
+                       errsz)) != GEOD_OK ||
+        (code = factor(L, 1.0, eps, mass, NULL, m->nv, NULL, "factorising L + eps M", &s->poisson, err,
+                       errsz)) != GEOD_OK ||
+        (code = factor_interior(s, &e, err, errsz)) != GEOD_OK)
+        goto out;
 out:
-    if (s && s->cc_started)
-        cholmod_free_sparse(&A, &s->cc);
-    free(d);
-    free(remap);
     geod__idt_close(&idt);
     if (!s || !s->L) {   /* not handed over to the solver */
         geo_csr_free(L);
         free(mass);
     }
     geo_edges_close(&e);
-    if (!ok) {
+    if (code != GEOD_OK) {
         geod_solver_free(s);
         return code;
     }

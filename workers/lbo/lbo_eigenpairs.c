@@ -1,14 +1,14 @@
 /* lbo_eigenpairs.c — the first k Laplace–Beltrami eigenpairs by
- * shift-invert Lanczos: CHOLMOD factorisation of L - sigma M, ARPACK
- * dsaupd/dseupd in mode 3; see lbo.h. */
+ * shift-invert Lanczos: sparse Cholesky factorisation of L - sigma M
+ * (chol.h), ARPACK dsaupd/dseupd in mode 3; see lbo.h. */
 #include "lbo/lbo.h"
+#include "chol/chol.h"
 #include "util/errbuf.h"
 
 #include <arpack/arpack.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <suitesparse/cholmod.h>
 
 void lbo_basis_close(lbo_basis *b)
 {
@@ -40,47 +40,34 @@ int lbo_basis_first(const lbo_basis *b, int k, lbo_basis *out)
     return LBO_OK;
 }
 
-/* The upper triangle of L - sigma M as a CHOLMOD symmetric (stype 1)
- * matrix; a row whose diagonal comes out 0 (a vertex without area or
- * edges) gets 1: it is decoupled and the matrix stays definite. */
-static cholmod_sparse *shifted(const geo_csr *L, const double *mass, double sigma,
-                               cholmod_common *cc)
+/* *out = the factorised L - sigma M; a row whose diagonal comes out 0 (a
+ * vertex without area or edges) gets 1: it is decoupled and the matrix
+ * stays definite. AMD ordering only: deterministic. */
+static int factor_shifted(const geo_csr *L, const double *mass, double sigma, chol **out,
+                          char *err, size_t errsz)
 {
     int n = L->n;
-    size_t nnz = 0;
-    for (int j = 0; j < n; j++)
+    char detail[256] = "";
+    double *d = malloc((size_t)n * sizeof *d);
+    int rc = d ? chol_new(n, (size_t)L->row_start[n], CHOL_ORDER_AMD, out, detail, sizeof detail)
+               : CHOL_ENOMEM;
+    for (int j = 0; rc == CHOL_OK && j < n; j++) {
+        d[j] = -sigma * mass[j];
         for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++)
-            nnz += L->col[p] <= j;
-    cholmod_sparse *A = cholmod_allocate_sparse(n, n, nnz + n, 1, 1, 1, CHOLMOD_REAL, cc);
-    if (!A)
-        return NULL;
-    int *cp = A->p, *ri = A->i;
-    double *x = A->x;
-    size_t at = 0;
-    for (int j = 0; j < n; j++) {   /* column j of the upper triangle = row j's entries c <= j */
-        cp[j] = (int)at;
-        int diag = 0;
-        for (int p = L->row_start[j]; p < L->row_start[j + 1]; p++) {
-            int c = L->col[p];
-            if (c > j)
-                continue;
-            ri[at] = c;
-            x[at] = L->val[p];
-            if (c == j) {
-                x[at] -= sigma * mass[j];
-                if (!(x[at] != 0))
-                    x[at] = 1;
-                diag = 1;
-            }
-            at++;
-        }
-        if (!diag) {   /* columns sorted: the diagonal is the last entry */
-            ri[at] = j;
-            x[at++] = -sigma * mass[j] != 0 ? -sigma * mass[j] : 1;
-        }
+            if (L->col[p] <= j)
+                chol_add(*out, L->col[p], j, L->val[p]);
     }
-    cp[n] = (int)at;
-    return A;
+    if (rc == CHOL_OK && (rc = chol_assemble(*out, CHOL_DIAG_SHIFT_UNIT, d, detail, sizeof detail)) == CHOL_OK)
+        rc = chol_factorise(*out, detail, sizeof detail);
+    free(d);
+    if (rc == CHOL_OK)
+        return LBO_OK;
+    chol_free(*out);
+    *out = NULL;
+    if (rc == CHOL_ENOMEM)
+        return errbuf_set(err, errsz, LBO_ENOMEM, "out of memory factorising L - sigma M (%d "
+                          "vertices)%s%s", n, detail[0] ? ": " : "", detail);
+    return errbuf_set(err, errsz, LBO_EFACTOR, "factorising L - sigma M: %s", detail);
 }
 
 /* xorshift in [-1, 1): the fixed start vector. */
@@ -93,9 +80,7 @@ static double start_value(unsigned long long *s)
 }
 
 typedef struct op {
-    cholmod_common *cc;
-    cholmod_factor *F;
-    cholmod_dense *b, *x, *y, *e;   /* right-hand side, solution, solve workspaces */
+    chol *F;                        /* L - sigma M, factorised */
     const double *mass;
     int n, solves;
 } op;
@@ -103,10 +88,8 @@ typedef struct op {
 /* out = (L - sigma M)^-1 in. */
 static int op_solve(op *o, const double *in, double *out)
 {
-    memcpy(o->b->x, in, (size_t)o->n * sizeof *in);
-    if (!cholmod_solve2(CHOLMOD_A, o->F, o->b, NULL, &o->x, NULL, &o->y, &o->e, o->cc))
+    if (chol_solve(o->F, in, 1, out, NULL, 0) != CHOL_OK)
         return 0;
-    memcpy(out, o->x->x, (size_t)o->n * sizeof *out);
     o->solves++;
     return 1;
 }
@@ -174,7 +157,7 @@ static int lanczos(op *o, int k, double sigma, double *d, double *z, int *restar
     rc = LBO_OK;
     goto out;
 solve_failed:
-    rc = errbuf_set(err, errsz, LBO_EFACTOR, "CHOLMOD solve failed (status %d)", o->cc->status);
+    rc = errbuf_set(err, errsz, LBO_EFACTOR, "CHOLMOD solve failed (status %d)", chol_status(o->F));
 out:
     free(resid);
     free(v);
@@ -239,29 +222,17 @@ int lbo_eigenpairs(const geo_csr *L, const double *mass, int nv, int k, lbo_basi
     double sigma = LBO_SHIFT_REL * lsum / msum;
 
     int rc = LBO_ENOMEM;
-    cholmod_common cc;
-    cholmod_start(&cc);
-    cc.print = 0;
-    cc.nmethods = 1;                /* AMD only: deterministic */
-    cc.method[0].ordering = CHOLMOD_AMD;
-    cc.postorder = 1;
-    op o = {.cc = &cc, .mass = mass, .n = nv};
-    cholmod_sparse *A = shifted(L, mass, sigma, &cc);
+    op o = {.mass = mass, .n = nv};
     double *d = malloc((size_t)k * sizeof *d), *z = malloc((size_t)nv * k * sizeof *z);
     out->lambda = malloc((size_t)k * sizeof *out->lambda);
     out->phi = malloc((size_t)nv * k * sizeof *out->phi);
-    if (!A || !d || !z || !out->lambda || !out->phi ||
-        !(o.b = cholmod_allocate_dense(nv, 1, nv, CHOLMOD_REAL, &cc))) {
+    if (!d || !z || !out->lambda || !out->phi) {
         rc = errbuf_set(err, errsz, LBO_ENOMEM, "out of memory for %d eigenpairs of %d vertices",
                         k, nv);
         goto out;
     }
-    o.F = cholmod_analyze(A, &cc);
-    if (!o.F || !cholmod_factorize(A, o.F, &cc) || cc.status != CHOLMOD_OK) {
-        rc = errbuf_set(err, errsz, cc.status == CHOLMOD_OUT_OF_MEMORY ? LBO_ENOMEM : LBO_EFACTOR,
-                        "factorising L - sigma M failed (CHOLMOD status %d)", cc.status);
+    if ((rc = factor_shifted(L, mass, sigma, &o.F, err, errsz)) != LBO_OK)
         goto out;
-    }
     if ((rc = lanczos(&o, k, sigma, d, z, &out->restarts, err, errsz)) != LBO_OK)
         goto out;
     if (!store(d, z, nv, k, out)) {
@@ -272,13 +243,7 @@ int lbo_eigenpairs(const geo_csr *L, const double *mass, int nv, int k, lbo_basi
     out->k = k;
     out->op_solves = o.solves;
 out:
-    cholmod_free_dense(&o.b, &cc);
-    cholmod_free_dense(&o.x, &cc);
-    cholmod_free_dense(&o.y, &cc);
-    cholmod_free_dense(&o.e, &cc);
-    cholmod_free_factor(&o.F, &cc);
-    cholmod_free_sparse(&A, &cc);
-    cholmod_finish(&cc);
+    chol_free(o.F);
     free(d);
     free(z);
     if (rc != LBO_OK)

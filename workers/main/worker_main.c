@@ -82,10 +82,20 @@ static int fail(const char *dir, uint64_t job_id, int code, const char *msg)
     return cancelled ? SPOOL_EXIT_CANCELLED : SPOOL_EXIT_JOB;
 }
 
-int main(int argc, char **argv)
+/* The command line. */
+typedef struct worker_opts {
+    const char *dir, *progress_tcp, *secret_file;
+    const char *picture;          /* --picture FILE: draw the map, run nothing */
+    uint64_t job_id;
+    int progress_fd;              /* -1: none */
+    wrk_limits lim;
+} worker_opts;
+
+/* Reads the command line into o and sets the process's resource limits:
+ * -1 to go on with the job, else the exit status (bad usage, --help,
+ * --version, --list-devices). */
+static int parse_options(int argc, char **argv, worker_opts *o)
 {
-    ompenv_ensure_passive(argv);
-    double t0 = now();
     static const struct option opts[] = {
         {"job", required_argument, 0, 'j'},          {"job-id", required_argument, 0, 'i'},
         {"progress-fd", required_argument, 0, 'p'},  {"threads", required_argument, 0, 't'},
@@ -95,63 +105,60 @@ int main(int argc, char **argv)
         {"max-cpu-s", required_argument, 0, 'C'},    {"help", no_argument, 0, 'h'},
         {"version", no_argument, 0, 'V'},          {"picture", required_argument, 0, 'P'},
         {0, 0, 0, 0}};
-    const char *progress_tcp = NULL, *secret_file = NULL;
-    const char *dir = NULL, *picture = NULL;
-    uint64_t job_id = 0;
-    int have_id = 0, progress_fd = -1, bad = 0, list_devices = 0;
+    int have_id = 0, bad = 0, list_devices = 0;
     unsigned long long max_memory_mb = 0, max_cpu_s = 0;
-    wrk_limits lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 };
+    *o = (worker_opts){.progress_fd = -1, .lim = { MESH_MAX_VERTICES, MESH_MAX_FACES, 0 }};
     unsigned long long v;
     int c;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (c) {
-        case 'j': dir = optarg; break;
+        case 'j': o->dir = optarg; break;
         case 'i':
             if (!(bad |= wrk_parse_num(PROG, "job-id", optarg, 1, UINT64_MAX, &v) != 0)) {
-                job_id = v;
+                o->job_id = v;
                 have_id = 1;
             }
             break;
         case 'p':
             if (!(bad |= wrk_parse_num(PROG, "progress-fd", optarg, 0, 1 << 20, &v) != 0))
-                progress_fd = (int)v;
+                o->progress_fd = (int)v;
             break;
         case 't':
             if (!(bad |= wrk_parse_num(PROG, "threads", optarg, 0, 1024, &v) != 0))
-                lim.threads = (int)v;
+                o->lim.threads = (int)v;
             break;
         case 'v': case 'f': case 'm':
-            bad |= wrk_limit_option(PROG, c, optarg, &lim, &max_memory_mb) != 0;
+            bad |= wrk_limit_option(PROG, c, optarg, &o->lim, &max_memory_mb) != 0;
             break;
         case 'C':
             bad |= wrk_parse_num(PROG, "max-cpu-s", optarg, 1, WRK_MAX_CPU_S, &max_cpu_s) != 0;
             break;
-        case 'c': progress_tcp = optarg; break;
-        case 's': secret_file = optarg; break;
+        case 'c': o->progress_tcp = optarg; break;
+        case 's': o->secret_file = optarg; break;
         case 'L': list_devices = 1; break;
-        case 'P': picture = optarg; break;
+        case 'P': o->picture = optarg; break;
         case 'h': usage(); return SPOOL_EXIT_USAGE;
         case 'V': printf(PROG " %s\n", MC_VERSION); return 0;
         default: bad = 1;
         }
     }
     if (!bad && list_devices)
-        return wrk_list_devices(lim.threads) ? SPOOL_EXIT_USAGE : 0;
-    if (!bad && (!dir || !have_id || optind != argc)) {
+        return wrk_list_devices(o->lim.threads) ? SPOOL_EXIT_USAGE : 0;
+    if (!bad && (!o->dir || !have_id || optind != argc)) {
         fprintf(stderr, "meshcorr-worker: --job and --job-id are required, nothing else\n");
         bad = 1;
     }
     struct stat st;
-    if (!bad && (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
-        fprintf(stderr, "meshcorr-worker: --job %s: not a directory\n", dir);
+    if (!bad && (stat(o->dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
+        fprintf(stderr, "meshcorr-worker: --job %s: not a directory\n", o->dir);
         bad = 1;
     }
-    if (!bad && (!progress_tcp != !secret_file || (progress_tcp && progress_fd >= 0))) {
+    if (!bad && (!o->progress_tcp != !o->secret_file || (o->progress_tcp && o->progress_fd >= 0))) {
         fprintf(stderr, "meshcorr-worker: --progress-tcp needs --secret-file, and excludes --progress-fd\n");
         bad = 1;
     }
-    if (!bad && progress_fd >= 0 && fcntl(progress_fd, F_GETFD) < 0) {
-        fprintf(stderr, "meshcorr-worker: --progress-fd %d: not an open descriptor\n", progress_fd);
+    if (!bad && o->progress_fd >= 0 && fcntl(o->progress_fd, F_GETFD) < 0) {
+        fprintf(stderr, "meshcorr-worker: --progress-fd %d: not an open descriptor\n", o->progress_fd);
         bad = 1;
     }
     /* allocations past the limit fail (NOMEM) instead of waking the OOM killer;
@@ -165,9 +172,11 @@ int main(int argc, char **argv)
         usage();
         return SPOOL_EXIT_USAGE;
     }
-    if (picture)
-        return wrk_picture(dir, job_id, &lim, picture);
+    return -1;
+}
 
+static void catch_signals(void)
+{
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_term;
@@ -176,7 +185,12 @@ int main(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
     sigaction(SIGINT, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);   /* a closed progress pipe is EPIPE, not death */
+}
 
+/* The job in o->dir, from job.frame to result.frame or error.frame; the
+ * exit status. t0: when the worker started. */
+static int run_job(const worker_opts *o, double t0)
+{
     int status;
     char err[4096] = "", path[4096];
     unsigned char *frame = NULL;
@@ -190,27 +204,27 @@ int main(int argc, char **argv)
     memset(&job, 0, sizeof job);
     memset(&res, 0, sizeof res);
     memset(&out, 0, sizeof out);
-    snprintf(path, sizeof path, "%s/%s", dir, SPOOL_JOB_FRAME);
+    snprintf(path, sizeof path, "%s/%s", o->dir, SPOOL_JOB_FRAME);
     int rc = wrk_frame_read(path, PROTO_MSG_SUBMIT, &frame, &sub, err, sizeof err);
     if (rc) {
-        status = fail(dir, job_id, rc, err);
+        status = fail(o->dir, o->job_id, rc, err);
         goto done;
     }
-    ctx.pg.fd = progress_fd;
-    ctx.pg.job_id = job_id;
+    ctx.pg.fd = o->progress_fd;
+    ctx.pg.job_id = o->job_id;
     ctx.t0 = t0;
-    if (progress_tcp) {        /* a socket: before the sandbox, which allows none */
-        snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", dir, SPOOL_PROGRESS_FILE);
-        wrk_progress_connect(&ctx.pg, progress_tcp, secret_file);
+    if (o->progress_tcp) {     /* a socket: before the sandbox, which allows none */
+        snprintf(ctx.pg.file, sizeof ctx.pg.file, "%s/%s", o->dir, SPOOL_PROGRESS_FILE);
+        wrk_progress_connect(&ctx.pg, o->progress_tcp, o->secret_file);
     }
     /* the meshes are Draco bytes from a client: decoded and solved in the
      * sandbox only, the profile by the backend the job asks for */
     if ((rc = sbx_enter(wrk_sandbox_profile(&sub.u.submit), PROG, err, sizeof err))) {
-        status = fail(dir, job_id, PROTO_EINTERNAL, err);
+        status = fail(o->dir, o->job_id, PROTO_EINTERNAL, err);
         goto done;
     }
-    if ((rc = wrk_job_from_submit(&sub.u.submit, &lim, &job, err, sizeof err))) {
-        status = fail(dir, job_id, rc, err);
+    if ((rc = wrk_job_from_submit(&sub.u.submit, &o->lim, &job, err, sizeof err))) {
+        status = fail(o->dir, o->job_id, rc, err);
         goto done;
     }
     corr_input in;
@@ -225,24 +239,24 @@ int main(int argc, char **argv)
         snprintf(err, sizeof err, "cancelled by SIGTERM after %d of %d outer iterations",
                  ctx.last_outer, job.params.iterations);
     if (rc) {
-        status = fail(dir, job_id, corr_wire_code(rc), err);
+        status = fail(o->dir, o->job_id, corr_wire_code(rc), err);
         goto done;
     }
-    if ((rc = wrk_result_build(&job, &res, job_id, now() - t0, &out, err, sizeof err))) {
-        status = fail(dir, job_id, rc, err);
+    if ((rc = wrk_result_build(&job, &res, o->job_id, now() - t0, &out, err, sizeof err))) {
+        status = fail(o->dir, o->job_id, rc, err);
         goto done;
     }
-    if (wrk_frame_write(dir, SPOOL_RESULT_FRAME, &out.msg, err, sizeof err)) {
+    if (wrk_frame_write(o->dir, SPOOL_RESULT_FRAME, &out.msg, err, sizeof err)) {
         /* the job did not fail, its answer could not be kept (a full disk):
          * no error.frame, which would end it; it runs again */
-        fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": cannot write %s: %s\n", job_id,
+        fprintf(stderr, "meshcorr-worker: job %" PRIu64 ": cannot write %s: %s\n", o->job_id,
                 SPOOL_RESULT_FRAME, err);
         status = SPOOL_EXIT_NO_ANSWER;
         goto done;
     }
     status = SPOOL_EXIT_OK;
 done:
-    if (progress_tcp && ctx.pg.fd >= 0)
+    if (o->progress_tcp && ctx.pg.fd >= 0)
         close(ctx.pg.fd);
     wrk_result_close(&out);
     ectm_result_close(&res);
@@ -250,4 +264,18 @@ done:
     proto_msg_free(&sub);
     free(frame);
     return status;
+}
+
+int main(int argc, char **argv)
+{
+    ompenv_ensure_passive(argv);
+    double t0 = now();
+    worker_opts o;
+    int status = parse_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    if (o.picture)
+        return wrk_picture(o.dir, o.job_id, &o.lim, o.picture);
+    catch_signals();
+    return run_job(&o, t0);
 }

@@ -29,27 +29,16 @@ static int parse_index(const char *s, long *out)
     return 0;
 }
 
-int vmap_read(const char *path, int base, const mesh *source, const mesh *target, bmap **out,
-              int *base_used, char *err, size_t errsz)
+/* The n indices of the file fp (path) into ids, each one's line into
+ * lines; whether 0 and nt (the target's vertex count) are among them.
+ * 0, or a BMAP_E* code with the file and line in err. */
+static int read_ids(FILE *fp, const char *path, int n, int nt, long *ids, long *lines, int *has_zero,
+                    int *has_nv, char *err, size_t errsz)
 {
-    *out = NULL;
-    int rc = 0, n = source->nv;
-    long *ids = malloc(sizeof(long) * ((size_t)n + 1)), *lines = malloc(sizeof(long) * ((size_t)n + 1));
-    int *vface = malloc(sizeof(int) * ((size_t)target->nv + 1));
     char *buf = NULL;
     size_t cap = 0;
     long line = 0, count = 0;
-    bmap *P = NULL;
-    FILE *fp = NULL;
-    if (!ids || !lines || !vface) {
-        rc = errbuf_set(err, errsz, BMAP_ENOMEM, "%s: out of memory", path);
-        goto done;
-    }
-    if (!(fp = fopen(path, "r"))) {
-        rc = errbuf_set(err, errsz, BMAP_EIO, "%s: cannot open: %s", path, strerror(errno));
-        goto done;
-    }
-    int has_zero = 0, has_nv = 0;
+    int rc = 0;
     while (getline(&buf, &cap, fp) >= 0) {
         line++;
         const char *s = buf + strspn(buf, " \t\r\n");
@@ -61,45 +50,72 @@ int vmap_read(const char *path, int base, const mesh *source, const mesh *target
             rc = errbuf_set(err, errsz, BMAP_EPARSE,
                             "%s:%ld: '%.40s' is not a target vertex index (one integer a line)",
                             path, line, s);
-            goto done;
+            break;
         }
         if (count == n) {
             rc = errbuf_set(err, errsz, BMAP_ESIZE,
                             "%s:%ld: more than %d entries: the source mesh has %d vertices "
                             "(one target vertex per source vertex)", path, line, n, n);
-            goto done;
+            break;
         }
-        has_zero |= v == 0;
-        has_nv |= v == target->nv;
+        *has_zero |= v == 0;
+        *has_nv |= v == nt;
         lines[count] = line;
         ids[count++] = v;
     }
-    if (ferror(fp)) {
-        rc = errbuf_set(err, errsz, BMAP_EIO, "%s:%ld: read error", path, line);
-        goto done;
-    }
-    if (count < n) {
-        rc = errbuf_set(err, errsz, BMAP_ESIZE,
-                        "%s:%ld: %ld entries, expected %d (one target vertex per source vertex)",
-                        path, line, count, n);
-        goto done;
-    }
-    if (base == VMAP_BASE_AUTO) {
+    free(buf);
+    if (rc)
+        return rc;
+    if (ferror(fp))
+        return errbuf_set(err, errsz, BMAP_EIO, "%s:%ld: read error", path, line);
+    if (count < n)
+        return errbuf_set(err, errsz, BMAP_ESIZE,
+                          "%s:%ld: %ld entries, expected %d (one target vertex per source vertex)",
+                          path, line, count, n);
+    return 0;
+}
+
+/* *base as given, or for VMAP_BASE_AUTO the one the indices show: 0 when
+ * 0 is among them, 1 when nt is. 0, or BMAP_EPARSE. */
+static int index_base(int *base, int has_zero, int has_nv, const char *path, int nt, char *err,
+                      size_t errsz)
+{
+    if (*base == VMAP_BASE_AUTO) {
         if (has_zero)
-            base = 0;
+            *base = 0;
         else if (has_nv)
-            base = 1;
-        else {
-            rc = errbuf_set(err, errsz, BMAP_EPARSE,
-                            "%s: neither 0 nor %d among the indices: 0- or 1-based cannot be "
-                            "told; give the base (--init-base 0 or 1)", path, target->nv);
-            goto done;
-        }
+            *base = 1;
+        else
+            return errbuf_set(err, errsz, BMAP_EPARSE,
+                              "%s: neither 0 nor %d among the indices: 0- or 1-based cannot be "
+                              "told; give the base (--init-base 0 or 1)", path, nt);
     }
-    if (base != 0 && base != 1) {
-        rc = errbuf_set(err, errsz, BMAP_EPARSE, "%s: index base %d is not 0 or 1", path, base);
+    if (*base != 0 && *base != 1)
+        return errbuf_set(err, errsz, BMAP_EPARSE, "%s: index base %d is not 0 or 1", path, *base);
+    return 0;
+}
+
+int vmap_read(const char *path, int base, const mesh *source, const mesh *target, bmap **out,
+              int *base_used, char *err, size_t errsz)
+{
+    *out = NULL;
+    int rc = 0, n = source->nv;
+    long *ids = malloc(sizeof(long) * ((size_t)n + 1)), *lines = malloc(sizeof(long) * ((size_t)n + 1));
+    int *vface = malloc(sizeof(int) * ((size_t)target->nv + 1));
+    bmap *P = NULL;
+    FILE *fp = NULL;
+    if (!ids || !lines || !vface) {
+        rc = errbuf_set(err, errsz, BMAP_ENOMEM, "%s: out of memory", path);
         goto done;
     }
+    if (!(fp = fopen(path, "r"))) {
+        rc = errbuf_set(err, errsz, BMAP_EIO, "%s: cannot open: %s", path, strerror(errno));
+        goto done;
+    }
+    int has_zero = 0, has_nv = 0;
+    if ((rc = read_ids(fp, path, n, target->nv, ids, lines, &has_zero, &has_nv, err, errsz)) ||
+        (rc = index_base(&base, has_zero, has_nv, path, target->nv, err, errsz)))
+        goto done;
     for (int v = 0; v < target->nv; v++)
         vface[v] = -1;
     for (int q = 3 * target->nf - 1; q >= 0; q--)   /* the lowest face listing v, v's corner */
@@ -131,7 +147,6 @@ int vmap_read(const char *path, int base, const mesh *source, const mesh *target
 done:
     if (fp)
         fclose(fp);
-    free(buf);
     free(ids);
     free(lines);
     free(vface);

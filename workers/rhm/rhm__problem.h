@@ -9,11 +9,10 @@
 #ifndef RHM__PROBLEM_H
 #define RHM__PROBLEM_H
 #include "rhm/rhm.h"
+#include "chol/chol.h"
 #include "geo/geo_csr.h"
 #include "geod/geod.h"
 #include "proj/proj.h"
-
-#include <suitesparse/cholmod.h>
 
 typedef struct rhm__side {
     const mesh *m;          /* borrowed */
@@ -31,16 +30,14 @@ typedef struct rhm__side {
     double *anchor;         /* n by dim: the given map's image P⁰_ij X_j, or NULL */
     double *anchor_w;       /* n: the anchor term's weight per vertex: n/k at
                                the k anchors, 0 elsewhere (1 everywhere: k = 0) */
-    cholmod_sparse *A;      /* upper triangle, W's pattern: the X-step matrix */
-    cholmod_factor *F;      /* analysed once, factorised per X-step */
+    chol *A;                /* the X-step matrix, W's pattern: analysed once,
+                               its values written and factorised per X-step */
 } rhm__side;
 
 typedef struct rhm__problem {
     rhm_params p;
     int dim, nl;
     rhm__side side[2];
-    cholmod_common cc;
-    int cc_started;
 } rhm__problem;
 
 /* Builds geodesic solvers, embeddings, operators, trees and the X-step

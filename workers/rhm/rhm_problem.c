@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void side_close(rhm__side *sd, cholmod_common *cc, int cc_started)
+static void side_close(rhm__side *sd)
 {
     free(sd->mass);
     geo_csr_free(sd->W);
@@ -26,10 +26,7 @@ static void side_close(rhm__side *sd, cholmod_common *cc, int cc_started)
     free(sd->Xij);
     free(sd->anchor);
     free(sd->anchor_w);
-    if (cc_started) {
-        cholmod_free_sparse(&sd->A, cc);
-        cholmod_free_factor(&sd->F, cc);
-    }
+    chol_free(sd->A);
 }
 
 void rhm__problem_free(rhm__problem *pb)
@@ -37,41 +34,31 @@ void rhm__problem_free(rhm__problem *pb)
     if (!pb)
         return;
     for (int i = 0; i < 2; i++)
-        side_close(&pb->side[i], &pb->cc, pb->cc_started);
-    if (pb->cc_started)
-        cholmod_finish(&pb->cc);
+        side_close(&pb->side[i]);
     free(pb);
 }
 
-/* The upper triangle of W's pattern as a CHOLMOD symmetric matrix, values
- * W + diag(mass) (only the pattern matters to the analysis). Faces are
+/* sd->A = W + diag(mass) in W's pattern (only the pattern matters to the
+ * analysis), ordered by CHOLMOD's own choice and analysed. Faces are
  * edges of the mesh, so every product P_jiᵀ M_j P_ji fits this pattern. */
-static cholmod_sparse *pattern(const rhm__side *sd, cholmod_common *cc)
+static int x_step_matrix(rhm__side *sd, const char *name, char *err, size_t errsz)
 {
     const geo_csr *W = sd->W;
-    size_t nnz = 0;
-    for (int c = 0; c < W->n; c++)
+    char detail[256] = "";
+    int rc = chol_new(W->n, (size_t)W->row_start[W->n], CHOL_ORDER_CHOLMOD, &sd->A, detail,
+                      sizeof detail);
+    for (int c = 0; rc == CHOL_OK && c < W->n; c++)   /* W symmetric: row c = column c */
         for (int q = W->row_start[c]; q < W->row_start[c + 1]; q++)
-            nnz += W->col[q] <= c;
-    cholmod_sparse *A = cholmod_allocate_sparse((size_t)W->n, (size_t)W->n, nnz, 1, 1, 1,
-                                                CHOLMOD_REAL, cc);
-    if (!A)
-        return NULL;
-    int *cp = A->p, *ri = A->i;
-    double *x = A->x;
-    size_t at = 0;
-    for (int c = 0; c < W->n; c++) {   /* W symmetric: row c = column c */
-        cp[c] = (int)at;
-        for (int q = W->row_start[c]; q < W->row_start[c + 1]; q++) {
-            if (W->col[q] > c)
-                continue;
-            ri[at] = W->col[q];
-            x[at] = W->val[q] + (W->col[q] == c ? sd->mass[c] : 0);
-            at++;
-        }
-    }
-    cp[W->n] = (int)at;
-    return A;
+            if (W->col[q] <= c)
+                chol_add(sd->A, W->col[q], c, W->val[q]);
+    if (rc == CHOL_OK && (rc = chol_assemble(sd->A, CHOL_DIAG_SHIFT, sd->mass, detail,
+                                             sizeof detail)) == CHOL_OK)
+        rc = chol_analyse(sd->A, detail, sizeof detail);
+    if (rc == CHOL_OK)
+        return RHM_OK;
+    if (rc == CHOL_ENOMEM)
+        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    return errbuf_set(err, errsz, RHM_ENUMERIC, "%s: the X-step matrix: %s", name, detail);
 }
 
 static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char *name,
@@ -117,13 +104,7 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
     if (!sd->tree)
         return errbuf_set(err, errsz, nomem ? RHM_ENOMEM : RHM_ENUMERIC,
                           "%s: projection tree: %s", name, detail);
-    if (!(sd->A = pattern(sd, &pb->cc)))
-        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
-    sd->F = cholmod_analyze(sd->A, &pb->cc);
-    if (!sd->F || pb->cc.status != CHOLMOD_OK)
-        return errbuf_set(err, errsz, RHM_ENUMERIC, "%s: analysing the X-step matrix failed "
-                          "(CHOLMOD status %d)", name, pb->cc.status);
-    return RHM_OK;
+    return x_step_matrix(sd, name, err, errsz);
 }
 
 /* min_landmarks: PROTO_MIN_LANDMARKS for a start from landmarks, 0 for
@@ -152,9 +133,6 @@ static int problem_new(const mesh *S, const mesh *T, const lmk_set *L, int min_l
     pb->p = *p;
     pb->dim = p->dim;
     pb->nl = L->n;
-    cholmod_start(&pb->cc);
-    pb->cc_started = 1;
-    pb->cc.print = 0;
     for (int i = 0; i < 2; i++) {
         const int *src = i ? L->tgt : L->src;
         if (!(pb->side[i].lmk = malloc(sizeof(int) * ((size_t)L->n + 1)))) {

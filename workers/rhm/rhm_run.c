@@ -44,7 +44,7 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
             double tb = rhm__now();
             if ((rc = rhm__step_x(pb, i, beta)))
                 return errbuf_set(err, errsz, rc, "RHM iteration %d: X-step solve failed "
-                                  "(CHOLMOD status %d)", k, pb->cc.status);
+                                  "(CHOLMOD status %d)", k, chol_status(pb->side[i].A));
             r.t_project += tb - ta;
             r.t_solve += rhm__now() - tb;
         }

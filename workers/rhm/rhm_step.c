@@ -94,10 +94,10 @@ out:
     return rc;
 }
 
-/* Position of entry (r, c), r <= c, in the upper-triangular CSC matrix A. */
-static size_t entry(const cholmod_sparse *A, int r, int c)
+/* Position of entry (r, c), r <= c, in the upper-triangular compressed
+ * columns cp, ri. */
+static size_t entry(const int *cp, const int *ri, int r, int c)
 {
-    const int *cp = A->p, *ri = A->i;
     int lo = cp[c], hi = cp[c + 1] - 1;
     while (lo < hi) {
         int mid = (lo + hi) / 2;
@@ -116,10 +116,10 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
     double alpha = pb->p.alpha, gamma = pb->p.gamma;
     double cD = alpha / b->s, cR = (1 - alpha) / (b->s * b->s), cQ = beta / (a->s * b->s);
     double cL = gamma / (a->s * b->s);
-    cholmod_sparse *A = a->A;
     const geo_csr *W = a->W;
-    double *x = A->x;
-    const int *cp = A->p, *ri = A->i;
+    const int *cp, *ri;
+    double *x;
+    chol_csc(a->A, &cp, &ri, &x);
     /* α/s_j W_i (upper triangle) + β/(s_i s_j) M_i */
     for (int c = 0; c < n; c++) {
         int q = W->row_start[c];
@@ -130,12 +130,12 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
         }
     }
     for (int r = 0; r < pb->nl; r++)
-        x[entry(A, a->lmk[r], a->lmk[r])] += cL * a->mass[a->lmk[r]];
+        x[entry(cp, ri, a->lmk[r], a->lmk[r])] += cL * a->mass[a->lmk[r]];
     double cA = pb->p.anchor / (a->s * b->s);
     if (a->anchor && cA > 0)
         for (int l = 0; l < n; l++)
             if (a->anchor_w[l] > 0)
-                x[entry(A, l, l)] += cA * a->mass[l] * a->anchor_w[l];
+                x[entry(cp, ri, l, l)] += cA * a->mass[l] * a->anchor_w[l];
     /* (1−α)/s_j² P_jiᵀ M_j P_ji */
     const bmap *Pji = b->P;
     for (int l = 0; l < b->n; l++) {
@@ -144,16 +144,14 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
         for (int u = 0; u < 3; u++)
             for (int v = 0; v < 3; v++)
                 if (f[u] <= f[v] && w[u] != 0 && w[v] != 0)
-                    x[entry(A, f[u], f[v])] += cR * b->mass[l] * w[u] * w[v];
+                    x[entry(cp, ri, f[u], f[v])] += cR * b->mass[l] * w[u] * w[v];
     }
     /* right-hand side, column-major n by m */
-    cholmod_dense *B = cholmod_zeros((size_t)n, (size_t)m, CHOLMOD_REAL, &pb->cc);
+    double *bx = calloc((size_t)n * m, sizeof *bx);   /* then the solution */
     double *PX = malloc(sizeof(double) * (size_t)n * m);
-    cholmod_dense *Xs = NULL;
     int rc = RHM_ENOMEM;
-    if (!B || !PX)
+    if (!bx || !PX)
         goto out;
-    double *bx = B->x;
     for (int l = 0; l < b->n; l++) {
         const int *f = a->m->f + 3 * Pji->face[l];
         const double *w = Pji->w + 3 * l, *xj = b->X + (size_t)l * m;
@@ -175,18 +173,15 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
             for (int c = 0; c < m && a->anchor_w[l] > 0; c++)
                 bx[(size_t)c * n + l] += cA * a->mass[l] * a->anchor_w[l] * a->anchor[(size_t)l * m + c];
     rc = RHM_ENUMERIC;
-    if (!cholmod_factorize(A, a->F, &pb->cc) || pb->cc.status != CHOLMOD_OK)
+    if (chol_factorise(a->A, NULL, 0) != CHOL_OK || chol_solve(a->A, bx, m, bx, NULL, 0) != CHOL_OK)
         goto out;
-    if (!(Xs = cholmod_solve(CHOLMOD_A, a->F, B, &pb->cc)))
-        goto out;
-    const double *sx = Xs->x;
+    const double *sx = bx;
     for (int l = 0; l < n; l++)
         for (int c = 0; c < m; c++)
             a->Xij[(size_t)l * m + c] = sx[(size_t)c * n + l];
     rc = RHM_OK;
 out:
-    cholmod_free_dense(&B, &pb->cc);
-    cholmod_free_dense(&Xs, &pb->cc);
+    free(bx);
     free(PX);
     return rc;
 }
