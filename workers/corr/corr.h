@@ -26,6 +26,7 @@
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "repair/repair.h"
 #include "rhm/rhm.h"
 #include "proto.h"
 
@@ -54,6 +55,7 @@ int corr_from_lbo(int rc);
 int corr_from_lmk(int rc);
 int corr_from_bmap(int rc);
 int corr_from_mesh(int rc);
+int corr_from_repair(int rc);
 
 typedef enum corr_stage {
     CORR_STAGE_INIT = 0,     /* not reported: the first report is the start
@@ -186,6 +188,35 @@ void corr_progress_record(const corr_progress *p, proto_progress *out);
 /* 0 when the optimizer can use m; else CORR_EMESH with one line per problem
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
+
+/* Input repair (repair.h), the one check of a job's meshes before it runs:
+ * a mesh the optimizer can use as given is used as it is; one it cannot
+ * is repaired when repair is non-zero (the job parameter repair, yes by
+ * default), else refused with corr_validate's message. When either mesh is
+ * repaired, both go through repair_mesh_run (a usable one comes out the
+ * same), the landmarks and uploaded maps are carried into the repaired
+ * indexing (repair_landmarks, repair_map_from_user) and the results back
+ * (corr_fix_to_user). */
+typedef struct corr_fix {
+    int repaired;            /* 1 when either mesh was repaired             */
+    repair_mesh S, T;        /* when repaired: both meshes' repairs          */
+    lmk_set L;               /* the landmarks in the repaired indexing       */
+    bmap *P0, *Q0;           /* the uploaded maps in the repaired indexing   */
+} corr_fix;
+
+/* Checks and, with repair, repairs user's meshes; *in is the job's input
+ * as the engine runs it (user's own fields where nothing was repaired).
+ * CORR_OK; CORR_EMESH (not usable, repair off; or beyond repair: a bad
+ * index, a NaN), CORR_EMAP (an uploaded map on a removed face),
+ * CORR_ENOMEM. On error fx holds nothing. */
+int corr_fix_open(const corr_input *user, int repair, corr_fix *fx, corr_input *in, char *err,
+                  size_t errsz);
+/* The engine's result (on the repaired meshes) in the user's indexing:
+ * P and Q with one row per user vertex on the user's faces, Y and Yt one
+ * row per user vertex; last copied. CORR_ENOMEM. */
+int corr_fix_to_user(const corr_fix *fx, const ectm_result *res, ectm_result *out, char *err,
+                     size_t errsz);
+void corr_fix_close(corr_fix *fx);
 
 /* The sizes a job's meshes bound: DDM's basis (in->ddm_k, when the chain
  * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM may start from the

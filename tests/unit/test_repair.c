@@ -1,0 +1,311 @@
+/* test_repair.c — input mesh repair (repair.h, corr_fix_open): a clean
+ * mesh comes out as it went in; messy meshes the test makes from a clean
+ * one (a pinched vertex, an unwelded seam, a floating piece, a hole,
+ * degenerate, duplicate and flipped faces) are repaired, reported, matched
+ * against their clean original by the real pipeline with error <= 0.01
+ * against the identity, and every input vertex gets a row; with repair off
+ * the job is refused as before. */
+#include "support/harness.h"
+#include "support/testmesh.h"
+#include "corr/corr.h"
+#include "geo/geo_area.h"
+#include "mesh/mesh_check.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A sphere bent out of its symmetries (642 vertices), the clean original. */
+static mesh *clean(void)
+{
+    mesh *m = testmesh_icosphere(3);
+    for (int i = 0; i < m->nv; i++) {
+        double *p = m->v + 3 * i;
+        double x = p[0], y = p[1];
+        p[0] = 1.4 * x;
+        p[1] = y + 0.3 * x * x;
+        p[2] *= 0.8 + 0.2 * (y + 1);
+    }
+    return m;
+}
+
+/* The clean mesh bent and stretched: the target, identity ground truth. */
+static mesh *bent(const mesh *c)
+{
+    mesh *m = mesh_copy(c);
+    for (int i = 0; i < m->nv; i++) {
+        double *p = m->v + 3 * i;
+        p[1] += 0.1 * sin(p[0]);
+        p[2] *= 1 + 0.03 * p[0];
+    }
+    return m;
+}
+
+/* A messy mesh and, per vertex, the clean vertex it is (or is next to). */
+typedef struct messy {
+    mesh *m;
+    int *orig;
+    int exact;      /* vertices 0..exact-1 are scored against the identity */
+} messy;
+
+static messy grow(const mesh *c, int add_v, int add_f)
+{
+    messy x;
+    x.m = mesh_new(c->nv + add_v, c->nf + add_f);
+    x.orig = malloc(sizeof(int) * (size_t)(c->nv + add_v));
+    CHECK(x.m && x.orig);
+    memcpy(x.m->v, c->v, sizeof(double) * 3 * (size_t)c->nv);
+    memcpy(x.m->f, c->f, sizeof(int) * 3 * (size_t)c->nf);
+    for (int i = 0; i < c->nv + add_v; i++)
+        x.orig[i] = i < c->nv ? i : 0;
+    x.exact = c->nv;
+    return x;
+}
+
+/* A small closed tetrahedron that shares vertex v0 with the surface: v0
+ * becomes non-manifold (two fans). */
+static messy pinched(const mesh *c)
+{
+    messy x = grow(c, 3, 4);
+    int v0 = 17, n = c->nv;
+    const double *p = c->v + 3 * v0;
+    double d[3][3] = { { 0.03, 0, 0 }, { 0, 0.03, 0 }, { 0, 0, 0.03 } };
+    for (int k = 0; k < 3; k++) {
+        for (int j = 0; j < 3; j++)
+            x.m->v[3 * (n + k) + j] = p[j] * 1.01 + d[k][j];
+        x.orig[n + k] = v0;
+    }
+    int tf[4][3] = { { v0, n + 1, n }, { v0, n, n + 2 }, { v0, n + 2, n + 1 }, { n, n + 1, n + 2 } };
+    memcpy(x.m->f + 3 * c->nf, tf, sizeof tf);
+    return x;
+}
+
+/* Every vertex duplicated at the end; the faces with x > 0 use the
+ * duplicates: a seam all round, and originals only the other side used
+ * left in no face. */
+static messy seam(const mesh *c)
+{
+    messy x = grow(c, c->nv, 0);
+    memcpy(x.m->v + 3 * c->nv, c->v, sizeof(double) * 3 * (size_t)c->nv);
+    for (int i = 0; i < c->nv; i++)
+        x.orig[c->nv + i] = i;
+    for (int t = 0; t < c->nf; t++) {
+        int *f = x.m->f + 3 * t;
+        if (c->v[3 * f[0]] + c->v[3 * f[1]] + c->v[3 * f[2]] > 0)
+            for (int k = 0; k < 3; k++)
+                f[k] += c->nv;
+    }
+    x.exact = 2 * c->nv;
+    return x;
+}
+
+/* A small sphere floating beside the surface. */
+static messy floating(const mesh *c)
+{
+    mesh *s = testmesh_icosphere(1);
+    messy x = grow(c, s->nv, s->nf);
+    for (int i = 0; i < s->nv; i++) {
+        for (int j = 0; j < 3; j++)
+            x.m->v[3 * (c->nv + i) + j] = 0.2 * s->v[3 * i + j] + (j == 0 ? 2.5 : 0);
+    }
+    for (int c3 = 0; c3 < 3 * s->nf; c3++)
+        x.m->f[3 * c->nf + c3] = s->f[c3] + c->nv;
+    mesh_free(s);
+    return x;
+}
+
+/* The faces around vertex 40 removed: a hole, vertex 40 in no face. */
+static messy holed(const mesh *c)
+{
+    messy x = grow(c, 0, 0);
+    int n = 0;
+    for (int t = 0; t < c->nf; t++) {
+        const int *f = c->f + 3 * t;
+        if (f[0] == 40 || f[1] == 40 || f[2] == 40)
+            continue;
+        memcpy(x.m->f + 3 * n++, f, 3 * sizeof(int));
+    }
+    x.m->nf = n;
+    return x;
+}
+
+/* Faces repeating a vertex, a zero-area face through an edge's midpoint,
+ * five faces twice, three faces turned over. */
+static messy dirty_faces(const mesh *c)
+{
+    messy x = grow(c, 1, 2 + 1 + 5);
+    int n = c->nv, nf = c->nf;
+    const int *e = c->f;                       /* edge f0-f1 of face 0 */
+    for (int j = 0; j < 3; j++)
+        x.m->v[3 * n + j] = 0.5 * (c->v[3 * e[0] + j] + c->v[3 * e[1] + j]);
+    x.orig[n] = e[0];
+    int extra[8][3] = { { 5, 5, 9 }, { 7, 8, 7 }, { e[0], n, e[1] } };
+    for (int k = 0; k < 5; k++)
+        memcpy(extra[3 + k], c->f + 3 * (10 + 7 * k), 3 * sizeof(int));
+    memcpy(x.m->f + 3 * nf, extra, sizeof extra);
+    for (int t = 100; t < 103; t++) {
+        int *f = x.m->f + 3 * t, s = f[1];
+        f[1] = f[2];
+        f[2] = s;
+    }
+    return x;
+}
+
+/* The mean distance from each scored vertex's image to its clean vertex,
+ * over sqrt(area). */
+static double identity_error(const messy *x, const mesh *T, const bmap *P)
+{
+    double e = 0;
+    for (int u = 0; u < x->exact; u++) {
+        const int *f = T->f + 3 * P->face[u];
+        double d2 = 0;
+        for (int k = 0; k < 3; k++) {
+            double p = 0;
+            for (int c = 0; c < 3; c++)
+                p += P->w[3 * u + c] * T->v[3 * f[c] + k];
+            double d = p - T->v[3 * x->orig[u] + k];
+            d2 += d * d;
+        }
+        e += sqrt(d2);
+    }
+    return e / (x->exact * sqrt(geo_total_area(T)));
+}
+
+TEST(a_clean_mesh_comes_out_as_it_went_in)
+{
+    mesh *c = clean();
+    repair_mesh r;
+    char err[512];
+    CHECK_INT(repair_mesh_run(c, "clean", &r, err, sizeof err), REPAIR_OK);
+    CHECK(!repair_counts_any(&r.n));
+    CHECK_INT(r.m->nv, c->nv);
+    CHECK_INT(r.m->nf, c->nf);
+    CHECK(memcmp(r.m->v, c->v, sizeof(double) * 3 * (size_t)c->nv) == 0);
+    CHECK(memcmp(r.m->f, c->f, sizeof(int) * 3 * (size_t)c->nf) == 0);
+    for (int i = 0; i < c->nv; i++)
+        CHECK(r.row[i] == i && !r.carried[i]);
+    repair_mesh_close(&r);
+    mesh_free(c);
+}
+
+TEST(what_cannot_be_repaired_is_refused_with_the_reason)
+{
+    mesh *c = clean();
+    repair_mesh r;
+    char err[512];
+    c->v[3 * 5 + 1] = NAN;
+    CHECK_INT(repair_mesh_run(c, "m.off", &r, err, sizeof err), REPAIR_EMESH);
+    CHECK_STR_HAS(err, "m.off: vertex 5 has a NaN or infinite coordinate");
+    c->v[3 * 5 + 1] = 0;
+    c->f[7] = c->nv + 3;
+    CHECK_INT(repair_mesh_run(c, "m.off", &r, err, sizeof err), REPAIR_EMESH);
+    CHECK_STR_HAS(err, "m.off: face 2 has vertex index");
+    mesh_free(c);
+}
+
+/* Each messy mesh: what its repair reports, and that the repaired mesh is
+ * one the optimizer takes. */
+TEST(each_kind_of_mess_is_repaired_and_counted)
+{
+    mesh *c = clean();
+    messy (*make[5])(const mesh *) = { pinched, seam, floating, holed, dirty_faces };
+    for (int k = 0; k < 5; k++) {
+        messy x = make[k](c);
+        repair_mesh r;
+        char err[2048];
+        CHECK_INT(repair_mesh_run(x.m, "messy", &r, err, sizeof err), REPAIR_OK);
+        if (corr_validate(r.m, "repaired", err, sizeof err))
+            FAILF("case %d: %s", k, err);
+        const repair_counts *n = &r.n;
+        switch (k) {
+        case 0: CHECK(n->split_vertices == 1 && n->pieces == 1 && n->piece_vertices == 3); break;
+        case 1: CHECK(n->welded > 0 && n->unreferenced > 0 && n->split_vertices == 0 &&
+                      r.m->nv == c->nv); break;
+        case 2: CHECK(n->pieces == 1 && n->piece_vertices == 42); break;
+        case 3: CHECK(n->unreferenced == 1 && n->pieces == 0 && r.m->nv == c->nv - 1); break;
+        case 4:
+            CHECK(n->degenerate_faces == 3 && n->duplicate_faces == 5 &&
+                      n->flipped_faces == 3 && n->unreferenced == 1); break;
+        }
+        char text[2048];
+        CHECK(repair_counts_text(n, "messy", text, sizeof text) >= 1);
+        repair_mesh_close(&r);
+        free(x.orig);
+        mesh_free(x.m);
+    }
+    mesh_free(c);
+}
+
+/* The job as the engine runs it: repaired, matched, back in the messy
+ * mesh's indexing. */
+static void match(const messy *x, const mesh *c, int *lm, int nl)
+{
+    mesh *T = bent(c);
+    lmk_set L = { nl, lm, lm + nl };
+    corr_input user = { x->m, T, "messy", "clean", &L, NULL, NULL, NULL, CORR_STAGES_ALL, 0,
+                        CORR_DDM_AUTO };
+    corr_fix fx;
+    corr_input in;
+    char err[4096];
+    if (corr_fix_open(&user, 1, &fx, &in, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(fx.repaired);
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 40;
+    ectm_result res, back;
+    if (corr_run(&in, &p, NULL, NULL, &res, err, sizeof err))
+        FAILF("corr_run: %s", err);
+    if (corr_fix_to_user(&fx, &res, &back, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(back.P->n, x->m->nv);                  /* every input vertex has a row */
+    CHECK_INT(back.Q->n, T->nv);
+    for (int u = 0; u < back.P->n; u++)
+        CHECK(back.P->face[u] >= 0 && back.P->face[u] < T->nf);
+    double e = identity_error(x, T, back.P);
+    printf("  identity error %.5f\n", e);
+    CHECK(e <= 0.01);
+    ectm_result_close(&res);
+    ectm_result_close(&back);
+    corr_fix_close(&fx);
+    mesh_free(T);
+}
+
+TEST_T(messy_meshes_match_their_clean_original, 600)
+{
+    mesh *c = clean();
+    int lm[16] = { 0, 100, 200, 300, 400, 500, 600, 640 };
+    memcpy(lm + 8, lm, 8 * sizeof(int));
+    messy (*make[5])(const mesh *) = { pinched, seam, floating, holed, dirty_faces };
+    const char *names[5] = { "pinched vertex", "unwelded seam", "floating piece", "hole",
+                             "degenerate, duplicate and flipped faces" };
+    for (int k = 0; k < 5; k++) {
+        printf("  %s:\n", names[k]);
+        messy x = make[k](c);
+        match(&x, c, lm, 8);
+        free(x.orig);
+        mesh_free(x.m);
+    }
+    mesh_free(c);
+}
+
+TEST(repair_off_refuses_as_before)
+{
+    mesh *c = clean();
+    messy x = pinched(c);
+    int lm[16] = { 0, 100, 200, 300, 400, 500, 600, 640 };
+    memcpy(lm + 8, lm, 8 * sizeof(int));
+    lmk_set L = { 8, lm, lm + 8 };
+    corr_input user = { x.m, c, "messy.off", "clean", &L, NULL, NULL, NULL, CORR_STAGES_ALL, 0,
+                        CORR_DDM_AUTO };
+    corr_fix fx;
+    corr_input in;
+    char err[4096];
+    CHECK_INT(corr_fix_open(&user, 0, &fx, &in, err, sizeof err), CORR_EMESH);
+    CHECK_STR_HAS(err, "messy.off is not usable by the optimizer");
+    CHECK_STR_HAS(err, "non-manifold vertices");
+    free(x.orig);
+    mesh_free(x.m);
+    mesh_free(c);
+}
+
