@@ -162,7 +162,8 @@ def case_bad_input_refused():
     # one more face on an existing edge: three faces meet there
     Vb = np.vstack([V, [[2.0, 0, 0]]])
     Fb = np.vstack([F, [[F[0, 0], F[0, 1], nv]]])
-    expect_error(-19, "BAD_MESH", c.submit, (Vb, Fb), SRC, landmarks=LANDMARKS, **JOB, has="non-manifold")
+    expect_error(-19, "BAD_MESH", c.submit, (Vb, Fb), SRC, landmarks=LANDMARKS, **JOB, repair="no",
+                 has="non-manifold")
     expect_error(-20, "BAD_LANDMARKS", c.submit, SRC, TGT, landmarks=[[0, 0], [1, 1], [2, 500]], **JOB, has="500")
     expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, inner_iterations=500000,
                  has="inner_iterations")
