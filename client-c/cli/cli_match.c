@@ -44,15 +44,19 @@ static int on_progress(void *ctx, const corr_progress *cp)
     return 0;
 }
 
-/* Reads a mesh; with repair off (check non-zero) refuses one the optimizer
- * cannot use before any other input is read, so the user hears about the
- * mesh first. */
-static mesh *load(const char *path, int check, int *status)
+/* Reads a mesh and refuses one the job cannot use before any other input
+ * is read, so the user hears about the mesh first: with repair, one no
+ * repair fixes (repair_mesh_check); without, one the optimizer cannot use
+ * as given. */
+static mesh *load(const char *path, int repair, int *status)
 {
     char err[4096];
     mesh *m = NULL;
     int rc = corr_from_mesh(mesh_read(path, &m, err, sizeof err));
-    if (rc || (check && (rc = corr_validate(m, path, err, sizeof err)))) {
+    if (!rc)
+        rc = repair ? corr_from_repair(repair_mesh_check(m, path, err, sizeof err))
+                    : corr_validate(m, path, err, sizeof err);
+    if (rc) {
         fprintf(stderr, "meshcorr match: %s\n", err);
         mesh_free(m);
         *status = proto_kind_exit(-rc);
@@ -167,7 +171,7 @@ int cli_match(int argc, char **argv)
     corr_fix fix = {0};
     const char *src = argv[optind], *tgt = argv[optind + 1];
     int repair = job.w.repair == 0;            /* "yes|no" */
-    if (!(S = load(src, !repair, &status)) || !(T = load(tgt, !repair, &status)) ||
+    if (!(S = load(src, repair, &status)) || !(T = load(tgt, repair, &status)) ||
         cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
     /* --threads, else as many as the pair's size pays for (as the worker) */

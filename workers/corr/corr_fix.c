@@ -2,7 +2,7 @@
  * it runs, and its result carried back to the user's indexing (corr.h,
  * corr_fix_open). Combines repair.h's steps; computes no geometry itself.
  * Apart from corr.c so that the daemon's validator links it without the
- * stages. */
+ * stages; the way back (corr_fix_back.c) is apart for the same reason. */
 #include "corr/corr.h"
 #include "mesh/mesh_check.h"
 #include "util/errbuf.h"
@@ -95,20 +95,4 @@ fail:
     corr_fix_close(fx);
     *in = *user;
     return rc;
-}
-
-int corr_fix_to_user(const corr_fix *fx, const ectm_result *res, ectm_result *out, char *err,
-                     size_t errsz)
-{
-    memset(out, 0, sizeof *out);
-    out->last = res->last;
-    if ((res->P && !(out->P = repair_map_to_user(&fx->S, &fx->T, res->P))) ||
-        (res->Q && !(out->Q = repair_map_to_user(&fx->T, &fx->S, res->Q))) ||
-        (res->Y && !(out->Y = repair_points_to_user(&fx->S, res->Y))) ||
-        (res->Yt && !(out->Yt = repair_points_to_user(&fx->T, res->Yt)))) {
-        ectm_result_close(out);
-        return errbuf_set(err, errsz, CORR_ENOMEM, "the result in the mesh's own indexing: out of "
-                          "memory");
-    }
-    return CORR_OK;
 }

@@ -60,8 +60,7 @@ void repair_mesh_close(repair_mesh *r)
     memset(r, 0, sizeof *r);
 }
 
-/* What no repair fixes: a bad index, a coordinate that is not a number. */
-static int unrepairable(const mesh *u, const char *name, char *err, size_t errsz)
+int repair_mesh_check(const mesh *u, const char *name, char *err, size_t errsz)
 {
     for (int t = 0; t < u->nf; t++)
         for (int k = 0; k < 3; k++) {
@@ -82,7 +81,7 @@ static int unrepairable(const mesh *u, const char *name, char *err, size_t errsz
 int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
-    int rc = unrepairable(u, name, err, errsz);
+    int rc = repair_mesh_check(u, name, err, errsz);
     if (rc)
         return rc;
     const int nv = u->nv, nf = u->nf;

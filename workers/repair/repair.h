@@ -96,6 +96,9 @@ typedef struct repair_mesh {
  * 0). name prefixes messages. REPAIR_OK, REPAIR_EMESH or REPAIR_ENOMEM. */
 int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err, size_t errsz);
 void repair_mesh_close(repair_mesh *r);
+/* What no repair fixes, the first check of repair_mesh_run: a face index
+ * out of range, a NaN or infinite coordinate. REPAIR_OK or REPAIR_EMESH. */
+int repair_mesh_check(const mesh *u, const char *name, char *err, size_t errsz);
 
 /* --- the steps (used by repair_mesh_run; declared for the tests) --- */
 
