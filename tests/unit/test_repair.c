@@ -4,14 +4,18 @@
  * degenerate, duplicate and flipped faces) are repaired, reported, matched
  * against their clean original by the real pipeline with error <= 0.01
  * against the identity, and every input vertex gets a row; with repair off
- * the job is refused as before. */
+ * the job is refused as before; a coarse mesh matches its fine subdivision
+ * with no repair (coarse to fine); `meshcorr info` and `meshcorr fix` show
+ * and write the repair. */
 #include "support/harness.h"
 #include "support/testmesh.h"
+#include "support/testrun.h"
 #include "corr/corr.h"
 #include "geo/geo_area.h"
 #include "mesh/mesh_check.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -309,3 +313,91 @@ TEST(repair_off_refuses_as_before)
     mesh_free(c);
 }
 
+
+/* Different resolutions need no repair: coarse to fine matches a mesh of
+ * about 1000 vertices onto a bent copy of it subdivided twice (about
+ * 16000, over twice the coarse size, so the chain runs on its decimated
+ * copy); the subdivision keeps the coarse vertices as its first ones, so
+ * the identity of those is the ground truth. */
+TEST_T(a_coarse_mesh_matches_its_fine_subdivision_through_coarse_to_fine, 900)
+{
+    mesh *c = testmesh_spheroid(2.5, 30, 34);
+    mesh *f1 = testmesh_subdivided(c), *f = testmesh_subdivided(f1);
+    mesh_free(f1);
+    CHECK(c && f);
+    for (int i = 0; i < f->nv; i++) {
+        double *p = f->v + 3 * i;
+        p[0] += 0.15 * sin(p[2]);
+    }
+    printf("  %d vertices onto %d\n", c->nv, f->nv);
+    CHECK(c->nv < 1100 && f->nv > 15000);
+    int lm[16];
+    for (int k = 0; k < 8; k++)
+        lm[k] = lm[8 + k] = (int)((long)k * (c->nv - 1) / 7);
+    lmk_set L = { 8, lm, lm + 8 };
+    corr_input in = { c, f, "coarse", "fine", &L, NULL, NULL, NULL, CORR_STAGES_ALL, 0,
+                      CORR_DDM_AUTO };
+    CHECK(corr_coarse_wanted(&in));
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 40;
+    ectm_result res;
+    char err[2048];
+    if (corr_run(&in, &p, NULL, NULL, &res, err, sizeof err))
+        FAILF("corr_run: %s", err);
+    messy x = { c, NULL, c->nv };
+    int *orig = malloc(sizeof(int) * (size_t)c->nv);
+    for (int i = 0; i < c->nv; i++)
+        orig[i] = i;
+    x.orig = orig;
+    double e = identity_error(&x, f, res.P);
+    printf("  identity error %.5f\n", e);
+    CHECK(e <= 0.01);
+    free(orig);
+    ectm_result_close(&res);
+    mesh_free(c);
+    mesh_free(f);
+}
+
+/* `meshcorr info` says what the repair would do; `meshcorr fix` writes a
+ * mesh the optimizer takes, with the vertex map back to the input. */
+TEST(info_and_fix_show_and_write_the_repair)
+{
+    mesh *c = clean();
+    messy x = seam(c);
+    char in[600], fixed[600], vm[600], err[512], out[8192];
+    snprintf(in, sizeof in, "%s/seam.off", harness_tmpdir());
+    snprintf(fixed, sizeof fixed, "%s/fixed.ply", harness_tmpdir());
+    snprintf(vm, sizeof vm, "%s/fixed.vmap", harness_tmpdir());
+    CHECK_INT(mesh_write(in, x.m, err, sizeof err), 0);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr info %s 2>&1", in), 1);
+    CHECK_STR_HAS(out, "the optimizer cannot use this mesh as given");
+    CHECK_STR_HAS(out, "a job repairs it");
+    CHECK_STR_HAS(out, "vertices welded to another at the same position");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr fix %s %s --vertex-map %s 2>&1", in, fixed, vm),
+              0);
+    CHECK_STR_HAS(out, "seam.off: repaired:");
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr info %s 2>&1", fixed), 0);
+    mesh *r = NULL;
+    CHECK_INT(mesh_read(fixed, &r, err, sizeof err), 0);
+    CHECK_INT(r->nv, c->nv);
+    FILE *fp = fopen(vm, "r");
+    CHECK(fp);
+    int v, n = 0;
+    while (fscanf(fp, "%d", &v) == 1) {      /* each output vertex sits where its input vertex does */
+        CHECK(v >= 0 && v < x.m->nv);
+        CHECK(memcmp(r->v + 3 * n, x.m->v + 3 * v, 3 * sizeof(double)) == 0);
+        n++;
+    }
+    fclose(fp);
+    CHECK_INT(n, r->nv);
+    /* nothing to repair: written as it is */
+    snprintf(in, sizeof in, "%s/clean.off", harness_tmpdir());
+    CHECK_INT(mesh_write(in, c, err, sizeof err), 0);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr fix %s %s 2>&1", in, fixed), 0);
+    CHECK_STR_HAS(out, "nothing to repair");
+    mesh_free(r);
+    free(x.orig);
+    mesh_free(x.m);
+    mesh_free(c);
+}
