@@ -510,6 +510,30 @@ def case_match_in_process_equals_the_daemons_job():
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
+def case_repair_record_and_keyword():
+    """The input repair: a mesh with a face written twice and a stray
+    triangle beside it is repaired alike by the daemon and by match():
+    result.repair says what was done, p has a row per vertex given; a job
+    whose meshes need nothing has no record; repair="no" refuses the mesh."""
+    c = meshcorr.Client(UNIX)
+    V, F = read_off(SRC)
+    nv = len(V)
+    Vb = np.vstack([V, [[3.0, 0, 0], [3.0, 1, 0], [3.0, 0, 1]]])
+    Fb = np.vstack([F, F[:1], [[nv, nv + 1, nv + 2]]])
+    job = c.submit((Vb, Fb), TGT, landmarks=LANDMARKS, **JOB)
+    assert job.wait() == "COMPLETED", job.reason
+    remote = job.result()
+    local = meshcorr.match((Vb, Fb), TGT, landmarks=LANDMARKS, **JOB)
+    rec = remote.repair
+    assert rec["source"]["duplicate_faces"] == 1 and rec["source"]["pieces"] == 1, rec
+    assert rec["source"]["piece_vertices"] == 3 and not any(rec["target"].values()), rec
+    assert local.repair == rec and local.p == remote.p and len(remote.p) == nv + 3
+    assert meshcorr.match(SRC, TGT, landmarks=LANDMARKS, **JOB).repair is None
+    for fn in (c.submit, meshcorr.match):
+        expect_error(-19, "BAD_MESH", fn, (Vb, Fb), TGT, landmarks=LANDMARKS, repair="no", **JOB,
+                     has="duplicate faces")
+
+
 def case_reprs_and_type_hints():
     """10: the reprs say what the object is; every public function's hints
     resolve; the package says it is typed (py.typed)."""

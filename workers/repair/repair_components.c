@@ -3,6 +3,7 @@
  * surface: the piece of largest area is kept; a vertex on another piece,
  * or in no face, takes the map of the nearest kept vertex. */
 #include "repair/repair.h"
+#include "repair/repair__sort.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -75,7 +76,10 @@ int repair_nearest(const double *p, int np, const double *q, int nq, int *out)
         return -1;
     for (int i = 0; i < np; i++)
         o[i] = i;
-    qsort_r(o, (size_t)np, sizeof *o, by_x, (void *)p);
+    if (repair__sort(o, (size_t)np, sizeof *o, by_x, (void *)p)) {
+        free(o);
+        return -1;
+    }
     for (int j = 0; j < nq; j++) {
         const double *x = q + 3 * (size_t)j;
         int lo = 0, hi = np;                 /* first sorted point with p.x >= x.x */

@@ -1,10 +1,12 @@
 /* repair_edges.c — the sorted half-edge table of repair__edges.h. */
 #include "repair/repair__edges.h"
+#include "repair/repair__sort.h"
 
 #include <stdlib.h>
 
-static int half_cmp(const void *x, const void *y)
+static int half_cmp(const void *x, const void *y, void *ctx)
 {
+    (void)ctx;
     const repair__half *p = x, *q = y;
     if (p->a != q->a)
         return p->a < q->a ? -1 : 1;
@@ -23,7 +25,10 @@ repair__half *repair__edges(const int *f, int nf)
             int x = f[3 * (size_t)t + k], y = f[3 * (size_t)t + (k + 1) % 3];
             h[3 * (size_t)t + k] = (repair__half){ x < y ? x : y, x < y ? y : x, t, k, x < y };
         }
-    qsort(h, 3 * (size_t)nf, sizeof *h, half_cmp);
+    if (repair__sort(h, 3 * (size_t)nf, sizeof *h, half_cmp, NULL)) {
+        free(h);
+        return NULL;
+    }
     return h;
 }
 

@@ -4,6 +4,7 @@
  * elastic energy's reference metric singular; a second face on the same
  * three vertices makes an edge non-manifold. The first of duplicates stays. */
 #include "repair/repair.h"
+#include "repair/repair__sort.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -31,8 +32,9 @@ static int degenerate(const double *v, const int *f)
 
 typedef struct tri { int s[3]; int t; } tri;
 
-static int tri_cmp(const void *a, const void *b)
+static int tri_cmp(const void *a, const void *b, void *ctx)
 {
+    (void)ctx;
     const tri *x = a, *y = b;
     for (int k = 0; k < 3; k++)
         if (x->s[k] != y->s[k])
@@ -71,7 +73,11 @@ int repair_faces(const double *v, int nv, int *f, int *id, int nf, int *ndegener
         sort3(k[nk].s);
         k[nk++].t = t;
     }
-    qsort(k, (size_t)nk, sizeof *k, tri_cmp);
+    if (repair__sort(k, (size_t)nk, sizeof *k, tri_cmp, NULL)) {
+        free(drop);
+        free(k);
+        return -1;
+    }
     for (int i = 1; i < nk; i++)
         if (memcmp(k[i].s, k[i - 1].s, sizeof k[i].s) == 0) {   /* sorted by face: later one */
             drop[k[i].t] = 1;

@@ -4,6 +4,7 @@
  * purpose. Whether a weld stays is repair_split's decision (a weld that
  * makes a pinch is split again). */
 #include "repair/repair.h"
+#include "repair/repair__sort.h"
 
 #include <stdlib.h>
 
@@ -26,7 +27,10 @@ int repair_weld(const mesh *u, int *rep)
         return -1;
     for (int i = 0; i < u->nv; i++)
         order[i] = rep[i] = i;
-    qsort_r(order, (size_t)u->nv, sizeof *order, by_position, u->v);
+    if (repair__sort(order, (size_t)u->nv, sizeof *order, by_position, u->v)) {
+        free(order);
+        return -1;
+    }
     int welded = 0;
     for (int a = 0; a < u->nv;) {
         int b = a + 1;
