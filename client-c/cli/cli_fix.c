@@ -67,7 +67,7 @@ int cli_fix(int argc, char **argv)
     }
     repair_mesh r;
     int status = 1;
-    if (repair_mesh_run(m, pos[0], &r, err, sizeof err)) {
+    if (repair_mesh_run(m, pos[0], NULL, &r, err, sizeof err)) {
         fprintf(stderr, "meshcorr fix: %s\n", err);
         mesh_free(m);
         return 1;

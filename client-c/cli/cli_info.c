@@ -16,7 +16,7 @@ static void print_repair(const mesh *m, const char *path)
 {
     repair_mesh rm;
     char err[1024], text[2048], prefix[1100];
-    if (repair_mesh_run(m, path, &rm, err, sizeof err)) {
+    if (repair_mesh_run(m, path, NULL, &rm, err, sizeof err)) {
         fprintf(stderr, "meshcorr info: %s\n", err);
         return;
     }

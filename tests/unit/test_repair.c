@@ -4,7 +4,8 @@
  * degenerate, duplicate and flipped faces) are repaired, reported, matched
  * against their clean original by the real pipeline with error <= 0.01
  * against the identity, and every input vertex gets a row; with repair off
- * the job is refused as before; a coarse mesh matches its fine subdivision
+ * the job is refused as before; pieces the landmarks pair are matched pair
+ * by pair; a coarse mesh matches its fine subdivision
  * with no repair (coarse to fine); `meshcorr info` and `meshcorr fix` show
  * and write the repair. */
 #include "support/harness.h"
@@ -180,7 +181,7 @@ TEST(a_clean_mesh_comes_out_as_it_went_in)
     mesh *c = clean();
     repair_mesh r;
     char err[512];
-    CHECK_INT(repair_mesh_run(c, "clean", &r, err, sizeof err), REPAIR_OK);
+    CHECK_INT(repair_mesh_run(c, "clean", NULL, &r, err, sizeof err), REPAIR_OK);
     CHECK(!repair_counts_any(&r.n));
     CHECK_INT(r.m->nv, c->nv);
     CHECK_INT(r.m->nf, c->nf);
@@ -198,11 +199,11 @@ TEST(what_cannot_be_repaired_is_refused_with_the_reason)
     repair_mesh r;
     char err[512];
     c->v[3 * 5 + 1] = NAN;
-    CHECK_INT(repair_mesh_run(c, "m.off", &r, err, sizeof err), REPAIR_EMESH);
+    CHECK_INT(repair_mesh_run(c, "m.off", NULL, &r, err, sizeof err), REPAIR_EMESH);
     CHECK_STR_HAS(err, "m.off: vertex 5 has a NaN or infinite coordinate");
     c->v[3 * 5 + 1] = 0;
     c->f[7] = c->nv + 3;
-    CHECK_INT(repair_mesh_run(c, "m.off", &r, err, sizeof err), REPAIR_EMESH);
+    CHECK_INT(repair_mesh_run(c, "m.off", NULL, &r, err, sizeof err), REPAIR_EMESH);
     CHECK_STR_HAS(err, "m.off: face 2 has vertex index");
     mesh_free(c);
 }
@@ -217,7 +218,7 @@ TEST(each_kind_of_mess_is_repaired_and_counted)
         messy x = make[k](c);
         repair_mesh r;
         char err[2048];
-        CHECK_INT(repair_mesh_run(x.m, "messy", &r, err, sizeof err), REPAIR_OK);
+        CHECK_INT(repair_mesh_run(x.m, "messy", NULL, &r, err, sizeof err), REPAIR_OK);
         if (corr_validate(r.m, "repaired", err, sizeof err))
             FAILF("case %d: %s", k, err);
         const repair_counts *n = &r.n;
@@ -399,5 +400,87 @@ TEST(info_and_fix_show_and_write_the_repair)
     mesh_free(r);
     free(x.orig);
     mesh_free(x.m);
+    mesh_free(c);
+}
+
+/* Two shapes side by side: the bent sphere and a small sphere beside it. */
+static mesh *two_pieces(void)
+{
+    mesh *a = clean(), *b = testmesh_icosphere(2);
+    mesh *m = mesh_new(a->nv + b->nv, a->nf + b->nf);
+    CHECK(m != NULL);
+    memcpy(m->v, a->v, sizeof(double) * 3 * (size_t)a->nv);
+    memcpy(m->f, a->f, sizeof(int) * 3 * (size_t)a->nf);
+    for (int i = 0; i < b->nv; i++) {
+        m->v[3 * (a->nv + i)] = 0.6 * b->v[3 * i] * 1.2 + 3;
+        m->v[3 * (a->nv + i) + 1] = 0.6 * b->v[3 * i + 1];
+        m->v[3 * (a->nv + i) + 2] = 0.6 * b->v[3 * i + 2] * (1 + 0.3 * b->v[3 * i]);
+    }
+    for (int c = 0; c < 3 * b->nf; c++)
+        m->f[3 * a->nf + c] = b->f[c] + a->nv;
+    mesh_free(a);
+    mesh_free(b);
+    return m;
+}
+
+/* Landmarks on both pieces pair them: each pair is matched on its own and
+ * every vertex of both lands near its own; with landmarks on the large
+ * piece only, the small one is left out and carried by the nearest point. */
+TEST_T(pieces_the_landmarks_pair_are_matched_piece_by_piece, 600)
+{
+    mesh *c = two_pieces();
+    mesh *T = bent(c);
+    int big = 642, lm[12] = { 0, 100, 200, 300, 400, 500, 600, 640, big + 0, big + 40, big + 90,
+                              big + 150 };
+    for (int round = 0; round < 2; round++) {
+        int nl = round == 0 ? 12 : 8;            /* 8: the large piece's only */
+        int pairs[24];
+        memcpy(pairs, lm, (size_t)nl * sizeof(int));
+        memcpy(pairs + nl, lm, (size_t)nl * sizeof(int));
+        lmk_set L = { nl, pairs, pairs + nl };
+        /* a stray triangle makes the source need repair at all */
+        mesh *S = mesh_new(c->nv + 3, c->nf + 1);
+        memcpy(S->v, c->v, sizeof(double) * 3 * (size_t)c->nv);
+        memcpy(S->f, c->f, sizeof(int) * 3 * (size_t)c->nf);
+        double tri[9] = { 0, 5, 0, 0.1, 5, 0, 0, 5.1, 0 };
+        memcpy(S->v + 3 * c->nv, tri, sizeof tri);
+        int tf[3] = { c->nv, c->nv + 1, c->nv + 2 };
+        memcpy(S->f + 3 * c->nf, tf, sizeof tf);
+        corr_input user = { S, T, "two", "bent", &L, NULL, NULL, NULL, CORR_STAGES_ALL, 0,
+                            CORR_DDM_AUTO }, in;
+        corr_fix fx;
+        char err[4096];
+        if (corr_fix_open(&user, 1, &fx, &in, err, sizeof err))
+            FAILF("%s", err);
+        ectm_params p;
+        ectm_params_init(&p);
+        p.iterations = 40;
+        ectm_result res, back;
+        if (corr_run(&in, &p, NULL, NULL, &res, err, sizeof err))
+            FAILF("corr_run: %s", err);
+        if (corr_fix_to_user(&fx, &res, &back, err, sizeof err))
+            FAILF("%s", err);
+        CHECK_INT(back.P->n, S->nv);
+        int *orig = malloc(sizeof(int) * (size_t)S->nv);
+        for (int i = 0; i < S->nv; i++)
+            orig[i] = i < c->nv ? i : 0;
+        messy whole = { S, orig, c->nv }, large = { S, orig, big };
+        double e = identity_error(&whole, T, back.P), el = identity_error(&large, T, back.P);
+        printf("  landmarks on %s: pieces left out %d + %d; identity error %.5f (large piece %.5f)\n",
+               round == 0 ? "both pieces" : "the large piece", fx.S.n.pieces, fx.T.n.pieces, e, el);
+        if (round == 0) {
+            CHECK(fx.S.n.pieces == 1 && fx.T.n.pieces == 0);   /* the stray triangle only */
+            CHECK(e <= 0.01);
+        } else {
+            CHECK(fx.S.n.pieces == 2 && fx.T.n.pieces == 1);
+            CHECK(el <= 0.01 && e > 0.02);                     /* the small piece carried */
+        }
+        free(orig);
+        ectm_result_close(&res);
+        ectm_result_close(&back);
+        corr_fix_close(&fx);
+        mesh_free(S);
+    }
+    mesh_free(T);
     mesh_free(c);
 }

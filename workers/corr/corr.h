@@ -196,7 +196,11 @@ int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
  * repaired, both go through repair_mesh_run (a usable one comes out the
  * same), the landmarks and uploaded maps are carried into the repaired
  * indexing (repair_landmarks, repair_map_from_user) and the results back
- * (corr_fix_to_user). */
+ * (corr_fix_to_user). Pieces: without a given map, when the landmarks pair
+ * pieces of the two meshes (repair_pieces_pair: at least
+ * PROTO_MIN_LANDMARKS on a piece, all landing on one piece of the other
+ * mesh), those pieces are kept and corr_run matches each pair on its own;
+ * else the largest piece of each is kept. */
 typedef struct corr_fix {
     int repaired;            /* 1 when either mesh was repaired             */
     repair_mesh S, T;        /* when repaired: both meshes' repairs          */
@@ -311,6 +315,10 @@ void corr_coarse_close(corr_coarse *c);
 double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, size_t wsz);
 
 /* Runs the pipeline: the stages of in->stages (corr_stages_check first).
+ * Meshes in pieces that in->L pairs one to one (no given map) run pair by
+ * pair, each pair's share of the progress by its vertices, and the maps
+ * are joined (corr__pieces.h); pieces the landmarks do not pair are
+ * CORR_EMESH.
  * When the chain ends before ECTM, out->P and out->Q are the last stage's
  * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
  * the model is bijective) and out->Y, out->Yt, out->last stay empty. */

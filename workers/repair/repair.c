@@ -57,6 +57,7 @@ void repair_mesh_close(repair_mesh *r)
     free(r->rep);
     free(r->row);
     free(r->carried);
+    free(r->piece);
     memset(r, 0, sizeof *r);
 }
 
@@ -78,7 +79,10 @@ int repair_mesh_check(const mesh *u, const char *name, char *err, size_t errsz)
     return REPAIR_OK;
 }
 
-int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err, size_t errsz)
+const unsigned char REPAIR_ALL_PIECES[1];
+
+int repair_mesh_run(const mesh *u, const char *name, const unsigned char *pick, repair_mesh *out,
+                    char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
     int rc = repair_mesh_check(u, name, err, errsz);
@@ -92,11 +96,12 @@ int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err
     int *id = malloc(sizeof *id * ((size_t)nf + 1));
     int *sf = NULL, *svert = NULL, snv = 0;
     unsigned char *keep = malloc((size_t)nf + 1);
+    int *piece = malloc(sizeof *piece * ((size_t)nf + 1));
     int *renum = NULL, *owner = NULL;
     out->rep = malloc(sizeof *out->rep * ((size_t)nv + 1));
     out->row = malloc(sizeof *out->row * ((size_t)nv + 1));
     out->carried = calloc((size_t)nv + 1, 1);
-    if (!f || !id || !keep || !out->rep || !out->row || !out->carried)
+    if (!f || !id || !keep || !piece || !out->rep || !out->row || !out->carried)
         goto nomem;
 
     /* weld, then the faces on the welded vertices */
@@ -121,11 +126,15 @@ int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err
         goto nomem;
     (void)conflicts;     /* cut by repair_split, counted in split_edges */
 
-    /* the largest piece; its vertices renumbered in order */
-    int pieces = repair_components(u->v, snv, sf, m, keep);
+    /* the pieces kept; their vertices renumbered in order */
+    int pieces = repair_components(u->v, snv, sf, m, piece);
     if (pieces < 0 || !(renum = malloc(sizeof *renum * ((size_t)snv + 1))))
         goto nomem;
-    n->pieces = pieces > 1 ? pieces - 1 : 0;
+    out->npieces = pieces;
+    for (int p = 0; p < pieces; p++)
+        n->pieces += !(pick == REPAIR_ALL_PIECES || (pick ? pick[p] != 0 : p == 0));
+    for (int t = 0; t < m; t++)
+        keep[t] = pick == REPAIR_ALL_PIECES || (pick ? pick[piece[t]] != 0 : piece[t] == 0);
     for (int i = 0; i < snv; i++)
         renum[i] = -1;
     int kf = 0, kv = 0;
@@ -138,9 +147,14 @@ int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err
     for (int i = 0; i < snv; i++)
         if (renum[i] == 0)
             renum[i] = kv++;
+    if (kf == 0) {
+        rc = errbuf_set(err, errsz, REPAIR_EMESH, "%s: none of its %d pieces is kept", name, pieces);
+        goto fail;
+    }
     if (!(out->m = mesh_new(kv, kf)) || !(out->vert = malloc(sizeof(int) * ((size_t)kv + 1))) ||
         !(out->face = malloc(sizeof(int) * ((size_t)kf + 1))) ||
-        !(out->corner = malloc(3 * (size_t)kf + 1)))
+        !(out->corner = malloc(3 * (size_t)kf + 1)) ||
+        !(out->piece = malloc(sizeof(int) * ((size_t)kv + 1))))
         goto nomem;
     for (int i = 0; i < snv; i++)
         if (renum[i] >= 0) {
@@ -149,8 +163,10 @@ int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err
         }
     for (int t = 0, j = 0; t < m; t++)
         if (keep[t]) {
-            for (int k = 0; k < 3; k++)
+            for (int k = 0; k < 3; k++) {
                 out->m->f[3 * (size_t)j + k] = renum[sf[3 * (size_t)t + k]];
+                out->piece[renum[sf[3 * (size_t)t + k]]] = piece[t];
+            }
             out->face[j++] = id[t];
         }
 
@@ -222,6 +238,7 @@ int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err
     free(sf);
     free(svert);
     free(keep);
+    free(piece);
     free(renum);
     free(owner);
     return REPAIR_OK;
@@ -234,6 +251,7 @@ fail:
     free(sf);
     free(svert);
     free(keep);
+    free(piece);
     free(renum);
     free(owner);
     repair_mesh_close(out);

@@ -16,9 +16,12 @@
  *                     vertex gets one copy per fan of faces around it; a
  *                     weld that made a pinch is undone here, so welds stay
  *                     only where they keep the mesh manifold
- *   repair_components.c  the largest piece (by area) is kept; vertices of
- *                     the others and unreferenced ones are carried by the
- *                     nearest kept vertex
+ *   repair_components.c  the largest piece (by area) is kept, or the pieces
+ *                     the caller names; vertices of the others and
+ *                     unreferenced ones are carried by the nearest kept
+ *                     vertex
+ *   repair_pairs.c    which kept piece goes with which, by the landmarks
+ *                     (the engine then matches each pair on its own)
  *   repair_index.c    results back into the user's indexing, landmarks and
  *                     uploaded maps into the engine's
  * Holes stay boundaries (the engine handles open meshes).
@@ -88,13 +91,21 @@ typedef struct repair_mesh {
                          vertex                                                */
     unsigned char *carried; /* nv_user: 1 when u was dropped (row is another
                                point's)                                        */
+    int npieces;      /* the pieces of the repaired surface, kept or not   */
+    int *piece;       /* m->nv: the piece of each vertex                       */
     repair_counts n;
 } repair_mesh;
 
 /* Repairs u into out (every step above; a mesh that needs nothing comes
  * out with the same vertices and faces in the same order and all counts
- * 0). name prefixes messages. REPAIR_OK, REPAIR_EMESH or REPAIR_ENOMEM. */
-int repair_mesh_run(const mesh *u, const char *name, repair_mesh *out, char *err, size_t errsz);
+ * 0). The pieces kept: with keep NULL the largest; else piece p (of
+ * out->npieces, numbered by decreasing area, as a first run with
+ * REPAIR_ALL_PIECES tells them) when keep[p] is non-zero, or every piece
+ * when keep is REPAIR_ALL_PIECES. name prefixes messages. REPAIR_OK,
+ * REPAIR_EMESH or REPAIR_ENOMEM. */
+extern const unsigned char REPAIR_ALL_PIECES[];
+int repair_mesh_run(const mesh *u, const char *name, const unsigned char *keep, repair_mesh *out,
+                    char *err, size_t errsz);
 void repair_mesh_close(repair_mesh *r);
 /* What no repair fixes, the first check of repair_mesh_run: a face index
  * out of range, a NaN or infinite coordinate. REPAIR_OK or REPAIR_EMESH. */
@@ -131,9 +142,16 @@ int repair_split(int nv, const int *f, int nf, int **out_f, int **out_vert, int 
                  int *split_edges, int *split_vertices);
 
 /* repair_components.c: the faces' pieces (connected through shared
- * vertices); keep[t] = 1 for the faces of the piece of largest area.
- * Returns the number of pieces, -1 without memory. */
-int repair_components(const double *v, int nv, const int *f, int nf, unsigned char *keep);
+ * vertices), numbered by decreasing area: piece[t] of each face, 0 the
+ * largest. Returns the number of pieces, -1 without memory. */
+int repair_components(const double *v, int nv, const int *f, int nf, int *piece);
+
+/* repair_pairs.c: the pieces landmarks pair. Landmark k joins piece
+ * ps[k] of the first mesh (ns pieces) and piece pt[k] of the second (nt);
+ * -1 leaves it out. Piece s gets pair[s] = t when all its landmarks land
+ * on piece t, at least min of them, and no other piece's all do; else -1.
+ * Returns the number of pairs, -1 without memory. */
+int repair_pieces_pair(const int *ps, const int *pt, int n, int ns, int nt, int min, int *pair);
 
 /* repair_components.c: for each of the nq query points q (nq by 3), the
  * index of the nearest of the np points p (np >= 1), Euclidean. -1 without

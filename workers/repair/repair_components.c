@@ -1,7 +1,7 @@
-/* repair_components.c — the piece that is matched, and the nearest kept
- * point for what is left out (repair.h). The engine matches one connected
- * surface: the piece of largest area is kept; a vertex on another piece,
- * or in no face, takes the map of the nearest kept vertex. */
+/* repair_components.c — the pieces of a mesh, largest first, and the
+ * nearest kept point for what is left out (repair.h). The engine matches
+ * connected surfaces: the pieces kept are matched, a vertex on another
+ * piece, or in no face, takes the map of the nearest kept vertex. */
 #include "repair/repair.h"
 #include "repair/repair__sort.h"
 
@@ -27,37 +27,62 @@ static double area(const double *v, const int *f)
     return 0.5 * sqrt(c0 * c0 + c1 * c1 + c2 * c2);
 }
 
-int repair_components(const double *v, int nv, const int *f, int nf, unsigned char *keep)
+/* A piece and its area, for the order by decreasing area (ties: the
+ * piece whose first face comes first). */
+typedef struct piece_area { int k; double a; } piece_area;
+
+static int by_area(const void *x, const void *y, void *ctx)
+{
+    (void)ctx;
+    const piece_area *p = x, *q = y;
+    if (p->a != q->a)
+        return p->a > q->a ? -1 : 1;
+    return (p->k > q->k) - (p->k < q->k);
+}
+
+int repair_components(const double *v, int nv, const int *f, int nf, int *piece)
 {
     int *par = malloc(sizeof *par * ((size_t)nv + 1));
-    double *a = calloc((size_t)nv + 1, sizeof *a);
-    if (!par || !a) {
-        free(par);
-        free(a);
-        return -1;
-    }
-    for (int i = 0; i < nv; i++)
+    int *label = malloc(sizeof *label * ((size_t)nv + 1));
+    int *rank = NULL;
+    piece_area *pa = NULL;
+    int np = 0, rc = -1;
+    if (!par || !label)
+        goto out;
+    for (int i = 0; i < nv; i++) {
         par[i] = i;
+        label[i] = -1;
+    }
     for (int t = 0; t < nf; t++)
         for (int k = 1; k < 3; k++) {
             int x = find(par, f[3 * (size_t)t]), y = find(par, f[3 * (size_t)t + k]);
             if (x != y)
                 par[x < y ? y : x] = x < y ? x : y;
         }
-    int pieces = 0, best = -1;
+    for (int t = 0; t < nf; t++) {
+        int r = find(par, f[3 * (size_t)t]);
+        if (label[r] < 0)
+            label[r] = np++;
+    }
+    if (!(pa = calloc((size_t)np + 1, sizeof *pa)) || !(rank = malloc(sizeof *rank * ((size_t)np + 1))))
+        goto out;
+    for (int k = 0; k < np; k++)
+        pa[k].k = k;
     for (int t = 0; t < nf; t++)
-        a[find(par, f[3 * (size_t)t])] += area(v, f + 3 * (size_t)t);
-    for (int i = 0; i < nv; i++)
-        if (find(par, i) == i && a[i] > 0) {
-            pieces++;
-            if (best < 0 || a[i] > a[best])
-                best = i;
-        }
+        pa[label[find(par, f[3 * (size_t)t])]].a += area(v, f + 3 * (size_t)t);
+    if (repair__sort(pa, (size_t)np, sizeof *pa, by_area, NULL))
+        goto out;
+    for (int i = 0; i < np; i++)
+        rank[pa[i].k] = i;
     for (int t = 0; t < nf; t++)
-        keep[t] = find(par, f[3 * (size_t)t]) == best;
+        piece[t] = rank[label[find(par, f[3 * (size_t)t])]];
+    rc = np;
+out:
     free(par);
-    free(a);
-    return pieces;
+    free(label);
+    free(rank);
+    free(pa);
+    return rc;
 }
 
 static int by_x(const void *a, const void *b, void *ctx)
