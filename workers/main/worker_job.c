@@ -58,12 +58,16 @@ static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 }
 
 /* A chain of stages that can run on the inputs (corr_stages_check); after
- * the landmarks are read, so that their own rule speaks first. */
-static int check_stages(const proto_submit *s, char *err, size_t errsz)
+ * the landmarks are read, so that their own rule speaks first, and with
+ * the landmarks the run will have (a repair leaves out those on vertices
+ * it dropped). */
+static int check_stages(const proto_submit *s, const wrk_job *job, char *err, size_t errsz)
 {
     char why[256];
+    corr_input in;
+    wrk_job_input(job, &in);
     int rc = corr_stages_check((corr_stages)s->params.stages, s->p.n > 0, s->q.n > 0,
-                               (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
+                               in.L ? in.L->n : 0, s->params.model == PROTO_MODEL_INJECTIVE,
                                s->params.rhm_landmark_weight, (corr_ddm_mode)s->params.ddm_mode,
                                why, sizeof why);
     return rc ? errbuf_set(err, errsz, corr_wire_code(rc), "params.stages: %s", why) : 0;
@@ -164,7 +168,7 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
         (rc = map_map(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
         (rc = map_map(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
         (rc = fix_meshes(job, err, errsz)) ||
-        (rc = check_stages(s, err, errsz)) ||
+        (rc = check_stages(s, job, err, errsz)) ||
         (rc = check_sizes(job, err, errsz))) {
         wrk_job_close(job);
         return rc;
