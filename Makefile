@@ -30,7 +30,7 @@ CPPFLAGS += -DMC_VERSION='"$(MC_VERSION)"'
 PIC      = -fPIC -fno-semantic-interposition
 CFLAGS   += -std=c11 $(OPT) $(WARN) $(PIC) -fopenmp -pthread
 CXXFLAGS += -std=c++17 $(OPT) $(WARN) $(PIC) -pthread $(shell pkg-config --cflags draco)
-LDLIBS   += $(shell pkg-config --libs $(PKGS) gnutls libseccomp) -lembree3 -lOpenMeshTools -lOpenMeshCore -lcholmod -larpack -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
+LDLIBS   += $(shell pkg-config --libs $(PKGS) gnutls libseccomp) -lembree3 -lOpenMeshTools -lOpenMeshCore -lcholmod -larpack -llapacke -llapack -lOpenCL -lm -lstdc++ -fopenmp -pthread
 
 # The engine library: everything under workers/ except the worker main.
 ENGINE_C   := $(filter-out workers/main/%,$(wildcard workers/*/*.c))
@@ -232,7 +232,7 @@ install-man:
 # The documentation, where the unit's Documentation= points, in the
 # repository's own layout so that the pages' links to each other work.
 DOCDIR ?= $(PREFIX)/share/doc/meshcorr
-DOCS   := README.md $(wildcard docs/*.md) protocol/PROTOCOL.md daemon/README.md daemon/MODBUS.md
+DOCS   := README.md $(wildcard docs/*.md) protocol/PROTOCOL.md daemon/README.md daemon/MODBUS.md workers/WORKER.md
 install: install-doc
 install-doc:
 	set -e; for f in $(DOCS); do d=$(DESTDIR)$(DOCDIR)/$$(dirname $$f); \

@@ -323,10 +323,9 @@ int mc_read_mesh(const char *path, double **v, int *nv, int **f, int *nf, char *
  * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate
  * over the bounding box. Quantizing trades the server's exact view of the
  * mesh for size: each coordinate moves by up to half a step, about
- * bbox / 2^(bits + 1), and the blob shrinks (wolf0, 4344 vertices: 156 KB
- * lossless, 72 KB at 16 bits), but the server then computes on other
- * positions than `meshcorr match` reads and its map differs (wolf0 -> wolf1,
- * 2 iterations: every row, mean 1.3e-3 and max 4e-2 of sqrt(area)). */
+ * bbox / 2^(bits + 1), and the blob shrinks, but the server then computes on
+ * other positions than `meshcorr match` reads and its map differs
+ * (docs/decisions.md, "Lossless positions by default"). */
 #define MC_QUANTIZATION_LOSSLESS 0
 #define MC_QUANTIZATION_MAX_BITS 30
 /* mc_encode_mesh_file with quantization_bits; a .drc file is sent as it is

@@ -80,7 +80,6 @@ int bk_prog_listen(mcd *d, const char *hostport, bk_prog_secret_fn fn, void *ctx
 /* Drops job id's connection (it ended). */
 void bk_prog_forget(bk_prog *p, uint64_t id);
 /* Whether job id has a live authenticated connection. */
-int bk_prog_connected(const bk_prog *p, uint64_t id);
 void bk_prog_close(bk_prog *p);
 
 #endif

@@ -319,14 +319,6 @@ void bk_prog_forget(bk_prog *p, uint64_t id)
         }
 }
 
-int bk_prog_connected(const bk_prog *p, uint64_t id)
-{
-    for (prog_conn *c = p ? p->conns : NULL; c; c = c->next)
-        if (c->job_id == id)
-            return 1;
-    return 0;
-}
-
 static void on_listener_closed(uv_handle_t *h)
 {
     bk_prog *p = h->data;

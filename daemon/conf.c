@@ -10,6 +10,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+static int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz);
 #include <unistd.h>
 
 enum kind { K_PATH, K_LISTEN, K_U32, K_INT, K_LONG, K_LEVEL, K_CONFIG, K_ENDPOINT, K_FLAG };
@@ -225,7 +227,7 @@ static char *trim(char *s)
     return s;
 }
 
-int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz)
+static int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz)
 {
     FILE *fp = fopen(path, "r");
     if (!fp)

@@ -61,9 +61,8 @@ int main(int argc, char **argv)
         return 2;
     }
     signal(SIGPIPE, SIG_IGN);
-    /* The workers we spawn inherit it and skip their re-exec: one program
-     * load less per job (bench_daemon's 162-vertex job: overhead 63-66 ->
-     * 51-53 ms). */
+    /* The workers we spawn inherit it and skip their re-exec: one program load
+     * less per job. */
     ompenv_set_passive();
     char vbuf[CONF_PATH + 64];
     const char *validator = conf_validator_path(&d.conf, vbuf, sizeof vbuf);

@@ -149,7 +149,6 @@ void conf_init(mcd_conf *c);
 int conf_parse_args(mcd_conf *c, int argc, char **argv, char *err, size_t errsz);
 /* One option by its long name without dashes ("max-queue", "5"). */
 int conf_set(mcd_conf *c, const char *key, const char *value, char *err, size_t errsz);
-int conf_load_file(mcd_conf *c, const char *path, char *err, size_t errsz);
 void conf_usage(FILE *fp);
 /* The meshcorr-worker program (--worker, or next to meshcorrd) into buf. */
 const char *conf_worker_path(const mcd_conf *c, char *buf, size_t sz);
@@ -638,7 +637,6 @@ int srv_send(conn *c, const proto_msg *m, int drop_if_full);
 /* ERROR frame; close_after: close once it is written. */
 void srv_send_error(conn *c, uint32_t request_id, int code, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
-void srv_close(conn *c);
 /* Stops reading and closes once the queued output is written. */
 void srv_close_soon(conn *c);
 

@@ -166,7 +166,7 @@ static void on_closed(uv_handle_t *h)
         conn_free(c);
 }
 
-void srv_close(conn *c)
+static void srv_close(conn *c)
 {
     if (c->closing)
         return;

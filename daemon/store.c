@@ -26,9 +26,8 @@
  * on the loop (WAL keeps the file consistent); it becomes durable with the
  * next FULL commit (any state change) or checkpoint. After a power loss the
  * last records of a job that was running may be missing; that job runs
- * again from the start anyway (store_recover). Measured on this project's
- * build machine, 500 records: 0.43 ms each as two FULL autocommits, 0.04 ms
- * each now (a disk with a slower fsync widens the gap).
+ * again from the start anyway (store_recover). That keeps an fsync per record
+ * off the loop (docs/decisions.md, "PROGRESS records without an fsync").
  *
  * Tables: jobs (one row per job; state as its Slurm name; the latest outer
  * iteration and energy), history (one row per PROGRESS record), counters

@@ -10,7 +10,7 @@ PACKAGES="
 build-essential pkg-config g++
 libembree-dev
 libdraco-dev draco
-libsuitesparse-dev liblapack-dev libarpack2-dev
+libsuitesparse-dev liblapack-dev liblapacke-dev libarpack2-dev
 libopenmesh-dev
 libcgal-demo
 ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo xxd

@@ -188,7 +188,6 @@ void proto_buf_put_u8(proto_buf *b, uint8_t v);
 void proto_buf_put_u16(proto_buf *b, uint16_t v);
 void proto_buf_put_u32(proto_buf *b, uint32_t v);
 void proto_buf_put_u64(proto_buf *b, uint64_t v);
-void proto_buf_put_f64(proto_buf *b, double v);
 /* Little-endian loads from at least 2/4/8 readable bytes. */
 uint16_t proto_le16(const uint8_t *p);
 uint32_t proto_le32(const uint8_t *p);

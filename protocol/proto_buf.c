@@ -92,13 +92,6 @@ void proto_buf_put_u64(proto_buf *b, uint64_t v)
     proto_buf_put(b, t, 8);
 }
 
-void proto_buf_put_f64(proto_buf *b, double v)
-{
-    uint64_t u;
-    memcpy(&u, &v, 8);
-    proto_buf_put_u64(b, u);
-}
-
 uint16_t proto_le16(const uint8_t *p)
 {
     return (uint16_t)(p[0] | (p[1] << 8));

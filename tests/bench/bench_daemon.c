@@ -268,7 +268,7 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
     testdaemon_stop(&d, SIGTERM);
 }
 
-/* Issue 16's small job: the 162-vertex icosphere pair of testdaemon_submit
+/* A small job: the 162-vertex icosphere pair of testdaemon_submit
  * (6 landmarks, 3 RHM and 2 ECTM iterations), NSMALL times one after the
  * other through the daemon (submit to END, then RESULT), against the same
  * job's corr_run in process (one thread, as the worker picks for this
@@ -276,11 +276,7 @@ TEST_T(daemon_overhead_against_the_in_process_run, 600)
  * spawning the worker, its decode, its threads, the result's write and
  * the round trips. The worker's own elapsed_s (from its start, decode
  * included) splits it in two, and the daemon's log gives the SUBMIT check's
- * share. Quiet, 2 cores, old and new programs alternating (3 runs each):
- * with meshcorr-validate (1ec9192) submit to RESULT 98.1-99.6 ms, overhead
- * 41.0-42.3 ms, the check 6.8-7.1 ms; with meshcorr-worker --validate
- * (72ef333; its first run's in-process figure was disturbed, the other two)
- * 104.3-106.4 ms, 47.3-49.4 ms, 14.0-14.2 ms. */
+ * share. */
 #define NSMALL 10
 
 static int cmp_double(const void *a, const void *b)

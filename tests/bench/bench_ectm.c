@@ -6,29 +6,7 @@
  * ../shared/data/ectm_demo_381_390/README.md) and the paper's 7.5 minutes
  * for 5K-vertex shapes on a GPU; where the time goes; and the speed-up of
  * 2 threads over 1 on the first 30 iterations. Prints figures, never fails
- * on time.
- *
- * Figures seen on this 2-core machine (shared: wall times vary by 2x with
- * the other jobs on it; compare evaluations, energy and uv distance):
- *   before issue 16 (liblbfgs, cold memory each Y-step, always 50 iterations):
- *     300 iterations 76.8 s (projections 4.2 s, L-BFGS 72.3 s), 133.5
- *     evaluations and 100 L-BFGS iterations per outer iteration, final
- *     energy 23.60194198, uv distance 0.00329; 30 iterations 1 thread
- *     8.60 s, 2 threads 8.36 s (1.03x).
- *   issue 16 (own L-BFGS, pairs kept across outer iterations, a Y-step stops
- *   at an iteration that gains < 5 % of the step's total), at 7c2dcc1:
- *   19.3 s under a load average of 6.6 (projections 7.6 s, L-BFGS 11.2 s;
- *   39.3 s at another moment of that load), 20.7 evaluations and 17.1
- *   L-BFGS iterations per outer iteration, final energy 23.50718625, uv
- *   distance 0.00366; 30 iterations 1 thread 3.26 s, 2 threads 3.17 s
- *   (1.03x). Before that fix (pairs reordered, one corrected twice):
- *   20.5 s with one other job running (projections 7.3 s, L-BFGS 12.8 s),
- *   34.1 s with three (projections 16.6 s, L-BFGS 17.0 s); 22.0 evaluations
- *   and 18.2 L-BFGS iterations per outer iteration, final energy
- *   23.3596379, uv distance 0.00324; 30 iterations 1 thread 4.05 s,
- *   2 threads 3.60 s (1.12x, loaded). The same before the two-loop's fused
- *   passes (rounding only): 17.7 s (projections 5.0 s, L-BFGS 12.3 s), 22.5
- *   evaluations, energy 23.56948296, uv distance 0.00392. */
+ * on time. */
 #include "support/harness.h"
 #include "support/testdemo.h"
 #include "ectm/ectm.h"

@@ -1,4 +1,4 @@
-/* bench_large.c — issue 16's large pairs, through corr_run's stages all
+/* bench_large.c — large pairs, through corr_run's stages all
  * with meshcorr match's defaults (start auto, RHM and its repair, ECTM and
  * its repair) and the threads the machine has:
  *
@@ -29,7 +29,7 @@
  * coarse start, "rhm+repair" the coarse RHM, "ectm+repair" both ECTM runs.
  * Options: --ectm-iterations=K, --levels=L (the scaling test's most
  * subdivisions, default 2), --coarse=N (the job parameter; 0: every stage
- * on the meshes as given, as before coarse to fine). Prints figures, never fails on time. */
+ * on the meshes as given). Prints figures, never fails on time. */
 #include "support/harness.h"
 #include "support/testapart.h"
 #include "support/testfit.h"

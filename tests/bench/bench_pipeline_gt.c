@@ -25,31 +25,8 @@
  * iterations and wall time of RHM and ECTM. The RHM paper reports a mean
  * geodesic error of about 0.033 on remeshed FAUST/SCAPE.
  *
- * With the given landmarks pinned in ECTM (566689d), against 72ef333 run
- * just before it (quiet, 2 cores): RHM + ECTM geodesic error FAUST 0.0164 ->
- * 0.0157, 0.0315 -> 0.0283, 0.0176 -> 0.0157, 0.0130 -> 0.0121; cat 0.0196
- * -> 0.0190; Homer 0.0193 -> 0.0184; head 0.0231 -> 0.0215 (RHM: 0.0203,
- * 0.0400, 0.0331, 0.0262, 0.0233, 0.0113, 0.0159); flipped 0.0-0.8 %,
- * collapsed 0 % on every pair both ways.
- * Measured at 5202800 (default 300 ECTM iterations, start auto, fold
- * repair after RHM and after ECTM; about 9 min on 2 loaded cores): FAUST
- * geodesic error RHM 0.0209 / 0.0352 / 0.0349 / 0.0262 (000->001,
- * 002->007, 000->020, 010->020), RHM + ECTM 0.0151 / 0.0300 / 0.0191 /
- * 0.0128; cat 0.0233 -> 0.0197; Homer 0.0113 -> 0.0194 and head 0.0159 ->
- * 0.0223 (ECTM raises them). After ECTM 0.1-0.2 % flipped (002->007:
- * 5.2 % flipped, 0.6 % collapsed) and mean |log a| below RHM's on every
- * pair. At 2d9c8da (liblbfgs, the harmonic repair without its reweighting,
- * the distances start) RHM + ECTM was 0.0189 / 0.0396 / 0.0251 / 0.0195,
- * cat 0.0235, Homer 0.0204, head 0.0226, and the repair of ECTM's maps
- * raised mean |log a| 2-5x on FAUST. Earlier, with --start=voronoi, RHM's
- * FAUST errors were 0.0377 / 0.0605 / 0.0320 / 0.0353, cat 0.0419, Homer
- * 0.0609, head 0.0166.
- * Scale: with --scale=0.01, 4, 100 or 1.0000001 the start and RHM rows
- * are the same to 4 decimals; --scale=4 (exact in floating point) repeats
- * ECTM's row bit for bit, the others move it by up to 0.0005 in geodesic
- * error, 0.04 in |log a| and 1.1 points of collapsed triangles, as much for a
- * 1e-7 change as for a factor 100: 300 alternations amplify rounding, so
- * ECTM's last digits are noise, not a scale dependence.
+ * --scale checks scale invariance: the start and RHM rows do not move;
+ * ECTM's last digits do, as 300 alternations amplify rounding.
  *
  * Options (after the test name, or alone):
  *   --ectm-iterations=K   ECTM outer iterations (default: the engine's 300)

@@ -1,4 +1,4 @@
-/* bench_refine.c — refining published maps (issue 13) on TOSCA_r
+/* bench_refine.c — refining published maps on TOSCA_r
  * non-isometric (../shared/data/tosca_r_nonisometric: gorilla_01 <-> man_01,
  * man_02, woman_01, both directions, 900 GT points) with the pipeline's
  * stage chains (corr.h), the maps read as `meshcorr match --init` reads
@@ -8,61 +8,17 @@
  *    the same method's published reverse map as q) and auto (the default,
  *    with q: bijective when the pair agrees): mean geodesic error
  *    (direct, and the BCICP protocol's smaller of direct and symmetric),
- *    median conformal distortion before and after, against the issue's
+ *    median conformal distortion before and after, against the
  *    targets (error within +0.005, median conformal at most half), and the
  *    round trip T->S->T of the pair of maps (metric_round_trip: the
- *    published pair, then the denoised pair). Measured (k = 100): plain
- *    met the targets on 11 of 12 maps (BIM man_02 -> gorilla_01 kept 0.66
- *    of its median conformal), bijective on 10 of 12: it met that one
- *    (0.265 of 1.066), gave a lower round trip than plain denoising on
- *    11 of 12, lowered the error of 4 of the 6 BCICP maps by 0.0026 to
- *    0.0031 (the others +0.0004, +0.0007) and halved their median
- *    conformal again (ratios 0.16 to 0.24 against plain's 0.35 to 0.45),
- *    but where BIM's two directions disagree wholesale (one of
- *    them flipped left to right: gorilla_01 -> man_01 0.48, woman_01 ->
- *    gorilla_01 0.53) the consistent pair meets in between: the bad
- *    direction improves (0.48 -> 0.13, 0.53 -> 0.23) and the good one is
- *    dragged along (man_01 -> gorilla_01 0.075 -> 0.389, gorilla_01 ->
- *    woman_01 0.109 -> 0.432). Auto, by the larger of a pair's two round
- *    trips (BCICP 0.011, 0.040, 0.011 and BIM man_02 0.037: bijective; BIM
- *    man_01 0.414 and woman_01 0.414: plain), met the targets on 12 of 12
- *    maps, as the better of the two per map does;
+ *    published pair, then the denoised pair).
  *  - the BCICP map refined by each chain of --chains (default
  *    "ectm;ddm,ectm;ddm,rhm,ectm", ';'-separated) with the default weights
  *    (--ectm-iterations=K to shorten ECTM), no landmarks: error, median
  *    conformal, flipped triangles and seconds, target: lower error; with
  *    --with-reverse=yes the published reverse BCICP map goes with it (q: ECTM
  *    starts from both, and ddm_mode auto may denoise the two together).
- *    Measured on all six (28b7902, 300 iterations): ectm and ddm,ectm
- *    lower the error of every map, alone or with the reverse map (ddm,ectm
- *    with it gains most: 0.0384-0.0519 from 0.0432-0.0564); ddm,rhm,ectm
- *    lowered 4 of 6 alone and 5 of 6 with it (gorilla_01 -> woman_01 0.0527
- *    -> 0.0600): RHM from a map without landmarks drifts. At 83e8f0d
- *    (before the anchors) alone all 6 (0.0435, 0.0424, 0.0496, 0.0413,
- *    0.0415, 0.0448 in the order of pairs[]), with the reverse map 5 of 6
- *    (0.0436, 0.0427, 0.0569 from 0.0527, 0.0412, 0.0400, 0.0437; RHM
- *    alone took that map 0.0502 -> 0.0627). With RHM's anchors (rhm.h,
- *    RHM_ANCHORS farthest points held softly to the given map's images):
- *    ddm,rhm,ectm lowers all 12: alone 0.0417, 0.0472, 0.0456, 0.0412,
- *    0.0457, 0.0428 (4.1-8.0 % flipped), with the reverse map 0.0427,
- *    0.0468, 0.0475, 0.0388, 0.0438, 0.0424 (0.8-7.7 % flipped); the
- *    man_02 maps keep less of the unanchored RHM's gain (0.0424 -> 0.0472,
- *    0.0415 -> 0.0457 alone), the mean over the six moves 0.0439 -> 0.0440
- *    alone and 0.0447 -> 0.0437 with the reverse map. ectm and ddm,ectm
- *    run no RHM and are unchanged (at 83e8f0d alone 0.0445, 0.0536, 0.0481,
- *    0.0417, 0.0474, 0.0433 and 0.0425, 0.0537, 0.0471, 0.0403, 0.0474,
- *    0.0434; with the reverse map 0.0445, 0.0535, 0.0485, 0.0418, 0.0493,
- *    0.0437 and 0.0409, 0.0519, 0.0464, 0.0384, 0.0481, 0.0419; those
- *    maps 7.7-18.9 % flipped, as ECTM leaves them). ECTM's maps after RHM
- *    get the fold repair when folded (over 5 %, corr.c): ddm,rhm,ectm
- *    alone 0.0417, 0.0478, 0.0456, 0.0408, 0.0451, 0.0430, flipped 4.3,
- *    0.2, 4.1, 0.2, 0.1, 0.0 % (unrepaired: 4.3, 5.6, 4.1, 5.2, 8.0,
- *    5.4 %); with the reverse map 0.0427, 0.0471, 0.0475, 0.0388, 0.0432,
- *    0.0423, flipped 4.1, 0.2, 0.8, 4.6, 0.3, 0.1 % (unrepaired 5.1, 7.7,
- *    6.5 % on the three repaired): every map still lower than its input,
- *    none left folded. The repair after ectm or ddm,ectm (measured, not
- *    used) made those maps 0-12 % flipped but raised the error of 10 of
- *    the 12 (ectm on gorilla_01 -> man_02 0.0535 -> 0.0734).
+ *
  * --ddm-table=no skips the DDM table (the chains only).
  * --ddm-k=K sets DDM's basis size (default CORR_DDM_K). --pairs=A_B,... (names as in maps_baseline, e.g. 8_gorilla_01_8_man_01)
  * picks the maps for both parts; --refine-pairs=... the maps the chains run

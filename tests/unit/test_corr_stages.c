@@ -9,7 +9,7 @@
  * a given map stays near it by its anchors; ECTM's folded maps are
  * repaired on ddm,rhm,ectm (only those folded) and not on ddm,ectm;
  * make demo's job (cow -> camel from landmarks) returns both maps within
- * issue 12's fold targets. */
+ * the fold targets (at most 2 % flipped, 0.5 % collapsed). */
 #include "support/harness.h"
 #include "support/testcowcamel.h"
 #include "support/testddm.h"
@@ -541,11 +541,9 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
 }
 
 /* make demo's job as the engine runs it: cow -> camel from the demo's 16
- * landmarks, every stage with the defaults. Issue 12's targets for it:
+ * landmarks, every stage with the defaults. The fold targets for it:
  * at most 2 % of the triangles flipped and 0.5 % collapsed, here for both
- * maps (the pipeline, 875905a: 0.57 % and 0 % forward, 0.88 % and 0 %
- * back; 2.07 % and 0 % forward before fold_relax, 6.31 % and 2.31 % two
- * commits earlier: what a regression of the fold repair shows first). */
+ * maps: what a regression of the fold repair shows first. */
 TEST_T(make_demos_job_returns_both_maps_within_the_fold_targets, 600)
 {
     mesh *S, *T;

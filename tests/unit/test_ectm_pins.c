@@ -1,5 +1,5 @@
-/* test_ectm_pins.c — the landmarks ectm_run pins in its P- and Q-steps
- * (issue 12): after a run, each given source landmark's row of P is its
+/* test_ectm_pins.c — the landmarks ectm_run pins in its P- and Q-steps:
+ * after a run, each given source landmark's row of P is its
  * target landmark vertex exactly (weight 1 at that corner of a face at it)
  * and each target landmark's row of Q its source landmark; a bad landmark
  * is refused before anything runs, the field named. On the authors' demo

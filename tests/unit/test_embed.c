@@ -209,7 +209,6 @@ TEST(bad_embedding_arguments_are_refused)
     CHECK_STR_HAS(err, "start -1");
     /* the default k is capped at nv (42 vertices) */
     CHECK_INT(embed_lmds(s, 3, 0, 0, Z, NULL, err, sizeof err), EMBED_OK);
-    CHECK(strcmp(embed_strerror(EMBED_EDISCONNECTED), "mesh not connected") == 0);
     free(Z);
     geod_solver_free(s);
     mesh_free(m);

@@ -2,7 +2,8 @@
  * (metric_curvature_error): zero for the identity, and on a real pair
  * that differs only in its triangulation (FAUST tr_reg_017: a 5K remesh
  * and the 6890-vertex registration, same pose) the exact map scores far
- * below a map shifted by 1 % of the body's height. */
+ * below a map shifted by 1 % of the body's height; a non-manifold mesh is
+ * an error naming the mesh and the edge. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "geo/geo_curvature.h"
@@ -12,6 +13,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* The vertex map i -> tgt[i] as a barycentric map (a face at the vertex,
  * weight 1 on its corner). */
@@ -124,4 +126,42 @@ TEST_T(curvature_error_tells_the_exact_map_of_a_remeshed_pair, 60)
     free(vb);
     mesh_free(S);
     mesh_free(T);
+}
+
+/* A mesh with an edge of three faces has no edge table for the fit: the
+ * error is METRIC_EMESH with the mesh and the edge named in err (what
+ * `meshcorr eval` prints), never METRIC_ENOMEM; *out is NaN. The same from
+ * the target's side. */
+TEST(curvature_error_names_a_non_manifold_mesh)
+{
+    mesh *S = testmesh_icosphere(1), *N = NULL;
+    CHECK(S != NULL);
+    CHECK((N = mesh_new(S->nv + 1, S->nf + 1)) != NULL);
+    memcpy(N->v, S->v, sizeof(double) * 3 * (size_t)S->nv);
+    memcpy(N->f, S->f, sizeof(int) * 3 * (size_t)S->nf);
+    N->v[3 * S->nv] = N->v[3 * S->nv + 1] = N->v[3 * S->nv + 2] = 0.5;
+    N->f[3 * S->nf] = S->f[0];        /* a third face on face 0's first edge */
+    N->f[3 * S->nf + 1] = S->f[1];
+    N->f[3 * S->nf + 2] = S->nv;
+    int *zero = calloc((size_t)N->nv, sizeof(int));
+    CHECK(zero != NULL);
+    bmap *P = vertex_map(S, zero, N->nv);   /* N onto S: every vertex at S's vertex 0 */
+    bmap *Q = vertex_map(N, zero, S->nv);   /* S onto N */
+    char err[512] = "";
+    double e = 0;
+    CHECK_INT(metric_curvature_error(N, S, P, &e, err, sizeof err), METRIC_EMESH);
+    CHECK(isnan(e));
+    CHECK_STR_HAS(err, "source mesh: edge");
+    CHECK_STR_HAS(err, "has 3 faces");
+    err[0] = '\0';
+    CHECK_INT(metric_curvature_error(S, N, Q, &e, err, sizeof err), METRIC_EMESH);
+    CHECK_STR_HAS(err, "target mesh: edge");
+    CHECK(strstr(err, "out of memory") == NULL);
+    /* without a buffer the code alone still says why */
+    CHECK_INT(metric_curvature_error(N, S, P, &e, NULL, 0), METRIC_EMESH);
+    bmap_free(P);
+    bmap_free(Q);
+    free(zero);
+    mesh_free(N);
+    mesh_free(S);
 }

@@ -513,7 +513,6 @@ TEST(closest_refuses_bad_dimension_scale_and_seed)
     f = m->nf;
     CHECK_INT(proj_closest(tree, 3, Z, 1, 1, Q, &f, w, &c), PROJ_EFACE);
     CHECK(w[0] == -7 && c == -7);   /* nothing written on error */
-    CHECK_STR_HAS(proj_strerror(PROJ_EFACE), "out of range");
     f = -1;
     CHECK_INT(proj_closest(tree, 3, Z, 1, 1, Q, &f, w, &c), 0);
     CHECK(f >= 0 && f < m->nf);

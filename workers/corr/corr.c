@@ -415,21 +415,18 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
         P = init.P12;
         Q = bij ? init.P21 : NULL;
     }
-    /* the job's landmarks, pinned in ECTM's P- and Q-steps (issue 12) */
+    /* the job's landmarks, pinned in ECTM's P- and Q-steps */
     ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
                           in->L ? in->L->n : 0 };
     rc = corr_from_ectm(ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz));
     if (rc == CORR_OK) {
         /* ECTM's projection folds where its deformed surface passes a thin
-         * part at an angle: the same repair, on the maps it returns, in
-         * the landmark pipeline where it was measured (bench_shrec07), and
-         * on a given map's chain through RHM each map that would be
-         * returned folded (over 5 %; bench_refine, ddm,rhm,ectm: see
-         * its header). Not on chains where ECTM starts from the given
-         * (or only denoised) map: its folds are scattered over 8-19 % of
-         * the triangles, and the repair's regions raised the error of
-         * every map but one (ddm,ectm 0.0409 -> 0.0448, ectm 0.0535 ->
-         * 0.0734 on gorilla_01 -> man_02) */
+         * part at an angle: the same repair runs on the maps it returns in the
+         * landmark pipeline, and on a given map's chain through RHM on each
+         * map that would be returned folded (over 5 %). Not on chains where
+         * ECTM starts from the given (or only denoised) map: there its folds
+         * are scattered over the whole map and the repair's regions raise the
+         * error (docs/decisions.md, "Fold repair after ECTM"). */
         bmap *rP = out->P, *rQ = out->Q;
         if (in->P0 && !(run & CORR_RUN_RHM))
             rP = rQ = NULL;

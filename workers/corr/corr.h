@@ -13,7 +13,8 @@
  *     (the rows of bad regions change; out->Y stays ECTM's deformation):
  *     from landmarks always; on a given map's chain only after RHM, each
  *     map that is folded (metric_verdict), not when ECTM starts
- *     from the given or denoised map (corr.c says what was measured)
+ *     from the given or denoised map (docs/decisions.md, "Fold repair after
+ *     ECTM")
  *
  * Stages report progress through one callback; a non-zero return cancels.
  * This module reads no files and knows no sockets: callers load meshes,
@@ -39,7 +40,6 @@ enum corr_error {
     PROTO_KINDS(CORR_ENUM)
 #undef CORR_ENUM
 };
-const char *corr_strerror(int code);   /* the kind's text (proto_kind_text) */
 /* The wire code of a pipeline code (0 for CORR_OK): what the worker's
  * error.frame carries. */
 int corr_wire_code(int code);
@@ -99,15 +99,11 @@ unsigned corr_stages_run(corr_stages s, int have_map);
 typedef enum corr_ddm_mode {
     CORR_DDM_PLAIN = 0, CORR_DDM_BIJECTIVE = 1, CORR_DDM_AUTO = 2
 } corr_ddm_mode;
-/* auto's bound on the given pair's round trip. Measured on the 12
- * published TOSCA_r maps (tests/bench/bench_refine.c), the larger of a
- * pair's two round trips: the three BCICP pairs and BIM man_02 <->
- * gorilla_01 0.011-0.040, where bijective denoising met issue 13's
- * targets on every map and beat plain's conformal distortion; BIM
- * gorilla_01 <-> man_01 and <-> woman_01 (one direction flipped left to
- * right) 0.414 both, where it dragged the good direction from 0.075 to
- * 0.38 in geodesic error. 0.1 is a tenth of the shape's size: a point
- * that comes back farther has come back to another part. */
+/* auto's bound on the given pair's round trip, the larger of a pair's two:
+ * below it bijective denoising is used, above it the maps disagree too much
+ * for it to help. 0.1 is a tenth of the shape's size: a point that comes back
+ * farther has come back to another part (docs/decisions.md, "Bijective
+ * denoising and its round-trip bound"). */
 #define CORR_DDM_AUTO_ROUND_TRIP 0.1
 
 /* Whether the chain can run on these inputs: 0, or an error with the
@@ -128,11 +124,9 @@ int corr_stages_check(corr_stages s, int have_map, int have_reverse, int nlandma
 int corr_stages_parse(const char *text, corr_stages *out, char *err, size_t errsz);
 
 /* The DDM stage's basis size when ddm_k is 0: min(CORR_DDM_K, vertices - 2).
- * k = 100 met issue 13's criteria (error within +0.005, median conformal
- * at most half) on 11 of the 12 published TOSCA BIM and BCICP maps
- * (tests/bench/bench_refine.c; the BIM map man_02 -> gorilla_01 kept 0.66
- * of its distortion, 0.61 at k = 150, 1.05 at k = 60); fewer functions
- * smooth more and cost error (tests/unit/test_ddm.c). */
+ * Fewer functions smooth more and cost error (tests/unit/test_ddm.c);
+ * docs/decisions.md, "Bijective denoising and its round-trip bound", says how
+ * the value was chosen. */
 #define CORR_DDM_K 100
 
 /* A DDM stage report: directions done of total (1: P only, 2: P and Q),
@@ -238,10 +232,10 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
  * folded (metric_verdict: over 5 % of either map's triangles flipped or
  * collapsed), RHM and the repair again from the functional-map start, the
  * maps with the fewer bad triangles kept (out->start says which).
- * Landmarks alone can leave the distances start mirrored on a part of a
- * shape, and a wrong map folds: SHREC'07 plier 203 -> 214, held-out error
- * 0.54 and 19 % flipped after the repair from distances, 0.026 and 0 %
- * from fmap (tests/bench/bench_shrec07.c). A failure of the second run
+ * Landmarks alone can leave the distances start mirrored on a part of a shape,
+ * and a wrong map folds, where the functional-map start may not
+ * (docs/decisions.md, "RHM's start: distances, then the functional map"). A
+ * failure of the second run
  * leaves the first maps; a cancel cancels. raw (may be NULL): a copy of
  * the kept forward map before its repair (for benchmarks). progress:
  * rhm_run's, the second run's reports from iteration 0 again. */

@@ -8,11 +8,6 @@
 #include "geod/geod.h"
 #include "lbo/lbo.h"
 
-const char *corr_strerror(int code)
-{
-    return code == CORR_OK ? "ok" : proto_kind_text(-code);
-}
-
 int corr_wire_code(int code)
 {
     return proto_kind_code(-code);

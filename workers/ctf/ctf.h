@@ -1,4 +1,4 @@
-/* ctf.h — coarse to fine (the paper's limitation section, issue 16): a
+/* ctf.h — coarse to fine (the paper's limitation section): a
  * pair too fine for RHM's cost is matched on decimated copies and the maps
  * are carried back to the full meshes, where ECTM finishes them. */
 #ifndef CTF_H

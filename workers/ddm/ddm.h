@@ -42,7 +42,6 @@ enum ddm_error {
     DDM_ERRORS(DDM_ENUM)
 #undef DDM_ENUM
 };
-const char *ddm_strerror(int code);
 
 typedef struct ddm_stats {
     long long faces_solved;   /* exact face problems solved, all rows */
@@ -115,9 +114,9 @@ int ddm_denoise(const lbo_basis *b1, const double *m1, const lbo_basis *b2, cons
  * bmap_new(n1, n2), bmap_new(n2, n1). Errors: DDM_EINVAL (k out of a
  * basis, alpha outside [0, 1), iterations < 0, maps of the wrong sizes or
  * with a face out of range, a missing mass), DDM_ENOMEM. */
-/* alpha = 0.8: the value the thesis' chapter 3 ran "the consistency
- * extension of DND" with; on the BIM maps of TOSCA gorilla_01 <-> man_01
- * it gave the most consistent maps of 0.2, 0.5, 0.8 (test_ddm.c). */
+/* alpha = 0.8: the value the thesis' chapter 3 ran "the consistency extension
+ * of DND" with; test_ddm.c checks that it gives consistent maps on the BIM
+ * maps of TOSCA gorilla_01 <-> man_01. */
 #define DDM_BIJ_ALPHA_DEFAULT 0.8
 #define DDM_BIJ_ITERATIONS_DEFAULT 3
 int ddm_denoise_bijective(const lbo_basis *b1, const double *m1, const mesh *S,

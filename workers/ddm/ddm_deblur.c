@@ -11,16 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *ddm_strerror(int code)
-{
-    switch (code) {
-#define DDM_STR(name, val, msg, kind) case name: return msg;
-        DDM_ERRORS(DDM_STR)
-#undef DDM_STR
-    }
-    return "unknown DDM error";
-}
-
 #define DDM__ROWS 8   /* rows of B per pass over A: the four pairs the kernel unrolls */
 typedef double ddm__v2 __attribute__((vector_size(16)));   /* GCC's and Clang's vectors */
 

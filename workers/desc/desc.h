@@ -45,7 +45,6 @@ enum desc_error {
     DESC_ERRORS(DESC_ENUM)
 #undef DESC_ENUM
 };
-const char *desc_strerror(int code);
 
 /* t: nt default times (ascending); e: ne default energies, *sigma their width. */
 int desc_hks_times(const lbo_basis *b, int nt, double *t);

@@ -5,16 +5,6 @@
 #include <math.h>
 #include <stdlib.h>
 
-const char *desc_strerror(int code)
-{
-    switch (code) {
-#define DESC_STR(name, val, msg) case name: return msg;
-        DESC_ERRORS(DESC_STR)
-#undef DESC_STR
-    }
-    return "unknown descriptor error";
-}
-
 /* Index of the first eigenvalue above the zero threshold, or -1; never 0
  * (lbo's spectra always start with the constants). */
 static int first_nonzero(const lbo_basis *b)

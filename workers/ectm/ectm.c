@@ -310,15 +310,10 @@ static int side_pins(side *a, const side *b, const int *rows, const int *vtx, in
     return ECTM_OK;
 }
 
-/* Sets a's pinned rows of P onto their vertices of b's mesh. Always: a
- * softer pin was measured and not kept (bench_shrec07, 12 pairs): skipping
- * a pin in a P-step where it would fold more of the row's faces than the
- * projection does (image normal against the other mesh's normal at the
- * pinned vertex) left fourleg at 0.0384 (pinned always 0.0420, unpinned
- * 0.0385) but pinned only 1 of its 11 landmarks at the end, flipped more
- * (fourleg 0.27 %, human 0.19 %; always 0.12 %, 0.01 %), and lost what
- * the pins gain elsewhere (teddy 0.0449, human 0.0319, armadillo 0.0404;
- * always 0.0430, 0.0305, 0.0398); the same 8 pairs met their targets. */
+/* Sets a's pinned rows of P onto their vertices of b's mesh, in every P-step:
+ * a pin skipped where it would fold the row's faces folds less locally but
+ * loses what the pins gain elsewhere (docs/decisions.md, "ECTM pins its
+ * landmarks in every P-step"). */
 static void apply_pins(side *a, const side *b)
 {
     const int *bf = b->X->f;
@@ -357,19 +352,12 @@ static void pstep(side *a, const side *b, double beta, double gamma, int bijecti
     bmap_apply(a->P, b->X->f, b->X->v, 3, a->PX);
 }
 
-/* A Y-step stops when one L-BFGS iteration lowers its energy by less than
- * this fraction of what the step has gained so far (or after
- * inner_iterations). With pairs kept across outer iterations, the later
- * iterations of a Y-step gain little that the next outer iteration would
- * not. Measured on the authors' demo (381 -> 390, 300 iterations; before
- * issue 16: 133.5 evaluations per outer iteration, final energy 23.602, uv
- * distance to the authors' result 0.0033): all 50 iterations with kept pairs
- * 106.9, 23.428, 0.0023; 0.02: 23.745, 0.0027; 0.03: 28.4, 23.278, 0.0029;
- * 0.05: 22.5, 23.569, 0.0039 (22.0, 23.360, 0.0032 after a change of
- * rounding only: the final energy moves by ~1 % with rounding; 20.7,
- * 23.507, 0.0037 once opt_memory_add_diagonal kept the pairs' order);
- * 0.1: 15.8, 23.866, 0.0052 (too far). The 0.02-0.1 figures are from a
- * build whose opt_memory_add_diagonal reordered the pairs. */
+/* A Y-step stops when one L-BFGS iteration lowers its energy by less than this
+ * fraction of what the step has gained so far (or after inner_iterations).
+ * With pairs kept across outer iterations, the later iterations of a Y-step
+ * gain little that the next outer iteration would not; the fraction trades
+ * those evaluations against the final energy (docs/decisions.md, "ECTM's
+ * Y-step stops on a relative gain"). */
 #define ECTM_INNER_REL_DECREASE 0.05
 
 typedef struct pair {
@@ -412,9 +400,8 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
         return ECTM_ENUMERIC;
     /* Terms at the returned Y: the last evaluation's, unless that was a
      * rejected trial point (an admissible set that changed without changing
-     * its count is not evaluated again, here as within the solve). Demo
-     * 381 -> 390: the same final energy to the last digit, 2 evaluations
-     * fewer per outer iteration. */
+     * its count is not evaluated again, here as within the solve), which saves
+     * an evaluation per Y-step. */
     double f = os.last_at_x ? os.f : ystep_eval(&st, a->Y, scratch, n3);
     if (!isfinite(f))
         return ECTM_ENUMERIC;

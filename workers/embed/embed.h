@@ -9,7 +9,7 @@
  * classical MDS of those (B = -1/2 J D2 J, top dim eigenpairs, LAPACK
  * dsyevr) as the start of SMACOF stress majorisation (embed_smacof; the
  * classical solution alone drops the negative eigenvalues and distorts
- * curved, branching shapes: the cow's sample correlation was 0.67); the
+ * curved, branching shapes); the
  * landmark positions rotated to their principal axes (coordinate 0 varies
  * most: RHM's projection trees bound with the first three); then every other
  * vertex by the biharmonic extension (embed_biharmonic) with the solver's
@@ -47,7 +47,6 @@ enum embed_error {
     EMBED_ERRORS(EMBED_ENUM)
 #undef EMBED_ENUM
 };
-const char *embed_strerror(int code);
 
 /* stress = sqrt(sum (d_emb - d_geo)^2 / sum d_geo^2); corr = Pearson
  * correlation of d_emb with d_geo. */

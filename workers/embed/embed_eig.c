@@ -2,24 +2,18 @@
  * LAPACK dsyevr; see embed.h. Knows nothing about meshes or distances. */
 #include "embed/embed.h"
 
+#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* LAPACK (Fortran) prototype, with gfortran's hidden string lengths. */
-void dsyevr_(const char *jobz, const char *range, const char *uplo, const int *n,
-             double *a, const int *lda, const double *vl, const double *vu,
-             const int *il, const int *iu, const double *abstol, int *m, double *w,
-             double *z, const int *ldz, int *isuppz, double *work, const int *lwork,
-             int *iwork, const int *liwork, int *info, size_t, size_t, size_t);
 
 static int syevr(char jobz, char range, int n, double *a, int il, int iu, int *found,
                  double *w, double *z, int *isuppz)
 {
     double vl = 0, vu = 0, abstol = 0, wq;
     int lwork = -1, liwork = -1, iq, info = 0, ldz = n > 1 ? n : 1;
-    dsyevr_(&jobz, &range, "U", &n, a, &n, &vl, &vu, &il, &iu, &abstol, found, w, z,
-            &ldz, isuppz, &wq, &lwork, &iq, &liwork, &info, 1, 1, 1);
+    info = LAPACKE_dsyevr_work(LAPACK_COL_MAJOR, jobz, range, 'U', n, a, n, vl, vu, il, iu, abstol,
+                               found, w, z, ldz, isuppz, &wq, lwork, &iq, liwork);
     if (info != 0)
         return EMBED_EEIGEN;
     lwork = (int)wq;
@@ -31,8 +25,8 @@ static int syevr(char jobz, char range, int n, double *a, int il, int iu, int *f
         free(iwork);
         return EMBED_ENOMEM;
     }
-    dsyevr_(&jobz, &range, "U", &n, a, &n, &vl, &vu, &il, &iu, &abstol, found, w, z,
-            &ldz, isuppz, work, &lwork, iwork, &liwork, &info, 1, 1, 1);
+    info = LAPACKE_dsyevr_work(LAPACK_COL_MAJOR, jobz, range, 'U', n, a, n, vl, vu, il, iu, abstol,
+                               found, w, z, ldz, isuppz, work, lwork, iwork, liwork);
     free(work);
     free(iwork);
     return info == 0 ? EMBED_OK : EMBED_EEIGEN;

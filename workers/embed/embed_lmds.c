@@ -9,16 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *embed_strerror(int code)
-{
-    switch (code) {
-#define EMBED_STR(name, val, msg) case name: return msg;
-        EMBED_ERRORS(EMBED_STR)
-#undef EMBED_STR
-    }
-    return "unknown embedding error";
-}
-
 static double dist_rows(const double *Z, int dim, int a, int b)
 {
     double s = 0;

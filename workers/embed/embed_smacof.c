@@ -2,10 +2,9 @@
  * 1977; the Guttman transform with unit weights) of a small dense distance
  * matrix; see embed.h. Knows nothing about meshes.
  *
- * Unit weights on purpose: weights 1/D and 1/D^2 (more weight on short
- * distances) were tried on FAUST tr_reg_000 -> tr_reg_001 (RHM from 12
- * landmarks): flipped triangles 14 % -> 30 % / 42 %, geodesic error
- * 0.038 -> 0.045 / 0.047. */
+ * Unit weights on purpose: weights that favour short distances (1/D, 1/D^2)
+ * give RHM starts that fold more (docs/decisions.md, "SMACOF with unit
+ * weights, summed in a fixed order"). */
 #include "embed/embed.h"
 
 #include <math.h>
@@ -16,8 +15,8 @@
  * run (a reduction over a dynamic schedule adds the rows in an order that
  * depends on the threads' timing, and SMACOF's stopping test on this value
  * then made the embedding, and every map after it, differ from run to run
- * in the last digits, which ECTM amplified: the demo cow -> camel gave
- * 4.50 % or 8.56 % flipped from one binary). rows: k doubles of scratch. */
+ * in the last digits, which ECTM amplifies into different maps). rows: k
+ * doubles of scratch. */
 static double raw_stress(const double *D, const double *Y, int k, int dim, double *rows)
 {
 #pragma omp parallel for schedule(dynamic, 16)

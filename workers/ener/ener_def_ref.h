@@ -8,11 +8,10 @@
 #include "ener/ener_def.h"
 
 /* A face is non-degenerate in Y when its area exceeds this fraction of its
- * reference area and it is no sliver (ener__face_admissible, ener_normal.h). Below about 1e-6 the unit normal of a sliver turns so fast
- * that no line-search step is accepted: with 1e-12, the reverse Y-step of the
- * cow -> camel demo (nearest-neighbour initial Q) stalled at iteration 0 with
- * liblbfgs' minimum-step error (the solver then); with 1e-6 it runs its 50
- * iterations. */
+ * reference area and it is no sliver (ener__face_admissible, ener_normal.h). A
+ * smaller fraction admits slivers whose unit normal turns so fast that no
+ * line-search step is accepted (docs/decisions.md, "The admissible area
+ * ratio"). */
 #define ENER_ADMISSIBLE_AREA_RATIO 1e-6
 
 typedef struct ener__face {

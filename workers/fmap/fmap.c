@@ -5,23 +5,10 @@
 #include "desc/desc.h"
 #include "util/errbuf.h"
 
+#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* LAPACK (Fortran) Cholesky solve, with gfortran's hidden string length. */
-void dposv_(const char *uplo, const int *n, const int *nrhs, double *a, const int *lda,
-            double *b, const int *ldb, int *info, size_t);
-
-const char *fmap_strerror(int code)
-{
-    switch (code) {
-#define FMAP_STR(name, val, msg) case name: return msg;
-        FMAP_ERRORS(FMAP_STR)
-#undef FMAP_STR
-    }
-    return "unknown functional map error";
-}
 
 /* A (k by nd) = Psi^T M F (first k columns of Psi), each column of F
  * divided by its M-norm (a zero column stays zero). 0 when out of memory. */
@@ -132,8 +119,7 @@ int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F
                 s += A2[(size_t)c * nd + q] * A1[(size_t)a * nd + q];
             row[c] = s;
         }
-        int n = k2, one = 1, info = 0;
-        dposv_("U", &n, &one, S, &n, row, &n, &info, 1);
+        int info = LAPACKE_dposv_work(LAPACK_COL_MAJOR, 'U', k2, 1, S, k2, row, k2);
         if (info != 0) {
             rc = errbuf_set(err, errsz, FMAP_ESOLVE,
                             "functional map: row %d's system is singular (LAPACK info %d; "

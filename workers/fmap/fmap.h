@@ -48,10 +48,8 @@
 
 #include <stddef.h>
 
-/* Weight of the Laplacian term. pyFM's 1e-3 left FAUST 000 -> 001 at 0.38
- * mean geodesic error with k = 50 (our descriptor term is not pyFM's);
- * 0.1 gave 0.053, and was also the best of 1e-3, 1e-2, 0.1 on FAUST
- * 002 -> 007 and TOSCA wolf0 -> wolf2 for k = 30, 50, 80. */
+/* Weight of the Laplacian term, chosen on FAUST and TOSCA pairs
+ * (docs/decisions.md, "Functional map weights"). */
 #define FMAP_MU_LAP_DEFAULT 0.1
 #define FMAP_ENERGIES_DEFAULT 50   /* WKS / WKM energies */
 
@@ -66,7 +64,6 @@ enum fmap_error {
     FMAP_ERRORS(FMAP_ENUM)
 #undef FMAP_ENUM
 };
-const char *fmap_strerror(int code);
 
 /* F1: n1 by nd, F2: n2 by nd (corresponding columns), m1, m2 the lumped
  * masses; C: k1 by k2. */
@@ -83,9 +80,8 @@ int fmap_from_descriptors(const lbo_basis *b1, const double *m1, const double *F
  * is below FMAP_CG_TOL of the right-hand side (at most FMAP_CG_MAX_ITER
  * steps; *iterations, may be NULL). mu_n = 0 gives fmap_from_descriptors'
  * result. */
-/* D_N weight: the best of 0.01, 0.1, 1 on FAUST 000 -> 001, 002 -> 007 and
- * 000 -> 020 (5 landmarks, k = 50; test_fmap.c has the figures); larger
- * values were not tried. */
+/* D_N weight, chosen on FAUST pairs (test_fmap.c checks it; docs/decisions.md,
+ * "Functional map weights"). */
 #define FMAP_MU_NORMAL_DEFAULT 1.0
 #define FMAP_CG_TOL 1e-10
 #define FMAP_CG_MAX_ITER 5000
@@ -108,12 +104,10 @@ int fmap_from_descriptors_normal(const lbo_basis *b1, const double *m1, const do
  * no = 0 gives fmap_from_descriptors_normal's result bit for bit. */
 /* Orientation weight and the descriptors it uses: per block of
  * fmap_landmark_descriptors' columns (the WKS, each landmark's WKM) the
- * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. mu_o = 3
- * was the best of 1, 3, 10 on bench_shrec07 --start=fmap --stop=rhm
- * over plier, glasses, airplane, hand, fish, ant (after RHM: mean flipped
- * 7.8 / 6.3 / 6.9 %, mean held-out error without the hand 0.0266 / 0.0257
- * / 0.0273; without the term 21.5 % and 0.0259) and the smallest of them
- * that keeps the mirrored plier of test_fmap below 10 % flipped. */
+ * FMAP_ORIENT_ENERGIES columns fmap_orientation_columns picks. The weight is
+ * the best of the values tried on SHREC'07 pairs, and the smallest of them
+ * that keeps the mirrored plier of test_fmap below 10 % flipped
+ * (docs/decisions.md, "Functional map weights"). */
 #define FMAP_MU_ORIENT_DEFAULT 3.0
 #define FMAP_ORIENT_ENERGIES 5
 int fmap_from_descriptors_oriented(const lbo_basis *b1, const double *m1, const double *F1,

@@ -34,8 +34,7 @@
  *           end. A harmonic disk map would crowd both ends toward a point,
  *           exponentially in length over girth (below what double
  *           precision resolves on the glasses' arms), and the two parts'
- *           proportions decide where the end lands (fourleg 381 -> 393:
- *           the hoof half-way up the target's leg). Such a region takes
+ *           proportions decide where the end lands. Such a region takes
  *           the tube's remap when it has one, moved-far or not, and a
  *           region holding vertices a tube remap placed takes only a tube
  *           remap in later passes (a disk remap of it would crowd the end
@@ -129,11 +128,9 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
  * neighbour and that neighbour, the one to move); sweeps while a vertex
  * moves, 10 at most. A vertex whose faces are all bad (inside a fold, or
  * a part mirrored as a whole) has nothing to be mended against and stays.
- * What it mends is what no region remap improves: the odd vertex of a
- * part stretched across a crease (make demo's cow -> camel: 2.07 % of the
- * faces flipped after fold_repair, 0.57 % after this). It hides the folds
- * of a map that is wrong as a whole just as well, though (SHREC'07 plier
- * from the distances start: 2858 bad faces, 48 after both), so it is not
+ * What it mends is what no region remap improves: the odd vertex of a part
+ * stretched across a crease. It hides the folds of a map that is wrong as a
+ * whole just as well, though, so it is not
  * for a map whose folds are read to judge it (corr_rhm's choice of start).
  * Returns FOLD_OK (rep: bad_before, bad_after, relaxed; accepted when a
  * vertex moved), FOLD_EINVAL, FOLD_ENOMEM or FOLD_EMESH (P unchanged). */

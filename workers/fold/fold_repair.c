@@ -21,8 +21,8 @@
 #define FOLD__CHART_RINGS 2       /* rings round the boundary image, at least */
 /* ... and at most (FOLD__MAX_CHART bounds it as well): the ring round a
  * thin part and the part's end kept beyond it can land a long way apart on
- * the target (the glasses' arms, 52 -> 58: more than 6 rings, so no chart
- * and no repair at all) */
+ * the target (a pair of glasses' arms: a low cap would leave no chart and no
+ * repair at all) */
 #define FOLD__CHART_MAX_RINGS 30
 /* A remap with the landmarks free counts only when it puts each of them
  * at most this far (in the chart's unit disk) from its image: farther, it
@@ -106,10 +106,8 @@ static int pinned(const ctx *c, const fold__patch *pS, int i)
 /* Whether the region's vertex i places the chart: its boundary and kept
  * holes, and for a remap that drags the landmarks (c->drag_landmarks) its
  * landmarks too: the drag must reach their images, and these may lie
- * beyond what the boundary's image encloses (make demo's cow -> camel: the
- * hind leg and tail, whose boundary lands on the camel's thigh, with
- * knee, hoof and tail tip far down the leg, so no chart held them and the
- * region was never dragged: 6.31 % of the map flipped, 2.31 % collapsed).
+ * beyond what the boundary's image encloses (a limb whose boundary lands high
+ * on the target's limb while its landmarks' images lie far down it).
  * A free remap's chart leaves them out: their images may lie far inside
  * the part the boundary encloses (a limb's tip), and they get their rows
  * back anyway. */
@@ -337,10 +335,8 @@ static int placed_folds(ctx *c, const fold__patch *pS, const double *uv)
  * a step the linear triangles cannot follow folds some of them: such a
  * step is halved (FOLD__DRAG_HALVINGS times at most) until the placement
  * has no more folded faces than before it, and the landmark stays where
- * it got when no step will do (its row comes back anyway). Unchecked,
- * make demo's hind leg with its tail, four landmarks dragged down the
- * camel's leg, kept 232 bad faces, and the pipeline's map ended 2.15 %
- * flipped; checked, 2.07 %. Returns 0, or -1 when out of memory. */
+ * it got when no step will do (its row comes back anyway). Returns 0, or -1
+ * when out of memory. */
 static int drag(ctx *c, const fold__patch *pS, const unsigned char *pin, const double *lm, double *uv)
 {
     double *before = malloc(sizeof(double) * 2 * ((size_t)pS->nv + 1));

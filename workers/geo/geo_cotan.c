@@ -8,7 +8,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-void geo_cotan_weights(const mesh *m, const geo_edges *e, double *w)
+/* w: ne. The edge weights w_e = (cot alpha + cot beta) / 2 = -L_ij. */
+static void geo_cotan_weights(const mesh *m, const geo_edges *e, double *w)
 {
     for (int i = 0; i < e->ne; i++)
         w[i] = 0;

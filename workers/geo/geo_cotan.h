@@ -23,9 +23,6 @@
 
 #include <stddef.h>
 
-/* w: ne. The edge weights w_e = (cot alpha + cot beta) / 2 = -L_ij. */
-void geo_cotan_weights(const mesh *m, const geo_edges *e, double *w);
-
 /* The Laplacian from the edge table e built from m. Errors: GEO_EMISMATCH
  * when e was built from a mesh of another size, GEO_ENOMEM. */
 int geo_cotan_laplacian(const mesh *m, const geo_edges *e, geo_csr **out,

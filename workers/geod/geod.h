@@ -29,17 +29,11 @@
  *  - Disconnected meshes: a vertex whose connected component holds no
  *    source gets INFINITY. Degenerate faces (zero area) contribute nothing.
  *
- * Accuracy measured with t_factor = 1 (tests/unit/test_geod.c): unit
- * icosphere level 4 (2562 vertices) max relative error 4.4%, mean 1.0%;
- * level 5 (10242) max rel ~5%, mean 0.7%; relative errors are over vertices
- * at least 5 h from the source; max absolute error 0.029 -> 0.019 from level 4
- * to 5. Flat disk, off-centre source, 817 -> 3169 vertices: max rel 5.5%,
- * mean 1.6% -> 1.2%, max abs 0.025 -> 0.018 (Neumann alone: max rel 11%).
- * Multi-source fields are less accurate where the fronts of two sources
- * meet: on level 4 with three sources the field differs from the minimum
- * of the single-source fields by up to 0.087 (~1.7 h, 3x the single-source
- * maximum error); pinning the Poisson solution equal at the sources did not
- * reduce this (measured), so the simple mean shift is kept.
+ * Accuracy: tests/unit/test_geod.c bounds the error against exact distances on
+ * icospheres and a flat disk (t_factor = 1); the error shrinks as the mesh is
+ * refined. Multi-source fields are less accurate where the fronts of two
+ * sources meet, and the sources are brought to 0 by a plain mean shift
+ * (docs/decisions.md, "Heat-method geodesics").
  *
  * Ownership and threads: the solver borrows the mesh (it must outlive the
  * solver, unchanged) and owns its factorisations. Calls on one solver must
@@ -92,8 +86,6 @@ const geo_csr *geod_solver_laplacian(const geod_solver *s);
 const double *geod_solver_mass(const geod_solver *s);
 /* Edges flipped to make that triangulation Delaunay (0: the mesh was). */
 int geod_solver_flips(const geod_solver *s);
-/* The heat time t actually used. */
-double geod_solver_time(const geod_solver *s);
 
 /* dist: nv. Geodesic distance from every vertex to the nearest of the nsrc
  * sources (the heat starts from all of them at once). Shift rule: per

@@ -5,10 +5,9 @@
  * Why: the cotan Laplacian of a mesh with obtuse triangles has negative
  * edge weights; the heat step (M + t L) u = delta then loses its sign
  * structure and round-off swamps u far from the source, where the normalised
- * gradient only keeps the noise's direction. Measured on Debian's CGAL
- * camel (12 % of edges non-Delaunay): distances from one vertex came out
- * below 0.8 x the edge-graph (Dijkstra) distance at 2871 of 9770 vertices,
- * the farthest at 0.36 x. On the intrinsic Delaunay triangulation every
+ * gradient only keeps the noise's direction, so distances collapse far from
+ * the source (docs/decisions.md, "Heat-method geodesics"). On the intrinsic
+ * Delaunay triangulation every
  * cotan weight is >= 0 (an M-matrix), the triangular solves add terms of
  * one sign, and that failure is gone.
  *

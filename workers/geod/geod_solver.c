@@ -27,7 +27,6 @@ int geod_solver_nv(const geod_solver *s) { return s->nv; }
 int geod_solver_flips(const geod_solver *s) { return s->flips; }
 const geo_csr *geod_solver_laplacian(const geod_solver *s) { return s->L; }
 const double *geod_solver_mass(const geod_solver *s) { return s->mass; }
-double geod_solver_time(const geod_solver *s) { return s->t; }
 
 void geod_solver_free(geod_solver *s)
 {

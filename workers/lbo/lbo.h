@@ -51,7 +51,6 @@ enum lbo_error {
     LBO_ERRORS(LBO_ENUM)
 #undef LBO_ENUM
 };
-const char *lbo_strerror(int code);
 
 typedef struct lbo_basis {
     int nv, k;

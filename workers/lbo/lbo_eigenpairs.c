@@ -10,16 +10,6 @@
 #include <string.h>
 #include <suitesparse/cholmod.h>
 
-const char *lbo_strerror(int code)
-{
-    switch (code) {
-#define LBO_STR(name, val, msg, kind) case name: return msg;
-        LBO_ERRORS(LBO_STR)
-#undef LBO_STR
-    }
-    return "unknown eigen-solver error";
-}
-
 void lbo_basis_close(lbo_basis *b)
 {
     if (!b)

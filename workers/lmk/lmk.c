@@ -10,16 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *lmk_strerror(int code)
-{
-    switch (code) {
-#define LMK_STR(name, val, msg, kind) case name: return msg;
-        LMK_ERRORS(LMK_STR)
-#undef LMK_STR
-    }
-    return "unknown landmark error";
-}
-
 void lmk_free(lmk_set *l)
 {
     if (!l)

@@ -58,7 +58,6 @@ enum lmk_error {
     LMK_ERRORS(LMK_ENUM)
 #undef LMK_ENUM
 };
-const char *lmk_strerror(int code);
 
 typedef struct lmk_set {
     int n;      /* number of pairs */

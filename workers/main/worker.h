@@ -114,15 +114,6 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
                      double elapsed, wrk_result *r, char *err, size_t errsz);
 void wrk_result_close(wrk_result *r);
 
-/* worker_validate.c — meshcorr-validate, the daemon's check of a SUBMIT
- * (its main is there). wrk_validate reads one SUBMIT frame from in_fd and
- * builds the job from it as a run would (wrk_job_from_submit), running
- * nothing; with worker_memory_mb (0: none) a job whose estimated peak
- * memory (corr_cost_bytes) is over it is OVER_LIMIT. SPOOL_EXIT_OK when it
- * would run; else one ERROR frame (the code and the message naming the
- * blob, field or estimate) on out_fd and SPOOL_EXIT_JOB. */
-int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim, unsigned long long worker_memory_mb);
-
 /* The limits the worker sets whatever the daemon passes (WORKER.md,
  * "Sandbox"): its largest file is one frame (result.frame), it needs few
  * descriptors; --max-cpu-s is at most WRK_MAX_CPU_S, and a run that uses it

@@ -92,7 +92,13 @@ static int check_cost(const wrk_job *job, unsigned long long worker_memory_mb, c
                       human_bytes(bytes, est, sizeof est), what, worker_memory_mb);
 }
 
-int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim, unsigned long long worker_memory_mb)
+/* meshcorr-validate, the daemon's check of a SUBMIT: reads one SUBMIT
+ * frame from in_fd and builds the job from it as a run would
+ * (wrk_job_from_submit), running nothing; with worker_memory_mb (0: none) a job whose estimated peak
+ * memory (corr_cost_bytes) is over it is OVER_LIMIT. SPOOL_EXIT_OK when it
+ * would run; else one ERROR frame (the code and the message naming the
+ * blob, field or estimate) on out_fd and SPOOL_EXIT_JOB. */
+static int wrk_validate(int in_fd, int out_fd, const wrk_limits *lim, unsigned long long worker_memory_mb)
 {
     uint8_t hdr_bytes[PROTO_HDR_SIZE];
     unsigned char *frame = NULL;

@@ -13,16 +13,6 @@
 
 #define BMAP_HEADER "# meshcorr-map 1"
 
-const char *bmap_strerror(int code)
-{
-    switch (code) {
-#define BMAP_STR(name, val, msg, kind) case name: return msg;
-        BMAP_ERRORS(BMAP_STR)
-#undef BMAP_STR
-    }
-    return "unknown map error";
-}
-
 bmap *bmap_new(int n, int nt)
 {
     if (n < 0 || nt < 0 || n > MESH_MAX_VERTICES || nt > MESH_MAX_VERTICES)

@@ -32,7 +32,6 @@ enum bmap_error {
     BMAP_ERRORS(BMAP_ENUM)
 #undef BMAP_ENUM
 };
-const char *bmap_strerror(int code);
 
 typedef struct bmap {
     int n;       /* rows: source vertices */

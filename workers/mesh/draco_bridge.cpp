@@ -201,16 +201,6 @@ int encode(const double *v, int nv, const int *f, int nf, int bits,
 
 } // namespace
 
-extern "C" const char *dracob_strerror(int code)
-{
-    switch (code) {
-#define DRACOB_STR(name, val, msg) case name: return msg;
-        DRACOB_ERRORS(DRACOB_STR)
-#undef DRACOB_STR
-    }
-    return "unknown Draco bridge error";
-}
-
 extern "C" int dracob_decode(const unsigned char *buf, size_t len, int max_points,
                              int max_faces, double **v, int *nv, int **f, int *nf,
                              char *err, size_t errsz)

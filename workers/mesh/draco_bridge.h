@@ -36,7 +36,6 @@ enum dracob_error {
     DRACOB_ERRORS(DRACOB_ENUM)
 #undef DRACOB_ENUM
 };
-const char *dracob_strerror(int code);
 
 /* Largest buffer dracob_decode accepts, checked before Draco sees it. */
 #define DRACOB_MAX_BUFFER_BYTES (1LL << 30)
@@ -57,8 +56,8 @@ int dracob_decode(const unsigned char *buf, size_t len, int max_points, int max_
  * stores them unquantized and decodes them bit for bit (NaN, -0 and
  * denormals included): as float32 when every coordinate is a float
  * exactly, else as float64; 1..30 quantizes each coordinate to that many
- * bits over the bounding box (16 is Draco's usual: an error up to about
- * bbox / 2^17, and 72 KB instead of 156 KB lossless on a 4344-vertex mesh).
+ * bits over the bounding box (16 is Draco's usual: an error up to about bbox /
+ * 2^17, and about half the size of lossless).
  * Indices must be in range. */
 int dracob_encode(const double *v, int nv, const int *f, int nf, int quantization_bits,
                   unsigned char **buf, size_t *len, char *err, size_t errsz);

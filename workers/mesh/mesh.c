@@ -7,16 +7,6 @@
 #include <string.h>
 #include <strings.h>
 
-const char *mesh_strerror(int code)
-{
-    switch (code) {
-#define MESH_STR(name, val, msg, kind) case name: return msg;
-        MESH_ERRORS(MESH_STR)
-#undef MESH_STR
-    }
-    return "unknown mesh error";
-}
-
 mesh *mesh_new(int nv, int nf)
 {
     if (nv < 0 || nf < 0 || nv > MESH_MAX_VERTICES || nf > MESH_MAX_FACES)

@@ -37,7 +37,6 @@ enum mesh_error {
     MESH_ERRORS(MESH_ENUM)
 #undef MESH_ENUM
 };
-const char *mesh_strerror(int code);
 
 typedef struct mesh {
     int nv;      /* number of vertices */

@@ -11,16 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *mesh_check_strerror(int code)
-{
-    switch (code) {
-#define MESH_CHECK_STR(name, val, msg) case name: return msg;
-        MESH_CHECK_ERRORS(MESH_CHECK_STR)
-#undef MESH_CHECK_STR
-    }
-    return "unknown mesh check error";
-}
-
 typedef struct half {
     int a, b;      /* a < b */
     int face;

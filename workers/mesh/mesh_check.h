@@ -34,7 +34,6 @@ enum mesh_check_error {
     MESH_CHECK_ERRORS(MESH_CHECK_ENUM)
 #undef MESH_CHECK_ENUM
 };
-const char *mesh_check_strerror(int code);
 
 typedef struct mesh_check_report {
     /* counts */

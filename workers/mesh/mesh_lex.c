@@ -102,7 +102,7 @@ void mesh_lex_skip_line(mesh_lex *lx)
         lx->p++;
 }
 
-int mesh_lex_parse_double(const char *t, size_t n, double *out)
+static int mesh_lex_parse_double(const char *t, size_t n, double *out)
 {
     if (n == 0 || n > 63)
         return -1;

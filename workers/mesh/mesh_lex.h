@@ -26,8 +26,7 @@ int mesh_lex_double(mesh_lex *lx, double *out);
 int mesh_lex_long(mesh_lex *lx, long *out);
 /* The same on the current line only (-1 when the line has no more tokens). */
 int mesh_lex_double_inline(mesh_lex *lx, double *out);
-/* Parses exactly the n characters at t as a double / a base-10 long. */
-int mesh_lex_parse_double(const char *t, size_t n, double *out);
+/* Parses exactly the n characters at t as a base-10 long. */
 int mesh_lex_parse_long(const char *t, size_t n, long *out);
 
 #endif

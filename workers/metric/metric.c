@@ -7,16 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-const char *metric_strerror(int code)
-{
-    switch (code) {
-#define METRIC_STR(name, val, msg) case name: return msg;
-        METRIC_ERRORS(METRIC_STR)
-#undef METRIC_STR
-    }
-    return "unknown metric error";
-}
-
 static void tri_frame(const double *a, const double *b, const double *c,
                       double e1[3], double e2[3], double *area)
 {

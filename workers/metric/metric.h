@@ -30,7 +30,6 @@ enum metric_error {
     METRIC_ERRORS(METRIC_ENUM)
 #undef METRIC_ENUM
 };
-const char *metric_strerror(int code);
 
 /* logratio: nf values. src_area, img_area_total: total areas used for the
  * unit-area normalisation of source and image (the target's total area). */
@@ -87,11 +86,10 @@ int metric_summarize(const mesh *S, const mesh *T, const bmap *P, metric_summary
  * neighbourhood fit of geo_curvature.h (the paper's estimator, [KSNS07])
  * with one radius for both meshes: METRIC_CURVATURE_EDGES mean edge
  * lengths of the coarser one (at unit area), so two triangulations of one
- * shape compare at the same scale (test_geo_curvature: on a jittered
- * sphere the fit within 3 edges is 2.7 % off at worst, within 2 edges 9 %,
- * the cotan formula 22 %). (The cotan formula's per-vertex noise
- * on irregular meshes, uncorrelated between S and T, used to dominate this
- * figure: an exact map scored nearly what a rough one did.) */
+ * shape compare at the same scale (test_geo_curvature bounds the fit's error
+ * on a jittered sphere). Not the cotan formula: its per-vertex noise on
+ * irregular meshes, uncorrelated between S and T, would dominate the figure,
+ * so that an exact map scores nearly what a rough one does. */
 #define METRIC_CURVATURE_EDGES 3.0
 /* METRIC_OK; METRIC_ENOMEM, or METRIC_EMESH for a mesh without an edge
  * table (an edge of more than two faces: "source mesh: ...") or a fit that

@@ -1,7 +1,7 @@
 /* opt_lbfgs.c — see opt_lbfgs.h. L-BFGS as in Nocedal & Wright (Alg. 7.4,
  * two-loop recursion, H0 = sᵀy/yᵀy of the newest pair) with a backtracking
- * Armijo line search (halving, sufficient decrease 1e-4, 40 trials), the
- * conventions of liblbfgs 1.10, which this replaces: a first step of unit
+ * Armijo line search (halving, sufficient decrease 1e-4, 40 trials), liblbfgs
+ * 1.10's conventions: a first step of unit
  * length along −g when no pair is held, step 1 otherwise. A pair is kept
  * only when sᵀy > 0 (Armijo alone does not guarantee it). No energy
  * knowledge here. */
@@ -13,16 +13,6 @@
 
 #define OPT_FTOL 1e-4            /* Armijo sufficient decrease */
 #define OPT_MAX_LINESEARCH 40    /* trials per line search */
-
-const char *opt_strerror(int code)
-{
-    switch (code) {
-#define OPT_STR(name, val, msg) case name: return msg;
-        OPT_ERRORS(OPT_STR)
-#undef OPT_STR
-    }
-    return "unknown solver error";
-}
 
 void opt_params_init(opt_params *p)
 {
@@ -79,11 +69,6 @@ void opt_memory_free(opt_memory *m)
     free(m->xt);
     free(m->gt);
     free(m);
-}
-
-void opt_memory_clear(opt_memory *m)
-{
-    m->count = m->head = 0;
 }
 
 int opt_memory_pairs(const opt_memory *m)

@@ -27,7 +27,6 @@ enum opt_error {
     OPT_ERRORS(OPT_ENUM)
 #undef OPT_ENUM
 };
-const char *opt_strerror(int code);
 
 #define OPT_ITER_GO       0
 #define OPT_ITER_CHANGED  1
@@ -71,7 +70,6 @@ typedef struct opt_stats {
 typedef struct opt_memory opt_memory;
 opt_memory *opt_memory_new(int n, int pairs);   /* NULL: out of memory or bad sizes */
 void opt_memory_free(opt_memory *m);            /* NULL is fine */
-void opt_memory_clear(opt_memory *m);           /* forget every pair */
 /* The objective's Hessian changed by c·diag(d) (d: n values), as when the
  * weight of a quadratic term Σ d_i (x_i − t_i)²/2 changes by c: each kept y
  * gains c·d⊙s, which keeps the pairs exact for that term. */

@@ -40,7 +40,6 @@ enum proj_error {
     PROJ_ERRORS(PROJ_ENUM)
 #undef PROJ_ENUM
 };
-const char *proj_strerror(int code);
 
 #define PROJ_HD_MIN_DIM 8
 

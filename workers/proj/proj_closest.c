@@ -13,15 +13,9 @@
  * the distance: the 3-D ball of radius √best holds a number of faces that
  * grows with the mesh's resolution. There each call fits the tree's box
  * hierarchy (proj_hd.c: patches of X̃, boxes in R^d) to Z and searches it;
- * the Embree tree is not used. Measured (quiet machine, two runs each):
- * RHM on FAUST 5K, d = 16, 200 iterations: P-steps 6.6-7.0 s with the 3-D
- * tree and an R^d box test per face it handed over, 5.2-5.5 s with the
- * hierarchy (boxes as floats: 5.9 s, the conversions cost more than the
- * memory saved); TOSCA cat 28K: the 400 P-steps 41 s. Later (quiet, bench_rhm,
- * alternating builds, two runs each): the box bound four coordinates a
- * step without branches, 4.8 -> 4.0 s; leaves of 16 faces instead of 4,
- * 4.0 -> 3.45 s (8: 3.7 s, 32: 3.5 s; an AVX2 clone of the search: no
- * gain over the baseline's SSE2, not kept). Below that dimension
+ * the Embree tree is not used. Boxes are doubles, bounded four coordinates a
+ * step without branches, with leaves of 16 faces (docs/decisions.md, "The R^d
+ * projection's box hierarchy"). Below that dimension
  * (ECTM, d = 6) the leading coordinates, s·X̃, carry most of the distance
  * and the Embree tree stays. */
 #include "proj/proj.h"

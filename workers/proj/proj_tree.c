@@ -84,9 +84,8 @@ proj_tree *proj_tree_new(const mesh *target, char *err, size_t errsz)
     /* One build thread: Embree's parallel BVH build is not deterministic,
      * and the tree's shape decides which of two faces at equal cost a
      * query returns; ECTM's alternations amplify that into different maps
-     * from run to run (the cow -> camel demo: 0.5 % to 2.8 % flipped on one
-     * tree and input; with one build thread three runs were identical).
-     * The build is a small part of a job: one tree per mesh. */
+     * from run to run. The build is a small part of a job: one tree per mesh.
+      */
     t->device = rtcNewDevice("threads=1");
     if (!t->device) {
         nomem = embree_failed(rtcGetDeviceError(NULL), "rtcNewDevice failed", err, errsz);

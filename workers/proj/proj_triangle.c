@@ -10,16 +10,6 @@
 
 #include <math.h>
 
-const char *proj_strerror(int code)
-{
-    switch (code) {
-#define PROJ_STR(name, val, msg) case name: return msg;
-        PROJ_ERRORS(PROJ_STR)
-#undef PROJ_STR
-    }
-    return "unknown projection error";
-}
-
 /* Below this sin² of the angle at a (Gram determinant over |ab|²|ac|²) the
  * interior formula loses its digits; the edges then bound the triangle to
  * within its height, at most about 1e-7 of its size. */

@@ -27,10 +27,8 @@
  *    vertex coordinates (an exact projection in R^nl, proj.h), P21 the same
  *    the other way; X_ij = P_ij X_j. Not the thesis' start: it is ours,
  *    because the Voronoi start below collapses every cell to a point and a
- *    limb's turn about its axis is then left to chance (measured, FAUST
- *    tr_reg_000 -> 001 from 12 landmarks, after RHM: geodesic error 0.0377
- *    -> 0.0235, flipped triangles 14.3 % -> 5.8 %; FAUST 000 onto itself:
- *    0.046 -> 0.0026, flipped 30 % -> 5.7 %).
+ *    limb's turn about its axis is then left to chance (docs/decisions.md,
+ *    "RHM's start: distances, then the functional map").
  *  - voronoi (§3.3.2): P12 sends every vertex of a geodesic Voronoi cell of
  *    M1 (centres: source landmarks) to the cell's target landmark; P21
  *    sends every vertex v of M2 to the source landmark whose target
@@ -50,11 +48,9 @@
  *
  * Limitation seen on real shapes: a long thin part (a limb, a head on a
  * neck) whose cross-section the m-dimensional embedding squeezes can come
- * out turned about its axis (mirrored). From the Voronoi start this was
- * common (FAUST from 12 landmarks: limb segments twisted, 14 % of the
- * triangles flipped; the cow -> camel demo needed the ear tips as
- * landmarks); the distances start keeps most parts the right way round
- * (5.8 %), and landmarks on both sides of such parts help either way.
+ * out turned about its axis (mirrored). The Voronoi start does this often; the
+ * distances start keeps most parts the right way round, and landmarks on both
+ * sides of such parts help either way.
  *
  * This module reads no files. rhm_run reports the initial map (iteration 0)
  * and every iteration through a callback whose non-zero return cancels. */
@@ -80,7 +76,6 @@ enum rhm_error {
     RHM_ERRORS(RHM_ENUM)
 #undef RHM_ENUM
 };
-const char *rhm_strerror(int code);
 
 /* Basis size of the functional-map start (the k of fmap's tests and
  * figures), capped by what a small mesh has; ZoomOut (rhm_params.zoomout)
@@ -120,23 +115,14 @@ typedef struct rhm_params {
 } rhm_params;
 
 /* The anchor term of RHM from given maps (rhm_run_from_maps), ours: δ =
- * RHM_ANCHOR_WEIGHT on RHM_ANCHORS vertices per side. Without it nothing
- * holds RHM to the map it starts from (the thesis' RHM takes a map only
- * as its start, §3.3.2, and its β ramp starts small so that a degenerate
- * start can change a lot), and from a good map it drifts: the published
- * BCICP map gorilla_01 -> woman_01 with its reverse, denoised by DDM,
- * 0.0502 -> 0.0627 after RHM, 0.0569 after ECTM (input 0.0527); with
- * the anchors 0.0475 after ECTM, and the chain ddm,rhm,ectm lowers the
- * error of all six BCICP maps alone and with their reverse maps
- * (tests/bench/bench_refine.c). Sparse anchors leave the map free to
- * smooth between them; their weight n_i/|A_i| makes δ the weight of a
- * term over the whole mesh, a tenth of β's final value. Anchoring every
- * vertex at the same δ was measured too (RHM's map alone): 11 of the 12
- * maps lower than the input, but gorilla_01 -> man_01 with its reverse
- * 0.0474 -> 0.0550 (200 anchors: 0.0418; every vertex at δ = 0.01: 0.0456,
- * at 0.2: 0.0443); and a β without its ramp (β's final value from the
- * first iteration) did not hold it (gorilla_01 -> woman_01 with its
- * reverse, RHM alone: 0.0543). */
+ * RHM_ANCHOR_WEIGHT on RHM_ANCHORS vertices per side. Without it nothing holds
+ * RHM to the map it starts from (the thesis' RHM takes a map only as its
+ * start, §3.3.2, and its β ramp starts small so that a degenerate start can
+ * change a lot), and from a good map it drifts. Sparse anchors leave the map
+ * free to smooth between them; their weight n_i/|A_i| makes δ the weight of a
+ * term over the whole mesh, a tenth of β's final value. docs/decisions.md,
+ * "RHM from given maps: anchors", has the alternatives (every vertex anchored,
+ * β without its ramp). */
 #define RHM_ANCHOR_WEIGHT 0.05
 #define RHM_ANCHORS 200
 

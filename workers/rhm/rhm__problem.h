@@ -71,9 +71,8 @@ double rhm__now(void);   /* monotonic seconds */
  * landmarks / √area and, for r = 0..nl−1, RHM__ORIENT_WEIGHT times the sine
  * of the angle from ∇d_r to ∇d_{(r+1) mod nl} (geo_orient.h): the features
  * a mirrored match negates. The weight is about a quarter of a typical
- * distance (the distances run to ~1.5 at unit area): enough to tell a
- * shape's front from its back when the distances cannot (glasses 52 -> 58:
- * start flipped 42 % -> 16 %, RHM 80 % -> 12 %), small enough to leave
+ * distance at unit area: enough to tell a shape's front from its back when the
+ * distances cannot, small enough to leave
  * the distances in charge elsewhere. */
 #define RHM__ORIENT_WEIGHT 0.25
 

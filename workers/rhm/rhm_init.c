@@ -90,10 +90,8 @@ static double *landmark_description(rhm__side *a, int nl, int dd, int *rc)
  * cost, sooner where the leading coordinates carry the distance, and with
  * fewer than four landmarks (dd < PROJ_HD_MIN_DIM) its 3-D tree holds the
  * first three. The distances to the landmarks are strongly correlated (a
- * surface in R^dd): along the first three landmarks' distances the 3-D
- * bound let the search visit most faces (TOSCA cat0 -> cat1, 28K vertices,
- * 21 landmarks, dd = 42: 57 s for the start's two projections, 20 s in
- * these axes). */
+ * surface in R^dd): along the first three landmarks' distances the 3-D bound
+ * would let the search visit most faces. */
 static int principal_frame(double *D[2], const int n[2], int dd)
 {
     double *C = calloc((size_t)dd * dd, sizeof *C), *mu = calloc((size_t)dd, sizeof *mu);
@@ -144,9 +142,9 @@ out:
 
 /* P_ij row v: the closest point, in R^dd, of v's description (above) on
  * side j embedded with its own; exact (proj.h), in the principal axes of
- * both descriptions (principal_frame). Seeding
- * each search with a neighbour's face (waves over the edges) left the cat's
- * 20 s unchanged: the radius is set by the closest distance itself. */
+ * both descriptions (principal_frame). Each search starts unseeded: the radius
+ * is set by the closest distance itself, so a neighbour's face as a first
+ * guess would not shorten it. */
 static int start_distances(rhm__problem *pb, char *err, size_t errsz)
 {
     int nl = pb->nl, dd = nl + (RHM__ORIENT_WEIGHT > 0 ? nl : 0), rc = RHM_OK;

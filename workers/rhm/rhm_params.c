@@ -9,16 +9,6 @@
 #include <math.h>
 #include <string.h>
 
-const char *rhm_strerror(int code)
-{
-    switch (code) {
-#define RHM_STR(name, val, msg, kind) case name: return msg;
-        RHM_ERRORS(RHM_STR)
-#undef RHM_STR
-    }
-    return "unknown RHM error";
-}
-
 /* The job parameters' defaults and ranges are the rows of PROTO_PARAMS
  * (proto_params.h) whose ENGINE column is RHM; the rest is RHM's own. */
 #define RHM_ROW_RHM(x) x

@@ -23,8 +23,7 @@
  * partial sums sooner. Below that the lower bound
  * comes from the first three coordinates of the block listed first; early
  * on (small β) the reversibility block weighs more, and a bound from X_j
- * alone would prune almost nothing (measured: the first 20 iterations on
- * FAUST 5K cost 19 s that way), so that block goes first, on a tree
+ * alone would prune almost nothing, so that block goes first, on a tree
  * rebuilt over the current X_ji. */
 #include "rhm/rhm__problem.h"
 

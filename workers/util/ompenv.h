@@ -2,9 +2,8 @@
  *
  * libgomp spins at every barrier by default. When the machine is busier than
  * our thread count (a shared lab server, two jobs on two cores), a spinning
- * thread waits for a descheduled partner for a whole time slice: measured
- * here, 10 outer ECTM iterations on 381 -> 390 took 21.9 s with 2 spinning
- * threads under a load of 2, against 2.35 s with passive waiting. libgomp
+ * thread waits for a descheduled partner for a whole time slice
+ * (docs/decisions.md, "OpenMP threads wait passively"). libgomp
  * reads OMP_WAIT_POLICY once, when it is loaded, so a program must set it
  * before it starts: ompenv_ensure_passive re-executes the program with
  * OMP_WAIT_POLICY=passive unless the user set the variable (their choice is
@@ -24,9 +23,8 @@ int ompenv_set_passive(void);
  * requested when > 0 (the user's choice, kept), else one thread per
  * OMPENV_VERTICES_PER_THREAD vertices, at least 1 and at most the cores.
  * A small job's passes over its elements take microseconds, less than
- * waking a second thread at each of their barriers costs (issue 16: a
- * 162-vertex pair, 2 iterations, 0.76 s with 2 threads against 0.26 s with
- * 1). ompenv_threads.c; the caller passes the result to omp_set_num_threads
+ * waking a second thread at each of their barriers costs. ompenv_threads.c;
+ * the caller passes the result to omp_set_num_threads
  * and to the engines' thread parameters before the first parallel region. */
 #define OMPENV_VERTICES_PER_THREAD 2000
 int ompenv_threads_for(int vertices, int requested);
