@@ -316,7 +316,7 @@ def case_errors_are_builtin_subclasses():
     assert isinstance(e, meshcorr.BadLandmarksError) and (e.code, e.field) == (-20, "landmarks"), e
     V, F = read_off(SRC)
     bad = (np.vstack([V, [[2.0, 0, 0]]]), np.vstack([F, [[F[0, 0], F[0, 1], len(V)]]]))
-    e = expect(ValueError, c.submit, SRC, bad, landmarks=LANDMARKS)
+    e = expect(ValueError, c.submit, SRC, bad, landmarks=LANDMARKS, repair="no")
     assert isinstance(e, meshcorr.BadMeshError) and (e.code, e.field) == (-19, "target"), e
     garbage = os.path.join(DIR, "garbage.off")
     open(garbage, "w").write("OFF\n3 1 0\n0 0 0\n1 0\n")

@@ -1,6 +1,6 @@
 /* repair.c — repair_mesh_run: the steps of repair.h in their order, the
  * repaired mesh built from what they keep, each user vertex's row, and the
- * counts. Also the error texts and the counts' lines. */
+ * counts; the counts' lines. */
 #include "repair/repair.h"
 #include "util/errbuf.h"
 
@@ -8,16 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-const char *repair_strerror(int code)
-{
-    switch (code) {
-#define REPAIR_STR(name, val, msg, kind) case name: return msg;
-        REPAIR_ERRORS(REPAIR_STR)
-#undef REPAIR_STR
-    }
-    return "unknown repair error";
-}
 
 int repair_counts_any(const repair_counts *c)
 {

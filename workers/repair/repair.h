@@ -48,7 +48,6 @@ enum repair_error {
     REPAIR_ERRORS(REPAIR_ENUM)
 #undef REPAIR_ENUM
 };
-const char *repair_strerror(int code);
 
 /* The counts of one mesh's repair: X(member, text for a person). The one
  * list: the struct, the result's record (metric keys "repair.source.NAME",
