@@ -109,7 +109,8 @@ typedef struct mc_job_spec {
      * (NULL or "" = the server's default; "cpu", "opencl", "auto",
      * optionally ":DEVICE", a platform or device name part), stages
      * (MC_STAGES_*), ddm_k, ddm_mode (MC_DDM_PLAIN, MC_DDM_BIJECTIVE),
-     * zoomout, coarse. */
+     * zoomout, coarse, repair (0 yes: repair a mesh the optimizer cannot
+     * use as given; 1 no: refuse it). */
 #define MC_PARAM_CTYPE_ENUM int
 #define MC_PARAM_CTYPE_BOOL int
 #define MC_PARAM_CTYPE_U32  uint32_t

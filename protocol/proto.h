@@ -27,7 +27,7 @@
 
 /* ---- framing ------------------------------------------------------------ */
 #define PROTO_MAGIC      0x5052434Du  /* bytes "MCRP" on the wire */
-#define PROTO_VERSION    5
+#define PROTO_VERSION    6
 #define PROTO_HDR_SIZE   20
 
 /* ---- limits (PROTOCOL.md repeats each one) ------------------------------ */

@@ -112,6 +112,11 @@
       coarse, "",                                                                                \
       "coarse to fine, from landmarks: a mesh over twice this many vertices is decimated to "   \
       "this many, the chain runs on the decimated pair, its maps come back to the meshes and "  \
-      "ECTM finishes them there (0: off, every stage on the meshes as given)")
+      "ECTM finishes them there (0: off, every stage on the meshes as given)")                \
+    X(repair, "repair", ENUM, 0, 0, 1, 0, NONE, repair, "yes|no",                              \
+      "input mesh repair: a mesh the optimizer cannot use as given (non-manifold, unwelded, "   \
+      "degenerate or duplicate faces, stray pieces) is repaired, the repairs listed in the "    \
+      "result and the maps returned in the mesh's own vertex indexing; no: such a mesh is "     \
+      "refused (docs/repair.md)")
 
 #endif

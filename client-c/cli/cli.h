@@ -30,6 +30,7 @@ int cli_output_check(const char *cmd, const char *opt, const char *path);
 
 int cli_info(int argc, char **argv);
 int cli_convert(int argc, char **argv);
+int cli_fix(int argc, char **argv);
 int cli_match(int argc, char **argv);
 int cli_eval(int argc, char **argv);
 int cli_devices(int argc, char **argv);

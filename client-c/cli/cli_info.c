@@ -1,12 +1,31 @@
 /* cli_info.c — `meshcorr info MESH`: counts, topology, area, bounding box
- * and every problem of one mesh (mesh_check.h). Exit 0 only for a mesh the
- * optimizer can use; 1 for an unusable or unreadable one. */
+ * and every problem of one mesh (mesh_check.h), and for a mesh the
+ * optimizer cannot use as given what the input repair would do to it
+ * (repair.h). Exit 0 only for a mesh the optimizer can use as given; 1 for
+ * an unusable or unreadable one. */
 #include "cli/cli.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_check.h"
+#include "repair/repair.h"
 
 #include <stdio.h>
 #include <string.h>
+
+/* What the input repair (on by default in a job) would do to m. */
+static void print_repair(const mesh *m, const char *path)
+{
+    repair_mesh rm;
+    char err[1024], text[2048], prefix[1100];
+    if (repair_mesh_run(m, path, NULL, &rm, err, sizeof err)) {
+        fprintf(stderr, "meshcorr info: %s\n", err);
+        return;
+    }
+    snprintf(prefix, sizeof prefix, "  repair");
+    repair_counts_text(&rm.n, prefix, text, sizeof text);
+    printf("a job repairs it (job parameter repair, docs/repair.md) into %d vertices and %d faces; "
+           "`meshcorr fix` writes that mesh:\n%s", rm.m->nv, rm.m->nf, text);
+    repair_mesh_close(&rm);
+}
 
 int cli_info(int argc, char **argv)
 {
@@ -31,7 +50,6 @@ int cli_info(int argc, char **argv)
         mesh_free(m);
         return 1;
     }
-    mesh_free(m);
     printf("%s\n", path);
     printf("  vertices        %d\n  faces           %d\n  edges           %d\n",
            r.nv, r.nf, r.ne);
@@ -48,8 +66,12 @@ int cli_info(int argc, char **argv)
     int n = mesh_check_problems(&r, path, problems, sizeof problems);
     if (n > 0) {
         fputs(problems, stderr);
-        fprintf(stderr, "meshcorr info: %s: %d problem%s; the optimizer cannot use this mesh\n",
-                path, n, n == 1 ? "" : "s");
+        fprintf(stderr, "meshcorr info: %s: %d problem%s; the optimizer cannot use this mesh as "
+                "given\n", path, n, n == 1 ? "" : "s");
     }
-    return mesh_check_usable(&r) ? 0 : 1;
+    int usable = mesh_check_usable(&r);
+    if (!usable)
+        print_repair(m, path);
+    mesh_free(m);
+    return usable ? 0 : 1;
 }

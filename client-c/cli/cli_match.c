@@ -44,20 +44,37 @@ static int on_progress(void *ctx, const corr_progress *cp)
     return 0;
 }
 
-/* Reads a mesh and refuses one the optimizer cannot use before any other
- * input is read, so the user hears about the mesh first. */
-static mesh *load(const char *path, int *status)
+/* Reads a mesh and refuses one the job cannot use before any other input
+ * is read, so the user hears about the mesh first: with repair, one no
+ * repair fixes (repair_mesh_check); without, one the optimizer cannot use
+ * as given. */
+static mesh *load(const char *path, int repair, int *status)
 {
     char err[4096];
     mesh *m = NULL;
     int rc = corr_from_mesh(mesh_read(path, &m, err, sizeof err));
-    if (rc || (rc = corr_validate(m, path, err, sizeof err))) {
+    if (!rc)
+        rc = repair ? corr_from_repair(repair_mesh_check(m, path, err, sizeof err))
+                    : corr_validate(m, path, err, sizeof err);
+    if (rc) {
         fprintf(stderr, "meshcorr match: %s\n", err);
         mesh_free(m);
         *status = proto_kind_exit(-rc);
         return NULL;
     }
     return m;
+}
+
+/* What the repair did to each mesh, one line per kind (stderr). */
+static void print_repairs(const corr_fix *fx, const char *src, const char *tgt)
+{
+    char text[2048], prefix[4200];
+    snprintf(prefix, sizeof prefix, "meshcorr match: %s: repaired", src);
+    if (repair_counts_text(&fx->S.n, prefix, text, sizeof text))
+        fputs(text, stderr);
+    snprintf(prefix, sizeof prefix, "meshcorr match: %s: repaired", tgt);
+    if (repair_counts_text(&fx->T.n, prefix, text, sizeof text))
+        fputs(text, stderr);
 }
 
 static int write_mesh_with(const char *path, const mesh *faces_of, const double *v, int nv)
@@ -150,18 +167,34 @@ int cli_match(int argc, char **argv)
     mesh *S = NULL, *T = NULL;
     bmap *P0 = NULL, *Q0 = NULL;
     lmk_set *L = NULL;
-    ectm_result res = {0};
+    ectm_result res = {0}, eng = {0};       /* the user's indexing, the engine's */
+    corr_fix fix = {0};
     const char *src = argv[optind], *tgt = argv[optind + 1];
-    if (!(S = load(src, &status)) || !(T = load(tgt, &status)) ||
+    int repair = job.w.repair == 0;            /* "yes|no" */
+    if (!(S = load(src, repair, &status)) || !(T = load(tgt, repair, &status)) ||
         cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
         goto done;
     /* --threads, else as many as the pair's size pays for (as the worker) */
     pe.threads = rp.threads = ompenv_threads_for(S->nv + T->nv, threads);
     omp_set_num_threads(pe.threads);
-    corr_input in = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k,
-                      (corr_ddm_mode)job.w.ddm_mode };
-    int rc = corr_run(&in, &pe, on_progress, &progress, &res, err, sizeof err);
+    corr_input user = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k,
+                        (corr_ddm_mode)job.w.ddm_mode }, in;
+    int rc = corr_fix_open(&user, repair, &fix, &in, err, sizeof err);
+    if (rc) {
+        fprintf(stderr, "meshcorr match: %s\n", err);
+        status = proto_kind_exit(-rc);
+        goto done;
+    }
+    if (fix.repaired)
+        print_repairs(&fix, src, tgt);
+    rc = corr_run(&in, &pe, on_progress, &progress, &eng, err, sizeof err);
     cli_progress_end(stderr, progress);
+    if (!rc && fix.repaired)
+        rc = corr_fix_to_user(&fix, &eng, &res, err, sizeof err);
+    else if (!rc) {
+        res = eng;                           /* the user's indexing already */
+        memset(&eng, 0, sizeof eng);
+    }
     if (rc) {
         /* the kind's name and exit status, as a job through meshcorrd ends */
         fprintf(stderr, "meshcorr match: %s: %s\n", proto_kind_name(-rc), err);
@@ -199,9 +232,10 @@ int cli_match(int argc, char **argv)
         if (w)
             goto done;
     }
-    /* the last line: how good the map is (the worker's metrics and rule) */
+    /* the last line: how good the map is (the worker's metrics and rule,
+     * on the pair the engine ran) */
     metric_summary ms;
-    if (metric_summarize(S, T, res.P, &ms)) {
+    if (metric_summarize(in.S, in.T, fix.repaired ? eng.P : res.P, &ms)) {
         fprintf(stderr, "meshcorr match: out of memory\n");
         goto done;
     }
@@ -217,6 +251,8 @@ int cli_match(int argc, char **argv)
     status = 0;
 done:
     ectm_result_close(&res);
+    ectm_result_close(&eng);
+    corr_fix_close(&fix);
     lmk_free(L);
     bmap_free(P0);
     bmap_free(Q0);

@@ -13,6 +13,7 @@ static const struct {
 } commands[] = {
     { "info",    cli_info,    "MESH             print counts, topology, area, problems" },
     { "convert", cli_convert, "IN OUT           convert between .off .obj .ply .drc" },
+    { "fix",     cli_fix,     "IN OUT           write IN repaired as a job repairs it (docs/repair.md)" },
     { "match",   cli_match,   "SOURCE TARGET .. elastic correspondence (see meshcorr match --help)" },
     { "eval",    cli_eval,    "SOURCE TARGET P.map .. quality of a map (see meshcorr eval --help)" },
     { "devices", cli_devices, "                 list OpenCL devices for --backend opencl|auto" },

@@ -162,7 +162,8 @@ def case_bad_input_refused():
     # one more face on an existing edge: three faces meet there
     Vb = np.vstack([V, [[2.0, 0, 0]]])
     Fb = np.vstack([F, [[F[0, 0], F[0, 1], nv]]])
-    expect_error(-19, "BAD_MESH", c.submit, (Vb, Fb), SRC, landmarks=LANDMARKS, **JOB, has="non-manifold")
+    expect_error(-19, "BAD_MESH", c.submit, (Vb, Fb), SRC, landmarks=LANDMARKS, **JOB, repair="no",
+                 has="non-manifold")
     expect_error(-20, "BAD_LANDMARKS", c.submit, SRC, TGT, landmarks=[[0, 0], [1, 1], [2, 500]], **JOB, has="500")
     expect_error(-21, "BAD_PARAMS", c.submit, SRC, TGT, landmarks=LANDMARKS, inner_iterations=500000,
                  has="inner_iterations")
@@ -315,7 +316,7 @@ def case_errors_are_builtin_subclasses():
     assert isinstance(e, meshcorr.BadLandmarksError) and (e.code, e.field) == (-20, "landmarks"), e
     V, F = read_off(SRC)
     bad = (np.vstack([V, [[2.0, 0, 0]]]), np.vstack([F, [[F[0, 0], F[0, 1], len(V)]]]))
-    e = expect(ValueError, c.submit, SRC, bad, landmarks=LANDMARKS)
+    e = expect(ValueError, c.submit, SRC, bad, landmarks=LANDMARKS, repair="no")
     assert isinstance(e, meshcorr.BadMeshError) and (e.code, e.field) == (-19, "target"), e
     garbage = os.path.join(DIR, "garbage.off")
     open(garbage, "w").write("OFF\n3 1 0\n0 0 0\n1 0\n")
@@ -507,6 +508,30 @@ def case_match_in_process_equals_the_daemons_job():
            inner_iterations=10)
     assert time.monotonic() - t0 < 6, time.monotonic() - t0
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def case_repair_record_and_keyword():
+    """The input repair: a mesh with a face written twice and a stray
+    triangle beside it is repaired alike by the daemon and by match():
+    result.repair says what was done, p has a row per vertex given; a job
+    whose meshes need nothing has no record; repair="no" refuses the mesh."""
+    c = meshcorr.Client(UNIX)
+    V, F = read_off(SRC)
+    nv = len(V)
+    Vb = np.vstack([V, [[3.0, 0, 0], [3.0, 1, 0], [3.0, 0, 1]]])
+    Fb = np.vstack([F, F[:1], [[nv, nv + 1, nv + 2]]])
+    job = c.submit((Vb, Fb), TGT, landmarks=LANDMARKS, **JOB)
+    assert job.wait() == "COMPLETED", job.reason
+    remote = job.result()
+    local = meshcorr.match((Vb, Fb), TGT, landmarks=LANDMARKS, **JOB)
+    rec = remote.repair
+    assert rec["source"]["duplicate_faces"] == 1 and rec["source"]["pieces"] == 1, rec
+    assert rec["source"]["piece_vertices"] == 3 and not any(rec["target"].values()), rec
+    assert local.repair == rec and local.p == remote.p and len(remote.p) == nv + 3
+    assert meshcorr.match(SRC, TGT, landmarks=LANDMARKS, **JOB).repair is None
+    for fn in (c.submit, meshcorr.match):
+        expect_error(-19, "BAD_MESH", fn, (Vb, Fb), TGT, landmarks=LANDMARKS, repair="no", **JOB,
+                     has="duplicate faces")
 
 
 def case_reprs_and_type_hints():

@@ -102,7 +102,7 @@ void protosample_fill(int type, int v, proto_msg *m)
                                     v ? 0 : 0.5, (uint8_t)!v, v ? "" : "opencl:pocl",
                                     (uint8_t)(v ? PROTO_CHAIN_ALL : PROTO_CHAIN_DDM_RHM_ECTM),
                                     v ? 0 : 60, (uint8_t)(v ? PROTO_DDM_PLAIN : PROTO_DDM_BIJECTIVE), v ? 0 : 120,
-                                    v ? 0 : 4000 };
+                                    v ? 0 : 4000, (uint8_t)!v };
         u->priority = v ? 0 : -7;
         u->label = s;
         break;

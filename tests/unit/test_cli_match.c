@@ -85,12 +85,12 @@ TEST(match_refuses_map_sized_for_other_meshes)
     CHECK_STR_HAS(out, "9239");
 }
 
-TEST(match_refuses_non_manifold_mesh)
+TEST(match_refuses_non_manifold_mesh_with_repair_no)
 {
     paths();
     char cmd[4096], out[8192];
     const char *scape = harness_data_path("scape/Meshes/mesh000.off");
-    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map",
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --init %s --out %s/p.map --repair no",
              scape, s390, p0, harness_tmpdir());
     CHECK_INT(run(cmd, out, sizeof out), 1);
     CHECK_STR_HAS(out, "not usable");

@@ -145,7 +145,9 @@ TEST_T(meshes_and_landmarks_that_cannot_run_are_refused_naming_the_blob, 90)
     char err[256];
     CHECK_INT(mesh_encode_drc(N, &nb, &nl, err, sizeof err), 0);
     s->source = (proto_blob){nb, (uint32_t)nl};
+    s->params.repair = 1;                                /* "no": refused as it is */
     expect_refusal(c, &r, PROTO_EBAD_MESH, "source mesh", "non-manifold");
+    s->params.repair = 0;
     free(nb);
     mesh_free(N);
     mesh_free(S);

@@ -298,6 +298,7 @@ TEST_T(bad_meshes_landmarks_parameters_and_maps_are_refused_with_their_own_kind,
     unsigned char *twob = testdaemon_encode(two, &len);
     s.source = twob;
     s.source_len = len;
+    s.repair = 1;                   /* "no": a second piece is refused, not left out */
     CHECK_INT(mc_submit(c, &s, &id), PROTO_EBAD_MESH);
     CHECK_STR_HAS(mc_errmsg(c), "source mesh");
     free(twob);

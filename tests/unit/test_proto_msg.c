@@ -317,5 +317,5 @@ TEST(progress_fraction_and_time_left_are_checked_both_ways)
     proto_buf_free(&b);
     CHECK(strcmp(proto_stage_name(PROTO_STAGE_REPAIR), "repair") == 0);
     CHECK(strcmp(proto_stage_name(PROTO_STAGE_QUEUED), "queued") == 0);
-    CHECK_INT(PROTO_VERSION, 5);
+    CHECK_INT(PROTO_VERSION, 6);
 }

@@ -168,6 +168,8 @@ TEST(engine_checks_agree_with_the_validator_at_every_range_end)
             else if (i == PROTO_P_ddm_mode)
                 got = v != floor(v) || corr_chain_check(CORR_CHAIN_DDM, 1, 1, 0, 0, 0,
                                                          (corr_ddm_mode)v, err, sizeof err) != 0;
+            else if (i == PROTO_P_repair)       /* yes (0) or no (1): the worker's reading */
+                got = v != 0 && v != 1;
             if (got != want)
                 FAILF("%s = %g: validator %s, engine %s", f->name, v, want ? "refuses" : "accepts",
                       got ? "refuses" : "accepts");

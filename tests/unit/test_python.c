@@ -166,6 +166,11 @@ TEST_T(landmarks_must_be_integer_vertex_ids_named_when_refused, 120)
     run_case("landmarks_must_be_integer_vertex_ids");
 }
 
+TEST_T(repaired_meshes_have_the_record_on_the_result_and_repair_no_refuses, 120)
+{
+    run_case("repair_record_and_keyword");
+}
+
 TEST_T(match_in_process_gives_the_daemons_maps_progress_and_refusals, 180)
 {
     run_case("match_in_process_equals_the_daemons_job");

@@ -455,15 +455,20 @@ TEST(worker_refuses_draco_garbage_as_bad_mesh)
     expect_error(NULL, 1, PROTO_EBAD_MESH, "target mesh", NULL);
 }
 
-TEST(worker_refuses_non_manifold_mesh)
+/* With the job parameter repair no, a mesh the optimizer cannot use as
+ * given is refused naming the problem. */
+TEST(worker_refuses_non_manifold_mesh_with_repair_no)
 {
     char src[512], err[1024];
     snprintf(src, sizeof src, "%s", harness_data_path("scape/Meshes/mesh000.off"));
     demo_paths();
     ectm_params prm = short_params(1);
     proto_landmark L[4] = { {0, 0}, {100, 100}, {2000, 2000}, {5000, 5000} };
-    if (testjob_write(job_dir(), src, s390, L, 4, NULL, NULL, &prm, err, sizeof err))
+    testjob j;
+    if (testjob_build(&j, src, s390, L, 4, NULL, NULL, &prm, err, sizeof err))
         FAILF("%s", err);
+    j.msg.u.submit.params.repair = 1;        /* "no" */
+    save(&j);
     expect_error(NULL, 1, PROTO_EBAD_MESH, "source mesh", "non-manifold");
 }
 

@@ -6,11 +6,14 @@
 #include "corr/corr.h"
 #include "corr/corr__ddm.h"
 #include "corr/corr__plan.h"
+#include "corr/corr__pieces.h"
 #include "mesh/mesh_check.h"
 #include "metric/metric.h"
 #include "start/start.h"
 #include "util/errbuf.h"
 
+#include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -261,10 +264,66 @@ static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bma
     return rc;
 }
 
+/* A pair's reports as the whole job's: its fraction scaled into the
+ * pair's share of the pair-by-pair job, the job's time. */
+typedef struct piece_relay {
+    corr_progress_fn fn;
+    void *ctx;
+    double t0, base, share;
+} piece_relay;
+
+static int piece_report(void *ctx, const corr_progress *p)
+{
+    piece_relay *pr = ctx;
+    corr_progress q = *p;
+    q.elapsed = now() - pr->t0;
+    q.fraction = pr->base + pr->share * p->fraction;
+    q.eta_s = q.fraction > 0 ? q.elapsed * (1 - q.fraction) / q.fraction : NAN;
+    return pr->fn(pr->ctx, &q);
+}
+
+/* A job in pieces the landmarks pair (corr__pieces.h): each pair's chain
+ * on its own, in turn, its share of the job by its vertices; the maps
+ * joined. */
+static int run_pieces(const corr_input *in, const corr__pieces *pc, const ectm_params *p,
+                      corr_progress_fn progress, void *ctx, ectm_result *out, char *err,
+                      size_t errsz)
+{
+    ectm_result *res = calloc((size_t)pc->n, sizeof *res);
+    if (!res)
+        return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory for the pieces' results");
+    double total = in->S->nv + in->T->nv, done = 0, t0 = now();
+    int rc = CORR_OK;
+    for (int k = 0; k < pc->n && !rc; k++) {
+        const corr__piece *q = &pc->p[k];
+        piece_relay pr = { progress, ctx, t0, done / total, (q->S->nv + q->T->nv) / total };
+        corr__plan plan;
+        memset(&plan, 0, sizeof plan);
+        relay rl = { progress ? piece_report : NULL, &pr, t0, &plan, 0, 0 };
+        rc = run_chain(&q->in, p, &rl, &res[k], err, errsz);
+        done += q->S->nv + q->T->nv;
+    }
+    if (!rc)
+        rc = corr__pieces_join(in, pc, res, out, err, errsz);
+    for (int k = 0; k < pc->n; k++)
+        ectm_result_close(&res[k]);
+    free(res);
+    return rc;
+}
+
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
+    corr__pieces pc;
+    int rc = corr__pieces_open(in, &pc, err, errsz);
+    if (rc)
+        return rc;
+    if (pc.n) {
+        rc = run_pieces(in, &pc, p, progress, ctx, out, err, errsz);
+        corr__pieces_close(&pc);
+        return rc;
+    }
     corr__plan plan;
     memset(&plan, 0, sizeof plan);
     relay rl = { progress, ctx, now(), &plan, 0, 0 };

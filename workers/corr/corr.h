@@ -27,6 +27,7 @@
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "repair/repair.h"
 #include "rhm/rhm.h"
 #include "proto.h"
 
@@ -54,6 +55,7 @@ int corr_from_lbo(int rc);
 int corr_from_lmk(int rc);
 int corr_from_bmap(int rc);
 int corr_from_mesh(int rc);
+int corr_from_repair(int rc);
 
 /* A progress report's stage: the wire's list (PROTO_STAGES), so a report
  * goes out as it is. START: the start map is built (its RHM energies); RHM:
@@ -180,6 +182,39 @@ void corr_progress_record(const corr_progress *p, proto_progress *out);
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
+/* Input repair (repair.h), the one check of a job's meshes before it runs:
+ * a mesh the optimizer can use as given is used as it is; one it cannot
+ * is repaired when repair is non-zero (the job parameter repair, yes by
+ * default), else refused with corr_validate's message. When either mesh is
+ * repaired, both go through repair_mesh_run (a usable one comes out the
+ * same), the landmarks and uploaded maps are carried into the repaired
+ * indexing (repair_landmarks, repair_map_from_user) and the results back
+ * (corr_fix_to_user). Pieces: without a given map, when the landmarks pair
+ * pieces of the two meshes (repair_pieces_pair: at least
+ * PROTO_MIN_LANDMARKS on a piece, all landing on one piece of the other
+ * mesh), those pieces are kept and corr_run matches each pair on its own;
+ * else the largest piece of each is kept. */
+typedef struct corr_fix {
+    int repaired;            /* 1 when either mesh was repaired             */
+    repair_mesh S, T;        /* when repaired: both meshes' repairs          */
+    lmk_set L;               /* the landmarks in the repaired indexing       */
+    bmap *P0, *Q0;           /* the uploaded maps in the repaired indexing   */
+} corr_fix;
+
+/* Checks and, with repair, repairs user's meshes; *in is the job's input
+ * as the engine runs it (user's own fields where nothing was repaired).
+ * CORR_OK; CORR_EMESH (not usable, repair off; or beyond repair: a bad
+ * index, a NaN), CORR_EMAP (an uploaded map on a removed face),
+ * CORR_ENOMEM. On error fx holds nothing. */
+int corr_fix_open(const corr_input *user, int repair, corr_fix *fx, corr_input *in, char *err,
+                  size_t errsz);
+/* The engine's result (on the repaired meshes) in the user's indexing:
+ * P and Q with one row per user vertex on the user's faces, Y and Yt one
+ * row per user vertex; last copied. CORR_ENOMEM. */
+int corr_fix_to_user(const corr_fix *fx, const ectm_result *res, ectm_result *out, char *err,
+                     size_t errsz);
+void corr_fix_close(corr_fix *fx);
+
 /* The sizes a job's meshes bound: DDM's basis (in->ddm_k, when the chain
  * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM may start from the
  * functional map: start fmap, or auto's second run) hold at most
@@ -273,6 +308,10 @@ void corr_coarse_close(corr_coarse *c);
 double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, size_t wsz);
 
 /* Runs the pipeline: the stages of in->stages (corr_chain_check first).
+ * Meshes in pieces that in->L pairs one to one (no given map) run pair by
+ * pair, each pair's share of the progress by its vertices, and the maps
+ * are joined (corr__pieces.h); pieces the landmarks do not pair are
+ * CORR_EMESH.
  * When the chain ends before ECTM, out->P and out->Q are the last stage's
  * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
  * the model is bijective) and out->Y, out->Yt, out->last stay empty. */

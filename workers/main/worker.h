@@ -28,7 +28,10 @@ typedef struct wrk_limits {
                                       ompenv_threads_for) */
 } wrk_limits;
 
-/* A job ready for corr_run; everything owned (wrk_job_close). */
+/* A job ready for corr_run; everything owned (wrk_job_close). S, T, L, P0
+ * and Q0 are the client's, in its indexing; fix holds the repaired pair
+ * when a mesh needed repair (corr_fix_open), and wrk_job_input gives the
+ * engine that. */
 typedef struct wrk_job {
     mesh *S, *T;
     lmk_set *L;                    /* NULL when the SUBMIT has no landmarks */
@@ -38,11 +41,15 @@ typedef struct wrk_job {
     corr_chain stages;            /* the chain, DDM's basis and mode as sent */
     int ddm_k;
     corr_ddm_mode ddm_mode;
+    int repair;                    /* the parameter repair: 1 yes, 0 no */
+    corr_fix fix;
 } wrk_job;
 
 /* worker_job.c — the one mapping from a SUBMIT to a job: decodes both Draco
  * meshes (BAD_MESH naming "source mesh"/"target mesh", over the limits
- * included), validates them (corr_validate), checks and maps the
+ * included), checks and with the parameter repair repairs them
+ * (corr_fix_open, after the landmarks and maps are read in the client's
+ * indexing, which it translates; BAD_MESH), checks and maps the
  * parameters onto ectm_params and rhm_params (corr_params_from_job, i.e.
  * proto_params_check: BAD_PARAMS naming the field), checks that there are
  * landmarks or a map (and q only with p, bijective), builds the landmark set
@@ -60,7 +67,8 @@ void wrk_job_close(wrk_job *job);
 int wrk_map_of(const proto_map *w, const char *name, const mesh *from, const mesh *to, bmap **out, char *err,
                size_t errsz);
 /* The job as corr_run's input (pointers into job; the meshes named
- * "source mesh" and "target mesh", as in every message of a job). */
+ * "source mesh" and "target mesh", as in every message of a job): the
+ * repaired pair when there is one. */
 void wrk_job_input(const wrk_job *job, corr_input *in);
 
 /* worker_io.c — the spool files. wrk_frame_read reads path whole and decodes
@@ -94,12 +102,19 @@ void wrk_progress_send(wrk_progress *pg, const corr_progress *cp, double elapsed
 
 /* worker_result.c — the RESULT_OK message of a finished job: P, Q
  * (bijective), the deformed source as Draco (our order-keeping encoder) and
- * the metrics (WORKER.md lists the keys). The message borrows from r. */
+ * the metrics (WORKER.md lists the keys). res is the engine's result; when
+ * the job's meshes were repaired, the maps and the deformed mesh go out in
+ * the client's indexing (corr_fix_to_user), the metrics are the repaired
+ * pair's, and the repair's counts follow them (WRK_REPAIR_KEYS). The
+ * message borrows from r. */
+#define WRK_BASE_METRICS 12
+#define WRK_REPAIR_KEYS (2 * (0 REPAIR_COUNTS(WRK_ONE)))
+#define WRK_ONE(name, text) + 1
 typedef struct wrk_result {
     proto_msg msg;
     proto_map_row *p, *q;
     unsigned char *deformed;
-    proto_metric metrics[12];
+    proto_metric metrics[WRK_BASE_METRICS + WRK_REPAIR_KEYS];
 } wrk_result;
 int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
                      double elapsed, wrk_result *r, char *err, size_t errsz);

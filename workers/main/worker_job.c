@@ -20,6 +20,7 @@ void wrk_job_close(wrk_job *job)
     lmk_free(job->L);
     bmap_free(job->P0);
     bmap_free(job->Q0);
+    corr_fix_close(&job->fix);
     memset(job, 0, sizeof *job);
 }
 
@@ -28,9 +29,17 @@ static int load_mesh(const proto_blob *b, const char *name, const wrk_limits *li
 {
     int rc = mesh_read_drc_mem(b->data, b->len, lim->max_vertices, lim->max_faces, name, out,
                                err, errsz);
-    if (rc)                 /* over the limits included: "N points / M faces, over ..." */
-        return corr_wire_code(corr_from_mesh(rc));
-    return corr_wire_code(corr_validate(*out, name, err, errsz));
+    /* over the limits included: "N points / M faces, over ..." */
+    return rc ? corr_wire_code(corr_from_mesh(rc)) : 0;
+}
+
+/* The meshes as the engine will run them: used as given, repaired, or
+ * refused (corr_fix_open), landmarks and maps carried along. */
+static int fix_meshes(wrk_job *job, char *err, size_t errsz)
+{
+    corr_input user = { job->S, job->T, "source mesh", "target mesh", job->L, job->P0, job->Q0,
+                        &job->rhm, job->stages, job->ddm_k, job->ddm_mode }, in;
+    return corr_wire_code(corr_fix_open(&user, job->repair, &job->fix, &in, err, errsz));
 }
 
 /* The inputs' combination: a map or landmarks, q only with p and bijective. */
@@ -49,12 +58,16 @@ static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 }
 
 /* A chain of stages that can run on the inputs (corr_chain_check); after
- * the landmarks are read, so that their own rule speaks first. */
-static int check_stages(const proto_submit *s, char *err, size_t errsz)
+ * the landmarks are read, so that their own rule speaks first, and with
+ * the landmarks the run will have (a repair leaves out those on vertices
+ * it dropped). */
+static int check_stages(const proto_submit *s, const wrk_job *job, char *err, size_t errsz)
 {
     char why[256];
+    corr_input in;
+    wrk_job_input(job, &in);
     int rc = corr_chain_check((corr_chain)s->params.stages, s->p.n > 0, s->q.n > 0,
-                               (int)s->nlandmarks, s->params.model == PROTO_MODEL_INJECTIVE,
+                              in.L ? in.L->n : 0, s->params.model == PROTO_MODEL_INJECTIVE,
                                s->params.rhm_landmark_weight, (corr_ddm_mode)s->params.ddm_mode,
                                why, sizeof why);
     return rc ? errbuf_set(err, errsz, corr_wire_code(rc), "params.stages: %s", why) : 0;
@@ -64,6 +77,14 @@ void wrk_job_input(const wrk_job *job, corr_input *in)
 {
     *in = (corr_input){ job->S, job->T, "source mesh", "target mesh", job->L, job->P0, job->Q0,
                         &job->rhm, job->stages, job->ddm_k, job->ddm_mode };
+    if (job->fix.repaired) {
+        const corr_fix *fx = &job->fix;
+        in->S = fx->S.m;
+        in->T = fx->T.m;
+        in->L = job->L ? &fx->L : NULL;
+        in->P0 = fx->P0;
+        in->Q0 = fx->Q0;
+    }
 }
 
 /* The sizes the decoded meshes bound (corr_check_sizes), as the run would
@@ -139,13 +160,15 @@ int wrk_job_from_submit(const proto_submit *s, const wrk_limits *lim, wrk_job *j
     job->stages = (corr_chain)s->params.stages;
     job->ddm_k = (int)s->params.ddm_k;
     job->ddm_mode = (corr_ddm_mode)s->params.ddm_mode;
+    job->repair = s->params.repair == 0;     /* "yes|no" */
     if ((rc = check_inputs(s, err, errsz)) ||
         (rc = load_mesh(&s->source, "source mesh", lim, &job->S, err, errsz)) ||
         (rc = load_mesh(&s->target, "target mesh", lim, &job->T, err, errsz)) ||
         (rc = map_landmarks(s, job->S, job->T, &job->L, err, errsz)) ||
         (rc = wrk_map_of(&s->p, "initial map p", job->S, job->T, &job->P0, err, errsz)) ||
         (rc = wrk_map_of(&s->q, "initial map q", job->T, job->S, &job->Q0, err, errsz)) ||
-        (rc = check_stages(s, err, errsz)) ||
+        (rc = fix_meshes(job, err, errsz)) ||
+        (rc = check_stages(s, job, err, errsz)) ||
         (rc = check_sizes(job, err, errsz))) {
         wrk_job_close(job);
         return rc;

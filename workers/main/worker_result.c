@@ -30,32 +30,78 @@ static proto_map_row *rows_of(const bmap *P)
     return rows;
 }
 
+/* The repair's record: each count of each mesh under its key. */
+static int repair_metrics(const corr_fix *fx, proto_metric *m)
+{
+    static const char *const keys[] = {
+#define WRK_SOURCE_KEY(name, text) "repair_source_" #name,
+        REPAIR_COUNTS(WRK_SOURCE_KEY)
+#undef WRK_SOURCE_KEY
+#define WRK_TARGET_KEY(name, text) "repair_target_" #name,
+        REPAIR_COUNTS(WRK_TARGET_KEY)
+#undef WRK_TARGET_KEY
+    };
+    const double vals[] = {
+#define WRK_SOURCE_VAL(name, text) fx->S.n.name,
+        REPAIR_COUNTS(WRK_SOURCE_VAL)
+#undef WRK_SOURCE_VAL
+#define WRK_TARGET_VAL(name, text) fx->T.n.name,
+        REPAIR_COUNTS(WRK_TARGET_VAL)
+#undef WRK_TARGET_VAL
+    };
+    int n = (int)(sizeof keys / sizeof keys[0]);
+    for (int i = 0; i < n; i++)
+        m[i] = (proto_metric){ keys[i], vals[i] };
+    return n;
+}
+
+/* The message from res, in the client's indexing (user) where the meshes
+ * were repaired; the metrics from the engine's pair. */
+static int build(const wrk_job *job, const ectm_result *res, const ectm_result *user,
+                 uint64_t job_id, double elapsed, wrk_result *r, char *err, size_t errsz);
+
 int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
                      double elapsed, wrk_result *r, char *err, size_t errsz)
 {
     memset(r, 0, sizeof *r);
+    if (!job->fix.repaired)
+        return build(job, res, res, job_id, elapsed, r, err, errsz);
+    ectm_result user;
+    int rc = corr_fix_to_user(&job->fix, res, &user, err, errsz);
+    if (rc)
+        return corr_wire_code(rc);
+    rc = build(job, res, &user, job_id, elapsed, r, err, errsz);
+    ectm_result_close(&user);
+    return rc;
+}
+
+static int build(const wrk_job *job, const ectm_result *res, const ectm_result *user,
+                 uint64_t job_id, double elapsed, wrk_result *r, char *err, size_t errsz)
+{
     proto_result_ok *ok = &r->msg.u.result_ok;
     r->msg.type = PROTO_MSG_RESULT_OK;
     ok->job_id = job_id;
-    if (!(r->p = rows_of(res->P)) || (res->Q && !(r->q = rows_of(res->Q)))) {
+    corr_input in;              /* the engine's pair, for the metrics */
+    wrk_job_input(job, &in);
+    if (!(r->p = rows_of(user->P)) || (user->Q && !(r->q = rows_of(user->Q)))) {
         wrk_result_close(r);
         return errbuf_set(err, errsz, PROTO_ENOMEM, "result maps: out of memory");
     }
-    ok->p = (proto_map){ r->p, (uint32_t)res->P->n };
-    if (res->Q)
-        ok->q = (proto_map){ r->q, (uint32_t)res->Q->n };
+    ok->p = (proto_map){ r->p, (uint32_t)user->P->n };
+    if (user->Q)
+        ok->q = (proto_map){ r->q, (uint32_t)user->Q->n };
 
     /* a chain that ends before ECTM has no deformation: its mesh is the
      * map's image P X~ of the source (what ECTM's Y approximates) */
     double *image = NULL;
-    if (!res->Y) {
+    if (!user->Y) {
         if (!(image = malloc(sizeof(double) * 3 * (size_t)job->S->nv + 1))) {
             wrk_result_close(r);
             return errbuf_set(err, errsz, PROTO_ENOMEM, "result mesh: out of memory");
         }
-        bmap_apply(res->P, job->T->f, job->T->v, 3, image);
+        bmap_apply(user->P, job->T->f, job->T->v, 3, image);
     }
-    mesh deformed = { job->S->nv, job->S->nf, res->Y ? res->Y : image, job->S->f };
+    mesh deformed = { job->S->nv, job->S->nf, user->Y ? user->Y : image, job->S->f };
     size_t len = 0;
     char detail[512];
     int erc = mesh_encode_drc(&deformed, &r->deformed, &len, detail, sizeof detail);
@@ -73,8 +119,8 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
     ok->deformed = (proto_blob){ r->deformed, (uint32_t)len };
 
     metric_summary ms, mq = {0};
-    if (metric_summarize(job->S, job->T, res->P, &ms) ||
-        (res->Q && metric_summarize(job->T, job->S, res->Q, &mq))) {
+    if (metric_summarize(in.S, in.T, res->P, &ms) ||
+        (res->Q && metric_summarize(in.T, in.S, res->Q, &mq))) {
         wrk_result_close(r);
         return errbuf_set(err, errsz, PROTO_ENOMEM, "metrics: out of memory");
     }
@@ -98,8 +144,11 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
         { "reverse_flipped_fraction", mq.flipped_fraction },
         { "reverse_collapsed_fraction", mq.collapsed_fraction },
     };
+    _Static_assert(sizeof m / sizeof m[0] == WRK_BASE_METRICS, "WRK_BASE_METRICS");
     memcpy(r->metrics, m, sizeof m);
     ok->metrics = r->metrics;
     ok->nmetrics = sizeof m / sizeof m[0] - (res->Q ? 0 : 4);
+    if (job->fix.repaired)
+        ok->nmetrics += (uint32_t)repair_metrics(&job->fix, r->metrics + ok->nmetrics);
     return 0;
 }

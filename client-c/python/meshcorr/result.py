@@ -34,11 +34,15 @@ class Result:
     deformed: (V, F) of the deformed source when asked for, else None;
     metrics: {name: value} as the worker measured the map (flipped_fraction,
     collapsed_fraction, mean_abs_log_area, median_conformal, final_energy,
-    iterations, elapsed_s, quality_verdict, and reverse_* for q)."""
+    iterations, elapsed_s, quality_verdict, and reverse_* for q);
+    repair: what the input repair did, {"source": {count: n}, "target":
+    {...}} from the metrics repair_source_* and repair_target_*, or None
+    when neither mesh needed it (docs/repair.md)."""
 
     def __init__(self, p: Map, q: Optional[Map], deformed: Optional[Tuple[np.ndarray, np.ndarray]],
                  metrics: Dict[str, float]) -> None:
         self.p, self.q, self.deformed, self.metrics = p, q, deformed, metrics
+        self.repair = repair_of(metrics)
 
     def __repr__(self) -> str:
         parts = ["p=%r" % self.p, "q=%r" % self.q]
@@ -47,6 +51,17 @@ class Result:
         if "final_energy" in self.metrics:
             parts.append("final_energy=%.6g" % self.metrics["final_energy"])
         return "Result(%s)" % ", ".join(parts)
+
+
+def repair_of(metrics: Dict[str, float]) -> Optional[Dict[str, Dict[str, int]]]:
+    """The repair record of a result's metrics (keys repair_source_NAME and
+    repair_target_NAME), or None when there is none."""
+    rec: Dict[str, Dict[str, int]] = {"source": {}, "target": {}}
+    for key, value in metrics.items():
+        for side in rec:
+            if key.startswith("repair_%s_" % side):
+                rec[side][key[len("repair_%s_" % side):]] = int(value)
+    return rec if rec["source"] or rec["target"] else None
 
 
 def map_of(rows: Any, n: int, n_target: int) -> Map:
