@@ -169,7 +169,19 @@ static int write_curves(const char *svg, const char *csv, const char *const *nam
     return 0;
 }
 
-int cli_eval(int argc, char **argv)
+/* The command line of eval. */
+typedef struct eval_opts {
+    const char *rev, *gt, *gt2, *fmt;
+    const char *out_colors, *out_curve, *out_csv, *out_png;
+    int base, json, folds, map_base, pair;
+    int nmaps;
+    const char *spath, *tpath;
+    char *const *ppaths;
+} eval_opts;
+
+/* Reads and checks the command line, outputs included: -1 to go on, else
+ * the exit status (a usage error, --help). */
+static int parse_options(int argc, char **argv, eval_opts *o)
 {
     static const struct option opts[] = {
         {"reverse", required_argument, 0, 'r'},  {"gt", required_argument, 0, 'g'},
@@ -180,102 +192,170 @@ int cli_eval(int argc, char **argv)
         {"mark-folds", no_argument, 0, 'm'},     {"map-base", required_argument, 0, 'B'},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0}};
-    const char *rev = NULL, *gt = NULL, *gt2 = NULL, *fmt = NULL;
-    const char *out_colors = NULL, *out_curve = NULL, *out_csv = NULL, *out_png = NULL;
-    int base = LMK_BASE_DEFAULT, json = 0, folds = 0, c, map_base = VMAP_BASE_AUTO;
+    *o = (eval_opts){.base = LMK_BASE_DEFAULT, .map_base = VMAP_BASE_AUTO};
+    int c;
     optind = 1;
     while ((c = cli_getopt("eval", argc, argv, opts)) != -1) {
         switch (c) {
-        case 'r': rev = optarg; break;
-        case 'g': gt = optarg; break;
-        case 't': gt2 = optarg; break;
-        case 'f': fmt = optarg; break;
+        case 'r': o->rev = optarg; break;
+        case 'g': o->gt = optarg; break;
+        case 't': o->gt2 = optarg; break;
+        case 'f': o->fmt = optarg; break;
         case 'b':
             if (strcmp(optarg, "0") && strcmp(optarg, "1"))
                 return cli_usage_error("eval", "--gt-base: '%s' is not 0 or 1", optarg);
-            base = optarg[0] - '0';
+            o->base = optarg[0] - '0';
             break;
         case 'B':
             if (strcmp(optarg, "0") && strcmp(optarg, "1") && strcmp(optarg, "auto"))
                 return cli_usage_error("eval", "--map-base: '%s' is not 0, 1 or auto", optarg);
-            map_base = strcmp(optarg, "auto") ? optarg[0] - '0' : VMAP_BASE_AUTO;
+            o->map_base = strcmp(optarg, "auto") ? optarg[0] - '0' : VMAP_BASE_AUTO;
             break;
-        case 'j': json = 1; break;
-        case 'c': out_colors = optarg; break;
-        case 's': out_curve = optarg; break;
-        case 'v': out_csv = optarg; break;
-        case 'p': out_png = optarg; break;
-        case 'm': folds = 1; break;
+        case 'j': o->json = 1; break;
+        case 'c': o->out_colors = optarg; break;
+        case 's': o->out_curve = optarg; break;
+        case 'v': o->out_csv = optarg; break;
+        case 'p': o->out_png = optarg; break;
+        case 'm': o->folds = 1; break;
         case 'h': usage(stdout); return 0;
         default: return cli_usage_see("eval");
         }
     }
-    int pair = fmt && strcmp(fmt, "vts-pair") == 0, list = fmt && strcmp(fmt, "vertex-list") == 0;
-    int nmaps = argc - optind - 2;
-    if (nmaps < 1 || nmaps > EVAL_MAX_MAPS)
+    o->pair = o->fmt && strcmp(o->fmt, "vts-pair") == 0;
+    int list = o->fmt && strcmp(o->fmt, "vertex-list") == 0;
+    o->nmaps = argc - optind - 2;
+    if (o->nmaps < 1 || o->nmaps > EVAL_MAX_MAPS)
         return cli_usage_error("eval", "need SOURCE TARGET and 1 to %d maps (%d file%s given)", EVAL_MAX_MAPS,
                                argc - optind, argc - optind == 1 ? "" : "s");
-    if (rev && nmaps != 1)
+    if (o->rev && o->nmaps != 1)
         return cli_usage_error("eval", "--reverse goes with a single map");
-    if ((out_curve || out_csv) && !gt)
+    if ((o->out_curve || o->out_csv) && !o->gt)
         return cli_usage_error("eval", "--out-curve and --out-csv need a ground truth (--gt)");
-    if (folds && !out_png)
+    if (o->folds && !o->out_png)
         return cli_usage_error("eval", "--mark-folds goes with --out-png");
-    if (fmt && !pair && !list)
-        return cli_usage_error("eval", "--gt-format: '%s' is not vts-pair or vertex-list", fmt);
-    if (gt && !fmt)
+    if (o->fmt && !o->pair && !list)
+        return cli_usage_error("eval", "--gt-format: '%s' is not vts-pair or vertex-list", o->fmt);
+    if (o->gt && !o->fmt)
         return cli_usage_error("eval", "--gt needs --gt-format vts-pair or vertex-list");
-    if (gt && pair != !!gt2)
+    if (o->gt && o->pair != !!o->gt2)
         return cli_usage_error("eval", "--gt-target goes with --gt-format vts-pair, and only with it");
     char colors[4200];
-    snprintf(colors, sizeof colors, "%s.target.ply", out_colors ? out_colors : "");
-    if (cli_output_check("eval", "--out-colors", out_colors ? colors : NULL) ||
-        cli_output_check("eval", "--out-png", out_png) || cli_output_check("eval", "--out-curve", out_curve) ||
-        cli_output_check("eval", "--out-csv", out_csv))
+    snprintf(colors, sizeof colors, "%s.target.ply", o->out_colors ? o->out_colors : "");
+    if (cli_output_check("eval", "--out-colors", o->out_colors ? colors : NULL) ||
+        cli_output_check("eval", "--out-png", o->out_png) || cli_output_check("eval", "--out-curve", o->out_curve) ||
+        cli_output_check("eval", "--out-csv", o->out_csv))
         return CLI_EXIT_USAGE;
-    const char *spath = argv[optind], *tpath = argv[optind + 1];
-    char *const *ppaths = argv + optind + 2;
+    o->spath = argv[optind];
+    o->tpath = argv[optind + 1];
+    o->ppaths = argv + optind + 2;
+    return -1;
+}
+
+/* The ground truth's pairs (*gsrc)[k] -> (*gtgt)[k], *ngt of them: the
+ * vts-pair files line by line, or a vertex list (source vertex k -> line
+ * k). 0, or -1 with the message printed (out of memory included). */
+static int read_ground_truth(const eval_opts *o, const mesh *S, const mesh *T, int **gsrc, int **gtgt, int *ngt)
+{
+    int n2 = 0;
+    if (o->pair) {
+        if (read_indices(o->gt, o->base, S, gsrc, ngt) || read_indices(o->gt2, o->base, T, gtgt, &n2))
+            return -1;
+        if (*ngt != n2 || *ngt == 0) {
+            fprintf(stderr, "meshcorr eval: %s has %d lines but %s has %d: line k of one must "
+                    "match line k of the other\n", o->gt, *ngt, o->gt2, n2);
+            return -1;
+        }
+        return 0;
+    }
+    if (read_indices(o->gt, o->base, T, gtgt, ngt))
+        return -1;
+    if (*ngt != S->nv) {
+        fprintf(stderr, "meshcorr eval: %s has %d lines, but the source %s has %d vertices "
+                "(one line per source vertex)\n", o->gt, *ngt, o->spath, S->nv);
+        return -1;
+    }
+    if (!(*gsrc = malloc(sizeof(int) * (size_t)*ngt))) {
+        fprintf(stderr, "meshcorr eval: out of memory\n");
+        return -1;
+    }
+    for (int k = 0; k < *ngt; k++)
+        (*gsrc)[k] = k;
+    return 0;
+}
+
+/* The figures of one map, as one JSON line or as text; gmean and curve
+ * only when ngt > 0, trip only with a reverse map. */
+static void print_figures(const eval_opts *o, int a, const mesh *S, const mesh *T, const metric_summary *ms,
+                          double curv, double cover, int has_q, double trip, int ngt, double gmean,
+                          const double *curve)
+{
+    const char *ppath = o->ppaths[a];
+    if (o->json) {
+        printf("{\"map\":\"%s\",\"conformal_median\":%.9g,\"conformal_mean\":%.9g,"
+               "\"area_mean_abs_log\":%.9g,\"flipped\":%.9g,\"collapsed\":%.9g,"
+               "\"curvature_error\":%.9g,\"coverage\":%.9g", ppath, ms->median_conformal,
+               ms->mean_conformal, ms->mean_abs_log_area, ms->flipped_fraction,
+               ms->collapsed_fraction, curv, cover);
+        if (has_q)
+            printf(",\"round_trip\":%.9g", trip);
+        if (ngt) {
+            printf(",\"geodesic\":{\"points\":%d,\"mean\":%.9g,\"curve\":[", ngt, gmean);
+            for (int k = 0; k < EVAL_CURVE_STEPS; k++)
+                printf("%s[%.4g,%.6g]", k ? "," : "", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1), curve[k]);
+            printf("]}");
+        }
+        printf("}\n");
+        return;
+    }
+    printf("%smap %s: %s (%d vertices) -> %s (%d vertices)\n", a ? "\n" : "", ppath,
+           o->spath, S->nv, o->tpath, T->nv);
+    printf("conformal distortion: median %.4f, mean %.4f\n", ms->median_conformal, ms->mean_conformal);
+    printf("area distortion: mean |log area ratio| %.4f\n", ms->mean_abs_log_area);
+    printf("flipped triangles: %.2f %%\n", 100 * ms->flipped_fraction);
+    printf("collapsed triangles: %.2f %%\n", 100 * ms->collapsed_fraction);
+    printf("mean-curvature error: %.4f\n", curv);
+    printf("target area within %.2f of a mapped point: %.2f %%\n", METRIC_COVER_RADIUS, 100 * cover);
+    if (has_q)
+        printf("round trip |QPX - X|: %.4f\n", trip);
+    if (ngt) {
+        printf("geodesic error (/sqrt(area)): mean %.4f over %d points\n", gmean, ngt);
+        for (int k = 0; k < EVAL_CURVE_STEPS; k += 5)
+            printf("  error <= %.2f: %.1f %%\n", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1), 100 * curve[k]);
+    }
+}
+
+int cli_eval(int argc, char **argv)
+{
+    eval_opts o;
+    int status = parse_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    const char *spath = o.spath, *tpath = o.tpath;
+    char *const *ppaths = o.ppaths;
+    int nmaps = o.nmaps;
     char err[1024];
-    int status = 1, ngt = 0, n2 = 0;
+    int ngt = 0;
+    status = 1;
     mesh *S = NULL, *T = NULL;
     bmap *maps[EVAL_MAX_MAPS] = {0}, *Q = NULL;
     int *gsrc = NULL, *gtgt = NULL;
     double *gerr = NULL;
     geod_solver *gs = NULL;
     if (mesh_read(spath, &S, err, sizeof err) || mesh_read(tpath, &T, err, sizeof err) ||
-        (rev && vmap_read_any(rev, map_base, T, S, &Q, err, sizeof err))) {
+        (o.rev && vmap_read_any(o.rev, o.map_base, T, S, &Q, err, sizeof err))) {
         fprintf(stderr, "meshcorr eval: %s\n", err);
         goto done;
     }
     for (int a = 0; a < nmaps; a++)
-        if (vmap_read_any(ppaths[a], map_base, S, T, &maps[a], err, sizeof err)) {
+        if (vmap_read_any(ppaths[a], o.map_base, S, T, &maps[a], err, sizeof err)) {
             fprintf(stderr, "meshcorr eval: %s\n", err);
             goto done;
         }
-    if (gt && pair) {
-        if (read_indices(gt, base, S, &gsrc, &ngt) || read_indices(gt2, base, T, &gtgt, &n2))
-            goto done;
-        if (ngt != n2 || ngt == 0) {
-            fprintf(stderr, "meshcorr eval: %s has %d lines but %s has %d: line k of one must "
-                    "match line k of the other\n", gt, ngt, gt2, n2);
-            goto done;
-        }
-    } else if (gt) {
-        if (read_indices(gt, base, T, &gtgt, &ngt))
-            goto done;
-        if (ngt != S->nv) {
-            fprintf(stderr, "meshcorr eval: %s has %d lines, but the source %s has %d vertices "
-                    "(one line per source vertex)\n", gt, ngt, spath, S->nv);
-            goto done;
-        }
-        if (!(gsrc = malloc(sizeof(int) * (size_t)ngt)))
-            goto oom;
-        for (int k = 0; k < ngt; k++)
-            gsrc[k] = k;
-    }
+    if (o.gt && read_ground_truth(&o, S, T, &gsrc, &gtgt, &ngt))
+        goto done;
     double curves[EVAL_MAX_MAPS][EVAL_CURVE_STEPS], gmean[EVAL_MAX_MAPS];
-    render_map_words words = {spath, tpath, ppaths[0], NAN, NAN, NAN, 0, folds};
-    if (gt) {
+    render_map_words words = {spath, tpath, ppaths[0], NAN, NAN, NAN, 0, o.folds};
+    if (o.gt) {
         if (geod_solver_new(T, 0, &gs, err, sizeof err)) {
             fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);
             goto done;
@@ -299,7 +379,6 @@ int cli_eval(int argc, char **argv)
     for (int a = 0; a < nmaps; a++) {
         const bmap *P = maps[a];
         const char *ppath = ppaths[a];
-        const double *curve = curves[a];
         metric_summary ms;
         double curv, cover = metric_coverage(T, P, METRIC_COVER_RADIUS), trip = NAN;
         if (metric_summarize(S, T, P, &ms) || (Q && metric_round_trip(S, T, P, Q, &trip)))
@@ -314,50 +393,20 @@ int cli_eval(int argc, char **argv)
             words.flipped = ms.flipped_fraction;
             words.collapsed = ms.collapsed_fraction;
         }
-        if (json) {
-            printf("{\"map\":\"%s\",\"conformal_median\":%.9g,\"conformal_mean\":%.9g,"
-                   "\"area_mean_abs_log\":%.9g,\"flipped\":%.9g,\"collapsed\":%.9g,"
-                   "\"curvature_error\":%.9g,\"coverage\":%.9g", ppath, ms.median_conformal,
-                   ms.mean_conformal, ms.mean_abs_log_area, ms.flipped_fraction,
-                   ms.collapsed_fraction, curv, cover);
-            if (Q)
-                printf(",\"round_trip\":%.9g", trip);
-            if (gt) {
-                printf(",\"geodesic\":{\"points\":%d,\"mean\":%.9g,\"curve\":[", ngt, gmean[a]);
-                for (int k = 0; k < EVAL_CURVE_STEPS; k++)
-                    printf("%s[%.4g,%.6g]", k ? "," : "", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1), curve[k]);
-                printf("]}");
-            }
-            printf("}\n");
-        } else {
-            printf("%smap %s: %s (%d vertices) -> %s (%d vertices)\n", a ? "\n" : "", ppath,
-                   spath, S->nv, tpath, T->nv);
-            printf("conformal distortion: median %.4f, mean %.4f\n", ms.median_conformal, ms.mean_conformal);
-            printf("area distortion: mean |log area ratio| %.4f\n", ms.mean_abs_log_area);
-            printf("flipped triangles: %.2f %%\n", 100 * ms.flipped_fraction);
-            printf("collapsed triangles: %.2f %%\n", 100 * ms.collapsed_fraction);
-            printf("mean-curvature error: %.4f\n", curv);
-            printf("target area within %.2f of a mapped point: %.2f %%\n", METRIC_COVER_RADIUS, 100 * cover);
-            if (Q)
-                printf("round trip |QPX - X|: %.4f\n", trip);
-            if (gt) {
-                printf("geodesic error (/sqrt(area)): mean %.4f over %d points\n", gmean[a], ngt);
-                for (int k = 0; k < EVAL_CURVE_STEPS; k += 5)
-                    printf("  error <= %.2f: %.1f %%\n", EVAL_CURVE_MAX * k / (EVAL_CURVE_STEPS - 1), 100 * curve[k]);
-            }
-        }
+        print_figures(&o, a, S, T, &ms, curv, cover, Q != NULL, trip, o.gt ? ngt : 0, o.gt ? gmean[a] : NAN,
+                      curves[a]);
     }
-    if (out_colors && write_colors(out_colors, S, T, maps[0]))
+    if (o.out_colors && write_colors(o.out_colors, S, T, maps[0]))
         goto done;
-    words.gt_points = gt ? ngt : 0;
-    words.gt_mean = gt ? gmean[0] : NAN;
-    if (out_png && write_png(out_png, S, T, maps[0], &words))
+    words.gt_points = o.gt ? ngt : 0;
+    words.gt_mean = o.gt ? gmean[0] : NAN;
+    if (o.out_png && write_png(o.out_png, S, T, maps[0], &words))
         goto done;
-    if (out_curve || out_csv) {
+    if (o.out_curve || o.out_csv) {
         const double *cv[EVAL_MAX_MAPS];
         for (int a = 0; a < nmaps; a++)
             cv[a] = curves[a];
-        if (write_curves(out_curve, out_csv, (const char *const *)ppaths, cv, nmaps))
+        if (write_curves(o.out_curve, o.out_csv, (const char *const *)ppaths, cv, nmaps))
             goto done;
     }
     status = 0;
