@@ -8,6 +8,7 @@
  * agree) together and BIM's (one direction flipped) each alone; RHM from
  * a given map stays near it by its anchors; ECTM's folded maps are
  * repaired on ddm,rhm,ectm (only those folded) and not on ddm,ectm;
+ * a chain RHM then ECTM keeps RHM's maps as stages rhm returns them;
  * make demo's job (cow -> camel from landmarks) returns both maps within
  * the fold targets (at most 2 % flipped, 0.5 % collapsed). */
 #include "support/harness.h"
@@ -386,6 +387,55 @@ static int same_map(const bmap *a, const bmap *b)
 {
     return a->n == b->n && !memcmp(a->face, b->face, sizeof(int) * (size_t)a->n) &&
            !memcmp(a->w, b->w, sizeof(double) * 3 * (size_t)a->n);
+}
+
+/* The RHM maps a chain RHM then ECTM keeps beside ECTM's (rhm_P, rhm_Q)
+ * are, bit for bit, what stages rhm returns for the same job: on a small
+ * sphere pair as given, and on a larger one over twice the coarse size (the decimated
+ * pair's RHM maps carried back and repaired). Q only for the bijective
+ * model; a chain without RHM keeps none. */
+TEST_T(rhm_then_ectm_keeps_the_rhm_maps_stages_rhm_returns, 300)
+{
+    static int lv[6] = {0, 1, 2, 3, 4, 5};
+    lmk_set L = {6, lv, lv};
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 6;
+    ectm_params p;
+    ectm_params_init(&p);
+    p.iterations = 3;
+    p.beta_ramp = 3;
+    p.inner_iterations = 5;
+    char err[1024];
+    for (int k = 0; k < 3; k++) {
+        mesh *S = testmesh_icosphere(k == 1 ? 4 : 3), *T = testmesh_icosphere(k == 1 ? 4 : 3);
+        for (int i = 0; i < T->nv; i++) {
+            double *x = &T->v[3 * i];
+            x[0] *= 1.3;
+            x[2] += 0.15 * x[0] * x[0];
+        }
+        rp.coarse = k == 1 ? 500 : 0;       /* 2562 vertices: decimated to 500 */
+        p.model = k == 2 ? ECTM_INJECTIVE : ECTM_BIJECTIVE;
+        corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_PLAIN};
+        CHECK_INT(corr_coarse_wanted(&in), k == 1);
+        ectm_result all = {0}, rhm = {0};
+        if (corr_run(&in, &p, NULL, NULL, &all, err, sizeof err))
+            FAILF("%s", err);
+        in.stages = CORR_CHAIN_RHM;
+        if (corr_run(&in, &p, NULL, NULL, &rhm, err, sizeof err))
+            FAILF("%s", err);
+        CHECK(all.rhm_P && rhm.P && !rhm.rhm_P);
+        CHECK(same_map(all.rhm_P, rhm.P));
+        CHECK(!same_map(all.rhm_P, all.P));          /* ECTM moved it */
+        if (p.model == ECTM_BIJECTIVE)
+            CHECK(all.rhm_Q && same_map(all.rhm_Q, rhm.Q));
+        else
+            CHECK(!all.rhm_Q && !all.Q);
+        ectm_result_close(&all);
+        ectm_result_close(&rhm);
+        mesh_free(S);
+        mesh_free(T);
+    }
 }
 
 /* Which of ECTM's maps a given map's chain repairs (corr_run): through RHM

@@ -224,7 +224,8 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
                      char *err, size_t errsz);
 
 /* The chain of in (from landmarks) on the decimated pair, its last maps
- * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL).
+ * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL);
+ * when that chain ran RHM then ECTM, its RHM maps the same way: *rP, *rQ.
  * *ran = 0 (and nothing done) when there is no usable decimated pair: a
  * mesh still over twice the coarse size (collapses refused everywhere by
  * its normals or its faces' shapes), or a decimation that failed other
@@ -233,7 +234,7 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
  * reports through rl as part of the job: one plan, ECTM's iterations
  * counted over both runs. */
 static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bmap **P,
-                      bmap **Q, int *ran, char *err, size_t errsz)
+                      bmap **Q, bmap **rP, bmap **rQ, int *ran, char *err, size_t errsz)
 {
     corr_coarse c;
     ectm_result cr = {0};
@@ -258,6 +259,9 @@ static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bma
                  !(rc = corr_repair(in, *P, Q ? *Q : NULL, 0, rep, err, errsz)) &&
                  relay_repair(rl, 1 + !!cr.Q, 1 + !!cr.Q))
             rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled after the fold repair");
+        if (!rc && cr.rhm_P &&
+            !(rc = corr_coarse_carry(in, &c, cr.rhm_P, cr.rhm_Q, 0, rP, rQ, err, errsz)))
+            rc = corr_repair(in, *rP, rQ ? *rQ : NULL, 0, rep, err, errsz);
     }
     ectm_result_close(&cr);
     corr_coarse_close(&c);
@@ -363,6 +367,7 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
 
     bmap *dP = NULL, *dQ = NULL;               /* DDM's maps */
     rhm_result init = {0};                     /* RHM's maps (or the coarse chain's) */
+    bmap *sP = NULL, *sQ = NULL;               /* the coarse chain's RHM maps */
     const bmap *P = in->P0, *Q = bij ? in->Q0 : NULL;
     if (run & CORR_RUN_DDM) {
         if ((rc = corr__ddm(in, P, Q, relay_ddm, rl, &dP, &dQ, err, errsz)))
@@ -381,7 +386,8 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
         if (corr_coarse_wanted(in)) {
             /* the chain on the decimated pair; ECTM below finishes its
              * maps on in's meshes */
-            rc = run_coarse(in, p, rl, &init.P12, &init.P21, &coarse, err, errsz);
+            rc = run_coarse(in, p, rl, &init.P12, &init.P21, &sP, bij ? &sQ : NULL, &coarse,
+                            err, errsz);
             if (!rc && !coarse) {              /* no usable decimated pair: planned again */
                 rp.coarse = 0;
                 corr__plan_build(rl->plan, &planned, p, &rp);
@@ -402,6 +408,10 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
         }
         P = init.P12;
         Q = bij ? init.P21 : NULL;
+        if (!coarse) {
+            sP = init.P12;
+            sQ = bij ? init.P21 : NULL;
+        }
     }
     /* the job's landmarks, pinned in ECTM's P- and Q-steps */
     ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
@@ -426,7 +436,21 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
         if ((rP || rQ) && (rc = repair_reported(in, rl, rP, rQ, 1, rep, err, errsz)))
             ectm_result_close(out);
     }
+    if (rc == CORR_OK && (run & CORR_RUN_RHM)) {
+        /* RHM's maps stay in the result beside ECTM's */
+        out->rhm_P = sP;
+        out->rhm_Q = sQ;
+        if (sP == init.P12)
+            init.P12 = NULL;
+        if (sQ && sQ == init.P21)
+            init.P21 = NULL;
+        sP = sQ = NULL;
+    }
 done:
+    if (sP != init.P12)
+        bmap_free(sP);
+    if (sQ != init.P21)
+        bmap_free(sQ);
     bmap_free(dP);
     bmap_free(dQ);
     rhm_result_close(&init);

@@ -168,7 +168,9 @@ int corr__pieces_join(const corr_input *in, const corr__pieces *pc, const ectm_r
     memset(out, 0, sizeof *out);
     int nS = in->S->nv, nT = in->T->nv;
     int q = res[0].Q != NULL, y = res[0].Y != NULL, yt = res[0].Yt != NULL;
+    int rp = res[0].rhm_P != NULL, rq = res[0].rhm_Q != NULL;
     if (!(out->P = bmap_new(nS, nT)) || (q && !(out->Q = bmap_new(nT, nS))) ||
+        (rp && !(out->rhm_P = bmap_new(nS, nT))) || (rq && !(out->rhm_Q = bmap_new(nT, nS))) ||
         (y && !(out->Y = malloc(sizeof(double) * 3 * (size_t)nS))) ||
         (yt && !(out->Yt = malloc(sizeof(double) * 3 * (size_t)nT)))) {
         ectm_result_close(out);
@@ -181,6 +183,10 @@ int corr__pieces_join(const corr_input *in, const corr__pieces *pc, const ectm_r
             put_map(out->Q, res[k].Q, p->tv, p->sf);
         if (y && res[k].Y)
             put_points(out->Y, res[k].Y, p->S->nv, p->sv);
+        if (rp && res[k].rhm_P)
+            put_map(out->rhm_P, res[k].rhm_P, p->sv, p->tf);
+        if (rq && res[k].rhm_Q)
+            put_map(out->rhm_Q, res[k].rhm_Q, p->tv, p->sf);
         if (yt && res[k].Yt)
             put_points(out->Yt, res[k].Yt, p->T->nv, p->tv);
         out->last = res[k].last;

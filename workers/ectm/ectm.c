@@ -23,6 +23,8 @@ void ectm_result_close(ectm_result *r)
         return;
     bmap_free(r->P);
     bmap_free(r->Q);
+    bmap_free(r->rhm_P);
+    bmap_free(r->rhm_Q);
     free(r->Y);
     free(r->Yt);
     memset(r, 0, sizeof *r);

@@ -108,6 +108,8 @@ typedef struct ectm_result {
     double *Y;     /* n by 3: the deformed source, in the target's frame */
     double *Yt;    /* ñ by 3: the deformed target, in the source's frame (bijective) */
     ectm_report last;
+    bmap *rhm_P;   /* the pipeline's (corr_run) RHM maps that ECTM started */
+    bmap *rhm_Q;   /* from, for a chain RHM then ECTM; NULL from ectm_run  */
 } ectm_result;
 void ectm_result_close(ectm_result *r);
 
