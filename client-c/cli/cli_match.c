@@ -26,11 +26,13 @@ static void usage(FILE *fp)
 {
     fprintf(fp,
         "usage: meshcorr match SOURCE TARGET INPUTS --out P.map [--out-reverse Q.map]\n"
-        "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--stages CHAIN]\n"
+        "         [--out-deformed Y.ply] [--out-remeshed T.ply] [--out-stage rhm=P.map]\n"
+        "         [--out-stage rhm-reverse=Q.map] [--stages CHAIN]\n"
         "         [--log-eps E] [--threads N] [--progress auto|bar|text|json|none] [job options]\n"
         "--stages rhm stops after RHM and writes its maps; --stages ectm runs ECTM alone\n"
         "(needs --init); --init P.map --stages ddm,ectm denoises the given map by DDM, then\n"
-        "refines it by ECTM. Job options:\n");
+        "refines it by ECTM. --out-stage rhm=FILE writes RHM's map too, on a chain RHM then\n"
+        "ECTM (rhm-reverse=FILE: its reverse, bijective model). Job options:\n");
     cli_job_usage(fp);
 }
 
@@ -77,6 +79,48 @@ static void print_repairs(const corr_fix *fx, const char *src, const char *tgt)
         fputs(text, stderr);
 }
 
+/* --out-stage NAME=FILE: FILE into *rhm or *rhm_rev by NAME; -1 with the
+ * usage error printed for another name or no FILE. */
+static int stage_option(const char *arg, const char **rhm, const char **rhm_rev)
+{
+    const char *eq = strchr(arg, '=');
+    if (!eq || !eq[1])
+        return cli_usage_error("match", "--out-stage: '%s' is not NAME=FILE (rhm=P.map, "
+                               "rhm-reverse=Q.map)", arg), -1;
+    size_t n = (size_t)(eq - arg);
+    if (n == 3 && !strncmp(arg, "rhm", 3))
+        *rhm = eq + 1;
+    else if (n == 11 && !strncmp(arg, "rhm-reverse", 11))
+        *rhm_rev = eq + 1;
+    else
+        return cli_usage_error("match", "--out-stage: '%.*s' is not a stage's map (rhm, "
+                               "rhm-reverse)", (int)n, arg), -1;
+    return 0;
+}
+
+/* One map's quality line on stdout (the worker's metrics, on the pair the
+ * engine ran), with the verdict's warning (whose: its prefix) on stderr;
+ * -1 out of memory. */
+static int print_quality(const char *what, const char *whose, const mesh *S, const mesh *T,
+                         const bmap *P)
+{
+    metric_summary ms;
+    if (metric_summarize(S, T, P, &ms)) {
+        fprintf(stderr, "meshcorr match: out of memory\n");
+        return -1;
+    }
+    printf("%s: flipped %.2f %%, collapsed %.2f %%, mean |log area| %.4f, median conformal "
+           "%.4f\n", what, 100 * ms.flipped_fraction, 100 * ms.collapsed_fraction,
+           ms.mean_abs_log_area, ms.median_conformal);
+    int verdict = metric_verdict(ms.flipped_fraction, ms.collapsed_fraction);
+    if (verdict) {
+        char text[256];
+        metric_verdict_text(verdict, ms.flipped_fraction, ms.collapsed_fraction, text, sizeof text);
+        fprintf(stderr, "meshcorr match: warning: %s%s\n", whose, text);
+    }
+    return 0;
+}
+
 static int write_mesh_with(const char *path, const mesh *faces_of, const double *v, int nv)
 {
     char err[1024];
@@ -91,16 +135,18 @@ static int write_mesh_with(const char *path, const mesh *faces_of, const double 
 int cli_match(int argc, char **argv)
 {
     enum { O_OUT = 1, O_OUT_REVERSE, O_OUT_DEFORMED, O_OUT_REMESHED, O_LOG_EPS,
-           O_THREADS, O_PROGRESS };
+           O_THREADS, O_PROGRESS, O_OUT_STAGE };
     static const struct option opts[] = {
         CLI_JOB_OPTIONS,
         {"out", required_argument, 0, O_OUT},        {"out-reverse", required_argument, 0, O_OUT_REVERSE},
         {"out-deformed", required_argument, 0, O_OUT_DEFORMED},
         {"out-remeshed", required_argument, 0, O_OUT_REMESHED},
+        {"out-stage", required_argument, 0, O_OUT_STAGE},
         {"log-eps", required_argument, 0, O_LOG_EPS},
         {"threads", required_argument, 0, O_THREADS}, {"progress", required_argument, 0, O_PROGRESS},
         {"help", no_argument, 0, 'h'},              {0, 0, 0, 0}};
     const char *out = NULL, *out_rev = NULL, *out_def = NULL, *out_rem = NULL;
+    const char *out_rhm = NULL, *out_rhm_rev = NULL;
     cli_job job;
     cli_job_init(&job, argc, argv);
     ectm_params pe;
@@ -123,6 +169,10 @@ int cli_match(int argc, char **argv)
         case O_OUT_REVERSE: out_rev = optarg; break;
         case O_OUT_DEFORMED: out_def = optarg; break;
         case O_OUT_REMESHED: out_rem = optarg; break;
+        case O_OUT_STAGE:
+            if (stage_option(optarg, &out_rhm, &out_rhm_rev))
+                return CLI_EXIT_USAGE;
+            break;
         case O_LOG_EPS:
             log_eps = strtod(optarg, &e);
             if (!*optarg || *e || !(log_eps > 0) || !isfinite(log_eps))
@@ -156,9 +206,19 @@ int cli_match(int argc, char **argv)
         return cli_usage_error("match", "--out-deformed needs the ECTM stage (the deformation is ECTM's)");
     if (pe.model == ECTM_INJECTIVE && out_rev)
         return cli_usage_error("match", "--out-reverse needs the bijective model");
+    unsigned run = corr_chain_run(stages, !!job.init);
+    if ((out_rhm || out_rhm_rev) && (run & (CORR_RUN_RHM | CORR_RUN_ECTM)) !=
+                                        (CORR_RUN_RHM | CORR_RUN_ECTM))
+        return cli_usage_error("match", "--out-stage rhm needs a chain that runs RHM then ECTM "
+                               "(stages all from landmarks, rhm,ectm or ddm,rhm,ectm); with "
+                               "--stages rhm, --out is RHM's map");
+    if (pe.model == ECTM_INJECTIVE && out_rhm_rev)
+        return cli_usage_error("match", "--out-stage rhm-reverse needs the bijective model");
     if (cli_output_check("match", "--out", out) || cli_output_check("match", "--out-reverse", out_rev) ||
         cli_output_check("match", "--out-deformed", out_def) ||
-        cli_output_check("match", "--out-remeshed", out_rem))
+        cli_output_check("match", "--out-remeshed", out_rem) ||
+        cli_output_check("match", "--out-stage rhm", out_rhm) ||
+        cli_output_check("match", "--out-stage rhm-reverse", out_rhm_rev))
         return CLI_EXIT_USAGE;
     char err[1024];
     progress = cli_progress_resolve(progress, stderr);
@@ -218,6 +278,16 @@ int cli_match(int argc, char **argv)
         fprintf(stderr, "meshcorr match: %s\n", err);
         goto done;
     }
+    if (out_rhm || out_rhm_rev) {
+        char rc_comment[600];
+        snprintf(rc_comment, sizeof rc_comment, "meshcorr match %s -> %s, stages %s: the reversible "
+                 "harmonic map ECTM started from", src, tgt, chain);
+        if ((out_rhm && bmap_write(out_rhm, res.rhm_P, rc_comment, err, sizeof err)) ||
+            (out_rhm_rev && bmap_write(out_rhm_rev, res.rhm_Q, rc_comment, err, sizeof err))) {
+            fprintf(stderr, "meshcorr match: %s\n", err);
+            goto done;
+        }
+    }
     if (out_def && write_mesh_with(out_def, S, res.Y, S->nv))
         goto done;
     if (out_rem) {
@@ -232,22 +302,12 @@ int cli_match(int argc, char **argv)
         if (w)
             goto done;
     }
-    /* the last line: how good the map is (the worker's metrics and rule,
-     * on the pair the engine ran) */
-    metric_summary ms;
-    if (metric_summarize(in.S, in.T, fix.repaired ? eng.P : res.P, &ms)) {
-        fprintf(stderr, "meshcorr match: out of memory\n");
+    /* the last line: how good the map is; RHM's before it when it is
+     * written too */
+    const ectm_result *ran = fix.repaired ? &eng : &res;
+    if (((out_rhm || out_rhm_rev) && print_quality("rhm map quality", "RHM's map: ", in.S, in.T, ran->rhm_P)) ||
+        print_quality("map quality", "", in.S, in.T, ran->P))
         goto done;
-    }
-    printf("map quality: flipped %.2f %%, collapsed %.2f %%, mean |log area| %.4f, median conformal "
-           "%.4f\n", 100 * ms.flipped_fraction, 100 * ms.collapsed_fraction, ms.mean_abs_log_area,
-           ms.median_conformal);
-    int verdict = metric_verdict(ms.flipped_fraction, ms.collapsed_fraction);
-    if (verdict) {
-        char text[256];
-        metric_verdict_text(verdict, ms.flipped_fraction, ms.collapsed_fraction, text, sizeof text);
-        fprintf(stderr, "meshcorr match: warning: %s\n", text);
-    }
     status = 0;
 done:
     ectm_result_close(&res);

@@ -1,8 +1,10 @@
 /* test_cli_match.c — `meshcorr match` as a user runs it: refusals name the
  * file, line or field; a short real run writes every output; JSON progress
- * is one object per outer iteration. */
+ * is one object per outer iteration; --out-stage rhm writes the RHM maps
+ * --stages rhm writes. */
 #include "support/harness.h"
 #include "support/testfile.h"
+#include "support/testmesh.h"
 #include "support/testrun.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -336,4 +338,76 @@ TEST_T(match_refines_a_vertex_map_with_ddm_then_ectm, 300)
              s0, s1, l, d);
     CHECK_INT(run(cmd, out, sizeof out), 2);
     CHECK_STR_HAS(out, "--stages ddm,ectm needs --init");
+}
+
+static int same_map(const bmap *a, const bmap *b)
+{
+    return a->n == b->n && !memcmp(a->face, b->face, sizeof(int) * (size_t)a->n) &&
+           !memcmp(a->w, b->w, sizeof(double) * 3 * (size_t)a->n);
+}
+
+static bmap *read_map(const char *dir, const char *name, const mesh *S, const mesh *T)
+{
+    char path[1024], err[512];
+    bmap *P = NULL;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (bmap_read(path, S, T, &P, err, sizeof err))
+        FAILF("%s", err);
+    return P;
+}
+
+/* --out-stage rhm=FILE and rhm-reverse=FILE on a chain from landmarks:
+ * the files hold the maps --stages rhm writes for the same job, and RHM's
+ * quality line comes before the final map's. Refused before any work: a
+ * chain without RHM then ECTM, rhm-reverse with the injective model, a
+ * name that is not a stage's map, a FILE in a missing folder. */
+TEST_T(match_out_stage_rhm_writes_the_maps_stages_rhm_writes, 120)
+{
+    const char *d = harness_tmpdir();
+    char s0[600], s1[600], cmd[8192], out[65536], err[512];
+    mesh *S = testmesh_icosphere(3), *T = testmesh_icosphere(3);
+    for (int i = 0; i < T->nv; i++) {
+        double *x = &T->v[3 * i];
+        x[0] *= 1.3;
+        x[2] += 0.15 * x[0] * x[0];
+    }
+    snprintf(s0, sizeof s0, "%s/s.off", d);
+    snprintf(s1, sizeof s1, "%s/t.off", d);
+    if (mesh_write(s0, S, err, sizeof err) || mesh_write(s1, T, err, sizeof err))
+        FAILF("%s", err);
+    const char *l = testfile_text("l6.txt", "0 0\n1 1\n2 2\n3 3\n4 4\n5 5\n");
+    const char *job = "--rhm-iterations 4 --iterations 2 --inner-iterations 5 --progress none";
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s %s --out %s/p.map "
+             "--out-stage rhm=%s/r.map --out-stage rhm-reverse=%s/rq.map", s0, s1, l, job, d, d, d);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    char *rq = strstr(out, "rhm map quality: flipped ");
+    CHECK(rq && strstr(rq + 1, "\nmap quality: flipped "));
+    snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s %s --stages rhm "
+             "--out %s/r2.map --out-reverse %s/rq2.map", s0, s1, l, job, d, d);
+    CHECK_INT(run(cmd, out, sizeof out), 0);
+    bmap *r = read_map(d, "r.map", S, T), *r2 = read_map(d, "r2.map", S, T);
+    bmap *q = read_map(d, "rq.map", T, S), *q2 = read_map(d, "rq2.map", T, S);
+    bmap *p = read_map(d, "p.map", S, T);
+    CHECK(same_map(r, r2));
+    CHECK(same_map(q, q2));
+    CHECK(!same_map(p, r));                 /* ECTM's map is another */
+    bmap_free(r); bmap_free(r2); bmap_free(q); bmap_free(q2); bmap_free(p);
+
+    static const struct { const char *opts, *msg; } bad[] = {
+        {"--stages rhm --out-stage rhm=%s/x.map", "--out-stage rhm needs a chain that runs RHM then ECTM"},
+        {"--model injective --out-stage rhm-reverse=%s/x.map",
+         "--out-stage rhm-reverse needs the bijective model"},
+        {"--out-stage ectm=%s/x.map", "--out-stage: 'ectm' is not a stage's map (rhm, rhm-reverse)"},
+        {"--out-stage rhm=%s/no/such/x.map", "--out-stage rhm "}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        char opts[1024];
+        snprintf(opts, sizeof opts, bad[k].opts, d);
+        snprintf(cmd, sizeof cmd, "build/meshcorr match %s %s --landmarks %s %s --out %s/y.map %s",
+                 s0, s1, l, job, d, opts);
+        CHECK_INT(run(cmd, out, sizeof out), 2);
+        CHECK_STR_HAS(out, bad[k].msg);
+        CHECK(!strstr(out, "map quality"));  /* refused before the work */
+    }
+    mesh_free(S);
+    mesh_free(T);
 }
