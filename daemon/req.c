@@ -879,6 +879,10 @@ static void result_done(uv_work_t *w, int status)    /* loop */
             o->q = in->q;
         if (r->what & PROTO_WANT_DEFORMED)
             o->deformed = in->deformed;
+        if (r->what & PROTO_WANT_STAGE_RHM) {
+            o->rhm_p = in->rhm_p;
+            o->rhm_q = in->rhm_q;
+        }
         if (r->what & PROTO_WANT_METRICS) {
             o->metrics = in->metrics;
             o->nmetrics = in->nmetrics;

@@ -163,7 +163,11 @@ enum proto_term {
 #define PROTO_WANT_Q        2u
 #define PROTO_WANT_DEFORMED 4u
 #define PROTO_WANT_METRICS  8u
-#define PROTO_WANT_ALL      15u
+/* RHM's maps P and Q that ECTM started from (a chain RHM then ECTM): at
+ * RESULT_OK's end, only when asked, so a peer that never asks reads
+ * RESULT_OK as before */
+#define PROTO_WANT_STAGE_RHM 16u
+#define PROTO_WANT_ALL      31u
 
 /* Names for logs and the CLI; NULL for a value outside the list. */
 const char *proto_type_name(int type);    /* "SUBMIT" */
@@ -392,6 +396,8 @@ typedef struct proto_result_ok {
     proto_map p, q;                   /* q absent for the injective model */
     proto_blob deformed;              /* Draco; absent unless asked */
     proto_metric *metrics; uint32_t nmetrics;
+    proto_map rhm_p, rhm_q;           /* RHM's maps (PROTO_WANT_STAGE_RHM): on the
+                                       * wire only when either has rows */
 } proto_result_ok;
 typedef struct proto_stats_ok {
     uint32_t queued, running, workers;

@@ -442,6 +442,13 @@ static void io_result_ok(io *c, proto_result_ok *r)
         io_str(c, &r->metrics[i].key, "metric key");
         io_f64(c, &r->metrics[i].value);
     }
+    /* RHM's maps: a trailing part, written only when there are rows and
+     * read only when bytes are left, so RESULT_OK without them is the
+     * same bytes as before */
+    if (c->err || (c->dec ? c->pos == c->len : !r->rhm_p.n && !r->rhm_q.n))
+        return;
+    io_map(c, &r->rhm_p, "RHM's map P");
+    io_map(c, &r->rhm_q, "RHM's map Q");
 }
 
 static void io_stats_ok(io *c, proto_stats_ok *s)
@@ -619,6 +626,8 @@ void proto_msg_free(proto_msg *m)
         free(m->u.result_ok.p.rows);
         free(m->u.result_ok.q.rows);
         free(m->u.result_ok.metrics);
+        free(m->u.result_ok.rhm_p.rows);
+        free(m->u.result_ok.rhm_q.rows);
         break;
     case PROTO_MSG_STATS_OK:
         free(m->u.stats_ok.slots);

@@ -168,6 +168,8 @@ void protosample_fill(int type, int v, proto_msg *m)
             metrics[3] = (proto_metric){ "", 1e-300 };
             u->metrics = metrics;
             u->nmetrics = 4;
+            u->rhm_p = (proto_map){ res_p, 100 };   /* RHM's maps (PROTO_WANT_STAGE_RHM) */
+            u->rhm_q = (proto_map){ res_q, 60 };
         }
         break;
     }
@@ -334,6 +336,8 @@ const char *protosample_diff(const proto_msg *a, const proto_msg *b)
         DIFF(x->job_id != y->job_id, "result_ok.job_id");
         DIFF(map_ne(x->p, y->p), "result_ok.p");
         DIFF(map_ne(x->q, y->q), "result_ok.q");
+        DIFF(map_ne(x->rhm_p, y->rhm_p), "result_ok.rhm_p");
+        DIFF(map_ne(x->rhm_q, y->rhm_q), "result_ok.rhm_q");
         DIFF(blob_ne(x->deformed, y->deformed), "result_ok.deformed");
         DIFF(x->nmetrics != y->nmetrics, "result_ok.nmetrics");
         for (uint32_t i = 0; i < x->nmetrics; i++) {

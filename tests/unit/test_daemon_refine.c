@@ -6,10 +6,13 @@
  * auto says it denoised the two together; a chain that cannot run (ddm
  * with no map) and a basis larger than the meshes allow are refused before
  * SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
- * stretched and bent, the map a vertex map sent as weight-1 rows. */
+ * stretched and bent, the map a vertex map sent as weight-1 rows. A job
+ * from landmarks (RHM then ECTM) serves RHM's maps to a RESULT that asks
+ * for them (PROTO_WANT_STAGE_RHM): those the in-process chain keeps. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testmesh.h"
+#include "support/testraw.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -19,6 +22,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 typedef struct watch_log {
     int n;
@@ -220,6 +224,90 @@ TEST_T(submitted_ddm_job_streams_the_ddm_stage_and_returns_the_in_process_map, 1
     /* the stages value is one of the list: 8 is refused by the validator */
     spec_of(&p, 8, 1, &s);
     CHECK(mc_submit(c, &s, &id) != 0);
+    mc_close(c);
+    testdaemon_stop(&d, SIGTERM);
+    pair_close(&p);
+}
+
+static void check_rows(const proto_map *m, const bmap *want, const char *what)
+{
+    CHECK_INT(m->n, want->n);
+    for (int i = 0; i < want->n && i < (int)m->n; i++) {
+        if (m->rows[i].face != (uint32_t)want->face[i])
+            FAILF("%s row %d: face %u, in process %d", what, i, m->rows[i].face, want->face[i]);
+        for (int k = 0; k < 3; k++)
+            CHECK_NEAR(m->rows[i].w[k], want->w[3 * i + k], 1e-9);
+    }
+}
+
+TEST_T(a_landmark_jobs_rhm_maps_are_served_when_asked, 120)
+{
+    testdaemon_need_worker();
+    pair p;
+    pair_open(&p);
+    testdaemon d;
+    testdaemon_start(&d, "stagerhm", NULL);
+    mc_client *c = testdaemon_client(&d, NULL);
+    static const uint32_t lm[12] = {0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5};
+    mc_job_spec s;
+    spec_of(&p, MC_STAGES_ALL, 0, &s);
+    s.landmarks = lm;
+    s.nlandmarks = 6;
+    s.rhm_iterations = 4;
+    uint64_t id = 0;
+    if (mc_submit(c, &s, &id))
+        FAILF("SUBMIT: %s", mc_errmsg(c));
+    int state = -1;
+    char reason[1100];
+    if (mc_watch(c, id, 0, NULL, NULL, &state, reason, sizeof reason))
+        FAILF("WATCH: %s", mc_errmsg(c));
+    if (state != MC_COMPLETED)
+        FAILF("job ended %s: %s", mc_state_name(state), reason);
+
+    int fd = testraw_session(d.unix_addr, NULL);
+    proto_msg q = { .type = PROTO_MSG_RESULT, .request_id = 7 };
+    q.u.result = (proto_result){ id, PROTO_WANT_P | PROTO_WANT_STAGE_RHM };
+    testraw_send_msg(fd, &q);
+    proto_msg m;
+    uint8_t *buf = NULL;
+    CHECK_INT(testraw_read_msg(fd, &m, &buf, 30), 0);
+    CHECK_INT(m.type, PROTO_MSG_RESULT_OK);
+    const proto_result_ok *ok = &m.u.result_ok;
+
+    /* the same job in process: RHM's maps beside ECTM's */
+    lmk_set L = {6, (int[]){0, 1, 2, 3, 4, 5}, (int[]){0, 1, 2, 3, 4, 5}};
+    rhm_params rp;
+    rhm_params_init(&rp);
+    rp.iterations = 4;
+    ectm_params ep;
+    ectm_params_init(&ep);
+    ep.iterations = 3;
+    ep.beta_ramp = 3;
+    ep.inner_iterations = 10;
+    corr_input in = {p.S, p.T, "source", "target", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 30,
+                     CORR_DDM_PLAIN};
+    ectm_result want = {0};
+    char err[1024];
+    if (corr_run(&in, &ep, NULL, NULL, &want, err, sizeof err))
+        FAILF("in process: %s", err);
+    check_rows(&ok->p, want.P, "P");
+    check_rows(&ok->rhm_p, want.rhm_P, "RHM's P");
+    check_rows(&ok->rhm_q, want.rhm_Q, "RHM's Q");
+    CHECK_INT(ok->q.n, 0);                      /* not asked */
+    proto_msg_free(&m);
+    free(buf);
+
+    /* not asked: RESULT_OK as before, no RHM maps */
+    q.request_id = 8;
+    q.u.result.what = PROTO_WANT_P | PROTO_WANT_Q;
+    testraw_send_msg(fd, &q);
+    CHECK_INT(testraw_read_msg(fd, &m, &buf, 30), 0);
+    CHECK_INT(m.type, PROTO_MSG_RESULT_OK);
+    CHECK(m.u.result_ok.rhm_p.n == 0 && m.u.result_ok.rhm_q.n == 0 && m.u.result_ok.q.n > 0);
+    proto_msg_free(&m);
+    free(buf);
+    close(fd);
+    ectm_result_close(&want);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
     pair_close(&p);

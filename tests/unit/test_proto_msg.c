@@ -162,6 +162,49 @@ TEST(bad_checksum_on_blob_landmarks_or_map_is_refused)
     expect(PROTO_EBAD_CHECKSUM, "map P");
 }
 
+/* RHM's maps are RESULT_OK's trailing part: without them the payload
+ * ends after the metrics, as a reader that does not know them expects;
+ * with them it is the same bytes and then the two maps. A RESULT asking
+ * for them (what 16) is known; a bit above is not. */
+TEST(result_ok_carries_rhm_maps_only_as_a_trailing_part)
+{
+    proto_msg m;
+    protosample_fill(PROTO_MSG_RESULT_OK, 0, &m);
+    proto_result_ok *u = &m.u.result_ok;
+    proto_map rp = u->rhm_p, rq = u->rhm_q;
+    CHECK(rp.n && rq.n);
+    u->rhm_p = u->rhm_q = (proto_map){ NULL, 0 };
+    proto_buf without, with;
+    proto_buf_init(&without);
+    proto_buf_init(&with);
+    char err[256];
+    CHECK_INT(proto_msg_encode(&without, &m, err, sizeof err), 0);
+    u->rhm_p = rp;
+    u->rhm_q = rq;
+    CHECK_INT(proto_msg_encode(&with, &m, err, sizeof err), 0);
+    size_t maps = 2 * (4 + 4) + 28 * ((size_t)rp.n + rq.n);  /* count, CRC, rows */
+    CHECK_INT(with.len, without.len + maps);
+    CHECK(!memcmp(with.data + PROTO_HDR_SIZE, without.data + PROTO_HDR_SIZE,
+                  without.len - PROTO_HDR_SIZE));
+    proto_msg out;
+    size_t used;
+    CHECK_INT(proto_decode(without.data, without.len, 0, &out, &used, err, sizeof err), PROTO_READY);
+    CHECK(out.u.result_ok.rhm_p.n == 0 && out.u.result_ok.rhm_q.n == 0);
+    proto_msg_free(&out);
+    proto_buf_free(&without);
+    proto_buf_free(&with);
+
+    proto_msg q = { .type = PROTO_MSG_RESULT };
+    q.u.result = (proto_result){ 5, PROTO_WANT_P | PROTO_WANT_STAGE_RHM };
+    proto_buf_init(&with);
+    CHECK_INT(proto_msg_encode(&with, &q, err, sizeof err), 0);
+    proto_buf_free(&with);
+    q.u.result.what = 32;
+    proto_buf_init(&with);
+    CHECK_INT(proto_msg_encode(&with, &q, err, sizeof err), PROTO_EBAD_FRAME);
+    proto_buf_free(&with);
+}
+
 TEST(bad_strings_are_refused)
 {
     /* HELLO minimal: u16 version, token (u32 0, NUL), client (u32 0, NUL) */
@@ -223,7 +266,7 @@ TEST(out_of_range_enums_and_bits_are_refused)
     payload()[8] = PROTO_STATE_LAST + 1;     /* job state */
     expect(PROTO_EBAD_FRAME, "job state");
     encode(PROTO_MSG_RESULT, 0);
-    payload()[8] = 0x10;                     /* unknown `what` bit */
+    payload()[8] = 0x20;                     /* unknown `what` bit */
     expect(PROTO_EBAD_FRAME, "what");
     encode(PROTO_MSG_ERROR, 0);
     proto_set_le32(payload(), 5);            /* error codes are negative */

@@ -249,6 +249,7 @@ TEST_T(worker_demo_job_gives_the_in_process_map_with_progress_and_metrics, 90)
     CHECK_INT(ok->job_id, 42);
     CHECK_INT(ok->p.n, 6938);
     CHECK_INT(ok->q.n, 9239);
+    CHECK(ok->rhm_p.n == 0 && ok->rhm_q.n == 0);   /* ECTM alone: no RHM maps */
     CHECK_INT(metric(ok, "iterations"), 3);
     CHECK(isfinite(metric(ok, "final_energy")) && metric(ok, "final_energy") > 0);
     CHECK(metric(ok, "elapsed_s") > 0);
@@ -386,6 +387,14 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     CHECK_INT(m.type, PROTO_MSG_RESULT_OK);
     CHECK_INT(m.u.result_ok.p.n, 3906);
     CHECK_INT(m.u.result_ok.q.n, 3804);
+    /* RHM then ECTM: RHM's maps and their quality go out too */
+    const proto_result_ok *ok = &m.u.result_ok;
+    CHECK_INT(ok->rhm_p.n, 3906);
+    CHECK_INT(ok->rhm_q.n, 3804);
+    CHECK(memcmp(ok->rhm_p.rows, ok->p.rows, sizeof *ok->p.rows * ok->p.n) != 0);
+    double rf = metric(ok, "rhm_flipped_fraction");
+    CHECK(rf >= 0 && rf <= 1);
+    CHECK(isfinite(metric(ok, "rhm_mean_abs_log_area")));
     proto_msg_free(&m);
     free(file);
 }

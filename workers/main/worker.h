@@ -105,16 +105,19 @@ void wrk_progress_send(wrk_progress *pg, const corr_progress *cp, double elapsed
  * the metrics (WORKER.md lists the keys). res is the engine's result; when
  * the job's meshes were repaired, the maps and the deformed mesh go out in
  * the client's indexing (corr_fix_to_user), the metrics are the repaired
- * pair's, and the repair's counts follow them (WRK_REPAIR_KEYS). The
- * message borrows from r. */
+ * pair's, and the repair's counts follow them (WRK_REPAIR_KEYS). On a
+ * chain RHM then ECTM, RHM's maps go out too (rhm_p, rhm_q) with their
+ * quality under the keys rhm_NAME (WRK_RHM_KEYS). The message borrows
+ * from r. */
 #define WRK_BASE_METRICS 12
+#define WRK_RHM_KEYS 4
 #define WRK_REPAIR_KEYS (2 * (0 REPAIR_COUNTS(WRK_ONE)))
 #define WRK_ONE(name, text) + 1
 typedef struct wrk_result {
     proto_msg msg;
-    proto_map_row *p, *q;
+    proto_map_row *p, *q, *rhm_p, *rhm_q;
     unsigned char *deformed;
-    proto_metric metrics[WRK_BASE_METRICS + WRK_REPAIR_KEYS];
+    proto_metric metrics[WRK_BASE_METRICS + WRK_REPAIR_KEYS + WRK_RHM_KEYS];
 } wrk_result;
 int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id,
                      double elapsed, wrk_result *r, char *err, size_t errsz);

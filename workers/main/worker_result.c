@@ -14,6 +14,8 @@ void wrk_result_close(wrk_result *r)
         return;
     free(r->p);
     free(r->q);
+    free(r->rhm_p);
+    free(r->rhm_q);
     free(r->deformed);
     memset(r, 0, sizeof *r);
 }
@@ -90,6 +92,15 @@ static int build(const wrk_job *job, const ectm_result *res, const ectm_result *
     ok->p = (proto_map){ r->p, (uint32_t)user->P->n };
     if (user->Q)
         ok->q = (proto_map){ r->q, (uint32_t)user->Q->n };
+    if ((user->rhm_P && !(r->rhm_p = rows_of(user->rhm_P))) ||
+        (user->rhm_Q && !(r->rhm_q = rows_of(user->rhm_Q)))) {
+        wrk_result_close(r);
+        return errbuf_set(err, errsz, PROTO_ENOMEM, "result maps: out of memory");
+    }
+    if (user->rhm_P)
+        ok->rhm_p = (proto_map){ r->rhm_p, (uint32_t)user->rhm_P->n };
+    if (user->rhm_Q)
+        ok->rhm_q = (proto_map){ r->rhm_q, (uint32_t)user->rhm_Q->n };
 
     /* a chain that ends before ECTM has no deformation: its mesh is the
      * map's image P X~ of the source (what ECTM's Y approximates) */
@@ -150,5 +161,21 @@ static int build(const wrk_job *job, const ectm_result *res, const ectm_result *
     ok->nmetrics = sizeof m / sizeof m[0] - (res->Q ? 0 : 4);
     if (job->fix.repaired)
         ok->nmetrics += (uint32_t)repair_metrics(&job->fix, r->metrics + ok->nmetrics);
+    if (res->rhm_P) {
+        /* RHM's map's quality, as the final map's, on the engine's pair */
+        metric_summary mr;
+        if (metric_summarize(in.S, in.T, res->rhm_P, &mr)) {
+            wrk_result_close(r);
+            return errbuf_set(err, errsz, PROTO_ENOMEM, "metrics: out of memory");
+        }
+        const proto_metric rm[WRK_RHM_KEYS] = {
+            { "rhm_mean_abs_log_area", mr.mean_abs_log_area },
+            { "rhm_median_conformal", mr.median_conformal },
+            { "rhm_flipped_fraction", mr.flipped_fraction },
+            { "rhm_collapsed_fraction", mr.collapsed_fraction },
+        };
+        memcpy(r->metrics + ok->nmetrics, rm, sizeof rm);
+        ok->nmetrics += WRK_RHM_KEYS;
+    }
     return 0;
 }
