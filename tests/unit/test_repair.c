@@ -425,7 +425,8 @@ static mesh *two_pieces(void)
 
 /* Landmarks on both pieces pair them: each pair is matched on its own and
  * every vertex of both lands near its own; with landmarks on the large
- * piece only, the small one is left out and carried by the nearest point. */
+ * piece only, the small one is left out and carried by the nearest point.
+ * RHM's maps kept beside ECTM's are joined and carried back the same way. */
 TEST_T(pieces_the_landmarks_pair_are_matched_piece_by_piece, 600)
 {
     mesh *c = two_pieces();
@@ -461,6 +462,22 @@ TEST_T(pieces_the_landmarks_pair_are_matched_piece_by_piece, 600)
         if (corr_fix_to_user(&fx, &res, &back, err, sizeof err))
             FAILF("%s", err);
         CHECK_INT(back.P->n, S->nv);
+        if (round == 0) {
+            /* RHM's maps, joined from the pairs and carried back as the
+             * final ones: stages rhm's maps of the same job */
+            in.stages = CORR_CHAIN_RHM;
+            ectm_result rr, rb;
+            if (corr_run(&in, &p, NULL, NULL, &rr, err, sizeof err) ||
+                corr_fix_to_user(&fx, &rr, &rb, err, sizeof err))
+                FAILF("stages rhm: %s", err);
+            CHECK(back.rhm_P && back.rhm_Q);
+            CHECK(back.rhm_P->n == rb.P->n && back.rhm_Q->n == rb.Q->n);
+            CHECK(!memcmp(back.rhm_P->face, rb.P->face, sizeof(int) * (size_t)rb.P->n));
+            CHECK(!memcmp(back.rhm_P->w, rb.P->w, sizeof(double) * 3 * (size_t)rb.P->n));
+            CHECK(!memcmp(back.rhm_Q->w, rb.Q->w, sizeof(double) * 3 * (size_t)rb.Q->n));
+            ectm_result_close(&rr);
+            ectm_result_close(&rb);
+        }
         int *orig = malloc(sizeof(int) * (size_t)S->nv);
         for (int i = 0; i < S->nv; i++)
             orig[i] = i < c->nv ? i : 0;
