@@ -18,5 +18,8 @@ MC__HIDDEN void mc__progress_of(mc_progress *out, const proto_progress *p);
 /* The parts of r that `what` (MC_WANT_*) names, copied into out (zeroed
  * first; mc_result_free releases it). MC_ENOMEM leaves out freed. */
 MC__HIDDEN int mc__result_of(const proto_result_ok *r, unsigned what, mc_job_result *out);
+/* RHM's maps of r (rhm_p, rhm_q) copied into out (zeroed first).
+ * MC_ENOMEM leaves out freed. */
+MC__HIDDEN int mc__stage_of(const proto_result_ok *r, mc_stage_maps *out);
 
 #endif

@@ -815,6 +815,27 @@ int mc_result(mc_client *c, uint64_t id, unsigned what, mc_job_result *out)
     return rc ? fail(c, rc, "out of memory for the result") : 0;
 }
 
+int mc_result_stage(mc_client *c, uint64_t id, const char *stage, mc_stage_maps *out)
+{
+    MC_NEED_CLIENT(c);
+    if (!out)
+        return fail(c, MC_EARG, "mc_result_stage: out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!stage || strcmp(stage, "rhm"))
+        return fail(c, MC_EARG, "mc_result_stage: '%s' is not a stage whose maps a job keeps (rhm)",
+                    stage ? stage : "(null)");
+    proto_msg req, rep;
+    memset(&req, 0, sizeof req);
+    req.type = PROTO_MSG_RESULT;
+    req.u.result = (proto_result){id, PROTO_WANT_STAGE_RHM};
+    int rc = request(c, &req, PROTO_MSG_RESULT_OK, &rep);
+    if (rc)
+        return rc;
+    rc = mc__stage_of(&rep.u.result_ok, out);
+    proto_msg_free(&rep);
+    return rc ? fail(c, rc, "out of memory for the stage's maps") : 0;
+}
+
 void mc_stats_free(mc_server_stats *s)
 {
     if (!s)

@@ -125,3 +125,22 @@ int mc__result_of(const proto_result_ok *r, unsigned what, mc_job_result *out)
     }
     return 0;
 }
+
+void mc_stage_maps_free(mc_stage_maps *m)
+{
+    if (!m)
+        return;
+    free(m->p);
+    free(m->q);
+    memset(m, 0, sizeof *m);
+}
+
+int mc__stage_of(const proto_result_ok *r, mc_stage_maps *out)
+{
+    memset(out, 0, sizeof *out);
+    if (copy_map(&r->rhm_p, &out->p, &out->np) || copy_map(&r->rhm_q, &out->q, &out->nq)) {
+        mc_stage_maps_free(out);
+        return MC_ENOMEM;
+    }
+    return 0;
+}

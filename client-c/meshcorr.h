@@ -277,6 +277,19 @@ typedef int (*mc_progress_fn)(void *ctx, const mc_progress *p);
 int mc_watch(mc_client *c, uint64_t job_id, uint32_t from_outer, mc_progress_fn cb, void *ctx,
              int *end_state, char *reason, size_t reasonsz);
 int mc_result(mc_client *c, uint64_t job_id, unsigned what, mc_job_result *out);
+/* A stage's maps from before the final ones: for stage "rhm", the
+ * reversible harmonic maps that ECTM started from, on a job whose chain
+ * ran RHM then ECTM (np = nq = 0 on another job: for a chain ending at
+ * RHM, mc_result's maps are RHM's). Rows as in mc_job_result; q only for
+ * the bijective model. MC_EARG for another stage name; a server that
+ * does not know the request answers MC_EBAD_FRAME. Free with
+ * mc_stage_maps_free (accepts a zeroed struct). */
+typedef struct mc_stage_maps {
+    mc_map_row *p; uint32_t np;          /* the stage's source -> target map */
+    mc_map_row *q; uint32_t nq;          /* its target -> source map (bijective) */
+} mc_stage_maps;
+int mc_result_stage(mc_client *c, uint64_t job_id, const char *stage, mc_stage_maps *out);
+void mc_stage_maps_free(mc_stage_maps *m);
 int mc_cancel(mc_client *c, uint64_t job_id);
 int mc_delete(mc_client *c, uint64_t job_id);
 int mc_stats(mc_client *c, mc_server_stats *out);

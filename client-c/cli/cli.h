@@ -27,6 +27,10 @@ const char *cli_suggest(const char *word, const char *const *names, int n, const
  * exists and is writable); else -1 after printing "meshcorr CMD: OPT PATH:
  * why". Commands check every output before they start work. */
 int cli_output_check(const char *cmd, const char *opt, const char *path);
+/* --out-stage NAME=FILE (match, result): FILE into *rhm (NAME rhm) or
+ * *rhm_rev (rhm-reverse); -1 after the usage error for another NAME or no
+ * FILE. */
+int cli_out_stage(const char *cmd, const char *arg, const char **rhm, const char **rhm_rev);
 
 int cli_info(int argc, char **argv);
 int cli_convert(int argc, char **argv);

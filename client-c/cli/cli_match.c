@@ -79,25 +79,6 @@ static void print_repairs(const corr_fix *fx, const char *src, const char *tgt)
         fputs(text, stderr);
 }
 
-/* --out-stage NAME=FILE: FILE into *rhm or *rhm_rev by NAME; -1 with the
- * usage error printed for another name or no FILE. */
-static int stage_option(const char *arg, const char **rhm, const char **rhm_rev)
-{
-    const char *eq = strchr(arg, '=');
-    if (!eq || !eq[1])
-        return cli_usage_error("match", "--out-stage: '%s' is not NAME=FILE (rhm=P.map, "
-                               "rhm-reverse=Q.map)", arg), -1;
-    size_t n = (size_t)(eq - arg);
-    if (n == 3 && !strncmp(arg, "rhm", 3))
-        *rhm = eq + 1;
-    else if (n == 11 && !strncmp(arg, "rhm-reverse", 11))
-        *rhm_rev = eq + 1;
-    else
-        return cli_usage_error("match", "--out-stage: '%.*s' is not a stage's map (rhm, "
-                               "rhm-reverse)", (int)n, arg), -1;
-    return 0;
-}
-
 /* One map's quality line on stdout (the worker's metrics, on the pair the
  * engine ran), with the verdict's warning (whose: its prefix) on stderr;
  * -1 out of memory. */
@@ -170,7 +151,7 @@ int cli_match(int argc, char **argv)
         case O_OUT_DEFORMED: out_def = optarg; break;
         case O_OUT_REMESHED: out_rem = optarg; break;
         case O_OUT_STAGE:
-            if (stage_option(optarg, &out_rhm, &out_rhm_rev))
+            if (cli_out_stage("match", optarg, &out_rhm, &out_rhm_rev))
                 return CLI_EXIT_USAGE;
             break;
         case O_LOG_EPS:

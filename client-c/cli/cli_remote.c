@@ -648,7 +648,10 @@ int cli_watch(int argc, char **argv)
     return watch_job("watch", c, id, &w);
 }
 
-typedef struct result_opts { const char *out, *out_rev, *out_def, *target; int json; } result_opts;
+typedef struct result_opts {
+    const char *out, *out_rev, *out_def, *target, *rhm, *rhm_rev;
+    int json;
+} result_opts;
 
 static int result_opt(const char *cmd, int c, void *ctx)
 {
@@ -659,6 +662,7 @@ static int result_opt(const char *cmd, int c, void *ctx)
     else if (c == 'd') o->out_def = optarg;
     else if (c == 't') o->target = optarg;
     else if (c == 'j') o->json = 1;
+    else if (c == 's') return cli_out_stage("result", optarg, &o->rhm, &o->rhm_rev);
     return 0;
 }
 
@@ -686,11 +690,12 @@ int cli_result(int argc, char **argv)
     static const struct option extra[] = {
         {"out", required_argument, 0, 'o'}, {"out-reverse", required_argument, 0, 'O'},
         {"out-deformed", required_argument, 0, 'd'}, {"target", required_argument, 0, 't'},
-        {"json", no_argument, 0, 'j'}, {0, 0, 0, 0}};
+        {"json", no_argument, 0, 'j'}, {"out-stage", required_argument, 0, 's'}, {0, 0, 0, 0}};
     remote r;
     uint64_t id;
     result_opts o = {0};
     static const char usage[] = "usage: meshcorr result ID --out P.map [--out-reverse Q.map] [--out-deformed Y.ply]\n"
+                                "         [--out-stage rhm=R.map] [--out-stage rhm-reverse=RQ.map]\n"
                                 "         [--target MESH (injective jobs: the target's vertex count for P.map)]\n"
                                 "         [--json]\n" REMOTE_USAGE
                                 "prints the job's metrics, one `name value` a line; --json: one object\n"
@@ -699,20 +704,28 @@ int cli_result(int argc, char **argv)
     int u = one_id("result", usage, argc, argv, &r, &id, extra, result_opt, &o);
     if (u)
         return u > 0 ? 0 : CLI_EXIT_USAGE;
-    if (!o.out && !o.out_rev && !o.out_def && !o.json)
-        return cli_usage_error("result", "need --out P.map (or --out-reverse, --out-deformed, --json)");
+    if (!o.out && !o.out_rev && !o.out_def && !o.json && !o.rhm && !o.rhm_rev)
+        return cli_usage_error("result", "need --out P.map (or --out-reverse, --out-deformed, "
+                               "--out-stage, --json)");
     if (cli_output_check("result", "--out", o.out) || cli_output_check("result", "--out-reverse", o.out_rev) ||
-        cli_output_check("result", "--out-deformed", o.out_def))
+        cli_output_check("result", "--out-deformed", o.out_def) ||
+        cli_output_check("result", "--out-stage rhm", o.rhm) ||
+        cli_output_check("result", "--out-stage rhm-reverse", o.rhm_rev))
         return CLI_EXIT_USAGE;
     mc_client *c = remote_connect("result", &r);
     if (!c)
         return 1;
     mc_job_result res;
-    unsigned what = MC_WANT_METRICS | (o.out || o.out_rev || o.json ? MC_WANT_P | MC_WANT_Q : 0) |
+    mc_stage_maps st = {0};
+    unsigned what = MC_WANT_METRICS | (o.out || o.out_rev || o.json || o.rhm ? MC_WANT_P | MC_WANT_Q : 0) |
                     (o.out_def ? MC_WANT_DEFORMED : 0);
     int rc = mc_result(c, id, what, &res), status = 1;
     if (rc)
         return fail("result", c, rc);
+    if ((o.rhm || o.rhm_rev) && (rc = mc_result_stage(c, id, "rhm", &st))) {
+        mc_result_free(&res);
+        return fail("result", c, rc);
+    }
     char comment[128], err[1024];
     snprintf(comment, sizeof comment, "meshcorrd job %llu", (unsigned long long)id);
     int nt = (int)res.nq;
@@ -733,6 +746,25 @@ int cli_result(int argc, char **argv)
     if (o.out_rev && (!res.nq || write_map(o.out_rev, res.q, res.nq, (int)res.np, comment))) {
         if (!res.nq)
             fprintf(stderr, "meshcorr result: job %llu has no reverse map (injective)\n", (unsigned long long)id);
+        goto done;
+    }
+    if ((o.rhm || o.rhm_rev) && !st.np) {
+        fprintf(stderr, "meshcorr result: job %llu has no RHM map of its own (its chain did not run "
+                "RHM then ECTM)\n", (unsigned long long)id);
+        goto done;
+    }
+    char rcomment[160];
+    snprintf(rcomment, sizeof rcomment, "meshcorrd job %llu: the reversible harmonic map ECTM started from",
+             (unsigned long long)id);
+    if (o.rhm && (!nt || write_map(o.rhm, st.p, st.np, nt, rcomment))) {
+        if (!nt)
+            fprintf(stderr, "meshcorr result: injective job: give --target MESH for the map's header\n");
+        goto done;
+    }
+    if (o.rhm_rev && (!st.nq || write_map(o.rhm_rev, st.q, st.nq, (int)st.np, rcomment))) {
+        if (!st.nq)
+            fprintf(stderr, "meshcorr result: job %llu has no reverse RHM map (injective)\n",
+                    (unsigned long long)id);
         goto done;
     }
     if (o.out_def) {
@@ -794,6 +826,7 @@ int cli_result(int argc, char **argv)
 done:
     mesh_free(T);
     mc_result_free(&res);
+    mc_stage_maps_free(&st);
     mc_close(c);
     return status;
 }

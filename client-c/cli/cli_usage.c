@@ -215,3 +215,20 @@ int cli_output_check(const char *cmd, const char *opt, const char *path)
     free(copy);
     return rc;
 }
+
+int cli_out_stage(const char *cmd, const char *arg, const char **rhm, const char **rhm_rev)
+{
+    const char *eq = strchr(arg, '=');
+    if (!eq || !eq[1])
+        return cli_usage_error(cmd, "--out-stage: '%s' is not NAME=FILE (rhm=P.map, "
+                               "rhm-reverse=Q.map)", arg), -1;
+    size_t n = (size_t)(eq - arg);
+    if (n == 3 && !strncmp(arg, "rhm", 3))
+        *rhm = eq + 1;
+    else if (n == 11 && !strncmp(arg, "rhm-reverse", 11))
+        *rhm_rev = eq + 1;
+    else
+        return cli_usage_error(cmd, "--out-stage: '%.*s' is not a stage's map (rhm, rhm-reverse)",
+                               (int)n, arg), -1;
+    return 0;
+}

@@ -8,11 +8,13 @@
  * SUBMIT_OK with the reason. Icospheres of 162 vertices, the target
  * stretched and bent, the map a vertex map sent as weight-1 rows. A job
  * from landmarks (RHM then ECTM) serves RHM's maps to a RESULT that asks
- * for them (PROTO_WANT_STAGE_RHM): those the in-process chain keeps. */
+ * for them (PROTO_WANT_STAGE_RHM): those the in-process chain keeps, also
+ * through mc_result_stage and `meshcorr result --out-stage`. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testmesh.h"
 #include "support/testraw.h"
+#include "support/testrun.h"
 #include "corr/corr.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
@@ -307,6 +309,36 @@ TEST_T(a_landmark_jobs_rhm_maps_are_served_when_asked, 120)
     proto_msg_free(&m);
     free(buf);
     close(fd);
+
+    /* libmeshcorr's mc_result_stage, and meshcorr result --out-stage */
+    mc_stage_maps st;
+    CHECK_INT(mc_result_stage(c, id, "rhm", &st), 0);
+    CHECK_INT(st.np, (uint32_t)want.rhm_P->n);
+    CHECK_INT(st.nq, (uint32_t)want.rhm_Q->n);
+    for (uint32_t i = 0; i < st.np; i++) {
+        CHECK_INT(st.p[i].face, (uint32_t)want.rhm_P->face[i]);
+        CHECK_NEAR(st.p[i].w[0], want.rhm_P->w[3 * i], 1e-9);
+    }
+    mc_stage_maps_free(&st);
+    CHECK_INT(mc_result_stage(c, id, "ectm", &st), MC_EARG);
+    char out[8192], R[700], RQ[700];
+    snprintf(R, sizeof R, "%s/r.map", harness_tmpdir());
+    snprintf(RQ, sizeof RQ, "%s/rq.map", harness_tmpdir());
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr result %llu --out-stage rhm=%s "
+                       "--out-stage rhm-reverse=%s --server %s 2>&1", (unsigned long long)id, R, RQ,
+                       d.unix_addr), 0);
+    CHECK_STR_HAS(out, "rhm_flipped_fraction ");   /* RHM's quality beside the final map's */
+    CHECK_STR_HAS(out, "\nflipped_fraction ");
+    bmap *fr = NULL, *fq = NULL;
+    if (bmap_read(R, p.S, p.T, &fr, err, sizeof err) || bmap_read(RQ, p.T, p.S, &fq, err, sizeof err))
+        FAILF("%s", err);
+    CHECK(!memcmp(fr->face, want.rhm_P->face, sizeof(int) * (size_t)fr->n));
+    CHECK(!memcmp(fq->face, want.rhm_Q->face, sizeof(int) * (size_t)fq->n));
+    bmap_free(fr);
+    bmap_free(fq);
+    CHECK_INT(testrunf(out, sizeof out, "build/meshcorr result %llu --out-stage ectm=%s --server %s 2>&1",
+                       (unsigned long long)id, R, d.unix_addr), 2);
+    CHECK_STR_HAS(out, "--out-stage: 'ectm' is not a stage's map");
     ectm_result_close(&want);
     mc_close(c);
     testdaemon_stop(&d, SIGTERM);
