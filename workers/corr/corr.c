@@ -367,7 +367,8 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
 
     bmap *dP = NULL, *dQ = NULL;               /* DDM's maps */
     rhm_result init = {0};                     /* RHM's maps (or the coarse chain's) */
-    bmap *sP = NULL, *sQ = NULL;               /* the coarse chain's RHM maps */
+    bmap *sP = NULL, *sQ = NULL;               /* RHM's maps for the result: init's, or the
+                                                * coarse chain's carried back */
     const bmap *P = in->P0, *Q = bij ? in->Q0 : NULL;
     if (run & CORR_RUN_DDM) {
         if ((rc = corr__ddm(in, P, Q, relay_ddm, rl, &dP, &dQ, err, errsz)))

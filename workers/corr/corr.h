@@ -314,7 +314,11 @@ double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, s
  * CORR_EMESH.
  * When the chain ends before ECTM, out->P and out->Q are the last stage's
  * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
- * the model is bijective) and out->Y, out->Yt, out->last stay empty. */
+ * the model is bijective) and out->Y, out->Yt, out->last stay empty.
+ * When the chain runs RHM then ECTM, out->rhm_P and (bijective) out->rhm_Q
+ * are RHM's maps that ECTM started from: what the chain ending at RHM
+ * returns for the same input, bit for bit (coarse to fine: carried back and
+ * repaired the same way; in pieces: joined the same way). */
 int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz);
 
