@@ -594,6 +594,22 @@ def case_venv_match_equals_daemon():
     assert len(local.p) == 162 and np.allclose(local.p.weights.sum(axis=1), 1)
 
 
+def case_rhm_stage_maps_same_as_cli():
+    c = meshcorr.Client(UNIX)
+    job = c.submit(SRC, TGT, landmarks=LANDMARKS, label="py", **JOB)
+    list(job.watch())
+    assert job.state == "COMPLETED", (job.state, job.reason)
+    res = job.result(stages=True)
+    r, rq = res.stages["rhm"], res.stages["rhm-reverse"]
+    assert len(r) == len(res.p) and len(rq) == len(res.q) and r != res.p
+    assert 0 <= res.metrics["rhm_flipped_fraction"] <= 1, res.metrics
+    assert job.result().stages == {}                               # not asked
+    rm, rqm = os.path.join(DIR, "cli-rhm.map"), os.path.join(DIR, "cli-rhmq.map")
+    cli("result", str(job.id), "--out-stage", "rhm=" + rm, "--out-stage", "rhm-reverse=" + rqm,
+        "--server", UNIX)
+    assert meshcorr.read_map(rm) == r and meshcorr.read_map(rqm) == rq
+
+
 if __name__ == "__main__":
     globals()["case_" + sys.argv[1]]()
     print("ok", sys.argv[1])

@@ -95,6 +95,11 @@ TEST_T(submit_from_files_watch_and_result_match_the_cli, 120)
     run_case("files_watch_result_same_as_cli");
 }
 
+TEST_T(a_jobs_rhm_maps_through_python_are_the_clis, 120)
+{
+    run_case("rhm_stage_maps_same_as_cli");
+}
+
 TEST_T(submit_from_numpy_arrays_gives_the_map_of_the_files, 120)
 {
     run_case("arrays_same_map_as_files");

@@ -114,6 +114,11 @@ class JobResult(ctypes.Structure):
                 ("nmetrics", ctypes.c_uint32)]
 
 
+class StageMaps(ctypes.Structure):
+    _fields_ = [("p", ctypes.POINTER(MapRow)), ("np", ctypes.c_uint32),
+                ("q", ctypes.POINTER(MapRow)), ("nq", ctypes.c_uint32)]
+
+
 class ServerStats(ctypes.Structure):
     _fields_ = [("queued", ctypes.c_uint32), ("running", ctypes.c_uint32),
                 ("workers", ctypes.c_uint32), ("completed", ctypes.c_uint64),
@@ -203,6 +208,9 @@ _declare("mc_watch", ctypes.c_int, c_client_p, ctypes.c_uint64, ctypes.c_uint32,
          ctypes.c_void_p, ctypes.POINTER(ctypes.c_int), c_err, ctypes.c_size_t)
 _declare("mc_result", ctypes.c_int, c_client_p, ctypes.c_uint64, ctypes.c_uint, ctypes.POINTER(JobResult))
 _declare("mc_result_free", None, ctypes.POINTER(JobResult))
+_declare("mc_result_stage", ctypes.c_int, c_client_p, ctypes.c_uint64, ctypes.c_char_p,
+         ctypes.POINTER(StageMaps))
+_declare("mc_stage_maps_free", None, ctypes.POINTER(StageMaps))
 _declare("mc_cancel", ctypes.c_int, c_client_p, ctypes.c_uint64)
 _declare("mc_delete", ctypes.c_int, c_client_p, ctypes.c_uint64)
 _declare("mc_stats", ctypes.c_int, c_client_p, ctypes.POINTER(ServerStats))

@@ -17,7 +17,7 @@ from ._lib import check, errbuf, lib
 from ._spec import MeshLike, Spec
 from .errors import (MC_EADDRESS, MC_EARG, MC_ETIMEOUT, ClientClosedError, InvalidInputError, MeshcorrError,
                      MeshcorrTimeoutError)
-from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, number, progress_dict, result_of
+from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, map_of, number, progress_dict, result_of
 
 
 def _default_server() -> str:
@@ -342,20 +342,34 @@ class Job:
             pass
         return self.state
 
-    def result(self, deformed: bool = False, metrics: bool = True, n_target: Optional[int] = None) -> Result:
+    def result(self, deformed: bool = False, metrics: bool = True, n_target: Optional[int] = None,
+               stages: bool = False) -> Result:
         """The maps of a COMPLETED job as a Result: p (and q for the
-        bijective model) as Maps, the deformed source (V, F) when deformed.
-        n_target: the target's vertex count for an injective job's P (known
-        when this client submitted it). JobStateError when the job has no
-        maps (not COMPLETED)."""
+        bijective model) as Maps, the deformed source (V, F) when deformed;
+        with stages, RHM's maps that ECTM started from in Result.stages
+        ("rhm", and "rhm-reverse" for the bijective model) on a chain RHM
+        then ECTM. n_target: the target's vertex count for an injective
+        job's P (known when this client submitted it). JobStateError when
+        the job has no maps (not COMPLETED)."""
         c = self.client._handle()
         want = WANT_P | WANT_Q | (WANT_DEFORMED if deformed else 0) | (WANT_METRICS if metrics else 0)
         r = _lib.JobResult()
         self.client._check(lib.mc_result(c, self.id, want, ctypes.byref(r)))
         try:
-            return result_of(r, n_target or self._n_target, "job %d" % self.id)
+            res = result_of(r, n_target or self._n_target, "job %d" % self.id)
         finally:
             lib.mc_result_free(ctypes.byref(r))
+        if stages:
+            s = _lib.StageMaps()
+            self.client._check(lib.mc_result_stage(c, self.id, b"rhm", ctypes.byref(s)))
+            try:
+                if s.np:
+                    res.stages["rhm"] = map_of(s.p, s.np, res.p.n_target)
+                if s.nq:
+                    res.stages["rhm-reverse"] = map_of(s.q, s.nq, s.np)
+            finally:
+                lib.mc_stage_maps_free(ctypes.byref(s))
+        return res
 
     def cancel(self) -> None:
         """Asks the server to cancel the job (it ends CANCELLED)."""

@@ -37,12 +37,16 @@ class Result:
     iterations, elapsed_s, quality_verdict, and reverse_* for q);
     repair: what the input repair did, {"source": {count: n}, "target":
     {...}} from the metrics repair_source_* and repair_target_*, or None
-    when neither mesh needed it (docs/repair.md)."""
+    when neither mesh needed it (docs/repair.md); stages: a stage's maps
+    from before the final ones when asked for (Job.result(stages=True)):
+    {"rhm": Map, "rhm-reverse": Map} on a chain RHM then ECTM, their
+    quality in metrics as rhm_*; else {}."""
 
     def __init__(self, p: Map, q: Optional[Map], deformed: Optional[Tuple[np.ndarray, np.ndarray]],
                  metrics: Dict[str, float]) -> None:
         self.p, self.q, self.deformed, self.metrics = p, q, deformed, metrics
         self.repair = repair_of(metrics)
+        self.stages: Dict[str, Map] = {}
 
     def __repr__(self) -> str:
         parts = ["p=%r" % self.p, "q=%r" % self.q]
