@@ -181,11 +181,13 @@ TEST(parameter_list_as_data_sets_each_member_as_the_cli_parses_its_option)
     CHECK(strcmp(mc_param_name(0), "model") == 0 && strcmp(mc_param_values(0), "bijective|injective") == 0);
     CHECK_INT(mc_param_type(0), MC_PARAM_ENUM);
     int last = mc_param_count() - 1;
-    CHECK(strcmp(mc_param_name(last), "coarse") == 0 && mc_param_type(last) == MC_PARAM_U32);
-    CHECK(strcmp(mc_param_name(last - 1), "zoomout") == 0 && mc_param_type(last - 1) == MC_PARAM_U32);
-    CHECK(strcmp(mc_param_name(last - 2), "ddm_mode") == 0 && mc_param_type(last - 2) == MC_PARAM_ENUM);
-    CHECK(strcmp(mc_param_name(last - 3), "ddm_k") == 0 && mc_param_type(last - 3) == MC_PARAM_U32);
-    CHECK(strcmp(mc_param_name(last - 5), "backend") == 0 && mc_param_type(last - 5) == MC_PARAM_STR);
+    CHECK(strcmp(mc_param_name(last), "repair") == 0 && mc_param_type(last) == MC_PARAM_ENUM &&
+          strcmp(mc_param_values(last), "yes|no") == 0);
+    CHECK(strcmp(mc_param_name(last - 1), "coarse") == 0 && mc_param_type(last - 1) == MC_PARAM_U32);
+    CHECK(strcmp(mc_param_name(last - 2), "zoomout") == 0 && mc_param_type(last - 2) == MC_PARAM_U32);
+    CHECK(strcmp(mc_param_name(last - 3), "ddm_mode") == 0 && mc_param_type(last - 3) == MC_PARAM_ENUM);
+    CHECK(strcmp(mc_param_name(last - 4), "ddm_k") == 0 && mc_param_type(last - 4) == MC_PARAM_U32);
+    CHECK(strcmp(mc_param_name(last - 6), "backend") == 0 && mc_param_type(last - 6) == MC_PARAM_STR);
     CHECK(mc_param_name(last + 1) == NULL && mc_param_type(-1) == -1);
     for (int i = 0; i <= last; i++)
         CHECK(mc_param_cli(i) && mc_param_help(i)[0] && mc_param_values(i));
