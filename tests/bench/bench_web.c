@@ -9,6 +9,7 @@
  * figures, never fails on time. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testhttp.h"
 #include "meshcorr.h"
 
 #include <arpa/inet.h>
@@ -33,19 +34,6 @@ static double now(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
 }
 
 /* CPU seconds (user + system) of /proc/<pid>/stat or .../task/<tid>/stat. */
@@ -95,40 +83,8 @@ static double quantile(samples *s, double q)
 /* One GET with the token; the body into out (NUL-terminated); the status. */
 static int get(int port, const char *path, char *out, size_t osz)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_port = htons((uint16_t)port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a)) {
-        if (fd >= 0)
-            close(fd);
-        return -1;
-    }
-    char req[512];
-    int n = snprintf(req, sizeof req, "GET %s HTTP/1.0\r\nHost: 127.0.0.1\r\nAuthorization: Bearer %s\r\n\r\n",
-                     path, TESTDAEMON_ALICE);
-    if (send(fd, req, (size_t)n, MSG_NOSIGNAL) != n) {
-        close(fd);
-        return -1;
-    }
-    size_t len = 0;
-    for (;;) {
-        struct pollfd p = {fd, POLLIN, 0};
-        if (poll(&p, 1, 10000) != 1)
-            break;
-        ssize_t r = read(fd, out + len, osz - 1 - len);
-        if (r <= 0 || len + (size_t)r >= osz - 1) {
-            len += r > 0 ? (size_t)r : 0;
-            break;
-        }
-        len += (size_t)r;
-    }
-    close(fd);
-    out[len] = '\0';
-    int status = 0;
-    sscanf(out, "HTTP/1.%*d %d", &status);
-    return status;
+    return testhttp_request(port, "GET", path, "Authorization: Bearer " TESTDAEMON_ALICE "\r\n", NULL, out, osz,
+                            10000);
 }
 
 typedef struct watcher {
@@ -239,7 +195,7 @@ static double ratio(double a, double b)
 TEST_T(web_page_and_api_under_50_watchers_of_one_running_job, 300)
 {
     testdaemon_need_worker();
-    int port = free_port();
+    int port = testhttp_free_port();
     char http[16];
     snprintf(http, sizeof http, "%d", port);
     const char *args[] = {"--http", http, "--workers", "1", NULL};

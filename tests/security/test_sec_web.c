@@ -12,6 +12,7 @@
  * - every answer carries the Content-Security-Policy. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testhttp.h"
 #include "support/testraw.h"
 #include "mcd.h"
 #include "meshcorr.h"
@@ -27,49 +28,15 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
-}
-
 /* One request (headers: extra lines ending in \r\n, may be ""): the whole
  * answer in a static buffer, its status in *status. */
 static const char *request(int port, const char *method, const char *path, const char *headers, const char *body,
                            int *status)
 {
     static char resp[1 << 16];
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_port = htons((uint16_t)port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a))
-        FAILF("connect to --http: %s", strerror(errno));
-    char req[4096];
-    int n = snprintf(req, sizeof req, "%s %s HTTP/1.0\r\nHost: 127.0.0.1\r\n%sContent-Length: %zu\r\n\r\n%s", method,
-                     path, headers, body ? strlen(body) : 0, body ? body : "");
-    CHECK(send(fd, req, (size_t)n, MSG_NOSIGNAL) == n);
-    size_t len = 0;
-    for (;;) {
-        struct pollfd p = {fd, POLLIN, 0};
-        if (poll(&p, 1, 5000) != 1)
-            FAILF("%s %s: no answer", method, path);
-        ssize_t r = read(fd, resp + len, sizeof resp - 1 - len);
-        if (r <= 0)
-            break;
-        len += (size_t)r;
-    }
-    close(fd);
-    resp[len] = '\0';
-    CHECK(sscanf(resp, "HTTP/1.%*d %d", status) == 1);
+    *status = testhttp_request(port, method, path, headers, body, resp, sizeof resp, 5000);
+    if (*status <= 0)
+        FAILF("%s %s: no HTTP answer: %.100s", method, path, resp);
     return resp;
 }
 
@@ -101,7 +68,7 @@ static void login(int port, const char *token, char *cookie, size_t sz)
 
 TEST_T(guessing_on_the_login_form_is_throttled_with_the_protocol_and_logged, 60)
 {
-    int port = free_port();
+    int port = testhttp_free_port();
     char http[16];
     snprintf(http, sizeof http, "%d", port);
     const char *args[] = {"--http", http, NULL};
@@ -153,7 +120,7 @@ TEST_T(guessing_on_the_login_form_is_throttled_with_the_protocol_and_logged, 60)
 TEST_T(cookies_csrf_other_users_jobs_and_the_csp, 120)
 {
     testdaemon_need_worker();
-    int port = free_port();
+    int port = testhttp_free_port();
     char http[16];
     snprintf(http, sizeof http, "%d", port);
     const char *args[] = {"--http", http, "--workers", "2", NULL};

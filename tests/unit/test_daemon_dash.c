@@ -10,6 +10,7 @@
  * a decoder written here from the IEEE-754 layout. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testhttp.h"
 #include "support/testfile.h"
 #include "support/testrun.h"
 #include "map/bmap.h"
@@ -37,19 +38,6 @@ static double now_s(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + t.tv_nsec * 1e-9;
-}
-
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
 }
 
 static int tcp_connect(int port)
@@ -304,9 +292,9 @@ static uint64_t submit_demo(mc_client *c, int iterations, int inner)
 static void dash_start(dash *x, const char *name)
 {
     char mb[32], me[32];
-    x->modbus = free_port();
+    x->modbus = testhttp_free_port();
     do
-        x->metrics = free_port();
+        x->metrics = testhttp_free_port();
     while (x->metrics == x->modbus);
     snprintf(mb, sizeof mb, "127.0.0.1:%d", x->modbus);
     snprintf(me, sizeof me, "%d", x->metrics);     /* port only: 127.0.0.1 */
@@ -543,22 +531,11 @@ TEST_T(modbus_refuses_writes_and_junk_and_keeps_serving, 60)
 /* GET (or method) path over a raw socket: the status code; the body into body. */
 static int http_ask(int port, const char *method, const char *path, char *body, size_t bsz)
 {
-    int fd = tcp_connect(port);
-    char req[256];
-    int n = snprintf(req, sizeof req, "%s %s HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n", method, path);
-    CHECK(send(fd, req, (size_t)n, MSG_NOSIGNAL) == n);
     static char resp[1 << 16];
-    size_t len = 0;
-    int r;
-    while (len < sizeof resp - 1 && (r = read_wait(fd, (uint8_t *)resp + len, sizeof resp - 1 - len, 3000)) > 0)
-        len += (size_t)r;
-    resp[len] = '\0';
-    close(fd);
-    int status = 0;
-    if (sscanf(resp, "HTTP/1.%*d %d", &status) != 1)
+    int status = testhttp_request(port, method, path, "", NULL, resp, sizeof resp, 3000);
+    if (status <= 0)
         FAILF("not an HTTP response: %.100s", resp);
-    const char *b = strstr(resp, "\r\n\r\n");
-    snprintf(body, bsz, "%s", b ? b + 4 : "");
+    snprintf(body, bsz, "%s", testhttp_body(resp));
     return status;
 }
 

@@ -146,7 +146,7 @@ static int check_path_span(const char *doc, const char *text, const char *s, siz
     memcpy(path, s, n);
     path[n] = '\0';
     if (strpbrk(path, " \t\n<>$") || strstr(path, "..."))
-        return 0;                                     /* a command, a placeholder */
+        return 0;            /* a command line or a placeholder such as <FILE>: not a path */
     int top = 0;
     for (size_t i = 0; i < sizeof top_folders / sizeof top_folders[0]; i++)
         top |= strncmp(path, top_folders[i], strlen(top_folders[i])) == 0;

@@ -5,6 +5,7 @@
  * dashboard cannot drift from what the daemon exports. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testhttp.h"
 #include "support/testfile.h"
 #include "support/testjson.h"
 
@@ -19,48 +20,14 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
-}
-
 /* GET /metrics from 127.0.0.1:port: the body, in a static buffer. */
 static const char *get_metrics(int port)
 {
     static char resp[1 << 18];
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_port = htons((uint16_t)port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a))
-        FAILF("connect to --http: %s", strerror(errno));
-    static const char req[] = "GET /metrics HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n";
-    CHECK(send(fd, req, sizeof req - 1, MSG_NOSIGNAL) == (ssize_t)(sizeof req - 1));
-    size_t len = 0;
-    for (;;) {
-        struct pollfd p = {fd, POLLIN, 0};
-        if (poll(&p, 1, 5000) != 1)
-            FAILF("no answer from /metrics");
-        ssize_t r = read(fd, resp + len, sizeof resp - 1 - len);
-        if (r <= 0)
-            break;
-        len += (size_t)r;
-    }
-    close(fd);
-    resp[len] = '\0';
-    CHECK_STR_HAS(resp, "HTTP/1.1 200");
-    const char *body = strstr(resp, "\r\n\r\n");
-    CHECK(body != NULL);
-    return body + 4;
+    int status = testhttp_request(port, "GET", "/metrics", "", NULL, resp, sizeof resp, 5000);
+    if (status != 200)
+        FAILF("GET /metrics: status %d: %.100s", status, resp);
+    return testhttp_body(resp);
 }
 
 /* 1 when the text declares family name (# TYPE name ...), or name is a
@@ -90,7 +57,7 @@ TEST_T(every_grafana_query_names_a_metric_the_daemon_exports, 60)
     char *dash = (char *)testfile_read("deploy/grafana/meshcorr.json", &len);
     dash[len] = '\0';            /* testfile_read leaves room for it */
     CHECK(testjson_valid(dash));
-    int port = free_port();
+    int port = testhttp_free_port();
     char http[16];
     snprintf(http, sizeof http, "%d", port);
     const char *args[] = {"--http", http, NULL};

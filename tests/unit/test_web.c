@@ -13,6 +13,7 @@
  * chromium, chromedriver or selenium (deploy/install-deps.sh installs them). */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testhttp.h"
 #include "support/testrun.h"
 #include "meshcorr.h"
 
@@ -25,38 +26,14 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
-}
-
 /* GET path from 127.0.0.1:port with a Bearer token: the HTTP status. */
 static int api_status(int port, const char *path, const char *token)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_port = htons((uint16_t)port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a))
-        FAILF("connect to --http: %s", strerror(errno));
-    char req[512], resp[4096];
-    int n = snprintf(req, sizeof req, "GET %s HTTP/1.0\r\nAuthorization: Bearer %s\r\n\r\n", path, token);
-    CHECK(send(fd, req, (size_t)n, MSG_NOSIGNAL) == n);
-    ssize_t got = read(fd, resp, sizeof resp - 1);
-    close(fd);
-    CHECK(got > 12);
-    resp[got] = '\0';
-    int status = 0;
-    CHECK(sscanf(resp, "HTTP/1.%*d %d", &status) == 1);
+    char hdr[256], resp[4096];
+    snprintf(hdr, sizeof hdr, "Authorization: Bearer %s\r\n", token);
+    int status = testhttp_request(port, "GET", path, hdr, NULL, resp, sizeof resp, 5000);
+    if (status <= 0)
+        FAILF("GET %s: no HTTP answer: %.100s", path, resp);
     return status;
 }
 
@@ -72,7 +49,7 @@ TEST_T(browser_logs_in_sees_own_jobs_plot_result_and_cancels, 300)
 {
     testdaemon_need_worker();
     need_browser();
-    int port = free_port();
+    int port = testhttp_free_port();
     char http[16];
     snprintf(http, sizeof http, "%d", port);
     const char *args[] = {"--http", http, "--workers", "2", NULL};
