@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define RENDER_MAX_SIDE 8192      /* pixels per image side */
 #define RENDER_SUPERSAMPLE 3      /* samples per pixel side (3 x 3 averaged) */
@@ -27,11 +28,7 @@
     X(RENDER_EEIGEN, -3, "eigen-solver (LAPACK) failed")                    \
     X(RENDER_EPNG,   -4, "cannot write the PNG file")
 
-enum render_error {
-#define RENDER_ENUM(name, val, msg) name = val,
-    RENDER_ERRORS(RENDER_ENUM)
-#undef RENDER_ENUM
-};
+ERRLIST_ENUM(render, RENDER_ERRORS);
 const char *render_strerror(int code);
 
 typedef struct render_image {

@@ -7,11 +7,7 @@
 
 const char *render_strerror(int code)
 {
-    switch (code) {
-#define RENDER_STR(name, val, msg) case name: return msg;
-        RENDER_ERRORS(RENDER_STR)
-#undef RENDER_STR
-    }
+    switch (code) { RENDER_ERRORS(ERRLIST_CASE) }
     return "unknown render error";
 }
 

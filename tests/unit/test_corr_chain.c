@@ -77,19 +77,19 @@ TEST(chains_the_inputs_cannot_run_are_refused)
     /* each refusal with its kind: a chain that does not fit the inputs is
      * PARAMS, missing landmarks LANDMARKS, a reverse map alone MAP */
     static const struct { int s, map, rev, nl, inj; double gamma; int mode; const char *msg; int kind; } bad[] = {
-        {CORR_CHAIN_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
-        {CORR_CHAIN_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", CORR_EPARAMS},
-        {CORR_CHAIN_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map", CORR_EPARAMS},
-        {CORR_CHAIN_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks", CORR_ELANDMARKS},
-        {CORR_CHAIN_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2", CORR_ELANDMARKS},
+        {CORR_CHAIN_DDM_ECTM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", KIND_EPARAMS},
+        {CORR_CHAIN_DDM, 0, 0, 6, 0, 0, 0, "the DDM stage denoises a given map", KIND_EPARAMS},
+        {CORR_CHAIN_ECTM, 0, 0, 6, 0, 0, 0, "the ECTM stage alone needs an initial map", KIND_EPARAMS},
+        {CORR_CHAIN_ALL, 0, 0, 0, 0, 0, 0, "neither an initial map nor landmarks", KIND_ELANDMARKS},
+        {CORR_CHAIN_RHM_ECTM, 0, 0, 2, 0, 0, 0, "at least 3 landmark pairs, got 2", KIND_ELANDMARKS},
         {CORR_CHAIN_DDM_RHM, 1, 0, 0, 0, 0.5, 0, "weak landmark term (rhm_landmark_weight 0.5) needs landmarks",
-         CORR_EPARAMS},
-        {CORR_CHAIN_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model", CORR_EPARAMS},
-        {CORR_CHAIN_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map", CORR_EMAP},
+         KIND_EPARAMS},
+        {CORR_CHAIN_DDM_ECTM, 1, 1, 0, 1, 0, 0, "reverse map needs the bijective model", KIND_EPARAMS},
+        {CORR_CHAIN_RHM, 0, 1, 6, 0, 0, 0, "reverse map needs an initial map", KIND_EMAP},
         {CORR_CHAIN_DDM_ECTM, 1, 0, 0, 0, 0, CORR_DDM_BIJECTIVE, "it needs an initial reverse map too",
-         CORR_EPARAMS},
-        {CORR_CHAIN_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3", CORR_EPARAMS},
-        {8, 1, 0, 0, 0, 0, 0, "stages value 8", CORR_EPARAMS}};
+         KIND_EPARAMS},
+        {CORR_CHAIN_DDM, 1, 1, 0, 0, 0, 3, "ddm_mode value 3", KIND_EPARAMS},
+        {8, 1, 0, 0, 0, 0, 0, "stages value 8", KIND_EPARAMS}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         err[0] = '\0';
         CHECK_INT(corr_chain_check((corr_chain)bad[k].s, bad[k].map, bad[k].rev, bad[k].nl,
@@ -233,7 +233,7 @@ TEST_T(ddm_then_ectm_on_the_bcicp_map_of_gorilla_to_man, 300)
     /* a basis larger than the mesh allows names the parameter */
     in.stages = CORR_CHAIN_DDM;
     in.ddm_k = 4999;
-    CHECK_INT(corr_run(&in, &p, NULL, NULL, &r, err, sizeof err), CORR_EPARAMS);
+    CHECK_INT(corr_run(&in, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "params.ddm_k = 4999");
 
     bmap_free(D);

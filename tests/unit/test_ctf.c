@@ -41,7 +41,7 @@ TEST(decimation_keeps_topology_kept_vertices_and_positions)
         CHECK(c->nv <= target[k] + target[k] / 20);
         CHECK(c->nv >= target[k] / 2);
         CHECK_INT(euler(c), euler(m));
-        CHECK_INT(corr_validate(c, "coarse", err, sizeof err), CORR_OK);
+        CHECK_INT(corr_validate(c, "coarse", err, sizeof err), KIND_OK);
         for (int v = 0; v < c->nv; v++) {
             CHECK(fine[v] >= 0 && fine[v] < m->nv);
             CHECK(v == 0 || fine[v] > fine[v - 1]);

@@ -56,15 +56,15 @@ TEST(params_check_names_the_bad_field)
     char err[256];
     ectm_params_init(&p);
     p.alpha = -1;
-    CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_params_check(&p, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "alpha");
     ectm_params_init(&p);
     p.gamma = NAN;
-    CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_params_check(&p, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "gamma");
     ectm_params_init(&p);
     p.beta_ramp = 0;
-    CHECK_INT(ectm_params_check(&p, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_params_check(&p, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "beta_ramp = 0: out of range [1, 1000000]");
 }
 
@@ -76,7 +76,7 @@ TEST(map_sized_for_other_meshes_is_refused)
     ectm_params_init(&p);
     ectm_result r;
     char err[256];
-    CHECK_INT(ectm_run(d.T, d.S, d.P0, NULL, NULL, &p, NULL, NULL, &r, err, sizeof err), ECTM_EMAP);
+    CHECK_INT(ectm_run(d.T, d.S, d.P0, NULL, NULL, &p, NULL, NULL, &r, err, sizeof err), KIND_EMAP);
     CHECK_STR_HAS(err, "6938 -> 9239");
     testdemo_free(&d);
 }
@@ -115,7 +115,7 @@ TEST_T(progress_callback_cancels_run, 300)
     t.cancel_at = 2;
     ectm_result r;
     char err[256];
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, NULL, &p, record, &t, &r, err, sizeof err), ECTM_ECANCELED);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, NULL, &p, record, &t, &r, err, sizeof err), KIND_ECANCELLED);
     CHECK_INT(t.n, 2);
     CHECK(r.P == NULL);
     CHECK_STR_HAS(err, "cancelled");

@@ -114,30 +114,30 @@ TEST(bad_landmark_is_refused_with_its_field_named)
     char err[512];
 
     src[2] = d.S->nv;                       /* one past the source's last vertex */
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "landmarks.src[2] = 6938 out of range [0, 6938)");
     CHECK(r.P == NULL && r.Q == NULL);
     src[2] = 30;
 
     tgt[1] = -1;
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "landmarks.tgt[1] = -1 out of range [0, 9239)");
     tgt[1] = d.T->nv;
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "landmarks.tgt[1] = 9239");
     tgt[1] = 21;
 
     src[2] = 10;                            /* source vertex 10 pinned twice */
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "landmarks.src[2] = 10 repeats landmarks.src[0]");
     src[2] = 30;
 
     L.n = -1;
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "landmarks.n = -1");
     L.n = 3;
     L.tgt = NULL;
-    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), ECTM_EPARAM);
+    CHECK_INT(ectm_run(d.S, d.T, d.P0, d.Q0, &L, &p, NULL, NULL, &r, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "landmarks.tgt is NULL");
     testdemo_free(&d);
 }

@@ -41,8 +41,8 @@ TEST(every_kind_has_one_code_name_text_and_exit_through_every_layer)
         CHECK(proto_kind_name(k) && strcmp(proto_kind_name(k), name) == 0);                     \
         CHECK_INT(proto_err_code(name), code);                                                  \
         /* the engine's pipeline code is -kind, and the worker sends its wire code */           \
-        CHECK_INT(CORR_E##kind, -k);                                                            \
-        CHECK_INT(corr_wire_code(CORR_E##kind), code);                                          \
+        CHECK_INT(KIND_E##kind, -k);                                                            \
+        CHECK_INT(corr_wire_code(KIND_E##kind), code);                                          \
         CHECK(strcmp(proto_kind_text(k), text) == 0);                                           \
         /* libmeshcorr names it, and reads it back from a failed job's reason */               \
         CHECK(strcmp(mc_err_name(code), name) == 0);                                            \
@@ -79,8 +79,6 @@ TEST(every_kind_has_one_code_name_text_and_exit_through_every_layer)
 TEST(every_engine_module_error_translates_to_its_kind)
 {
 #define CHECK_ROW(fn, name, kind) CHECK_INT(fn(name), -PROTO_KIND_##kind);
-#define RHM_ROW(name, val, msg, kind) CHECK_ROW(corr_from_rhm, name, kind)
-#define ECTM_ROW(name, val, msg, kind) CHECK_ROW(corr_from_ectm, name, kind)
 #define FOLD_ROW(name, val, msg, kind) CHECK_ROW(corr_from_fold, name, kind)
 #define DDM_ROW(name, val, msg, kind) CHECK_ROW(corr_from_ddm, name, kind)
 #define CTF_ROW(name, val, msg, kind) CHECK_ROW(corr_from_ctf, name, kind)
@@ -89,8 +87,6 @@ TEST(every_engine_module_error_translates_to_its_kind)
 #define LMK_ROW(name, val, msg, kind) CHECK_ROW(corr_from_lmk, name, kind)
 #define BMAP_ROW(name, val, msg, kind) CHECK_ROW(corr_from_bmap, name, kind)
 #define MESH_ROW(name, val, msg, kind) CHECK_ROW(corr_from_mesh, name, kind)
-    RHM_ERRORS(RHM_ROW)
-    ECTM_ERRORS(ECTM_ROW)
     FOLD_ERRORS(FOLD_ROW)
     DDM_ERRORS(DDM_ROW)
     CTF_ERRORS(CTF_ROW)
@@ -99,17 +95,13 @@ TEST(every_engine_module_error_translates_to_its_kind)
     LMK_ERRORS(LMK_ROW)
     BMAP_ERRORS(BMAP_ROW)
     MESH_ERRORS(MESH_ROW)
-    CHECK_INT(corr_from_rhm(RHM_ENUMERIC), CORR_ENUMERIC);
-    CHECK_INT(corr_from_rhm(RHM_ELANDMARKS), CORR_ELANDMARKS);
-    CHECK_INT(corr_from_rhm(RHM_EMAP), CORR_EMAP);
-    CHECK_INT(corr_from_ectm(ECTM_ENUMERIC), CORR_ENUMERIC);
-    CHECK_INT(corr_from_lbo(LBO_EARPACK), CORR_ENUMERIC);
-    CHECK_INT(corr_from_lbo(LBO_ENOCONV), CORR_ENUMERIC);
-    CHECK_INT(corr_from_geod(GEOD_EFACTOR), CORR_ENUMERIC);
-    CHECK_INT(corr_from_bmap(BMAP_ERANGE), CORR_EMAP);
-    CHECK_INT(corr_from_lmk(LMK_ERANGE), CORR_ELANDMARKS);
-    CHECK_INT(corr_from_rhm(12345), CORR_EINTERNAL);   /* a code of no list */
-    CHECK_INT(corr_from_rhm(RHM_OK), CORR_OK);
+    CHECK_INT(corr_from_lbo(LBO_EARPACK), KIND_ENUMERIC);
+    CHECK_INT(corr_from_lbo(LBO_ENOCONV), KIND_ENUMERIC);
+    CHECK_INT(corr_from_geod(GEOD_EFACTOR), KIND_ENUMERIC);
+    CHECK_INT(corr_from_bmap(BMAP_ERANGE), KIND_EMAP);
+    CHECK_INT(corr_from_lmk(LMK_ERANGE), KIND_ELANDMARKS);
+    CHECK_INT(corr_from_geod(12345), KIND_EINTERNAL);   /* a code of no list */
+    CHECK_INT(corr_from_geod(GEOD_OK), KIND_OK);
 }
 
 /* The icosphere pair as a SUBMIT (testdaemon_pair), 3 + 3 iterations,

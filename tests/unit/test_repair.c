@@ -306,7 +306,7 @@ TEST(repair_off_refuses_as_before)
     corr_fix fx;
     corr_input in;
     char err[4096];
-    CHECK_INT(corr_fix_open(&user, 0, &fx, &in, err, sizeof err), CORR_EMESH);
+    CHECK_INT(corr_fix_open(&user, 0, &fx, &in, err, sizeof err), KIND_EMESH);
     CHECK_STR_HAS(err, "messy.off is not usable by the optimizer");
     CHECK_STR_HAS(err, "non-manifold vertices");
     free(x.orig);

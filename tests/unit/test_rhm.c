@@ -170,7 +170,7 @@ TEST_T(zoomout_lowers_the_fmap_starts_error_on_faust, 1200)
             rhm_params_init(&p);
             p.start = RHM_START_FMAP;
             p.zoomout = z ? kz : 0;
-            CHECK_INT(rhm_params_check(&p, err, sizeof err), RHM_OK);
+            CHECK_INT(rhm_params_check(&p, err, sizeof err), KIND_OK);
             rhm__problem *pb = NULL;
             double t0 = now_s();
             if (rhm__problem_new(g.S, g.T, &g.L, &p, &pb, err, sizeof err))
@@ -361,7 +361,7 @@ TEST_T(anchors_are_a_farthest_point_sample_that_the_x_step_holds, 60)
     pb->p.anchor = 0.5;
     for (int i = 0; i < 2; i++) {
         rhm__side *a = &pb->side[i];
-        CHECK_INT(rhm__anchors_set(pb, a, k), RHM_OK);
+        CHECK_INT(rhm__anchors_set(pb, a, k), KIND_OK);
         int count = 0;
         for (int l = 0; l < a->n; l++) {
             CHECK(a->anchor_w[l] == 0 || a->anchor_w[l] == (double)a->n / k);
@@ -541,7 +541,7 @@ TEST(run_stops_when_progress_returns_nonzero)
     rhm_result res;
     char err[256];
     int last = -1;
-    CHECK_INT(start_run(g.S, g.T, &g.L, &p, cancel_at_2, &last, &res, err, sizeof err), RHM_ECANCELED);
+    CHECK_INT(start_run(g.S, g.T, &g.L, &p, cancel_at_2, &last, &res, err, sizeof err), KIND_ECANCELLED);
     CHECK_INT(last, 2);
     CHECK(res.P12 == NULL && res.P21 == NULL);
     CHECK_STR_HAS(err, "iteration 2");
@@ -556,13 +556,13 @@ TEST(refuses_too_few_landmarks_and_bad_parameters)
     rhm_params_init(&p);
     rhm_result res;
     char err[256];
-    CHECK_INT(start_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_ELANDMARKS);
+    CHECK_INT(start_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), KIND_ELANDMARKS);
     CHECK_STR_HAS(err, "at least 3");
     L.n = 3;
     L.src = (int[]){0, 5, 9};
     L.tgt = (int[]){0, 5, 9};
     p.alpha = 1;
-    CHECK_INT(start_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), RHM_EPARAM);
+    CHECK_INT(start_run(m, m, &L, &p, NULL, NULL, &res, err, sizeof err), KIND_EPARAMS);
     CHECK_STR_HAS(err, "alpha");
     mesh_free(m);
 }

@@ -17,6 +17,7 @@
 #ifndef CHOL_H
 #define CHOL_H
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define CHOL_ERRORS(X)                                                      \
     X(CHOL_OK,       0, "ok", NONE)                                           \
@@ -25,11 +26,7 @@
     X(CHOL_ENOTPD,  -3, "matrix not positive definite", NUMERIC)              \
     X(CHOL_EFACTOR, -4, "sparse factorisation or solve failed", NUMERIC)
 
-enum chol_error {
-#define CHOL_ENUM(name, val, msg, kind) name = val,
-    CHOL_ERRORS(CHOL_ENUM)
-#undef CHOL_ENUM
-};
+ERRLIST_ENUM(chol, CHOL_ERRORS);
 
 /* The fill-reducing ordering. AMD alone is deterministic whatever METIS
  * would do; CHOLMOD's own choice tries AMD and may fall back to METIS on

@@ -99,7 +99,7 @@ int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report r
     if (rc)
         return errbuf_set(err, errsz, corr_from_fold(rc),
                           "repairing the folds of the maps: %s", fold_strerror(rc));
-    return CORR_OK;
+    return KIND_OK;
 }
 
 /* The share of bad triangles (flipped plus collapsed) of the map P from
@@ -132,12 +132,12 @@ static int repair_reported(const corr_input *in, relay *rl, bmap *P, bmap *Q, in
 {
     int total = !!P + !!Q, rc;
     if (relay_repair(rl, 0, total))
-        return errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled before the fold repair");
+        return errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled before the fold repair");
     if ((rc = corr_repair(in, P, Q, relax, rep, err, errsz)))
         return rc;
     if (relay_repair(rl, total, total))
-        return errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled after the fold repair");
-    return CORR_OK;
+        return errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled after the fold repair");
+    return KIND_OK;
 }
 
 /* One RHM run from q and its repair; raw: a copy of P12 before it. */
@@ -147,10 +147,10 @@ static int rhm_repaired(const corr_input *in, const rhm_params *q, relay *rl,
 {
     int rc = start_run(in->S, in->T, in->L, q, progress, ctx, out, err, errsz);
     if (rc)
-        return corr_from_rhm(rc);
+        return rc;
     if (raw) {
         if (!(*raw = bmap_new(out->P12->n, out->P12->nt)))
-            return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory");
+            return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
         memcpy((*raw)->face, out->P12->face, sizeof(int) * (size_t)out->P12->n);
         memcpy((*raw)->w, out->P12->w, sizeof(double) * 3 * (size_t)out->P12->n);
     }
@@ -182,12 +182,12 @@ static int rhm_chain(const corr_input *in, const rhm_params *rp, relay *rl,
     fold_report rep2[2];
     char why[1024];
     rc = rhm_repaired(in, &q, rl, progress, ctx, &alt, raw ? &raw2 : NULL, rep2, why, sizeof why);
-    if (rc == CORR_ECANCELLED || rc == CORR_ENOMEM) {
+    if (rc == KIND_ECANCELLED || rc == KIND_ENOMEM) {
         rhm_result_close(&alt);
         bmap_free(raw2);
         return errbuf_set(err, errsz, rc, "%s", why);
     }
-    if (rc == CORR_OK && start_keep_second(bad, folded(in, &alt))) {  /* keep the second map */
+    if (rc == KIND_OK && start_keep_second(bad, folded(in, &alt))) {  /* keep the second map */
         rhm_result t = *out;
         *out = alt;
         alt = t;
@@ -200,7 +200,7 @@ static int rhm_chain(const corr_input *in, const rhm_params *rp, relay *rl,
     }
     rhm_result_close(&alt);
     bmap_free(raw2);
-    return CORR_OK;
+    return KIND_OK;
 }
 
 int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
@@ -215,8 +215,7 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
                          size_t errsz)
 {
     fold_report rep[2];
-    int rc = corr_from_rhm(rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err,
-                                             errsz));
+    int rc = rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err, errsz);
     return rc ? rc : repair_reported(in, rl, out->P12, out->P21, 0, rep, err, errsz);
 }
 
@@ -239,9 +238,9 @@ static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bma
     corr_coarse c;
     ectm_result cr = {0};
     int rc = corr_coarse_open(in, &c, err, errsz);
-    if (rc && rc != CORR_ENOMEM) {
+    if (rc && rc != KIND_ENOMEM) {
         *ran = 0;
-        return CORR_OK;
+        return KIND_OK;
     }
     *ran = !rc && !corr_coarse_wanted(&c.in);
     if (rc || !*ran) {
@@ -254,11 +253,11 @@ static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bma
     if (!(rc = run_chain(&c.in, p, &coarse, &cr, err, errsz))) {
         rl->ectm_before = cr.last.outer;   /* fewer than planned if it stopped early */
         if (relay_repair(rl, 0, 1 + !!cr.Q))
-            rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled before the fold repair");
+            rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled before the fold repair");
         else if (!(rc = corr_coarse_carry(in, &c, cr.P, cr.Q, 0, P, Q, err, errsz)) &&
                  !(rc = corr_repair(in, *P, Q ? *Q : NULL, 0, rep, err, errsz)) &&
                  relay_repair(rl, 1 + !!cr.Q, 1 + !!cr.Q))
-            rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled after the fold repair");
+            rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled after the fold repair");
         if (!rc && cr.rhm_P &&
             !(rc = corr_coarse_carry(in, &c, cr.rhm_P, cr.rhm_Q, 0, rP, rQ, err, errsz)))
             rc = corr_repair(in, *rP, rQ ? *rQ : NULL, 0, rep, err, errsz);
@@ -295,9 +294,9 @@ static int run_pieces(const corr_input *in, const corr__pieces *pc, const ectm_p
 {
     ectm_result *res = calloc((size_t)pc->n, sizeof *res);
     if (!res)
-        return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory for the pieces' results");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory for the pieces' results");
     double total = in->S->nv + in->T->nv, done = 0, t0 = now();
-    int rc = CORR_OK;
+    int rc = KIND_OK;
     for (int k = 0; k < pc->n && !rc; k++) {
         const corr__piece *q = &pc->p[k];
         piece_relay pr = { progress, ctx, t0, done / total, (q->S->nv + q->T->nv) / total };
@@ -343,7 +342,7 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
     memset(out, 0, sizeof *out);
     int rc = ectm_params_check(p, err, errsz);
     if (rc)
-        return corr_from_ectm(rc);
+        return rc;
     if ((rc = corr_validate(in->S, in->S_name, err, errsz)) ||
         (rc = corr_validate(in->T, in->T_name, err, errsz)))
         return rc;
@@ -359,7 +358,7 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
         return rc;
     unsigned run = corr_chain_run(in->stages, !!in->P0);
     if ((run & CORR_RUN_RHM) && (rc = rhm_params_check(&rp, err, errsz)))
-        return corr_from_rhm(rc);
+        return rc;
     corr_input planned = *in;
     planned.rhm = &rp;
     if (rl->plan->n == 0)
@@ -417,8 +416,8 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
     /* the job's landmarks, pinned in ECTM's P- and Q-steps */
     ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
                           in->L ? in->L->n : 0 };
-    rc = corr_from_ectm(ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz));
-    if (rc == CORR_OK) {
+    rc = ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz);
+    if (rc == KIND_OK) {
         /* ECTM's projection folds where its deformed surface passes a thin
          * part at an angle: the same repair runs on the maps it returns in the
          * landmark pipeline, and on a given map's chain through RHM on each
@@ -437,7 +436,7 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
         if ((rP || rQ) && (rc = repair_reported(in, rl, rP, rQ, 1, rep, err, errsz)))
             ectm_result_close(out);
     }
-    if (rc == CORR_OK && (run & CORR_RUN_RHM)) {
+    if (rc == KIND_OK && (run & CORR_RUN_RHM)) {
         /* RHM's maps stay in the result beside ECTM's */
         out->rhm_P = sP;
         out->rhm_Q = sQ;

@@ -31,22 +31,12 @@
 #include "rhm/rhm.h"
 #include "proto.h"
 
-/* The pipeline's errors are the kinds of a job's failure (proto_kind.h):
- * CORR_EMESH, CORR_ELANDMARKS, CORR_EPARAMS, CORR_EMAP, CORR_ENUMERIC,
- * CORR_ENOMEM, CORR_ECANCELLED, CORR_EIO, CORR_EINTERNAL, each -kind. */
-enum corr_error {
-    CORR_OK = 0,
-#define CORR_ENUM(kind, code, exit, text) CORR_E##kind = -PROTO_KIND_##kind,
-    PROTO_KINDS(CORR_ENUM)
-#undef CORR_ENUM
-};
-/* The wire code of a pipeline code (0 for CORR_OK): what the worker's
+/* The pipeline returns the engine's codes by kind (util/kind.h). */
+/* The wire code of a pipeline code (0 for KIND_OK): what the worker's
  * error.frame carries. */
 int corr_wire_code(int code);
 /* An engine module's code as the pipeline's, by the kind column of the
- * module's error list (corr_kind.c); an unknown code is CORR_EINTERNAL. */
-int corr_from_rhm(int rc);
-int corr_from_ectm(int rc);
+ * module's error list (corr_kind.c); an unknown code is KIND_EINTERNAL. */
 int corr_from_fold(int rc);
 int corr_from_ddm(int rc);
 int corr_from_ctf(int rc);
@@ -106,12 +96,12 @@ typedef enum corr_ddm_mode {
 #define CORR_DDM_AUTO_ROUND_TRIP 0.1
 
 /* Whether the chain can run on these inputs: 0, or an error with the
- * reason in err: CORR_EPARAMS (ddm without a map, ECTM alone without one,
+ * reason in err: KIND_EPARAMS (ddm without a map, ECTM alone without one,
  * a reverse map with the injective model, a weak landmark term without
  * landmarks, bijective DDM without a reverse map, a stages or ddm_mode
  * value outside the list; auto without a reverse map runs plain),
- * CORR_ELANDMARKS (RHM from neither a map nor at least
- * PROTO_MIN_LANDMARKS landmarks), CORR_EMAP (a reverse map without a
+ * KIND_ELANDMARKS (RHM from neither a map nor at least
+ * PROTO_MIN_LANDMARKS landmarks), KIND_EMAP (a reverse map without a
  * map). The worker's
  * SUBMIT check and corr_run use it. */
 int corr_chain_check(corr_chain s, int have_map, int have_reverse, int nlandmarks,
@@ -178,7 +168,7 @@ typedef int (*corr_progress_fn)(void *ctx, const corr_progress *p);
  * The worker sends it, `meshcorr match` prints it. */
 void corr_progress_record(const corr_progress *p, proto_progress *out);
 
-/* 0 when the optimizer can use m; else CORR_EMESH with one line per problem
+/* 0 when the optimizer can use m; else KIND_EMESH with one line per problem
  * ("name: ...") in err. */
 int corr_validate(const mesh *m, const char *name, char *err, size_t errsz);
 
@@ -203,14 +193,14 @@ typedef struct corr_fix {
 
 /* Checks and, with repair, repairs user's meshes; *in is the job's input
  * as the engine runs it (user's own fields where nothing was repaired).
- * CORR_OK; CORR_EMESH (not usable, repair off; or beyond repair: a bad
- * index, a NaN), CORR_EMAP (an uploaded map on a removed face),
- * CORR_ENOMEM. On error fx holds nothing. */
+ * KIND_OK; KIND_EMESH (not usable, repair off; or beyond repair: a bad
+ * index, a NaN), KIND_EMAP (an uploaded map on a removed face),
+ * KIND_ENOMEM. On error fx holds nothing. */
 int corr_fix_open(const corr_input *user, int repair, corr_fix *fx, corr_input *in, char *err,
                   size_t errsz);
 /* The engine's result (on the repaired meshes) in the user's indexing:
  * P and Q with one row per user vertex on the user's faces, Y and Yt one
- * row per user vertex; last copied. CORR_ENOMEM. */
+ * row per user vertex; last copied. KIND_ENOMEM. */
 int corr_fix_to_user(const corr_fix *fx, const ectm_result *res, ectm_result *out, char *err,
                      size_t errsz);
 void corr_fix_close(corr_fix *fx);
@@ -219,7 +209,7 @@ void corr_fix_close(corr_fix *fx);
  * runs DDM) and ZoomOut's (in->rhm->zoomout, when RHM may start from the
  * functional map: start fmap, or auto's second run) hold at most
  * vertices - 2 eigenfunctions of either mesh.
- * CORR_OK, or CORR_EPARAMS with the parameter and both meshes named.
+ * KIND_OK, or KIND_EPARAMS with the parameter and both meshes named.
  * corr_run checks it first; the check of a job where it is built (the
  * daemon's of a SUBMIT) calls it too, so such a job is refused before it
  * is queued. */
@@ -247,13 +237,13 @@ int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progres
  * fold_relax of each: on ECTM's maps, which the pipeline returns, not on
  * RHM's, whose folds corr_rhm reads to choose the start and which ECTM
  * moves anyway. rep[0], rep[1]: P's and Q's reports (bad_after and
- * relaxed: after fold_relax when it ran). CORR_OK, or CORR_ENOMEM,
- * CORR_EMESH or CORR_EINTERNAL (corr_from_fold). */
+ * relaxed: after fold_relax when it ran). KIND_OK, or KIND_ENOMEM,
+ * KIND_EMESH or KIND_EINTERNAL (corr_from_fold). */
 int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
                 char *err, size_t errsz);
 
 /* A job's parameters (the wire form of the one list, proto_params.h) as the
- * engine's: checked with proto_params_check (CORR_EPARAMS, "NAME = V: ..."
+ * engine's: checked with proto_params_check (KIND_EPARAMS, "NAME = V: ..."
  * in err), a 0 that means the default left at the default, backend
  * "NAME[:DEVICE]" split into p->backend and p->device, threads into both.
  * p and r start from their _init defaults (log_eps stays ECTM's). */
@@ -284,8 +274,8 @@ typedef struct corr_coarse {
 /* Whether corr_run takes the coarse path for in. */
 int corr_coarse_wanted(const corr_input *in);
 /* Decimates in's meshes into c (c->in: the coarse pair's input, checked
- * with corr_validate). CORR_OK, CORR_ENOMEM, CORR_ENUMERIC or CORR_EINTERNAL
- * (the decimation), CORR_EMESH (a copy corr_validate refuses); on failure
+ * with corr_validate). KIND_OK, KIND_ENOMEM, KIND_ENUMERIC or KIND_EINTERNAL
+ * (the decimation), KIND_EMESH (a copy corr_validate refuses); on failure
  * c holds nothing. corr_run runs a job whose decimation fails other than
  * for memory on its meshes as given. */
 int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t errsz);
@@ -311,7 +301,7 @@ double corr_cost_bytes(const corr_input *in, const ectm_params *p, char *what, s
  * Meshes in pieces that in->L pairs one to one (no given map) run pair by
  * pair, each pair's share of the progress by its vertices, and the maps
  * are joined (corr__pieces.h); pieces the landmarks do not pair are
- * CORR_EMESH.
+ * KIND_EMESH.
  * When the chain ends before ECTM, out->P and out->Q are the last stage's
  * maps (RHM's repaired maps; DDM's denoised P, and Q when Q0 was given and
  * the model is bijective) and out->Y, out->Yt, out->last stay empty.

@@ -11,9 +11,9 @@ typedef int (*corr__ddm_report_fn)(void *ctx, const corr_ddm_report *r);
  * or min(CORR_DDM_K, nv - 2) when 0): ddm_denoise with k1 = k2 = k.
  * *P, *Q (NULL when Q0 is): new maps the caller frees. report (may be
  * NULL) hears the start (done 0) and each direction; a non-zero return
- * cancels. CORR_OK, CORR_EPARAMS (bijective without Q0),
- * CORR_ENUMERIC (the Laplacian's factorisation or the eigen-solver
- * failed), CORR_EMESH, CORR_ENOMEM, CORR_ECANCELLED; detail in err. */
+ * cancels. KIND_OK, KIND_EPARAMS (bijective without Q0),
+ * KIND_ENUMERIC (the Laplacian's factorisation or the eigen-solver
+ * failed), KIND_EMESH, KIND_ENOMEM, KIND_ECANCELLED; detail in err. */
 int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_report_fn report,
               void *ctx, bmap **P, bmap **Q, char *err, size_t errsz);
 

@@ -22,11 +22,11 @@ typedef struct corr__pieces {
 
 /* Splits in into its pairs. n = 0 (nothing else done) when neither mesh
  * is in more than one piece, or when in has no landmarks or has a given
- * map (then corr_run's check refuses pieces as before). CORR_EMESH when a
- * piece is left unpaired (naming the counts), CORR_ENOMEM. */
+ * map (then corr_run's check refuses pieces as before). KIND_EMESH when a
+ * piece is left unpaired (naming the counts), KIND_ENOMEM. */
 int corr__pieces_open(const corr_input *in, corr__pieces *pc, char *err, size_t errsz);
 /* The pairs' results (res[k] for pair k) as one result on in's meshes;
- * last: the last pair's report. CORR_ENOMEM. */
+ * last: the last pair's report. KIND_ENOMEM. */
 int corr__pieces_join(const corr_input *in, const corr__pieces *pc, const ectm_result *res,
                       ectm_result *out, char *err, size_t errsz);
 void corr__pieces_close(corr__pieces *pc);

@@ -29,37 +29,37 @@ int corr_chain_check(corr_chain s, int have_map, int have_reverse, int nlandmark
 {
     unsigned run = corr_chain_run(s, have_map);
     if (!run)
-        return errbuf_set(err, errsz, CORR_EPARAMS, "stages value %d is not one of the list", (int)s);
+        return errbuf_set(err, errsz, KIND_EPARAMS, "stages value %d is not one of the list", (int)s);
     if (ddm_mode != CORR_DDM_PLAIN && ddm_mode != CORR_DDM_BIJECTIVE && ddm_mode != CORR_DDM_AUTO)
-        return errbuf_set(err, errsz, CORR_EPARAMS, "ddm_mode value %d is not one of the list",
+        return errbuf_set(err, errsz, KIND_EPARAMS, "ddm_mode value %d is not one of the list",
                           (int)ddm_mode);
     if (have_reverse && !have_map)
-        return errbuf_set(err, errsz, CORR_EMAP, "an initial reverse map needs an initial map");
+        return errbuf_set(err, errsz, KIND_EMAP, "an initial reverse map needs an initial map");
     if (have_reverse && injective)
-        return errbuf_set(err, errsz, CORR_EPARAMS, "an initial reverse map needs the bijective model");
+        return errbuf_set(err, errsz, KIND_EPARAMS, "an initial reverse map needs the bijective model");
     if ((run & CORR_RUN_DDM) && !have_map)
-        return errbuf_set(err, errsz, CORR_EPARAMS,
+        return errbuf_set(err, errsz, KIND_EPARAMS,
                           "the DDM stage denoises a given map: it needs an initial map");
     if ((run & CORR_RUN_DDM) && ddm_mode == CORR_DDM_BIJECTIVE && !have_reverse)
-        return errbuf_set(err, errsz, CORR_EPARAMS,
+        return errbuf_set(err, errsz, KIND_EPARAMS,
                           "bijective DDM (ddm_mode bijective) denoises a map and its reverse "
                           "together: it needs an initial reverse map too");
     if (!have_map) {
         if (!(run & CORR_RUN_RHM))
-            return errbuf_set(err, errsz, CORR_EPARAMS, "the ECTM stage alone needs an initial map");
+            return errbuf_set(err, errsz, KIND_EPARAMS, "the ECTM stage alone needs an initial map");
         if (nlandmarks == 0)
-            return errbuf_set(err, errsz, CORR_ELANDMARKS,
+            return errbuf_set(err, errsz, KIND_ELANDMARKS,
                               "neither an initial map nor landmarks were given");
         if (nlandmarks < PROTO_MIN_LANDMARKS)
-            return errbuf_set(err, errsz, CORR_ELANDMARKS,
+            return errbuf_set(err, errsz, KIND_ELANDMARKS,
                               "RHM from landmarks needs at least %d landmark pairs, got %d",
                               PROTO_MIN_LANDMARKS, nlandmarks);
     }
     if ((run & CORR_RUN_RHM) && have_map && rhm_landmark_weight > 0 && nlandmarks == 0)
-        return errbuf_set(err, errsz, CORR_EPARAMS,
+        return errbuf_set(err, errsz, KIND_EPARAMS,
                           "RHM's weak landmark term (rhm_landmark_weight %g) needs landmarks",
                           rhm_landmark_weight);
-    return CORR_OK;
+    return KIND_OK;
 }
 
 static const char *const stage_word[3] = {"ddm", "rhm", "ectm"};   /* the order they run in */

@@ -31,7 +31,7 @@ static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, i
 {
     memcpy(clmk, lmk, sizeof(int) * (size_t)n);
     if (m->nv <= 2L * nc)
-        return CORR_OK;
+        return KIND_OK;
     char why[512];
     int *fine = NULL;
     int rc = ctf_decimate(m, nc, lmk, n, out, &fine, why, sizeof why);
@@ -40,7 +40,7 @@ static int coarse_side(const mesh *m, const char *name, const int *lmk, int n, i
     int *at = malloc(sizeof(int) * (size_t)m->nv);
     if (!at) {
         free(fine);
-        return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     }
     for (int c = 0; c < (*out)->nv; c++)
         at[fine[c]] = c;
@@ -58,7 +58,7 @@ int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t err
     c->lsrc = malloc(sizeof(int) * ((size_t)L->n + 1));
     c->ltgt = malloc(sizeof(int) * ((size_t)L->n + 1));
     if (!c->lsrc || !c->ltgt)
-        return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     int rc, nc = coarse_size(in);
     if ((rc = coarse_side(in->S, in->S_name, L->src, L->n, nc, &c->S, c->lsrc, err, errsz)) ||
         (rc = coarse_side(in->T, in->T_name, L->tgt, L->n, nc, &c->T, c->ltgt, err, errsz))) {
@@ -70,7 +70,7 @@ int corr_coarse_open(const corr_input *in, corr_coarse *c, char *err, size_t err
     c->in.S = c->S ? c->S : in->S;
     c->in.T = c->T ? c->T : in->T;
     c->in.L = &c->L;
-    return CORR_OK;
+    return KIND_OK;
 }
 
 int corr_coarse_carry(const corr_input *in, const corr_coarse *c, const bmap *Pc,

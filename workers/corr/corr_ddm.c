@@ -31,7 +31,7 @@ static int basis_open(basis *bs, const mesh *m, const char *name, int k, char *e
     if (rc)
         return errbuf_set(err, errsz, corr_from_lbo(rc),
                           "DDM: %s: %d eigenpairs: %s", name, k, detail);
-    return CORR_OK;
+    return KIND_OK;
 }
 
 static void basis_close(basis *bs)
@@ -52,13 +52,13 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
     if (in->ddm_mode == CORR_DDM_AUTO) {      /* bijective only for a pair that agrees */
         double st = NAN, ts = NAN;
         if (Q0 && (metric_round_trip(T, S, Q0, P0, &st) || metric_round_trip(S, T, P0, Q0, &ts)))
-            return errbuf_set(err, errsz, CORR_ENOMEM, "DDM: out of memory");
+            return errbuf_set(err, errsz, KIND_ENOMEM, "DDM: out of memory");
         r.round_trip = Q0 ? (st > ts ? st : ts) : NAN;
         r.mode = Q0 && r.round_trip <= CORR_DDM_AUTO_ROUND_TRIP ? CORR_DDM_BIJECTIVE
                                                                  : CORR_DDM_PLAIN;
     }
     if (report && report(ctx, &r))
-        return errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled before DDM");
+        return errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled before DDM");
     basis bs[2];
     memset(bs, 0, sizeof bs);
     int rc;
@@ -69,12 +69,12 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
         char detail[512] = "";
         double energy[DDM_BIJ_ITERATIONS_DEFAULT + 1];
         if (!Q0) {
-            rc = errbuf_set(err, errsz, CORR_EPARAMS,
+            rc = errbuf_set(err, errsz, KIND_EPARAMS,
                             "bijective DDM (ddm_mode bijective) needs an initial reverse map");
             goto out;
         }
         if (!(*P = bmap_new(P0->n, P0->nt)) || !(*Q = bmap_new(Q0->n, Q0->nt))) {
-            rc = errbuf_set(err, errsz, CORR_ENOMEM, "DDM: out of memory");
+            rc = errbuf_set(err, errsz, KIND_ENOMEM, "DDM: out of memory");
             goto out;
         }
         int drc = ddm_denoise_bijective(&bs[0].b, geod_solver_mass(bs[0].s), S, &bs[1].b,
@@ -89,7 +89,7 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
         r.done = 2;
         r.cost[0] = r.cost[1] = energy[DDM_BIJ_ITERATIONS_DEFAULT] / 2;
         rc = report && report(ctx, &r)
-                 ? errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled in DDM") : CORR_OK;
+                 ? errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled in DDM") : KIND_OK;
         goto out;
     }
     const bmap *in_map[2] = {P0, Q0};
@@ -100,7 +100,7 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
         char detail[512] = "";
         ddm_stats st;
         if (!(*out_map[d] = bmap_new(in_map[d]->n, in_map[d]->nt))) {
-            rc = errbuf_set(err, errsz, CORR_ENOMEM, "DDM: out of memory");
+            rc = errbuf_set(err, errsz, KIND_ENOMEM, "DDM: out of memory");
             goto out;
         }
         int drc = ddm_denoise(&a->b, geod_solver_mass(a->s), &b->b, to, in_map[d], k, k,
@@ -113,11 +113,11 @@ int corr__ddm(const corr_input *in, const bmap *P0, const bmap *Q0, corr__ddm_re
         r.done = d + 1;
         r.cost[d] = st.cost;
         if (report && report(ctx, &r)) {
-            rc = errbuf_set(err, errsz, CORR_ECANCELLED, "cancelled in DDM");
+            rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled in DDM");
             goto out;
         }
     }
-    rc = CORR_OK;
+    rc = KIND_OK;
 out:
     basis_close(&bs[0]);
     basis_close(&bs[1]);

@@ -28,7 +28,7 @@ static int usable(const mesh *m, const char *name, char *err, size_t errsz)
 {
     mesh_check_report rep;
     if (mesh_check_run(m, &rep, err, errsz)) {
-        errbuf_set(err, errsz, CORR_ENOMEM, "%s: out of memory checking the mesh", name);
+        errbuf_set(err, errsz, KIND_ENOMEM, "%s: out of memory checking the mesh", name);
         return -1;
     }
     return mesh_check_usable(&rep);
@@ -46,12 +46,12 @@ static int repair_one(const mesh *u, const char *name, const unsigned char *keep
     mesh_check_report rep;
     char lines[2048];
     if (mesh_check_run(r->m, &rep, lines, sizeof lines))
-        return errbuf_set(err, errsz, CORR_ENOMEM, "%s: out of memory checking the repair", name);
+        return errbuf_set(err, errsz, KIND_ENOMEM, "%s: out of memory checking the repair", name);
     rep.components = rep.components > 1 ? 1 : rep.components;
     if (mesh_check_usable(&rep))
-        return CORR_OK;
+        return KIND_OK;
     mesh_check_problems(&rep, name, lines, sizeof lines);
-    return errbuf_set(err, errsz, CORR_EMESH, "%s: still not usable after the repair:\n%s", name,
+    return errbuf_set(err, errsz, KIND_EMESH, "%s: still not usable after the repair:\n%s", name,
                       lines);
 }
 
@@ -74,7 +74,7 @@ static int choose_pieces(const corr_input *user, unsigned char **ks, unsigned ch
     int *ps = malloc(sizeof(int) * ((size_t)n + 1)), *pt = malloc(sizeof(int) * ((size_t)n + 1));
     int *pair = malloc(sizeof(int) * ((size_t)a.npieces + 1));
     if (!ps || !pt || !pair) {
-        rc = errbuf_set(err, errsz, CORR_ENOMEM, "out of memory pairing the meshes' pieces");
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory pairing the meshes' pieces");
         goto out;
     }
     if (a.npieces < 2 && b.npieces < 2)
@@ -86,7 +86,7 @@ static int choose_pieces(const corr_input *user, unsigned char **ks, unsigned ch
     }
     int pairs = repair_pieces_pair(ps, pt, n, a.npieces, b.npieces, PROTO_MIN_LANDMARKS, pair);
     if (pairs < 0) {
-        rc = errbuf_set(err, errsz, CORR_ENOMEM, "out of memory pairing the meshes' pieces");
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory pairing the meshes' pieces");
         goto out;
     }
     if (pairs == 0)
@@ -94,7 +94,7 @@ static int choose_pieces(const corr_input *user, unsigned char **ks, unsigned ch
     if (!(*ks = calloc((size_t)a.npieces, 1)) || !(*kt = calloc((size_t)b.npieces, 1))) {
         free(*ks);
         *ks = NULL;
-        rc = errbuf_set(err, errsz, CORR_ENOMEM, "out of memory pairing the meshes' pieces");
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory pairing the meshes' pieces");
         goto out;
     }
     for (int p = 0; p < a.npieces; p++)
@@ -118,9 +118,9 @@ int corr_fix_open(const corr_input *user, int repair, corr_fix *fx, corr_input *
     *in = *user;
     int us = usable(user->S, user->S_name, err, errsz), ut;
     if (us < 0 || (ut = usable(user->T, user->T_name, err, errsz)) < 0)
-        return CORR_ENOMEM;
+        return KIND_ENOMEM;
     if (us && ut)
-        return CORR_OK;
+        return KIND_OK;
     if (!repair)     /* the refusal names every problem of the first bad mesh */
         return us ? corr_validate(user->T, user->T_name, err, errsz)
                   : corr_validate(user->S, user->S_name, err, errsz);
@@ -143,7 +143,7 @@ int corr_fix_open(const corr_input *user, int repair, corr_fix *fx, corr_input *
         int n = user->L->n;
         if (!(fx->L.src = malloc(sizeof(int) * (size_t)n)) ||
             !(fx->L.tgt = malloc(sizeof(int) * (size_t)n))) {
-            rc = errbuf_set(err, errsz, CORR_ENOMEM, "landmarks: out of memory");
+            rc = errbuf_set(err, errsz, KIND_ENOMEM, "landmarks: out of memory");
             goto fail;
         }
         fx->L.n = repair_landmarks(&fx->S, &fx->T, user->L->src, user->L->tgt, n, fx->L.src,
@@ -162,7 +162,7 @@ int corr_fix_open(const corr_input *user, int repair, corr_fix *fx, corr_input *
     }
     in->P0 = fx->P0;
     in->Q0 = fx->Q0;
-    return CORR_OK;
+    return KIND_OK;
 fail:
     corr_fix_close(fx);
     *in = *user;

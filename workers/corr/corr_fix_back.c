@@ -18,8 +18,8 @@ int corr_fix_to_user(const corr_fix *fx, const ectm_result *res, ectm_result *ou
         (res->rhm_P && !(out->rhm_P = repair_map_to_user(&fx->S, &fx->T, res->rhm_P))) ||
         (res->rhm_Q && !(out->rhm_Q = repair_map_to_user(&fx->T, &fx->S, res->rhm_Q)))) {
         ectm_result_close(out);
-        return errbuf_set(err, errsz, CORR_ENOMEM, "the result in the mesh's own indexing: out of "
+        return errbuf_set(err, errsz, KIND_ENOMEM, "the result in the mesh's own indexing: out of "
                           "memory");
     }
-    return CORR_OK;
+    return KIND_OK;
 }

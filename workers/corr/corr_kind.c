@@ -21,10 +21,8 @@ int corr_wire_code(int code)
         switch (rc) {                                                                  \
             LIST(CORR_FROM_CASE)                                                       \
         }                                                                              \
-        return CORR_EINTERNAL;                                                         \
+        return KIND_EINTERNAL;                                                         \
     }
-CORR_FROM(rhm, RHM_ERRORS)
-CORR_FROM(ectm, ECTM_ERRORS)
 CORR_FROM(fold, FOLD_ERRORS)
 CORR_FROM(ddm, DDM_ERRORS)
 CORR_FROM(ctf, CTF_ERRORS)

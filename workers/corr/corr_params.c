@@ -22,7 +22,7 @@ int corr_params_from_job(const proto_params *w, int threads, ectm_params *p, rhm
     ectm_params_init(p);
     rhm_params_init(r);
     if (proto_params_check(w, err, errsz))
-        return CORR_EPARAMS;
+        return KIND_EPARAMS;
     /* in range now: counts fit an int; a 0 that means the default keeps it */
 #define CORR_FROM(name, cli, type, dflt, lo, hi, fl, eng, efield, ...)                      \
     CORR_HAS_##eng(if (!(((fl) & PROTO_PARAM_ZERO_DEFAULT) && w->name == 0))               \
@@ -35,7 +35,7 @@ int corr_params_from_job(const proto_params *w, int threads, ectm_params *p, rhm
         snprintf(p->backend, sizeof p->backend, "%.*s", (int)n, w->backend);
         snprintf(p->device, sizeof p->device, "%s", w->backend[n] ? w->backend + n + 1 : "");
     }
-    return CORR_OK;
+    return KIND_OK;
 }
 
 void corr_params_to_job(const ectm_params *p, const rhm_params *r, proto_params *w, char *backend,

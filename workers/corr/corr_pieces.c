@@ -68,9 +68,9 @@ int corr__pieces_open(const corr_input *in, corr__pieces *pc, char *err, size_t 
 {
     memset(pc, 0, sizeof *pc);
     if (!in->L || in->L->n == 0 || in->P0)
-        return CORR_OK;
+        return KIND_OK;
     const mesh *S = in->S, *T = in->T;
-    int n = in->L->n, rc = CORR_OK;
+    int n = in->L->n, rc = KIND_OK;
     int *fs = malloc(sizeof(int) * ((size_t)S->nf + 1)), *ft = malloc(sizeof(int) * ((size_t)T->nf + 1));
     int *vps = malloc(sizeof(int) * ((size_t)S->nv + 1)), *vpt = malloc(sizeof(int) * ((size_t)T->nv + 1));
     int *ls = malloc(sizeof(int) * ((size_t)S->nv + 1)), *lt = malloc(sizeof(int) * ((size_t)T->nv + 1));
@@ -100,7 +100,7 @@ int corr__pieces_open(const corr_input *in, corr__pieces *pc, char *err, size_t 
     if (pairs < 0)
         goto nomem;
     if (pairs != ns || pairs != nt) {
-        rc = errbuf_set(err, errsz, CORR_EMESH,
+        rc = errbuf_set(err, errsz, KIND_EMESH,
                         "%s is in %d pieces and %s in %d; the landmarks pair %d of them (a pair: at "
                         "least %d landmarks on a piece, all landing on one piece of the other mesh)",
                         in->S_name, ns, in->T_name, nt, pairs, PROTO_MIN_LANDMARKS);
@@ -131,7 +131,7 @@ int corr__pieces_open(const corr_input *in, corr__pieces *pc, char *err, size_t 
     }
     goto out;
 nomem:
-    rc = errbuf_set(err, errsz, CORR_ENOMEM, "out of memory splitting the meshes into pieces");
+    rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory splitting the meshes into pieces");
 out:
     if (rc)
         corr__pieces_close(pc);
@@ -174,7 +174,7 @@ int corr__pieces_join(const corr_input *in, const corr__pieces *pc, const ectm_r
         (y && !(out->Y = malloc(sizeof(double) * 3 * (size_t)nS))) ||
         (yt && !(out->Yt = malloc(sizeof(double) * 3 * (size_t)nT)))) {
         ectm_result_close(out);
-        return errbuf_set(err, errsz, CORR_ENOMEM, "out of memory joining the pieces' maps");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory joining the pieces' maps");
     }
     for (int k = 0; k < pc->n; k++) {
         const corr__piece *p = &pc->p[k];
@@ -191,5 +191,5 @@ int corr__pieces_join(const corr_input *in, const corr__pieces *pc, const ectm_r
             put_points(out->Yt, res[k].Yt, p->T->nv, p->tv);
         out->last = res[k].last;
     }
-    return CORR_OK;
+    return KIND_OK;
 }

@@ -9,6 +9,7 @@ extern "C" {
 #endif
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define CTF_ERRORS(X)                                                       \
     X(CTF_OK,       0, "ok", NONE)                                            \
@@ -16,11 +17,7 @@ extern "C" {
     X(CTF_ENOMEM,  -2, "out of memory", NOMEM)                                \
     X(CTF_EFAILED, -3, "decimation or projection failed", NUMERIC)
 
-enum ctf_error {
-#define CTF_ENUM(name, val, msg, kind) name = val,
-    CTF_ERRORS(CTF_ENUM)
-#undef CTF_ENUM
-};
+ERRLIST_ENUM(ctf, CTF_ERRORS);
 
 #define CTF_MAX_NORMAL_TURN 60.0  /* degrees a face's normal may turn per collapse */
 #define CTF_MIN_ASPECT 4.0        /* thinnest face a collapse may make (OpenMesh's ratio) */

@@ -31,17 +31,14 @@
 #include "mesh/mesh.h"
 
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define DDM_ERRORS(X)                                                       \
     X(DDM_OK,      0, "ok", NONE)                                             \
     X(DDM_ENOMEM, -1, "out of memory", NOMEM)                                 \
     X(DDM_EINVAL, -2, "invalid argument", INTERNAL)
 
-enum ddm_error {
-#define DDM_ENUM(name, val, msg, kind) name = val,
-    DDM_ERRORS(DDM_ENUM)
-#undef DDM_ENUM
-};
+ERRLIST_ENUM(ddm, DDM_ERRORS);
 
 typedef struct ddm_stats {
     long long faces_solved;   /* exact face problems solved, all rows */

@@ -31,6 +31,7 @@
 #ifndef DESC_H
 #define DESC_H
 #include "lbo/lbo.h"
+#include "util/errlist.h"
 
 #define DESC_ZERO_REL 1e-8       /* eigenvalues below this share of the largest count as 0 */
 #define DESC_WKS_SIGMA_REL 0.07  /* WKS width: share of the log-eigenvalue range */
@@ -40,11 +41,7 @@
     X(DESC_EINVAL, -1, "invalid argument")                                 \
     X(DESC_ENOMEM, -2, "out of memory")
 
-enum desc_error {
-#define DESC_ENUM(name, val, msg) name = val,
-    DESC_ERRORS(DESC_ENUM)
-#undef DESC_ENUM
-};
+ERRLIST_ENUM(desc, DESC_ERRORS);
 
 /* t: nt default times (ascending); e: ne default energies, *sigma their width. */
 int desc_hks_times(const lbo_basis *b, int nt, double *t);

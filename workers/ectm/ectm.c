@@ -102,22 +102,22 @@ static int side_open(side *s, const mesh *in, int partial, const ener_def_params
     memset(s, 0, sizeof *s);
     s->X = mesh_copy(in);
     if (!s->X)
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory copying the %s mesh", which);
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory copying the %s mesh", which);
     s->frame.scale = 1;
     if (!partial && geo_normalize_area(s->X, &s->frame, detail, sizeof detail))
-        return errbuf_set(err, errsz, ECTM_EMESH, "%s mesh: %s", which, detail);
+        return errbuf_set(err, errsz, KIND_EMESH, "%s mesh: %s", which, detail);
     if (geo_edges_build(s->X, &s->E, detail, sizeof detail))
-        return errbuf_set(err, errsz, ECTM_EMESH, "%s mesh: %s", which, detail);
+        return errbuf_set(err, errsz, KIND_EMESH, "%s mesh: %s", which, detail);
     int erc = ener_backend_new(s->X, &s->E, dp, p->backend, p->device, p->threads, &s->def,
                                detail, sizeof detail);
     if (erc)
-        return errbuf_set(err, errsz, erc == ENER_ENOMEM ? ECTM_ENOMEM
-                                      : erc == ENER_EDEGENERATE || erc == ENER_EINVAL ? ECTM_EMESH
-                                      : ECTM_EBACKEND,
+        return errbuf_set(err, errsz, erc == ENER_ENOMEM ? KIND_ENOMEM
+                                      : erc == ENER_EDEGENERATE || erc == ENER_EINVAL ? KIND_EMESH
+                                      : KIND_EPARAMS,
                           "%s mesh: %s", which, detail);
     s->tree = proj_tree_new(s->X, detail, sizeof detail);
     if (!s->tree)
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "%s mesh: %s", which, detail);
+        return errbuf_set(err, errsz, KIND_ENOMEM, "%s mesh: %s", which, detail);
     size_t n3 = (size_t)s->X->nv * 3;
     s->mass = malloc(sizeof(double) * ((size_t)s->X->nv + 1));
     s->Y = malloc(sizeof(double) * (n3 + 1));
@@ -130,11 +130,11 @@ static int side_open(side *s, const mesh *in, int partial, const ener_def_params
     opt_params_init(&op);
     s->mem = opt_memory_new((int)n3, op.memory);
     if (!s->mass || !s->Y || !s->PX || !s->PY || !s->tr_start || !s->Zq || !s->mass3 || !s->mem)
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory for the %s mesh", which);
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory for the %s mesh", which);
     geo_vertex_areas(s->X, s->mass);
     for (size_t i = 0; i < n3; i++)
         s->mass3[i] = s->mass[i / 3];
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 /* Rebuilds a's transpose of b's map (b->P maps b's vertices onto a's faces). */
@@ -146,7 +146,7 @@ static int side_transpose(side *a, const side *b)
         a->tr_w = malloc(sizeof(double) * ((size_t)rows * 3 + 1));
         a->resid = malloc(sizeof(double) * ((size_t)rows * 3 + 1));
         if (!a->tr_row || !a->tr_w || !a->resid)
-            return ECTM_ENOMEM;
+            return KIND_ENOMEM;
     }
     memset(a->tr_start, 0, sizeof(int) * ((size_t)n + 2));
     for (int j = 0; j < rows; j++)
@@ -161,7 +161,7 @@ static int side_transpose(side *a, const side *b)
             a->tr_row[at] = j;
             a->tr_w[at] = b->P->w[3 * j + k];
         }
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 /* The Y-step energy of side a given the other side b:
@@ -255,31 +255,31 @@ static int check_landmarks(const ectm_landmarks *L, const mesh *S, const mesh *T
                            size_t errsz)
 {
     if (!L || L->n == 0)
-        return ECTM_OK;
+        return KIND_OK;
     if (L->n < 0)
-        return errbuf_set(err, errsz, ECTM_EPARAM, "landmarks.n = %d < 0", L->n);
+        return errbuf_set(err, errsz, KIND_EPARAMS, "landmarks.n = %d < 0", L->n);
     if (!L->src || !L->tgt)
-        return errbuf_set(err, errsz, ECTM_EPARAM, "landmarks.%s is NULL with landmarks.n = %d",
+        return errbuf_set(err, errsz, KIND_EPARAMS, "landmarks.%s is NULL with landmarks.n = %d",
                           L->src ? "tgt" : "src", L->n);
     for (int k = 0; k < L->n; k++) {
         if (L->src[k] < 0 || L->src[k] >= S->nv)
-            return errbuf_set(err, errsz, ECTM_EPARAM,
+            return errbuf_set(err, errsz, KIND_EPARAMS,
                               "landmarks.src[%d] = %d out of range [0, %d) (source vertices)", k,
                               L->src[k], S->nv);
         if (L->tgt[k] < 0 || L->tgt[k] >= T->nv)
-            return errbuf_set(err, errsz, ECTM_EPARAM,
+            return errbuf_set(err, errsz, KIND_EPARAMS,
                               "landmarks.tgt[%d] = %d out of range [0, %d) (target vertices)", k,
                               L->tgt[k], T->nv);
     }
     int *first = malloc(sizeof(int) * (size_t)S->nv);   /* each source vertex's first pair */
     if (!first)
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory checking the landmarks");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory checking the landmarks");
     for (int v = 0; v < S->nv; v++)
         first[v] = -1;
-    int rc = ECTM_OK;
+    int rc = KIND_OK;
     for (int k = 0; k < L->n && !rc; k++) {
         if (first[L->src[k]] >= 0)
-            rc = errbuf_set(err, errsz, ECTM_EPARAM, "landmarks.src[%d] = %d repeats landmarks.src[%d]",
+            rc = errbuf_set(err, errsz, KIND_EPARAMS, "landmarks.src[%d] = %d repeats landmarks.src[%d]",
                             k, L->src[k], first[L->src[k]]);
         first[L->src[k]] = k;
     }
@@ -292,13 +292,13 @@ static int check_landmarks(const ectm_landmarks *L, const mesh *S, const mesh *T
 static int side_pins(side *a, const side *b, const int *rows, const int *vtx, int n)
 {
     if (n <= 0)
-        return ECTM_OK;
+        return KIND_OK;
     a->pin_row = malloc(sizeof(int) * (size_t)n);
     a->pin_vtx = malloc(sizeof(int) * (size_t)n);
     char *taken = calloc((size_t)a->X->nv, 1);
     if (!a->pin_row || !a->pin_vtx || !taken) {
         free(taken);
-        return ECTM_ENOMEM;
+        return KIND_ENOMEM;
     }
     const int *vf = b->E.vf_start;
     for (int k = 0; k < n; k++) {
@@ -309,7 +309,7 @@ static int side_pins(side *a, const side *b, const int *rows, const int *vtx, in
         a->pin_vtx[a->npin++] = vtx[k];
     }
     free(taken);
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 /* Sets a's pinned rows of P onto their vertices of b's mesh, in every P-step:
@@ -397,16 +397,16 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
     a->mem_beta = beta;
     int rc = opt_minimize(n3, a->Y, ystep_eval, ystep_iter, &st, &op, a->mem, &os);
     if (rc == OPT_ENOMEM)
-        return ECTM_ENOMEM;
+        return KIND_ENOMEM;
     if (rc == OPT_ENONFINITE)
-        return ECTM_ENUMERIC;
+        return KIND_ENUMERIC;
     /* Terms at the returned Y: the last evaluation's, unless that was a
      * rejected trial point (an admissible set that changed without changing
      * its count is not evaluated again, here as within the solve), which saves
      * an evaluation per Y-step. */
     double f = os.last_at_x ? os.f : ystep_eval(&st, a->Y, scratch, n3);
     if (!isfinite(f))
-        return ECTM_ENUMERIC;
+        return KIND_ENUMERIC;
     terms->w_mem = st.w_mem;
     terms->w_bnd = st.w_bnd;
     terms->mismatch = st.mismatch;
@@ -415,7 +415,7 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
     terms->evaluations = os.evaluations;
     terms->admissible_edges = st.admissible;
     terms->energy = f;
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 /* Builds Q by nearest neighbour: each vertex of b goes to the closest point of
@@ -425,26 +425,26 @@ static int reverse_by_nearest(side *a, side *b, char *err, size_t errsz)
     mesh img = { a->X->nv, a->X->nf, a->PX, a->X->f };
     proj_tree *t = proj_tree_new(&img, err, errsz);
     if (!t)
-        return ECTM_ENOMEM;
+        return KIND_ENOMEM;
     for (int j = 0; j < b->X->nv; j++)
         b->P->face[j] = -1;
     int rc = proj_closest(t, 3, img.v, 1.0, b->X->nv, b->X->v, b->P->face, b->P->w, NULL);
     proj_tree_free(t);
-    return rc ? ECTM_EPARAM : ECTM_OK;
+    return rc ? KIND_EPARAMS : KIND_OK;
 }
 
 static int check_map(const bmap *P, const mesh *from, const mesh *to, const char *name,
                      char *err, size_t errsz)
 {
     if (P->n != from->nv || P->nt != to->nv)
-        return errbuf_set(err, errsz, ECTM_EMAP,
+        return errbuf_set(err, errsz, KIND_EMAP,
                           "%s is sized %d -> %d vertices, the meshes have %d -> %d",
                           name, P->n, P->nt, from->nv, to->nv);
     for (int i = 0; i < P->n; i++)
         if (P->face[i] < 0 || P->face[i] >= to->nf)
-            return errbuf_set(err, errsz, ECTM_EMAP, "%s row %d: face %d out of range [0, %d)",
+            return errbuf_set(err, errsz, KIND_EMAP, "%s row %d: face %d out of range [0, %d)",
                               name, i, P->face[i], to->nf);
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 static void total_energy(const pair *pr, ectm_report *r)
@@ -466,8 +466,8 @@ static double *unscaled(const double *Y, int nv, const geo_scaling *f)
 }
 
 /* The sides' maps from the start P0 (and Q0, or the reverse by nearest
- * point when bijective), their pins and Y ← P X̃ (Ỹ ← Q X). ECTM_OK,
- * ECTM_ENOMEM or reverse_by_nearest's code. */
+ * point when bijective), their pins and Y ← P X̃ (Ỹ ← Q X). KIND_OK,
+ * KIND_ENOMEM or reverse_by_nearest's code. */
 static int pair_start(pair *pr, const bmap *P0, const bmap *Q0, const ectm_landmarks *L,
                       char *err, size_t errsz)
 {
@@ -478,17 +478,17 @@ static int pair_start(pair *pr, const bmap *P0, const bmap *Q0, const ectm_landm
     a->P = bmap_new(a->X->nv, b->X->nv);
     b->P = bmap_new(b->X->nv, a->X->nv);
     if (!a->Zt || !b->Zt || !a->P || !b->P)
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     if (L && L->n > 0 &&
         (side_pins(a, b, L->src, L->tgt, L->n) ||
          (pr->bijective && side_pins(b, a, L->tgt, L->src, L->n))))
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     memcpy(a->P->face, P0->face, sizeof(int) * (size_t)a->X->nv);
     memcpy(a->P->w, P0->w, sizeof(double) * 3 * (size_t)a->X->nv);
     bmap_apply(a->P, b->X->f, b->X->v, 3, a->PX);
     memcpy(a->Y, a->PX, sizeof(double) * 3 * (size_t)a->X->nv);   /* Y ← P X̃ */
     if (!pr->bijective)
-        return ECTM_OK;
+        return KIND_OK;
     if (Q0) {
         memcpy(b->P->face, Q0->face, sizeof(int) * (size_t)b->X->nv);
         memcpy(b->P->w, Q0->w, sizeof(double) * 3 * (size_t)b->X->nv);
@@ -498,12 +498,12 @@ static int pair_start(pair *pr, const bmap *P0, const bmap *Q0, const ectm_landm
     bmap_apply(b->P, a->X->f, a->X->v, 3, b->PX);
     memcpy(b->Y, b->PX, sizeof(double) * 3 * (size_t)b->X->nv);   /* Ỹ ← Q X */
     if (side_transpose(a, b) || side_transpose(b, a))
-        return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
-    return ECTM_OK;
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
+    return KIND_OK;
 }
 
 /* Outer iteration k at β = beta (scaled): per direction the P-step then
- * the Y-step, then the energies into r. ECTM_OK or the failing step's
+ * the Y-step, then the energies into r. KIND_OK or the failing step's
  * code, named in err. */
 static int outer_iteration(pair *pr, int k, double beta, ectm_report *r, double *scratch,
                            char *err, size_t errsz)
@@ -516,18 +516,20 @@ static int outer_iteration(pair *pr, int k, double beta, ectm_report *r, double 
         double tp = now();
         pstep(u, v, beta, p->gamma, pr->bijective);
         if (pr->bijective && side_transpose(v, u))
-            return errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+            return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
         double ts = now();
         r->t_project += ts - tp;
         int rc = solve_y(pr, dir, beta, &r->dir[dir], scratch);
         r->t_solve += now() - ts;
         const char *be = ener_backend_error(u->def);
         if (rc && be)
-            rc = ECTM_EBACKEND;
+            rc = KIND_EPARAMS;
         if (rc)
             return errbuf_set(err, errsz, rc, "%s in the %s Y-step at outer iteration %d%s%s",
-                              ectm_strerror(rc), dir ? "target" : "source", k, be ? ": " : "",
-                              be ? be : "");
+                              be                      ? "energy backend failed"
+                              : rc == KIND_ENUMERIC ? "non-finite energy"
+                                                    : proto_kind_text(-rc),
+                              dir ? "target" : "source", k, be ? ": " : "", be ? be : "");
     }
     if (pr->bijective) {
         /* The source's γ term changed with the new Q: report it current. */
@@ -537,7 +539,7 @@ static int outer_iteration(pair *pr, int k, double beta, ectm_report *r, double 
         r->dir[0].reverse = st0.reverse;
     }
     total_energy(pr, r);
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
@@ -579,7 +581,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
     side *a = &pr.s[0], *b = &pr.s[1];
     int nmax = a->X->nv > b->X->nv ? a->X->nv : b->X->nv;
     if (!(scratch = malloc(sizeof(double) * ((size_t)nmax * 3 + 1)))) {
-        rc = errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
         goto done;
     }
     if ((rc = pair_start(&pr, P0, Q0, L, err, errsz)))
@@ -598,11 +600,11 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         r.elapsed = now() - t0;
         out->last = r;
         if (!isfinite(r.energy)) {
-            rc = errbuf_set(err, errsz, ECTM_ENUMERIC, "energy is not finite at outer iteration %d", k);
+            rc = errbuf_set(err, errsz, KIND_ENUMERIC, "energy is not finite at outer iteration %d", k);
             goto done;
         }
         if (progress && progress(ctx, &r)) {
-            rc = errbuf_set(err, errsz, ECTM_ECANCELED, "cancelled at outer iteration %d", k);
+            rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled at outer iteration %d", k);
             goto done;
         }
         if (p->stop_change > 0 && beta == prev_beta &&
@@ -611,7 +613,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         prev_energy = r.energy;
         prev_beta = beta;
     }
-    rc = ECTM_OK;
+    rc = KIND_OK;
     out->Y = unscaled(a->Y, a->X->nv, &b->frame);
     if (pr.bijective)
         out->Yt = unscaled(b->Y, b->X->nv, &a->frame);
@@ -623,7 +625,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
     }
     if (!out->Y || (pr.bijective && !out->Yt)) {
         ectm_result_close(out);
-        rc = errbuf_set(err, errsz, ECTM_ENOMEM, "out of memory");
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     }
 done:
     side_close(&pr.s[0]);

@@ -23,23 +23,7 @@
 #include <stddef.h>
 #include "mesh/mesh.h"
 #include "map/bmap.h"
-
-#define ECTM_ERRORS(X)                                                          \
-    X(ECTM_OK,          0, "ok", NONE)                                        \
-    X(ECTM_EPARAM,     -1, "invalid parameter", PARAMS)                       \
-    X(ECTM_EMESH,      -2, "mesh not usable by the optimizer", MESH)          \
-    X(ECTM_EMAP,       -3, "initial map does not fit the meshes", MAP)        \
-    X(ECTM_ENOMEM,     -4, "out of memory", NOMEM)                            \
-    X(ECTM_ECANCELED,  -5, "cancelled", CANCELLED)                            \
-    X(ECTM_ENUMERIC,   -6, "numerical failure (non-finite energy)", NUMERIC)  \
-    X(ECTM_EBACKEND,   -7, "energy backend unavailable or failed", PARAMS)
-
-enum ectm_error {
-#define ECTM_ENUM(name, val, msg, kind) name = val,
-    ECTM_ERRORS(ECTM_ENUM)
-#undef ECTM_ENUM
-};
-const char *ectm_strerror(int code);
+#include "util/kind.h"
 
 typedef enum ectm_model { ECTM_BIJECTIVE = 0, ECTM_INJECTIVE = 1 } ectm_model;
 
@@ -72,7 +56,7 @@ void ectm_params_init(ectm_params *p);
 /* The values the paper's text gives: α = 20, η = 1e-3, β 1e3 → 2e5 over
  * 200 iterations, γ = 2e4 (twice the released code's β and γ). */
 void ectm_params_paper(ectm_params *p);
-/* 0 or ECTM_EPARAM with the offending field named in err (the job
+/* 0 or KIND_EPARAMS with the offending field named in err (the job
  * parameters by proto_param_check: "alpha = 0: out of range (0, inf)"). */
 int ectm_params_check(const ectm_params *p, char *err, size_t errsz);
 /* β at outer iteration k (1-based). */
@@ -128,7 +112,7 @@ typedef struct ectm_landmarks {
 /* Runs the optimisation. P0 is required; Q0 may be NULL (bijective: then it
  * is built by nearest neighbour — each target vertex goes to the closest
  * point of the source's image P0·X̃). L: the landmarks to pin, or NULL (as
- * L->n = 0: none); a bad one is refused with ECTM_EPARAM before anything
+ * L->n = 0: none); a bad one is refused with KIND_EPARAMS before anything
  * runs, the pair and field named in err ("landmarks.src[3] = 9999 out of
  * range [0, 6938)"). The meshes must be manifold with no degenerate faces
  * (validate with mesh_check first). */

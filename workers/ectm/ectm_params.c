@@ -1,7 +1,7 @@
 /* ectm_params.c — ECTM's parameters (the defaults and ranges of the job
- * parameter list, the paper's values, checks, the β schedule) and error
- * strings. Apart from ectm.c so that what only checks a job's parameters
- * (the daemon's validator) links without the optimisation. */
+ * parameter list, the paper's values, checks, the β schedule). Apart from ectm.c so that
+ * what only checks a job's parameters (the daemon's validator) links
+ * without the optimisation. */
 #include "ectm/ectm.h"
 #include "ener/ener_def.h"
 #include "proto.h"
@@ -9,16 +9,6 @@
 
 #include <math.h>
 #include <string.h>
-
-const char *ectm_strerror(int code)
-{
-    switch (code) {
-#define ECTM_STR(name, val, msg, kind) case name: return msg;
-        ECTM_ERRORS(ECTM_STR)
-#undef ECTM_STR
-    }
-    return "unknown ECTM error";
-}
 
 /* The job parameters' defaults and ranges are the rows of PROTO_PARAMS
  * (proto_params.h) whose ENGINE column is ECTM; the rest is ECTM's own. */
@@ -51,12 +41,12 @@ int ectm_params_check(const ectm_params *p, char *err, size_t errsz)
 {
 #define ECTM_CHECK(name, cli, type, dflt, lo, hi, fl, eng, efield, ...)                      \
     ECTM_ROW_##eng(if (proto_param_check(PROTO_P_##name, (double)p->efield, err, errsz)) \
-                       return ECTM_EPARAM;)
+                       return KIND_EPARAMS;)
     PROTO_PARAMS(ECTM_CHECK)
 #undef ECTM_CHECK
 #define NEED(cond, field, what)                                                     \
     if (!(cond))                                                                    \
-        return errbuf_set(err, errsz, ECTM_EPARAM, "parameter %s must be %s", field, what)
+        return errbuf_set(err, errsz, KIND_EPARAMS, "parameter %s must be %s", field, what)
     NEED(isfinite(p->log_eps) && p->log_eps > 0 && p->log_eps < 1, "log-eps", "in (0, 1)");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");
     NEED(memchr(p->backend, 0, sizeof p->backend) &&
@@ -64,7 +54,7 @@ int ectm_params_check(const ectm_params *p, char *err, size_t errsz)
           !strcmp(p->backend, "auto")), "backend", "cpu, opencl or auto");
     NEED(memchr(p->device, 0, sizeof p->device), "device", "shorter than 128 bytes");
 #undef NEED
-    return ECTM_OK;
+    return KIND_OK;
 }
 
 double ectm_beta(const ectm_params *p, int k)

@@ -24,6 +24,7 @@
 #include "geod/geod.h"
 
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define EMBED_DIM_DEFAULT 8
 #define EMBED_MAX_DIM 64
@@ -42,11 +43,7 @@
     X(EMBED_EEIGEN,       -5, "eigen-solver failed")                       \
     X(EMBED_ESOLVE,       -6, "sparse solve failed")
 
-enum embed_error {
-#define EMBED_ENUM(name, val, msg) name = val,
-    EMBED_ERRORS(EMBED_ENUM)
-#undef EMBED_ENUM
-};
+ERRLIST_ENUM(embed, EMBED_ERRORS);
 
 /* stress = sqrt(sum (d_emb - d_geo)^2 / sum d_geo^2); corr = Pearson
  * correlation of d_emb with d_geo. */

@@ -53,11 +53,7 @@ struct ener_def {
 
 const char *ener_strerror(int code)
 {
-    switch (code) {
-#define ENER_MSG(name, val, msg) case name: return msg;
-        ENER_ERRORS(ENER_MSG)
-#undef ENER_MSG
-    }
+    switch (code) { ENER_ERRORS(ERRLIST_CASE) }
     return "unknown error";
 }
 

@@ -31,6 +31,7 @@
 #include <stddef.h>
 #include "mesh/mesh.h"
 #include "geo/geo_edges.h"
+#include "util/errlist.h"
 
 #define ENER_LOG_EPS_DEFAULT 1e-20
 
@@ -43,11 +44,7 @@
     X(ENER_EBUILD,     -5, "OpenCL kernel build failed")                   \
     X(ENER_EDEVICE,    -6, "OpenCL device error")
 
-enum ener_error {
-#define ENER_ENUM(name, val, msg) name = val,
-    ENER_ERRORS(ENER_ENUM)
-#undef ENER_ENUM
-};
+ERRLIST_ENUM(ener, ENER_ERRORS);
 const char *ener_strerror(int code);
 
 typedef struct ener_def_params {

@@ -47,6 +47,7 @@
 #include "mesh/mesh.h"
 
 #include <stddef.h>
+#include "util/errlist.h"
 
 /* Weight of the Laplacian term, chosen on FAUST and TOSCA pairs
  * (docs/decisions.md, "Functional map weights"). */
@@ -59,11 +60,7 @@
     X(FMAP_EINVAL, -2, "invalid argument")                                  \
     X(FMAP_ESOLVE, -3, "least-squares system singular")
 
-enum fmap_error {
-#define FMAP_ENUM(name, val, msg) name = val,
-    FMAP_ERRORS(FMAP_ENUM)
-#undef FMAP_ENUM
-};
+ERRLIST_ENUM(fmap, FMAP_ERRORS);
 
 /* F1: n1 by nd, F2: n2 by nd (corresponding columns), m1, m2 the lumped
  * masses; C: k1 by k2. */

@@ -78,6 +78,7 @@
 #include <stddef.h>
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define FOLD_ERRORS(X)                                                       \
     X(FOLD_OK,      0, "ok", NONE)                                            \
@@ -85,11 +86,7 @@
     X(FOLD_ENOMEM, -2, "out of memory", NOMEM)                                \
     X(FOLD_EMESH,  -3, "a mesh is not manifold (its edge table failed)", MESH)
 
-enum fold_error {
-#define FOLD_ENUM(name, val, msg, kind) name = val,
-    FOLD_ERRORS(FOLD_ENUM)
-#undef FOLD_ENUM
-};
+ERRLIST_ENUM(fold, FOLD_ERRORS);
 const char *fold_strerror(int code);
 
 typedef struct fold_params {

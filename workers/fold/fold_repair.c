@@ -15,11 +15,7 @@
 
 const char *fold_strerror(int code)
 {
-    switch (code) {
-#define FOLD_STR(name, val, msg, kind) case name: return msg;
-        FOLD_ERRORS(FOLD_STR)
-#undef FOLD_STR
-    }
+    switch (code) { FOLD_ERRORS(ERRLIST_CASE) }
     return "unknown fold repair error";
 }
 

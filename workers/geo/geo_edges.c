@@ -9,11 +9,7 @@
 
 const char *geo_strerror(int code)
 {
-    switch (code) {
-#define GEO_STR(name, val, msg) case name: return msg;
-        GEO_ERRORS(GEO_STR)
-#undef GEO_STR
-    }
+    switch (code) { GEO_ERRORS(ERRLIST_CASE) }
     return "unknown geometry error";
 }
 

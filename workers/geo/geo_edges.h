@@ -12,6 +12,7 @@
 #ifndef GEO_EDGES_H
 #define GEO_EDGES_H
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define GEO_ERRORS(X)                                                      \
     X(GEO_OK,            0, "ok")                                          \
@@ -20,11 +21,7 @@
     X(GEO_EDEGENERATE,  -3, "degenerate geometry")                     \
     X(GEO_EMISMATCH,    -4, "edge table built from another mesh")
 
-enum geo_error {
-#define GEO_ENUM(name, val, msg) name = val,
-    GEO_ERRORS(GEO_ENUM)
-#undef GEO_ENUM
-};
+ERRLIST_ENUM(geo, GEO_ERRORS);
 const char *geo_strerror(int code);
 
 typedef struct geo_edges {

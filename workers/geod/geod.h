@@ -46,6 +46,7 @@
 #include "mesh/mesh.h"
 
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define GEOD_T_FACTOR_DEFAULT 1.0  /* t = 1 * h^2, the paper's choice */
 #define GEOD_POISSON_REG 1e-10     /* relative regularisation of L, see above */
@@ -58,11 +59,7 @@
     X(GEOD_EMESH,      -3, "mesh unusable for geodesics", MESH)               \
     X(GEOD_EFACTOR,    -4, "sparse factorisation or solve failed", NUMERIC)
 
-enum geod_error {
-#define GEOD_ENUM(name, val, msg, kind) name = val,
-    GEOD_ERRORS(GEOD_ENUM)
-#undef GEOD_ENUM
-};
+ERRLIST_ENUM(geod, GEOD_ERRORS);
 const char *geod_strerror(int code);
 
 typedef struct geod_solver geod_solver;

@@ -16,11 +16,7 @@
 
 const char *geod_strerror(int code)
 {
-    switch (code) {
-#define GEOD_STR(name, val, msg, kind) case name: return msg;
-        GEOD_ERRORS(GEOD_STR)
-#undef GEOD_STR
-    }
+    switch (code) { GEOD_ERRORS(ERRLIST_CASE) }
     return "unknown geodesic error";
 }
 

@@ -33,6 +33,7 @@
 #include "geo/geo_csr.h"
 
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define LBO_MAX_K 300           /* eigenpairs at most */
 #define LBO_SHIFT_REL (-1e-6)   /* sigma relative to mean(L_ii) / mean(M_ii) */
@@ -46,11 +47,7 @@
     X(LBO_EARPACK,  -4, "ARPACK failed", NUMERIC)                             \
     X(LBO_ENOCONV,  -5, "eigenpairs did not converge", NUMERIC)
 
-enum lbo_error {
-#define LBO_ENUM(name, val, msg, kind) name = val,
-    LBO_ERRORS(LBO_ENUM)
-#undef LBO_ENUM
-};
+ERRLIST_ENUM(lbo, LBO_ERRORS);
 
 typedef struct lbo_basis {
     int nv, k;

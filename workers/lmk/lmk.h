@@ -34,6 +34,7 @@
 #define LMK_H
 #include <stddef.h>
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #include "proto_params.h"   /* PROTO_MIN_LANDMARKS, PROTO_MAX_LANDMARKS: the one rule */
 
@@ -53,11 +54,7 @@
     X(LMK_ELAYOUT,  -7, "the file is not in a layout this reader takes", LANDMARKS) \
     X(LMK_EBASE,    -8, "the file's positions contradict the index base", LANDMARKS)
 
-enum lmk_error {
-#define LMK_ENUM(name, val, msg, kind) name = val,
-    LMK_ERRORS(LMK_ENUM)
-#undef LMK_ENUM
-};
+ERRLIST_ENUM(lmk, LMK_ERRORS);
 
 typedef struct lmk_set {
     int n;      /* number of pairs */

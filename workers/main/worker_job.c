@@ -46,13 +46,13 @@ static int fix_meshes(wrk_job *job, char *err, size_t errsz)
 static int check_inputs(const proto_submit *s, char *err, size_t errsz)
 {
     if (s->p.n == 0 && s->nlandmarks == 0)
-        return errbuf_set(err, errsz, corr_wire_code(CORR_ELANDMARKS),
+        return errbuf_set(err, errsz, corr_wire_code(KIND_ELANDMARKS),
                           "landmarks: none, and no initial map p: need one or at least %d pairs",
                           PROTO_MIN_LANDMARKS);
     if (s->q.n && !s->p.n)
-        return errbuf_set(err, errsz, corr_wire_code(CORR_EMAP), "initial map q without p");
+        return errbuf_set(err, errsz, corr_wire_code(KIND_EMAP), "initial map q without p");
     if (s->q.n && s->params.model == PROTO_MODEL_INJECTIVE)
-        return errbuf_set(err, errsz, corr_wire_code(CORR_EPARAMS),
+        return errbuf_set(err, errsz, corr_wire_code(KIND_EPARAMS),
                           "initial map q needs the bijective model");
     return 0;
 }
@@ -127,7 +127,7 @@ int wrk_map_of(const proto_map *w, const char *name, const mesh *from, const mes
     if (w->n == 0)
         return 0;
     if (w->n != (uint32_t)from->nv)
-        return errbuf_set(err, errsz, corr_wire_code(CORR_EMAP),
+        return errbuf_set(err, errsz, corr_wire_code(KIND_EMAP),
                           "%s has %u rows, its mesh has %d vertices", name, w->n, from->nv);
     bmap *P = bmap_new(from->nv, to->nv);
     if (!P)
@@ -140,7 +140,7 @@ int wrk_map_of(const proto_map *w, const char *name, const mesh *from, const mes
             snprintf(where, sizeof where, "%s: row %d", name, i);
             bmap_check_row(w->rows[i].face, wt, to->nf, where, err, errsz);
             bmap_free(P);
-            return corr_wire_code(CORR_EMAP);
+            return corr_wire_code(KIND_EMAP);
         }
         P->face[i] = (int)w->rows[i].face;
     }

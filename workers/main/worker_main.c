@@ -230,12 +230,12 @@ static int run_job(const worker_opts *o, double t0)
     corr_input in;
     wrk_job_input(&job, &in);
     if (cancel_requested)
-        rc = CORR_ECANCELLED;
+        rc = KIND_ECANCELLED;
     else
         rc = corr_run(&in, &job.params, on_progress, &ctx, &res, err, sizeof err);
-    if (rc == CORR_OK && cancel_requested)
-        rc = CORR_ECANCELLED;                 /* SIGTERM during the last iteration */
-    if (rc == CORR_ECANCELLED)
+    if (rc == KIND_OK && cancel_requested)
+        rc = KIND_ECANCELLED;                 /* SIGTERM during the last iteration */
+    if (rc == KIND_ECANCELLED)
         snprintf(err, sizeof err, "cancelled by SIGTERM after %d of %d outer iterations",
                  ctx.last_outer, job.params.iterations);
     if (rc) {

@@ -15,6 +15,7 @@
 #define BMAP_H
 #include <stddef.h>
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define BMAP_WEIGHT_TOL 1e-4   /* |sum - 1| and -w allowed when reading */
 
@@ -27,11 +28,7 @@
     X(BMAP_EWEIGHT,  -5, "weights negative or not summing to 1", MAP)         \
     X(BMAP_ENOMEM,   -6, "out of memory", NOMEM)
 
-enum bmap_error {
-#define BMAP_ENUM(name, val, msg, kind) name = val,
-    BMAP_ERRORS(BMAP_ENUM)
-#undef BMAP_ENUM
-};
+ERRLIST_ENUM(bmap, BMAP_ERRORS);
 
 typedef struct bmap {
     int n;       /* rows: source vertices */

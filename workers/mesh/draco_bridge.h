@@ -17,6 +17,7 @@
 #ifndef DRACO_BRIDGE_H
 #define DRACO_BRIDGE_H
 #include <stddef.h>
+#include "util/errlist.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -31,11 +32,7 @@ extern "C" {
     X(DRACOB_EENCODE, -5, "Draco encoding failed")                        \
     X(DRACOB_ENOMEM,  -6, "out of memory")
 
-enum dracob_error {
-#define DRACOB_ENUM(name, val, msg) name = val,
-    DRACOB_ERRORS(DRACOB_ENUM)
-#undef DRACOB_ENUM
-};
+ERRLIST_ENUM(dracob, DRACOB_ERRORS);
 
 /* Largest buffer dracob_decode accepts, checked before Draco sees it. */
 #define DRACOB_MAX_BUFFER_BYTES (1LL << 30)

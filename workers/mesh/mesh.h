@@ -16,6 +16,7 @@
 #ifndef MESH_H
 #define MESH_H
 #include <stddef.h>
+#include "util/errlist.h"
 
 /* Limits on input sizes, checked before any allocation. */
 #define MESH_MAX_VERTICES 20000000
@@ -32,11 +33,7 @@
     X(MESH_EDRACO,  -6, "Draco error", MESH)                                  \
     X(MESH_EINVAL,  -7, "invalid mesh data", MESH)
 
-enum mesh_error {
-#define MESH_ENUM(name, val, msg, kind) name = val,
-    MESH_ERRORS(MESH_ENUM)
-#undef MESH_ENUM
-};
+ERRLIST_ENUM(mesh, MESH_ERRORS);
 
 typedef struct mesh {
     int nv;      /* number of vertices */

@@ -19,17 +19,14 @@
 #include "mesh/mesh.h"
 
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define METRIC_ERRORS(X)                                                    \
     X(METRIC_OK,      0, "ok")                                              \
     X(METRIC_ENOMEM, -1, "out of memory")                                   \
     X(METRIC_EMESH,  -2, "a mesh is not usable for this measure (not manifold)")
 
-enum metric_error {
-#define METRIC_ENUM(name, val, msg) name = val,
-    METRIC_ERRORS(METRIC_ENUM)
-#undef METRIC_ENUM
-};
+ERRLIST_ENUM(metric, METRIC_ERRORS);
 
 /* logratio: nf values. src_area, img_area_total: total areas used for the
  * unit-area normalisation of source and image (the target's total area). */

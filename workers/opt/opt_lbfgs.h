@@ -14,6 +14,7 @@
  * admissible edge set): f and g are evaluated again there, the pairs kept. */
 #ifndef OPT_LBFGS_H
 #define OPT_LBFGS_H
+#include "util/errlist.h"
 
 #define OPT_ERRORS(X)                                                         \
     X(OPT_OK,          0, "ok")                                               \
@@ -22,11 +23,7 @@
     X(OPT_EPARAM,     -3, "invalid solver parameter")                         \
     X(OPT_ENONFINITE, -4, "energy or gradient is not finite")
 
-enum opt_error {
-#define OPT_ENUM(name, val, msg) name = val,
-    OPT_ERRORS(OPT_ENUM)
-#undef OPT_ENUM
-};
+ERRLIST_ENUM(opt, OPT_ERRORS);
 
 #define OPT_ITER_GO       0
 #define OPT_ITER_CHANGED  1

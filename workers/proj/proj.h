@@ -26,6 +26,7 @@
 #define PROJ_H
 #include <stddef.h>
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define PROJ_ERRORS(X)                                                      \
     X(PROJ_OK,      0, "ok")                                                \
@@ -35,11 +36,7 @@
     X(PROJ_EEMBREE,-4, "Embree error")                                      \
     X(PROJ_ENOMEM, -5, "out of memory")
 
-enum proj_error {
-#define PROJ_ENUM(name, val, msg) name = val,
-    PROJ_ERRORS(PROJ_ENUM)
-#undef PROJ_ENUM
-};
+ERRLIST_ENUM(proj, PROJ_ERRORS);
 
 #define PROJ_HD_MIN_DIM 8
 

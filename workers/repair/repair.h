@@ -36,6 +36,7 @@
 #include <stddef.h>
 #include "map/bmap.h"
 #include "mesh/mesh.h"
+#include "util/errlist.h"
 
 #define REPAIR_ERRORS(X)                                                 \
     X(REPAIR_OK,      0, "ok", NONE)                                     \
@@ -43,11 +44,7 @@
     X(REPAIR_ENOMEM, -2, "out of memory", NOMEM)                         \
     X(REPAIR_EMAP,   -3, "a given map lands where the repair removed faces", MAP)
 
-enum repair_error {
-#define REPAIR_ENUM(name, val, msg, kind) name = val,
-    REPAIR_ERRORS(REPAIR_ENUM)
-#undef REPAIR_ENUM
-};
+ERRLIST_ENUM(repair, REPAIR_ERRORS);
 
 /* The counts of one mesh's repair: X(member, text for a person). The one
  * list: the struct, the result's record (metric keys "repair.source.NAME",

@@ -45,22 +45,7 @@
 #include "lmk/lmk.h"
 #include "map/bmap.h"
 #include "mesh/mesh.h"
-
-#define RHM_ERRORS(X)                                                           \
-    X(RHM_OK,         0, "ok", NONE)                                          \
-    X(RHM_EPARAM,    -1, "invalid parameter", PARAMS)                         \
-    X(RHM_EMESH,     -2, "mesh not usable (geodesics or embedding failed)", MESH) \
-    X(RHM_ELANDMARKS, -3, "landmarks do not fit the meshes", LANDMARKS)       \
-    X(RHM_ENOMEM,    -4, "out of memory", NOMEM)                              \
-    X(RHM_ECANCELED, -5, "cancelled", CANCELLED)                              \
-    X(RHM_ENUMERIC,  -6, "numerical failure (factorisation or projection)", NUMERIC) \
-    X(RHM_EMAP,      -7, "a given map does not fit the meshes", MAP)
-
-enum rhm_error {
-#define RHM_ENUM(name, val, msg, kind) name = val,
-    RHM_ERRORS(RHM_ENUM)
-#undef RHM_ENUM
-};
+#include "util/kind.h"
 
 typedef enum rhm_start {
     RHM_START_DISTANCES = 0,   /* projection on distances to the landmarks  */
@@ -112,7 +97,7 @@ typedef struct rhm_params {
  * start: auto (ours, see above); anchor RHM_ANCHOR_WEIGHT on RHM_ANCHORS
  * (given maps only). */
 void rhm_params_init(rhm_params *p);
-/* 0 or RHM_EPARAM with the offending field named in err. */
+/* 0 or KIND_EPARAMS with the offending field named in err. */
 int rhm_params_check(const rhm_params *p, char *err, size_t errsz);
 double rhm_beta(const rhm_params *p, int k);
 
@@ -162,7 +147,7 @@ typedef struct rhm_side {
     bmap *P;               /* to fill: side i -> side 1 − i                 */
 } rhm_side;
 
-/* Fills side[0].P (P12) and side[1].P (P21) for the parameters p; RHM_OK
+/* Fills side[0].P (P12) and side[1].P (P21) for the parameters p; KIND_OK
  * or an RHM_* error with its detail in err. */
 typedef int (*rhm_start_fn)(const rhm_params *p, rhm_side side[2], char *err, size_t errsz);
 
@@ -170,8 +155,8 @@ typedef int (*rhm_start_fn)(const rhm_params *p, rhm_side side[2], char *err, si
  * at least PROTO_MIN_LANDMARKS): the set-up, the start maps by start (the
  * start module's start_maps from p->start: start_run), X_ij = P_ij X_j,
  * then the iterations. The meshes must be validated (manifold,
- * connected, no degenerate face). Errors: RHM_EPARAM, RHM_ELANDMARKS,
- * RHM_EMESH, RHM_ENOMEM, RHM_ECANCELED, RHM_ENUMERIC, or start's; detail
+ * connected, no degenerate face). Errors: KIND_EPARAMS, KIND_ELANDMARKS,
+ * KIND_EMESH, KIND_ENOMEM, KIND_ECANCELLED, KIND_ENUMERIC, or start's; detail
  * in err. out->start is -1 (start_run sets it). */
 int rhm_run_start(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,
                   rhm_start_fn start, rhm_progress_fn progress, void *ctx, rhm_result *out,
@@ -188,7 +173,7 @@ int rhm_run_start(const mesh *S, const mesh *T, const lmk_set *L, const rhm_para
  * the iterations of rhm_run_start. L may be NULL or hold any number of pairs:
  * landmarks serve only the weak landmark term, so p->gamma > 0 needs at
  * least one. p->start is unused. The maps are copied, not kept. Errors as
- * rhm_run_start; RHM_EMAP for maps sized for other meshes or with a face
+ * rhm_run_start; KIND_EMAP for maps sized for other meshes or with a face
  * out of range. */
 int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap *P12,
                       const bmap *P21, const rhm_params *p, rhm_progress_fn progress, void *ctx,

@@ -54,7 +54,7 @@ void rhm__problem_free(rhm__problem *pb);
 /* The anchors of side sd from its current X_ij (rhm_given.c): anchor =
  * X_ij, weight n/k at k farthest points of the embedding X (Euclidean in
  * R^m, the first at vertex 0, ties to the lower vertex), or 1 at every
- * vertex when k is 0 or at least n. RHM_OK or RHM_ENOMEM. */
+ * vertex when k is 0 or at least n. KIND_OK or KIND_ENOMEM. */
 int rhm__anchors_set(rhm__problem *pb, rhm__side *sd, int k);
 
 /* The loop (rhm_run.c) from the current state, maps and X_ij set: reports

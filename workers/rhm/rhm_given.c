@@ -14,13 +14,13 @@ static int check_map(const bmap *P, const mesh *from, const mesh *to, const char
                      char *err, size_t errsz)
 {
     if (P->n != from->nv || P->nt != to->nv)
-        return errbuf_set(err, errsz, RHM_EMAP, "RHM: %s is %d by %d, the meshes have %d and %d "
+        return errbuf_set(err, errsz, KIND_EMAP, "RHM: %s is %d by %d, the meshes have %d and %d "
                           "vertices", name, P->n, P->nt, from->nv, to->nv);
     for (int i = 0; i < P->n; i++)
         if (P->face[i] < 0 || P->face[i] >= to->nf)
-            return errbuf_set(err, errsz, RHM_EMAP, "RHM: %s row %d: face %d of %d", name, i,
+            return errbuf_set(err, errsz, KIND_EMAP, "RHM: %s row %d: face %d of %d", name, i,
                               P->face[i], to->nf);
-    return RHM_OK;
+    return KIND_OK;
 }
 
 static void copy_map(bmap *dst, const bmap *src)
@@ -38,7 +38,7 @@ static int reverse_by_nearest(rhm__problem *pb)
     int m = pb->dim;
     int *vf = malloc(sizeof(int) * ((size_t)a->n + 1));
     if (!vf)
-        return RHM_ENOMEM;
+        return KIND_ENOMEM;
     for (int q = 3 * a->m->nf - 1; q >= 0; q--)
         vf[a->m->f[q]] = q;
 #pragma omp parallel for schedule(static)
@@ -61,7 +61,7 @@ static int reverse_by_nearest(rhm__problem *pb)
             b->P->w[3 * (size_t)v + c] = c == vf[arg] % 3;
     }
     free(vf);
-    return RHM_OK;
+    return KIND_OK;
 }
 
 int rhm__anchors_set(rhm__problem *pb, rhm__side *sd, int k)
@@ -72,13 +72,13 @@ int rhm__anchors_set(rhm__problem *pb, rhm__side *sd, int k)
     double *d = k > 0 ? malloc(sizeof(double) * (size_t)n) : NULL;
     if (!sd->anchor || !sd->anchor_w || (k > 0 && !d)) {
         free(d);
-        return RHM_ENOMEM;
+        return KIND_ENOMEM;
     }
     memcpy(sd->anchor, sd->Xij, sizeof(double) * (size_t)n * m);
     if (k <= 0 || k >= n) {
         for (int l = 0; l < n; l++)
             sd->anchor_w[l] = 1;
-        return RHM_OK;
+        return KIND_OK;
     }
     for (int l = 0; l < n; l++)
         d[l] = DBL_MAX;
@@ -100,7 +100,7 @@ int rhm__anchors_set(rhm__problem *pb, rhm__side *sd, int k)
         v = next;
     }
     free(d);
-    return RHM_OK;
+    return KIND_OK;
 }
 
 int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap *P12,
@@ -112,12 +112,12 @@ int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap
     double t0 = rhm__now();
     int rc;
     if (!P12)
-        return errbuf_set(err, errsz, RHM_EMAP, "RHM from given maps: no map");
+        return errbuf_set(err, errsz, KIND_EMAP, "RHM from given maps: no map");
     if ((rc = check_map(P12, S, T, "the given map", err, errsz)) ||
         (P21 && (rc = check_map(P21, T, S, "the given reverse map", err, errsz))))
         return rc;
     if (p->gamma > 0 && (!L || L->n == 0))
-        return errbuf_set(err, errsz, RHM_EPARAM, "RHM's weak landmark term (landmark weight %g) "
+        return errbuf_set(err, errsz, KIND_EPARAMS, "RHM's weak landmark term (landmark weight %g) "
                           "needs landmarks", p->gamma);
     if (p->threads > 0)
         omp_set_num_threads(p->threads);
@@ -128,7 +128,7 @@ int rhm_run_from_maps(const mesh *S, const mesh *T, const lmk_set *L, const bmap
     a->P = bmap_new(a->n, b->n);
     b->P = bmap_new(b->n, a->n);
     if (!a->P || !b->P) {
-        rc = errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
         goto out;
     }
     copy_map(a->P, P12);

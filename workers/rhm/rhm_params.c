@@ -36,12 +36,12 @@ int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
 {
 #define RHM_CHECK(name, cli, type, dflt, lo, hi, fl, eng, efield, ...)                      \
     RHM_ROW_##eng(if (proto_param_check(PROTO_P_##name, (double)p->efield, err, errsz)) \
-                      return RHM_EPARAM;)
+                      return KIND_EPARAMS;)
     PROTO_PARAMS(RHM_CHECK)
 #undef RHM_CHECK
 #define NEED(cond, field, what)                                                     \
     if (!(cond))                                                                    \
-        return errbuf_set(err, errsz, RHM_EPARAM, "RHM parameter %s must be %s", field, what)
+        return errbuf_set(err, errsz, KIND_EPARAMS, "RHM parameter %s must be %s", field, what)
     NEED(isfinite(p->beta_step) && p->beta_step > 0, "beta-step", "a finite number > 0");
     NEED(p->beta_ramp >= 1, "beta-ramp", "an integer >= 1");
     NEED(p->min_iterations >= 1, "min-iterations", "an integer >= 1");
@@ -50,7 +50,7 @@ int rhm_params_check(const rhm_params *p, char *err, size_t errsz)
     NEED(p->anchors >= 0, "anchors", "an integer >= 0");
     NEED(p->threads >= 0 && p->threads <= 1024, "threads", "an integer in [0, 1024]");
 #undef NEED
-    return RHM_OK;
+    return KIND_OK;
 }
 
 double rhm_beta(const rhm_params *p, int k)

@@ -55,10 +55,10 @@ static int x_step_matrix(rhm__side *sd, const char *name, char *err, size_t errs
                                              sizeof detail)) == CHOL_OK)
         rc = chol_analyse(sd->A, detail, sizeof detail);
     if (rc == CHOL_OK)
-        return RHM_OK;
+        return KIND_OK;
     if (rc == CHOL_ENOMEM)
-        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
-    return errbuf_set(err, errsz, RHM_ENUMERIC, "%s: the X-step matrix: %s", name, detail);
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
+    return errbuf_set(err, errsz, KIND_ENUMERIC, "%s: the X-step matrix: %s", name, detail);
 }
 
 static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char *name,
@@ -74,27 +74,27 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
     sd->X = malloc(sizeof(double) * (size_t)m->nv * (size_t)pb->dim);
     sd->Xij = malloc(sizeof(double) * (size_t)m->nv * (size_t)pb->dim);
     if (!sd->mass || !sd->X || !sd->Xij)
-        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     geo_vertex_areas(m, sd->mass);
     if ((rc = geod_solver_new(m, 0, &sd->geod, detail, sizeof detail)))
-        return errbuf_set(err, errsz, rc == GEOD_ENOMEM ? RHM_ENOMEM : RHM_EMESH, "%s: geodesics: %s",
+        return errbuf_set(err, errsz, rc == GEOD_ENOMEM ? KIND_ENOMEM : KIND_EMESH, "%s: geodesics: %s",
                           name, detail);
     if (m->nv <= pb->dim)
-        return errbuf_set(err, errsz, RHM_EMESH, "%s: %d vertices are too few for a %d-D embedding",
+        return errbuf_set(err, errsz, KIND_EMESH, "%s: %d vertices are too few for a %d-D embedding",
                           name, m->nv, pb->dim);
     if ((rc = embed_lmds(sd->geod, pb->dim, 0, 0, sd->X, NULL, detail, sizeof detail)))
-        return errbuf_set(err, errsz, rc == EMBED_ENOMEM ? RHM_ENOMEM : RHM_EMESH,
+        return errbuf_set(err, errsz, rc == EMBED_ENOMEM ? KIND_ENOMEM : KIND_EMESH,
                           "%s: embedding: %s", name, detail);
     if ((rc = geo_edges_build(m, &e, detail, sizeof detail)) ||
         (rc = geo_cotan_laplacian(m, &e, &sd->W, detail, sizeof detail))) {
         geo_edges_close(&e);
-        return errbuf_set(err, errsz, RHM_EMESH, "%s: Laplacian: %s", name, detail);
+        return errbuf_set(err, errsz, KIND_EMESH, "%s: Laplacian: %s", name, detail);
     }
     geo_edges_close(&e);
     /* the tree: M's connectivity, positions = the embedding's first three columns */
     mesh *emb = mesh_new(m->nv, m->nf);
     if (!emb)
-        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     for (int v = 0; v < m->nv; v++)
         memcpy(emb->v + 3 * v, sd->X + (size_t)v * pb->dim, 3 * sizeof(double));
     memcpy(emb->f, m->f, sizeof(int) * 3 * (size_t)m->nf);
@@ -102,7 +102,7 @@ static int side_build(rhm__problem *pb, rhm__side *sd, const mesh *m, const char
     int nomem = errno == ENOMEM;
     mesh_free(emb);
     if (!sd->tree)
-        return errbuf_set(err, errsz, nomem ? RHM_ENOMEM : RHM_ENUMERIC,
+        return errbuf_set(err, errsz, nomem ? KIND_ENOMEM : KIND_ENUMERIC,
                           "%s: projection tree: %s", name, detail);
     return x_step_matrix(sd, name, err, errsz);
 }
@@ -120,23 +120,23 @@ static int problem_new(const mesh *S, const mesh *T, const lmk_set *L, int min_l
     if (!L)
         L = &none;
     if (L->n < min_landmarks)
-        return errbuf_set(err, errsz, RHM_ELANDMARKS, "RHM needs at least %d landmark pairs, got %d",
+        return errbuf_set(err, errsz, KIND_ELANDMARKS, "RHM needs at least %d landmark pairs, got %d",
                           min_landmarks, L->n);
     for (int r = 0; r < L->n; r++) {
         if (L->src[r] < 0 || L->src[r] >= S->nv || L->tgt[r] < 0 || L->tgt[r] >= T->nv)
-            return errbuf_set(err, errsz, RHM_ELANDMARKS, "landmark %d (%d, %d) out of range",
+            return errbuf_set(err, errsz, KIND_ELANDMARKS, "landmark %d (%d, %d) out of range",
                               r + 1, L->src[r], L->tgt[r]);
     }
     rhm__problem *pb = calloc(1, sizeof *pb);
     if (!pb)
-        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     pb->p = *p;
     pb->dim = p->dim;
     pb->nl = L->n;
     for (int i = 0; i < 2; i++) {
         const int *src = i ? L->tgt : L->src;
         if (!(pb->side[i].lmk = malloc(sizeof(int) * ((size_t)L->n + 1)))) {
-            rc = errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+            rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
             goto fail;
         }
         if (L->n)
@@ -145,7 +145,7 @@ static int problem_new(const mesh *S, const mesh *T, const lmk_set *L, int min_l
             goto fail;
     }
     *out = pb;
-    return RHM_OK;
+    return KIND_OK;
 fail:
     rhm__problem_free(pb);
     return rc;

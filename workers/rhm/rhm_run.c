@@ -31,7 +31,7 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
     r.energy = rhm__energy(pb, r.beta, r.dir);
     r.t_setup = r.elapsed = rhm__now() - t0;
     if (progress && progress(ctx, &r))
-        return errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled after the initial map");
+        return errbuf_set(err, errsz, KIND_ECANCELLED, "RHM cancelled after the initial map");
     for (int k = 1; k <= p->iterations; k++) {
         double prev = r.energy, beta = rhm_beta(p, k);
         int rc;
@@ -53,9 +53,9 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
         r.energy = rhm__energy(pb, beta, r.dir);
         r.elapsed = rhm__now() - t0;
         if (!isfinite(r.energy))
-            return errbuf_set(err, errsz, RHM_ENUMERIC, "RHM iteration %d: energy is not finite", k);
+            return errbuf_set(err, errsz, KIND_ENUMERIC, "RHM iteration %d: energy is not finite", k);
         if (progress && progress(ctx, &r))
-            return errbuf_set(err, errsz, RHM_ECANCELED, "RHM cancelled at iteration %d", k);
+            return errbuf_set(err, errsz, KIND_ECANCELLED, "RHM cancelled at iteration %d", k);
         if (k >= p->min_iterations && fabs(r.energy - prev) < p->stop_change * prev)
             break;
     }
@@ -63,7 +63,7 @@ int rhm__iterate(rhm__problem *pb, double t0, rhm_progress_fn progress, void *ct
     out->P12 = pb->side[0].P;
     out->P21 = pb->side[1].P;
     pb->side[0].P = pb->side[1].P = NULL;
-    return RHM_OK;
+    return KIND_OK;
 }
 
 int rhm__start(rhm__problem *pb, rhm_start_fn start, char *err, size_t errsz)
@@ -74,7 +74,7 @@ int rhm__start(rhm__problem *pb, rhm_start_fn start, char *err, size_t errsz)
     a->P = bmap_new(a->n, b->n);
     b->P = bmap_new(b->n, a->n);
     if (!a->P || !b->P)
-        return errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+        return errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
     rhm_side view[2];
     for (int i = 0; i < 2; i++) {
         const rhm__side *sd = &pb->side[i];
@@ -86,7 +86,7 @@ int rhm__start(rhm__problem *pb, rhm_start_fn start, char *err, size_t errsz)
         return rc;
     bmap_apply(a->P, b->m->f, b->X, pb->dim, a->Xij);
     bmap_apply(b->P, a->m->f, a->X, pb->dim, b->Xij);
-    return RHM_OK;
+    return KIND_OK;
 }
 
 int rhm_run_start(const mesh *S, const mesh *T, const lmk_set *L, const rhm_params *p,

@@ -66,7 +66,7 @@ int rhm__step_p(rhm__problem *pb, int i, double beta, char *why, size_t whysz)
     double *Q = malloc(sizeof(double) * (size_t)a->n * d);
     mesh *emb = NULL;
     proj_tree *tmp = NULL;
-    int rc = RHM_ENOMEM;
+    int rc = KIND_ENOMEM;
     if (!Z || !Q)
         goto out;
     double s;
@@ -80,12 +80,12 @@ int rhm__step_p(rhm__problem *pb, int i, double beta, char *why, size_t whysz)
                 emb->v[3 * v + c] = Z[(size_t)v * d + c] / s;
         memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
         if (!(tmp = proj_tree_new(emb, why, whysz))) {
-            rc = errno == ENOMEM ? RHM_ENOMEM : RHM_ENUMERIC;
+            rc = errno == ENOMEM ? KIND_ENOMEM : KIND_ENUMERIC;
             goto out;
         }
         tree = tmp;
     }
-    rc = proj_closest(tree, d, Z, s, a->n, Q, a->P->face, a->P->w, NULL) ? RHM_ENUMERIC : RHM_OK;
+    rc = proj_closest(tree, d, Z, s, a->n, Q, a->P->face, a->P->w, NULL) ? KIND_ENUMERIC : KIND_OK;
 out:
     proj_tree_free(tmp);
     mesh_free(emb);
@@ -149,7 +149,7 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
     /* right-hand side, column-major n by m */
     double *bx = calloc((size_t)n * m, sizeof *bx);   /* then the solution */
     double *PX = malloc(sizeof(double) * (size_t)n * m);
-    int rc = RHM_ENOMEM;
+    int rc = KIND_ENOMEM;
     if (!bx || !PX)
         goto out;
     for (int l = 0; l < b->n; l++) {
@@ -172,14 +172,14 @@ int rhm__step_x(rhm__problem *pb, int i, double beta)
         for (int l = 0; l < n; l++)
             for (int c = 0; c < m && a->anchor_w[l] > 0; c++)
                 bx[(size_t)c * n + l] += cA * a->mass[l] * a->anchor_w[l] * a->anchor[(size_t)l * m + c];
-    rc = RHM_ENUMERIC;
+    rc = KIND_ENUMERIC;
     if (chol_factorise(a->A, NULL, 0) != CHOL_OK || chol_solve(a->A, bx, m, bx, NULL, 0) != CHOL_OK)
         goto out;
     const double *sx = bx;
     for (int l = 0; l < n; l++)
         for (int c = 0; c < m; c++)
             a->Xij[(size_t)l * m + c] = sx[(size_t)c * n + l];
-    rc = RHM_OK;
+    rc = KIND_OK;
 out:
     free(bx);
     free(PX);

@@ -23,27 +23,27 @@ static double *landmark_description(const rhm_side *a, int nl, int dd, int *rc)
     double *f = malloc(sizeof(double) * (size_t)nl * a->n);
     double *D = malloc(sizeof(double) * (size_t)dd * a->n);
     double *o = malloc(sizeof(double) * (size_t)a->n);
-    *rc = RHM_ENOMEM;
+    *rc = KIND_ENOMEM;
     if (f && D && o) {
         int g = geod_all_pairs_from(a->geod, a->lmk, nl, f);
-        *rc = g == GEOD_OK ? RHM_OK : g == GEOD_ENOMEM ? RHM_ENOMEM : RHM_EMESH;
+        *rc = g == GEOD_OK ? KIND_OK : g == GEOD_ENOMEM ? KIND_ENOMEM : KIND_EMESH;
     }
-    if (*rc == RHM_OK) {
+    if (*rc == KIND_OK) {
         double sc = 1 / sqrt(a->area);
         for (int v = 0; v < a->n; v++)
             for (int r = 0; r < nl; r++)
                 D[(size_t)v * dd + r] = sc * f[(size_t)r * a->n + v];
-        for (int r = 0; nl + r < dd && *rc == RHM_OK; r++) {
+        for (int r = 0; nl + r < dd && *rc == KIND_OK; r++) {
             if (geo_gradient_sine(a->m, f + (size_t)r * a->n, 1,
                                   f + (size_t)((r + 1) % nl) * a->n, 1, o)) {
-                *rc = RHM_ENOMEM;
+                *rc = KIND_ENOMEM;
                 break;
             }
             for (int v = 0; v < a->n; v++)
                 D[(size_t)v * dd + nl + r] = START_ORIENT_WEIGHT * o[v];
         }
     }
-    if (*rc != RHM_OK) {
+    if (*rc != KIND_OK) {
         free(D);
         D = NULL;
     }
@@ -67,7 +67,7 @@ static int principal_frame(double *D[2], const int n[2], int dd)
     double *C = calloc((size_t)dd * dd, sizeof *C), *mu = calloc((size_t)dd, sizeof *mu);
     double *w = malloc(sizeof(double) * (size_t)dd), *V = malloc(sizeof(double) * (size_t)dd * dd);
     double *row = malloc(sizeof(double) * (size_t)dd);
-    int rc = RHM_ENOMEM;
+    int rc = KIND_ENOMEM;
     if (!C || !mu || !w || !V || !row)
         goto out;
     long total = (long)n[0] + n[1];
@@ -86,7 +86,7 @@ static int principal_frame(double *D[2], const int n[2], int dd)
         for (int b = 0; b < a; b++)
             C[(size_t)a * dd + b] = C[(size_t)b * dd + a];
     if (embed_top_eigenpairs(C, dd, dd, w, V, NULL)) {
-        rc = RHM_ENUMERIC;
+        rc = KIND_ENUMERIC;
         goto out;
     }
     for (int i = 0; i < 2; i++)
@@ -100,7 +100,7 @@ static int principal_frame(double *D[2], const int n[2], int dd)
             }
             memcpy(x, row, sizeof(double) * (size_t)dd);
         }
-    rc = RHM_OK;
+    rc = KIND_OK;
 out:
     free(C);
     free(mu);
@@ -117,33 +117,33 @@ out:
  * guess would not shorten it. */
 int start_distances(rhm_side side[2], char *err, size_t errsz)
 {
-    int nl = side[0].nl, dd = nl + (START_ORIENT_WEIGHT > 0 ? nl : 0), rc = RHM_OK;
+    int nl = side[0].nl, dd = nl + (START_ORIENT_WEIGHT > 0 ? nl : 0), rc = KIND_OK;
     double *D[2] = {NULL, NULL};
-    for (int i = 0; i < 2 && rc == RHM_OK; i++)
+    for (int i = 0; i < 2 && rc == KIND_OK; i++)
         if (!(D[i] = landmark_description(&side[i], nl, dd, &rc)))
             errbuf_set(err, errsz, rc, "%s: distances to the landmarks failed",
                        i ? "target" : "source");
     const int n[2] = { side[0].n, side[1].n };
-    if (rc == RHM_OK && (rc = principal_frame(D, n, dd)))
+    if (rc == KIND_OK && (rc = principal_frame(D, n, dd)))
         errbuf_set(err, errsz, rc, "the start map: the principal axes of the distances failed");
-    for (int i = 0; i < 2 && rc == RHM_OK; i++) {
+    for (int i = 0; i < 2 && rc == KIND_OK; i++) {
         rhm_side *a = &side[i], *b = &side[1 - i];
         mesh *emb = mesh_new(b->n, b->m->nf);
         proj_tree *t = NULL;
         char why[256] = "";
-        rc = RHM_ENOMEM;
+        rc = KIND_ENOMEM;
         if (emb) {
             for (int v = 0; v < b->n; v++)
                 memcpy(emb->v + 3 * v, D[1 - i] + (size_t)v * dd, 3 * sizeof(double));
             memcpy(emb->f, b->m->f, sizeof(int) * 3 * (size_t)b->m->nf);
-            rc = (t = proj_tree_new(emb, why, sizeof why)) ? RHM_OK
-                 : errno == ENOMEM                   ? RHM_ENOMEM
-                                                     : RHM_ENUMERIC;
+            rc = (t = proj_tree_new(emb, why, sizeof why)) ? KIND_OK
+                 : errno == ENOMEM                   ? KIND_ENOMEM
+                                                     : KIND_ENUMERIC;
         }
-        for (int v = 0; rc == RHM_OK && v < a->n; v++)
+        for (int v = 0; rc == KIND_OK && v < a->n; v++)
             a->P->face[v] = -1;
-        if (rc == RHM_OK && proj_closest(t, dd, D[1 - i], 1, a->n, D[i], a->P->face, a->P->w, NULL))
-            rc = RHM_ENUMERIC;
+        if (rc == KIND_OK && proj_closest(t, dd, D[1 - i], 1, a->n, D[i], a->P->face, a->P->w, NULL))
+            rc = KIND_ENUMERIC;
         if (rc)
             errbuf_set(err, errsz, rc, "the start map %s: projection failed%s%s",
                        i ? "target -> source" : "source -> target", why[0] ? ": " : "", why);

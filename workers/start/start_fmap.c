@@ -23,13 +23,13 @@ _Static_assert(PROTO_ZOOMOUT_MIN == START_FMAP_K + 1, "ZoomOut grows the fmap st
 int start_fmap(rhm_side side[2], int zoomout, char *err, size_t errsz)
 {
     rhm_side *s = side;
-    int k = START_FMAP_K, rc = RHM_ENOMEM, nl = s[0].nl, kz = zoomout;
+    int k = START_FMAP_K, rc = KIND_ENOMEM, nl = s[0].nl, kz = zoomout;
     for (int i = 0; i < 2; i++)
         if (k > s[i].n - 2)
             k = s[i].n - 2;
     for (int i = 0; i < 2; i++)
         if (kz > s[i].n - 2)
-            return errbuf_set(err, errsz, RHM_EPARAM,
+            return errbuf_set(err, errsz, KIND_EPARAMS,
                               "params.zoomout = %d: a basis holds at most vertices - 2 = %d "
                               "eigenfunctions here (%d vertices)", kz, s[i].n - 2, s[i].n);
     int kb = kz > k ? kz : k;                    /* the bases' size */
@@ -51,7 +51,7 @@ int start_fmap(rhm_side side[2], int zoomout, char *err, size_t errsz)
         if (lbo_basis_first(&bz[i], k, &b[i]))
             goto nomem;
     if (lrc) {
-        rc = errbuf_set(err, errsz, RHM_ENUMERIC, "the functional-map start: eigenpairs: %s", detail);
+        rc = errbuf_set(err, errsz, KIND_ENUMERIC, "the functional-map start: eigenpairs: %s", detail);
         goto out;
     }
     if (!C || !cols || (kz && (!CZ || !zmap)))
@@ -86,10 +86,10 @@ int start_fmap(rhm_side side[2], int zoomout, char *err, size_t errsz)
             lrc = kz ? ddm_deblur(&bz[i], NULL, &bz[j], s[j].m, CZ, kz, kz, s[i].P, NULL, detail, sizeof detail)
                      : ddm_deblur(&b[i], NULL, &b[j], s[j].m, C, k, k, s[i].P, NULL, detail, sizeof detail);
     }
-    rc = lrc ? errbuf_set(err, errsz, RHM_ENUMERIC, "the functional-map start: %s", detail) : RHM_OK;
+    rc = lrc ? errbuf_set(err, errsz, KIND_ENUMERIC, "the functional-map start: %s", detail) : KIND_OK;
     goto out;
 nomem:
-    rc = errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+    rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
 out:
     for (int i = 0; i < 2; i++) {
         lbo_basis_close(&b[i]);

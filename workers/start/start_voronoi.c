@@ -41,18 +41,18 @@ static int vertex_faces(const mesh *m, int **vface, int **vcorner)
 int start_voronoi(rhm_side side[2], char *err, size_t errsz)
 {
     rhm_side *a = &side[0], *b = &side[1];
-    int dim = a->dim, nl = a->nl, rc = RHM_ENOMEM;
+    int dim = a->dim, nl = a->nl, rc = KIND_ENOMEM;
     int *fa = NULL, *ca = NULL, *fb = NULL, *cb = NULL;
     geod_voronoi *vor = NULL;
     char detail[512];
     if (vertex_faces(a->m, &fa, &ca) || vertex_faces(b->m, &fb, &cb)) {
-        errbuf_set(err, errsz, RHM_ENOMEM, "out of memory");
+        errbuf_set(err, errsz, KIND_ENOMEM, "out of memory");
         goto out;
     }
     int g = geod_voronoi_new(a->geod, a->lmk, nl, &vor, detail, sizeof detail);
     if (g) {
-        rc = errbuf_set(err, errsz, g == GEOD_ENOMEM ? RHM_ENOMEM : g == GEOD_EINVAL ? RHM_ELANDMARKS
-                                                                                    : RHM_EMESH,
+        rc = errbuf_set(err, errsz, g == GEOD_ENOMEM ? KIND_ENOMEM : g == GEOD_EINVAL ? KIND_ELANDMARKS
+                                                                                    : KIND_EMESH,
                         "Voronoi cells of the source landmarks: %s", detail);
         goto out;
     }
@@ -76,7 +76,7 @@ int start_voronoi(rhm_side side[2], char *err, size_t errsz)
         }
         row_at_vertex(b->P, v, fa, ca, a->lmk[best]);
     }
-    rc = RHM_OK;
+    rc = KIND_OK;
 out:
     geod_voronoi_free(vor);
     free(fa);
