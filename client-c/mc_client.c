@@ -662,24 +662,26 @@ int mc_status(mc_client *c, uint64_t id, mc_job_status *o)
     return 0;
 }
 
-int mc_cancel(mc_client *c, uint64_t id)
+/* A request about job id whose answer is OK and carries nothing. */
+static int job_request_ok(mc_client *c, int type, uint64_t id)
 {
-    MC_NEED_CLIENT(c);
     proto_msg rep;
-    int rc = job_request(c, PROTO_MSG_CANCEL, PROTO_MSG_OK, id, &rep);
+    int rc = job_request(c, type, PROTO_MSG_OK, id, &rep);
     if (!rc)
         proto_msg_free(&rep);
     return rc;
 }
 
+int mc_cancel(mc_client *c, uint64_t id)
+{
+    MC_NEED_CLIENT(c);
+    return job_request_ok(c, PROTO_MSG_CANCEL, id);
+}
+
 int mc_delete(mc_client *c, uint64_t id)
 {
     MC_NEED_CLIENT(c);
-    proto_msg rep;
-    int rc = job_request(c, PROTO_MSG_DELETE, PROTO_MSG_OK, id, &rep);
-    if (!rc)
-        proto_msg_free(&rep);
-    return rc;
+    return job_request_ok(c, PROTO_MSG_DELETE, id);
 }
 
 int mc_ping(mc_client *c)

@@ -9,6 +9,21 @@
 #include <stdlib.h>
 #include <string.h>
 
+const char *cli_param_default(int i, char *buf, size_t size)
+{
+    const proto_param_info *f = &proto_param_infos[i];
+    char name[64];
+    if (f->type == PROTO_PARAM_STR)
+        snprintf(buf, size, "cpu");
+    else if (f->type == PROTO_PARAM_ENUM)
+        snprintf(buf, size, "%s", proto_param_value_name(i, (unsigned)f->dflt, name, sizeof name));
+    else if (f->type == PROTO_PARAM_BOOL)
+        snprintf(buf, size, "off");
+    else
+        snprintf(buf, size, "%.10g", f->dflt);
+    return buf;
+}
+
 void cli_job_usage(FILE *fp)
 {
     fprintf(fp,
@@ -34,21 +49,14 @@ void cli_job_usage(FILE *fp)
         PROTO_MIN_LANDMARKS);
     for (int i = 0; i < PROTO_NPARAMS; i++) {
         const proto_param_info *f = &proto_param_infos[i];
-        char opt[96], dflt[64], name[64];
+        char opt[96], dflt[64];
         const char *arg = f->type == PROTO_PARAM_U32 ? " N" : f->type == PROTO_PARAM_F64 ? " X" : "";
         if (f->type == PROTO_PARAM_ENUM || f->type == PROTO_PARAM_STR) {
             snprintf(opt, sizeof opt, "--%s %s", f->cli, f->values);
         } else {
             snprintf(opt, sizeof opt, "--%s%s", f->cli, arg);
         }
-        if (f->type == PROTO_PARAM_STR)
-            snprintf(dflt, sizeof dflt, "cpu");
-        else if (f->type == PROTO_PARAM_ENUM)
-            snprintf(dflt, sizeof dflt, "%s", proto_param_value_name(i, (unsigned)f->dflt, name, sizeof name));
-        else if (f->type == PROTO_PARAM_BOOL)
-            snprintf(dflt, sizeof dflt, "off");
-        else
-            snprintf(dflt, sizeof dflt, "%.10g", f->dflt);
+        cli_param_default(i, dflt, sizeof dflt);
         char range[160];
         fprintf(fp, "  %-30s %s\n  %-30s default %s", opt, f->help, "", dflt);
         if (f->type == PROTO_PARAM_U32 || f->type == PROTO_PARAM_F64)

@@ -77,4 +77,8 @@ int cli_job_engine(const cli_job *j, const char *cmd, int threads, ectm_params *
 int cli_job_load(const cli_job *j, const char *cmd, const mesh *S, const mesh *T,
                  lmk_set **L, bmap **P0, bmap **Q0);
 
+/* Parameter i's default as the help writes it ("cpu", "bijective", "off",
+ * "300") into buf; returns buf. */
+const char *cli_param_default(int i, char *buf, size_t size);
+
 #endif

@@ -17,21 +17,14 @@ static void params_mdoc(FILE *fp)
 {
     for (int i = 0; i < PROTO_NPARAMS; i++) {
         const proto_param_info *f = &proto_param_infos[i];
-        char dflt[64], name[64], range[160];
+        char dflt[64], range[160];
         if (f->type == PROTO_PARAM_ENUM || f->type == PROTO_PARAM_STR)
             fprintf(fp, ".It Fl \\-%s Ar %s\n", f->cli, f->values);
         else if (f->type == PROTO_PARAM_BOOL)
             fprintf(fp, ".It Fl \\-%s\n", f->cli);
         else
             fprintf(fp, ".It Fl \\-%s Ar %s\n", f->cli, f->type == PROTO_PARAM_U32 ? "N" : "X");
-        if (f->type == PROTO_PARAM_STR)
-            snprintf(dflt, sizeof dflt, "cpu");
-        else if (f->type == PROTO_PARAM_ENUM)
-            snprintf(dflt, sizeof dflt, "%s", proto_param_value_name(i, (unsigned)f->dflt, name, sizeof name));
-        else if (f->type == PROTO_PARAM_BOOL)
-            snprintf(dflt, sizeof dflt, "off");
-        else
-            snprintf(dflt, sizeof dflt, "%.10g", f->dflt);
+        cli_param_default(i, dflt, sizeof dflt);
         /* the help, wrapped at blanks to lines of at most 72 bytes (it
          * holds no backslash and no word starts with a dot) */
         for (const char *h = f->help; *h;) {

@@ -100,7 +100,7 @@ int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn
     corr_input in;
     wrk_job_input(&job, &in);
     rc = corr_run(&in, &job.params, on_progress, &run, &res, err, errsz);
-    if (rc == CORR_ECANCELLED && run.stopped)
+    if (rc == KIND_ECANCELLED && run.stopped)
         snprintf(err, errsz, "cancelled by the progress callback after %d of %d outer iterations",
                  run.last_outer, job.params.iterations);
     if (rc) {

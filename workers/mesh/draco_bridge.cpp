@@ -3,13 +3,15 @@
 // try/catch(...) so no exception ever crosses into C. It knows nothing about
 // the mesh type or files; mesh_drc.c does that.
 #include "mesh/draco_bridge.h"
+extern "C" {
+#include "util/errbuf.h"
+}
 
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/mesh/mesh.h>
 
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -17,20 +19,6 @@
 #include <vector>
 
 namespace {
-
-int fail(char *err, size_t errsz, int code, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-int fail(char *err, size_t errsz, int code, const char *fmt, ...)
-{
-    if (err && errsz) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errsz, fmt, ap);
-        va_end(ap);
-    }
-    return code;
-}
 
 // Decodes into v/f (malloc'ed) or returns an error; may throw.
 int decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
@@ -40,35 +28,35 @@ int decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
     db.Init(reinterpret_cast<const char *>(buf), len);
     auto kind = draco::Decoder::GetEncodedGeometryType(&db);
     if (!kind.ok())
-        return fail(err, errsz, DRACOB_EDECODE, "not a Draco buffer: %s",
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "not a Draco buffer: %s",
                     kind.status().error_msg());
     if (kind.value() == draco::POINT_CLOUD)
-        return fail(err, errsz, DRACOB_EKIND,
+        return errbuf_set(err, errsz, DRACOB_EKIND,
                     "the Draco buffer holds a point cloud; a triangle mesh is needed");
     if (kind.value() != draco::TRIANGULAR_MESH)
-        return fail(err, errsz, DRACOB_EKIND, "the Draco buffer holds no triangle mesh");
+        return errbuf_set(err, errsz, DRACOB_EKIND, "the Draco buffer holds no triangle mesh");
     draco::Decoder dec;
     auto res = dec.DecodeMeshFromBuffer(&db);
     if (!res.ok())
-        return fail(err, errsz, DRACOB_EDECODE, "Draco decoding failed: %s",
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "Draco decoding failed: %s",
                     res.status().error_msg());
     std::unique_ptr<draco::Mesh> dm = std::move(res).value();
     if (!dm)
-        return fail(err, errsz, DRACOB_EDECODE, "Draco decoding returned no mesh");
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "Draco decoding returned no mesh");
     const long long np = dm->num_points(), nfaces = dm->num_faces();
     if (np > max_points || nfaces > max_faces)
-        return fail(err, errsz, DRACOB_ELIMIT,
+        return errbuf_set(err, errsz, DRACOB_ELIMIT,
                     "%lld points / %lld faces, over the limit of %d / %d",
                     np, nfaces, max_points, max_faces);
     const draco::PointAttribute *pos =
         dm->GetNamedAttribute(draco::GeometryAttribute::POSITION);
     if (!pos || pos->num_components() != 3)
-        return fail(err, errsz, DRACOB_EDECODE, "no 3-component POSITION attribute");
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "no 3-component POSITION attribute");
     const int idx_id = dm->GetAttributeIdByMetadataEntry(DRACOB_INDEX_METADATA_NAME,
                                                          DRACOB_INDEX_METADATA_VALUE);
     const draco::PointAttribute *ia = idx_id >= 0 ? dm->attribute(idx_id) : nullptr;
     if (ia && ia->num_components() != 1)
-        return fail(err, errsz, DRACOB_EDECODE, "vertex index attribute has %d components",
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "vertex index attribute has %d components",
                     ia->num_components());
 
     // where[p] = the output row of decoded point p.
@@ -78,9 +66,9 @@ int decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
         for (long long p = 0; p < np; p++) {
             int32_t orig = -1;
             if (!ia->ConvertValue<int32_t>(ia->mapped_index(draco::PointIndex(p)), 1, &orig))
-                return fail(err, errsz, DRACOB_EDECODE, "point %lld: unreadable vertex index", p);
+                return errbuf_set(err, errsz, DRACOB_EDECODE, "point %lld: unreadable vertex index", p);
             if (orig < 0 || orig >= np || seen[orig])
-                return fail(err, errsz, DRACOB_EDECODE,
+                return errbuf_set(err, errsz, DRACOB_EDECODE,
                             "point %lld: vertex index %d is not part of a permutation of 0..%lld",
                             p, orig, np - 1);
             seen[orig] = 1;
@@ -96,14 +84,14 @@ int decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
     if (!ov || !of) {
         free(ov);
         free(of);
-        return fail(err, errsz, DRACOB_ENOMEM, "out of memory for %lld points", np);
+        return errbuf_set(err, errsz, DRACOB_ENOMEM, "out of memory for %lld points", np);
     }
     for (long long p = 0; p < np; p++) {
         double q[3];
         if (!pos->ConvertValue<double>(pos->mapped_index(draco::PointIndex(p)), 3, q)) {
             free(ov);
             free(of);
-            return fail(err, errsz, DRACOB_EDECODE, "point %lld: unreadable position", p);
+            return errbuf_set(err, errsz, DRACOB_EDECODE, "point %lld: unreadable position", p);
         }
         memcpy(ov + 3 * (size_t)where[p], q, sizeof q);
     }
@@ -114,7 +102,7 @@ int decode(const unsigned char *buf, size_t len, int max_points, int max_faces,
             if (p >= static_cast<uint64_t>(np)) {
                 free(ov);
                 free(of);
-                return fail(err, errsz, DRACOB_EDECODE,
+                return errbuf_set(err, errsz, DRACOB_EDECODE,
                             "face %lld: point index %u out of range [0, %lld)", t, p, np);
             }
             of[3 * t + k] = where[p];
@@ -159,7 +147,7 @@ int encode(const double *v, int nv, const int *f, int nf, int bits,
             sizeof(int32_t), 0);
     const int idx_id = dm.AddAttribute(gi, true, static_cast<uint32_t>(nv));
     if (pos_id < 0 || idx_id < 0)
-        return fail(err, errsz, DRACOB_EENCODE, "cannot add Draco attributes");
+        return errbuf_set(err, errsz, DRACOB_EENCODE, "cannot add Draco attributes");
     draco::PointAttribute *pa = dm.attribute(pos_id);
     draco::PointAttribute *ia = dm.attribute(idx_id);
     for (int i = 0; i < nv; i++) {
@@ -189,10 +177,10 @@ int encode(const double *v, int nv, const int *f, int nf, int bits,
     draco::EncoderBuffer eb;
     const draco::Status st = enc.EncodeMeshToBuffer(dm, &eb);
     if (!st.ok())
-        return fail(err, errsz, DRACOB_EENCODE, "Draco encoding failed: %s", st.error_msg());
+        return errbuf_set(err, errsz, DRACOB_EENCODE, "Draco encoding failed: %s", st.error_msg());
     unsigned char *out = static_cast<unsigned char *>(malloc(eb.size() + 1));
     if (!out)
-        return fail(err, errsz, DRACOB_ENOMEM, "out of memory for %zu bytes", eb.size());
+        return errbuf_set(err, errsz, DRACOB_ENOMEM, "out of memory for %zu bytes", eb.size());
     memcpy(out, eb.data(), eb.size());
     *buf = out;
     *len = eb.size();
@@ -206,22 +194,22 @@ extern "C" int dracob_decode(const unsigned char *buf, size_t len, int max_point
                              char *err, size_t errsz)
 {
     if (!v || !nv || !f || !nf)
-        return fail(err, errsz, DRACOB_EARG, "dracob_decode: NULL output");
+        return errbuf_set(err, errsz, DRACOB_EARG, "dracob_decode: NULL output");
     *v = nullptr;
     *f = nullptr;
     *nv = *nf = 0;
     if (!buf || len == 0)
-        return fail(err, errsz, DRACOB_EDECODE, "empty Draco buffer");
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "empty Draco buffer");
     if (static_cast<unsigned long long>(len) > static_cast<unsigned long long>(DRACOB_MAX_BUFFER_BYTES))
-        return fail(err, errsz, DRACOB_ELIMIT, "Draco buffer of %zu bytes, over the limit of %lld",
+        return errbuf_set(err, errsz, DRACOB_ELIMIT, "Draco buffer of %zu bytes, over the limit of %lld",
                     len, static_cast<long long>(DRACOB_MAX_BUFFER_BYTES));
     try {
         return decode(buf, len, max_points, max_faces, v, nv, f, nf, err, errsz);
     } catch (const std::bad_alloc &) {
-        return fail(err, errsz, DRACOB_EDECODE,
+        return errbuf_set(err, errsz, DRACOB_EDECODE,
                     "malformed Draco buffer (the decoder ran out of memory)");
     } catch (...) {
-        return fail(err, errsz, DRACOB_EDECODE, "malformed Draco buffer (decoder exception)");
+        return errbuf_set(err, errsz, DRACOB_EDECODE, "malformed Draco buffer (decoder exception)");
     }
 }
 
@@ -230,30 +218,30 @@ extern "C" int dracob_encode(const double *v, int nv, const int *f, int nf,
                              char *err, size_t errsz)
 {
     if (!buf || !len)
-        return fail(err, errsz, DRACOB_EARG, "dracob_encode: NULL output");
+        return errbuf_set(err, errsz, DRACOB_EARG, "dracob_encode: NULL output");
     *buf = nullptr;
     *len = 0;
     if (nv < 0 || nf < 0 || (nv > 0 && !v) || (nf > 0 && !f))
-        return fail(err, errsz, DRACOB_EARG, "dracob_encode: bad sizes or NULL arrays");
+        return errbuf_set(err, errsz, DRACOB_EARG, "dracob_encode: bad sizes or NULL arrays");
     if (quantization_bits < 0 || quantization_bits > 30)
-        return fail(err, errsz, DRACOB_EARG, "quantization of %d bits; expected 0..30",
+        return errbuf_set(err, errsz, DRACOB_EARG, "quantization of %d bits; expected 0..30",
                     quantization_bits);
     for (long long i = 0; i < 3LL * nf; i++)
         if (f[i] < 0 || f[i] >= nv)
-            return fail(err, errsz, DRACOB_EARG, "face %lld: vertex index %d out of range [0, %d)",
+            return errbuf_set(err, errsz, DRACOB_EARG, "face %lld: vertex index %d out of range [0, %d)",
                         i / 3, f[i], nv);
     /* quantization maps positions onto a grid over their bounding box: a
      * NaN or infinity has no place on it (Draco throws) */
     for (long long i = 0; quantization_bits > 0 && i < 3LL * nv; i++)
         if (!std::isfinite(v[i]))
-            return fail(err, errsz, DRACOB_EARG,
+            return errbuf_set(err, errsz, DRACOB_EARG,
                         "vertex %lld: %c coordinate is %s (a %d-bit quantized encoding needs finite positions)",
                         i / 3, "xyz"[i % 3], std::isnan(v[i]) ? "NaN" : "infinite", quantization_bits);
     try {
         return encode(v, nv, f, nf, quantization_bits, buf, len, err, errsz);
     } catch (const std::bad_alloc &) {
-        return fail(err, errsz, DRACOB_ENOMEM, "out of memory while encoding");
+        return errbuf_set(err, errsz, DRACOB_ENOMEM, "out of memory while encoding");
     } catch (...) {
-        return fail(err, errsz, DRACOB_EENCODE, "Draco encoder exception");
+        return errbuf_set(err, errsz, DRACOB_EENCODE, "Draco encoder exception");
     }
 }

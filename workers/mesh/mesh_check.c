@@ -105,11 +105,9 @@ static void sort3(int *s)
     if (s[0] > s[1]) { t = s[0]; s[0] = s[1]; s[1] = t; }
 }
 
-/* Area of face t and whether it is degenerate (see header). */
-static double face_area(const mesh *m, int t, int *degenerate)
+double mesh_face_area(const double *v, const int *f, int *degenerate)
 {
-    const int *f = m->f + 3 * t;
-    const double *p = m->v + 3 * f[0], *q = m->v + 3 * f[1], *s = m->v + 3 * f[2];
+    const double *p = v + 3 * (size_t)f[0], *q = v + 3 * (size_t)f[1], *s = v + 3 * (size_t)f[2];
     double u[3], w[3], d[3];
     for (int k = 0; k < 3; k++) {
         u[k] = q[k] - p[k];
@@ -122,7 +120,8 @@ static double face_area(const mesh *m, int t, int *degenerate)
     double l = fmax(fmax(u[0] * u[0] + u[1] * u[1] + u[2] * u[2],
                          w[0] * w[0] + w[1] * w[1] + w[2] * w[2]),
                     d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    *degenerate = f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || !(twice > 2e-12 * l);
+    if (degenerate)
+        *degenerate = f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || !(twice > 2e-12 * l);
     return 0.5 * twice;
 }
 
@@ -183,7 +182,7 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
         for (int k = 0; k < 3; k++)
             used[f[k]] = 1;
         int degenerate;
-        double a = face_area(m, t, &degenerate);
+        double a = mesh_face_area(m->v, m->f + 3 * (size_t)t, &degenerate);
         if (isfinite(a))
             r->area += a;
         if (degenerate && r->degenerate_faces++ == 0)

@@ -24,16 +24,13 @@
 #define MESH_CHECK_H
 #include "mesh/mesh.h"
 #include <stddef.h>
+#include "util/errlist.h"
 
 #define MESH_CHECK_ERRORS(X)                                         \
     X(MESH_CHECK_OK,      0, "ok")                                   \
     X(MESH_CHECK_ENOMEM, -1, "out of memory")
 
-enum mesh_check_error {
-#define MESH_CHECK_ENUM(name, val, msg) name = val,
-    MESH_CHECK_ERRORS(MESH_CHECK_ENUM)
-#undef MESH_CHECK_ENUM
-};
+ERRLIST_ENUM(mesh_check, MESH_CHECK_ERRORS);
 
 typedef struct mesh_check_report {
     /* counts */
@@ -63,5 +60,9 @@ int mesh_check_usable(const mesh_check_report *r);
 /* Writes one line per problem, each starting with "path: ", into out
  * (truncated to outsz); returns the number of problem lines. */
 int mesh_check_problems(const mesh_check_report *r, const char *path, char *out, size_t outsz);
+/* The area of the face f (three indices into the positions v, three doubles
+ * a vertex); when degenerate is not NULL, whether the face is degenerate by
+ * the rule above. */
+double mesh_face_area(const double *v, const int *f, int *degenerate);
 
 #endif

@@ -67,6 +67,17 @@ static bool visit_face(struct RTCPointQueryFunctionArguments *args)
     return true;
 }
 
+/* Row i of the answer from the search's best face r. */
+static void store_row(const proj__row *r, int i, int *face, double *bary, double *cost)
+{
+    face[i] = r->face;
+    bary[3 * (size_t)i] = r->bary[0];
+    bary[3 * (size_t)i + 1] = r->bary[1];
+    bary[3 * (size_t)i + 2] = r->bary[2];
+    if (cost)
+        cost[i] = r->best;
+}
+
 int proj_closest(const proj_tree *t, int d, const double *Z, double s,
                  int n, const double *Q, int *face, double *bary, double *cost)
 {
@@ -118,12 +129,7 @@ int proj_closest(const proj_tree *t, int d, const double *Z, double s,
         struct RTCPointQueryContext ctx;
         rtcInitPointQueryContext(&ctx);
         rtcPointQuery(t->scene, &pq, &ctx, visit_face, &r);
-        face[i] = r.face;
-        bary[3 * (size_t)i] = r.bary[0];
-        bary[3 * (size_t)i + 1] = r.bary[1];
-        bary[3 * (size_t)i + 2] = r.bary[2];
-        if (cost)
-            cost[i] = r.best;
+        store_row(&r, i, face, bary, cost);
     }
     return 0;
 }
@@ -144,11 +150,6 @@ void proj_closest_brute(const mesh *target, int d, const double *Z,
                 r.bary[0] = w[0], r.bary[1] = w[1], r.bary[2] = w[2];
             }
         }
-        face[i] = r.face;
-        bary[3 * (size_t)i] = r.bary[0];
-        bary[3 * (size_t)i + 1] = r.bary[1];
-        bary[3 * (size_t)i + 2] = r.bary[2];
-        if (cost)
-            cost[i] = r.best;
+        store_row(&r, i, face, bary, cost);
     }
 }

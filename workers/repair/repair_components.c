@@ -3,6 +3,7 @@
  * connected surfaces: the pieces kept are matched, a vertex on another
  * piece, or in no face, takes the map of the nearest kept vertex. */
 #include "repair/repair.h"
+#include "mesh/mesh_check.h"
 #include "repair/repair__sort.h"
 
 #include <math.h>
@@ -15,16 +16,6 @@ static int find(int *par, int x)
         x = par[x];
     }
     return x;
-}
-
-static double area(const double *v, const int *f)
-{
-    const double *p = v + 3 * (size_t)f[0], *q = v + 3 * (size_t)f[1], *s = v + 3 * (size_t)f[2];
-    double u[3] = { q[0] - p[0], q[1] - p[1], q[2] - p[2] };
-    double w[3] = { s[0] - p[0], s[1] - p[1], s[2] - p[2] };
-    double c0 = u[1] * w[2] - u[2] * w[1], c1 = u[2] * w[0] - u[0] * w[2],
-           c2 = u[0] * w[1] - u[1] * w[0];
-    return 0.5 * sqrt(c0 * c0 + c1 * c1 + c2 * c2);
 }
 
 /* A piece and its area, for the order by decreasing area (ties: the
@@ -69,7 +60,7 @@ int repair_components(const double *v, int nv, const int *f, int nf, int *piece)
     for (int k = 0; k < np; k++)
         pa[k].k = k;
     for (int t = 0; t < nf; t++)
-        pa[label[find(par, f[3 * (size_t)t])]].a += area(v, f + 3 * (size_t)t);
+        pa[label[find(par, f[3 * (size_t)t])]].a += mesh_face_area(v, f + 3 * (size_t)t, NULL);
     if (repair__sort(pa, (size_t)np, sizeof *pa, by_area, NULL))
         goto out;
     for (int i = 0; i < np; i++)

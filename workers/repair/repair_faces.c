@@ -5,30 +5,10 @@
  * three vertices makes an edge non-manifold. The first of duplicates stays. */
 #include "repair/repair.h"
 #include "repair/repair__sort.h"
+#include "mesh/mesh_check.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int degenerate(const double *v, const int *f)
-{
-    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2])
-        return 1;
-    const double *p = v + 3 * (size_t)f[0], *q = v + 3 * (size_t)f[1], *s = v + 3 * (size_t)f[2];
-    double u[3], w[3], d[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = q[k] - p[k];
-        w[k] = s[k] - p[k];
-        d[k] = s[k] - q[k];
-    }
-    double c0 = u[1] * w[2] - u[2] * w[1], c1 = u[2] * w[0] - u[0] * w[2],
-           c2 = u[0] * w[1] - u[1] * w[0];
-    double twice = sqrt(c0 * c0 + c1 * c1 + c2 * c2);
-    double l = fmax(fmax(u[0] * u[0] + u[1] * u[1] + u[2] * u[2],
-                         w[0] * w[0] + w[1] * w[1] + w[2] * w[2]),
-                    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    return !(twice > 2e-12 * l);
-}
 
 typedef struct tri { int s[3]; int t; } tri;
 
@@ -64,7 +44,9 @@ int repair_faces(const double *v, int nv, int *f, int *id, int nf, int *ndegener
     }
     int nk = 0;
     for (int t = 0; t < nf; t++) {
-        if (degenerate(v, f + 3 * (size_t)t)) {
+        int dg;
+        mesh_face_area(v, f + 3 * (size_t)t, &dg);
+        if (dg) {
             drop[t] = 1;
             ++*ndegenerate;
             continue;

@@ -5,20 +5,10 @@
  * area. A one-sided piece (a Moebius band) keeps edges run the same way;
  * repair_split cuts them. */
 #include "repair/repair.h"
+#include "mesh/mesh_check.h"
 #include "repair/repair__edges.h"
 
-#include <math.h>
 #include <stdlib.h>
-
-static double area(const double *v, const int *f)
-{
-    const double *p = v + 3 * (size_t)f[0], *q = v + 3 * (size_t)f[1], *s = v + 3 * (size_t)f[2];
-    double u[3] = { q[0] - p[0], q[1] - p[1], q[2] - p[2] };
-    double w[3] = { s[0] - p[0], s[1] - p[1], s[2] - p[2] };
-    double c0 = u[1] * w[2] - u[2] * w[1], c1 = u[2] * w[0] - u[0] * w[2],
-           c2 = u[0] * w[1] - u[1] * w[0];
-    return 0.5 * sqrt(c0 * c0 + c1 * c1 + c2 * c2);
-}
 
 int repair_orient(const double *v, int nv, int *f, int nf, int *conflicts)
 {
@@ -58,9 +48,9 @@ int repair_orient(const double *v, int nv, int *f, int nf, int *conflicts)
         while (head < tail) {
             int t = queue[head++];
             if (flip[t])
-                turned += area(v, f + 3 * (size_t)t);
+                turned += mesh_face_area(v, f + 3 * (size_t)t, NULL);
             else
-                kept += area(v, f + 3 * (size_t)t);
+                kept += mesh_face_area(v, f + 3 * (size_t)t, NULL);
             for (int k = 0; k < 3; k++) {
                 int s = nbr[3 * t + k];
                 if (s < 0)
