@@ -258,22 +258,6 @@ int ener_def_update_admissible(ener_def *d, const double *Y)
     return count;
 }
 
-/* Face t's edge vectors e1 = y1 - y0, e2 = y2 - y0 in Y and their cross
- * product n (not normalized): pass A needs them twice, around the logs. */
-static inline void face_edges(const double *Y, const int *f, int t, double e1[3], double e2[3],
-                              double n[3])
-{
-    const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
-    const double *y2 = corner(Y, f, t, 2);
-    for (int k = 0; k < 3; k++) {
-        e1[k] = y1[k] - y0[k];
-        e2[k] = y2[k] - y0[k];
-    }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-}
-
 /* Pass A on chunk c of faces: each face's unit normal into fn and its
  * membrane gradient into gf (with grad), the chunk's logs in one tight loop;
  * returns the chunk's membrane energy, summed in face order. */
@@ -288,8 +272,13 @@ static inline double membrane_chunk(ener_def *d, const double *Y, const double *
     const int t1 = nf - t0 < ENER_CHUNK ? nf : t0 + ENER_CHUNK;
     double det[ENER_CHUNK], logd[ENER_CHUNK];
     for (int t = t0; t < t1; t++) {
-        double e1[3], e2[3], n[3];
-        face_edges(Y, f, t, e1, e2, n);
+        const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+        const double *y2 = corner(Y, f, t, 2);
+        const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+        const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                             e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
         double *un = fn + 4 * (size_t)t;
         un[3] = ener__unit_normal_of(e1, e2, n, un);
         det[t - t0] = ener__membrane_det(fr[t].ginv, n);
@@ -298,8 +287,13 @@ static inline double membrane_chunk(ener_def *d, const double *Y, const double *
         logd[k] = log(det[k] > log_eps ? det[k] : log_eps);
     double s = 0.0;
     for (int t = t0; t < t1; t++) {
-        double e1[3], e2[3], n[3];
-        face_edges(Y, f, t, e1, e2, n);
+        const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+        const double *y2 = corner(Y, f, t, 2);
+        const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+        const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                             e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
         s += ener__membrane_finish(fr[t].ginv, fr[t].ahat, alpha * fr[t].ahat,
                                    log_eps, e1, e2, n,
                                    det[t - t0], logd[t - t0],
