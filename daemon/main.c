@@ -33,18 +33,17 @@ static void on_signal(uv_signal_t *h, int sig)
     drain_start(h->data, sig);
 }
 
-int main(int argc, char **argv)
+/* --version, the options into d->conf and the log level: -1 to go on,
+ * else the exit status (--version, --help, a usage error). */
+static int parse_command_line(mcd *d, int argc, char **argv)
 {
-    static mcd d;
     char err[1024];
     if (argc == 2 && strcmp(argv[1], "--version") == 0) {
         printf("meshcorrd %s\n", MC_VERSION);
         return 0;
     }
-    if (argc > 1 && strcmp(argv[1], "token") == 0)
-        return token_main(argc - 1, argv + 1);
-    conf_init(&d.conf);
-    int rc = conf_parse_args(&d.conf, argc, argv, err, sizeof err);
+    conf_init(&d->conf);
+    int rc = conf_parse_args(&d->conf, argc, argv, err, sizeof err);
     if (rc == 1) {
         conf_usage(stdout);
         return 0;
@@ -54,7 +53,62 @@ int main(int argc, char **argv)
         conf_usage(stderr);
         return 2;
     }
-    dlog_set_level(d.conf.log_level);
+    dlog_set_level(d->conf.log_level);
+    return -1;
+}
+
+/* SIGTERM and SIGINT start the drain. Set before the port file and the
+ * sockets exist: a SIGTERM sent as soon as they do is a drain once the loop
+ * runs, never the default death. */
+static void signals_start(mcd *d)
+{
+    uv_signal_init(d->loop, &d->sigterm);
+    uv_signal_init(d->loop, &d->sigint);
+    d->sigterm.data = d->sigint.data = d;
+    uv_signal_start(&d->sigterm, on_signal, SIGTERM);
+    uv_signal_start(&d->sigint, on_signal, SIGINT);
+}
+
+/* Closes and frees all that main set up; after a start-up failure
+ * (status non-zero) the handles a drain would have closed too. */
+static void close_all(mcd *d, int status)
+{
+    if (status) {
+        /* a start-up failure: close whatever was opened */
+        if (uv_is_active((uv_handle_t *)&d->sigterm)) {
+            uv_close((uv_handle_t *)&d->sigterm, NULL);
+            uv_close((uv_handle_t *)&d->sigint, NULL);
+        }
+        srv_stop_listening(d);
+        bk_close(d);
+        job_close(d);
+        snap_close(d);
+        web_cancel_close(d);
+        uv_run(d->loop, UV_RUN_NOWAIT);
+    }
+    mbus_stop(d->mbus);
+    http_stop(d->http);
+    hook_stop();
+    tls_close(d);
+    snap_free(d->snap);
+    uv_loop_close(d->loop);
+    web_cancel_free(d->web_cancel);
+    store_close(d->store);
+    sched_free(d->sched);
+    auth_tokens_free(d->tokens);
+    free(d->slots);
+    free(d->listeners);
+}
+
+int main(int argc, char **argv)
+{
+    static mcd d;
+    char err[1024];
+    if (argc > 1 && strcmp(argv[1], "token") == 0)
+        return token_main(argc - 1, argv + 1);
+    int status = parse_command_line(&d, argc, argv);
+    if (status >= 0)
+        return status;
     priv_user priv;
     if (priv_init(&d.conf, &priv, err, sizeof err)) {
         dlog(DLOG_ERROR, "%s", err);
@@ -69,7 +123,7 @@ int main(int argc, char **argv)
     if (access(validator, X_OK) != 0)
         dlog(DLOG_WARN, "validator program %s is not executable: every SUBMIT is refused until it is",
              validator);
-    int status = 1;
+    status = 1;
     d.loop = uv_default_loop();
     /* the tokens file is read as the user the daemon runs as: SIGHUP reads it again as that user */
     if (priv_become(&priv, d.conf.state_dir, err, sizeof err) ||
@@ -89,13 +143,7 @@ int main(int argc, char **argv)
         dlog(DLOG_ERROR, "out of memory");
         goto done;
     }
-    /* Before the port file and the sockets exist: a SIGTERM sent as soon as
-     * they do is a drain once the loop runs, never the default death. */
-    uv_signal_init(d.loop, &d.sigterm);
-    uv_signal_init(d.loop, &d.sigint);
-    d.sigterm.data = d.sigint.data = &d;
-    uv_signal_start(&d.sigterm, on_signal, SIGTERM);
-    uv_signal_start(&d.sigint, on_signal, SIGINT);
+    signals_start(&d);
     /* the TLS key is read while root is still at hand, with the binds */
     if (bk_init(&d, err, sizeof err) || snap_init(&d, err, sizeof err) ||
         priv_bind_begin(&priv, err, sizeof err) || tls_init(&d, err, sizeof err) || srv_listen(&d, err, sizeof err) ||
@@ -118,30 +166,6 @@ int main(int argc, char **argv)
     status = 0;
     dlog(DLOG_INFO, "stopped");
 done:
-    if (status) {
-        /* a start-up failure: close whatever was opened */
-        if (uv_is_active((uv_handle_t *)&d.sigterm)) {
-            uv_close((uv_handle_t *)&d.sigterm, NULL);
-            uv_close((uv_handle_t *)&d.sigint, NULL);
-        }
-        srv_stop_listening(&d);
-        bk_close(&d);
-        job_close(&d);
-        snap_close(&d);
-        web_cancel_close(&d);
-        uv_run(d.loop, UV_RUN_NOWAIT);
-    }
-    mbus_stop(d.mbus);
-    http_stop(d.http);
-    hook_stop();
-    tls_close(&d);
-    snap_free(d.snap);
-    uv_loop_close(d.loop);
-    web_cancel_free(d.web_cancel);
-    store_close(d.store);
-    sched_free(d.sched);
-    auth_tokens_free(d.tokens);
-    free(d.slots);
-    free(d.listeners);
+    close_all(&d, status);
     return status;
 }

@@ -324,6 +324,44 @@ static void print_figures(const eval_opts *o, int a, const mesh *S, const mesh *
     }
 }
 
+/* The geodesic error of each of the nmaps maps at the ngt ground-truth
+ * pairs on T (tpath): its mean (gmean) and its curve (curves); 0, or -1
+ * with the message printed (out of memory included). */
+static int geodesic_figures(const char *tpath, const mesh *T, bmap *const *maps, int nmaps, const int *gsrc,
+                            const int *gtgt, int ngt, double *gmean, double (*curves)[EVAL_CURVE_STEPS])
+{
+    char err[1024];
+    geod_solver *gs = NULL;
+    double *gerr = NULL;
+    int status = -1;
+    if (geod_solver_new(T, 0, &gs, err, sizeof err)) {
+        fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);
+        goto done;
+    }
+    if (!(gerr = malloc(sizeof(double) * (size_t)ngt * (size_t)nmaps))) {
+        fprintf(stderr, "meshcorr eval: out of memory\n");
+        goto done;
+    }
+    int rc = metric_geodesic_errors(gs, T, (const bmap *const *)maps, nmaps, gsrc, gtgt, ngt, gerr);
+    if (rc) {
+        fprintf(stderr, "meshcorr eval: geodesic distances on %s failed: %s\n", tpath,
+                rc == -1 ? "out of memory" : geod_strerror(rc));
+        goto done;
+    }
+    for (int a = 0; a < nmaps; a++) {
+        const double *e = gerr + (size_t)a * (size_t)ngt;
+        gmean[a] = 0;
+        for (int k = 0; k < ngt; k++)
+            gmean[a] += e[k] / ngt;
+        metric_error_curve(e, ngt, EVAL_CURVE_MAX, EVAL_CURVE_STEPS, curves[a]);
+    }
+    status = 0;
+done:
+    geod_solver_free(gs);
+    free(gerr);
+    return status;
+}
+
 int cli_eval(int argc, char **argv)
 {
     eval_opts o;
@@ -339,8 +377,6 @@ int cli_eval(int argc, char **argv)
     mesh *S = NULL, *T = NULL;
     bmap *maps[EVAL_MAX_MAPS] = {0}, *Q = NULL;
     int *gsrc = NULL, *gtgt = NULL;
-    double *gerr = NULL;
-    geod_solver *gs = NULL;
     if (mesh_read(spath, &S, err, sizeof err) || mesh_read(tpath, &T, err, sizeof err) ||
         (o.rev && vmap_read_any(o.rev, o.map_base, T, S, &Q, err, sizeof err))) {
         fprintf(stderr, "meshcorr eval: %s\n", err);
@@ -355,27 +391,8 @@ int cli_eval(int argc, char **argv)
         goto done;
     double curves[EVAL_MAX_MAPS][EVAL_CURVE_STEPS], gmean[EVAL_MAX_MAPS];
     render_map_words words = {spath, tpath, ppaths[0], NAN, NAN, NAN, 0, o.folds};
-    if (o.gt) {
-        if (geod_solver_new(T, 0, &gs, err, sizeof err)) {
-            fprintf(stderr, "meshcorr eval: %s: %s\n", tpath, err);
-            goto done;
-        }
-        if (!(gerr = malloc(sizeof(double) * (size_t)ngt * (size_t)nmaps)))
-            goto oom;
-        int rc = metric_geodesic_errors(gs, T, (const bmap *const *)maps, nmaps, gsrc, gtgt, ngt, gerr);
-        if (rc) {
-            fprintf(stderr, "meshcorr eval: geodesic distances on %s failed: %s\n", tpath,
-                    rc == -1 ? "out of memory" : geod_strerror(rc));
-            goto done;
-        }
-        for (int a = 0; a < nmaps; a++) {
-            const double *e = gerr + (size_t)a * (size_t)ngt;
-            gmean[a] = 0;
-            for (int k = 0; k < ngt; k++)
-                gmean[a] += e[k] / ngt;
-            metric_error_curve(e, ngt, EVAL_CURVE_MAX, EVAL_CURVE_STEPS, curves[a]);
-        }
-    }
+    if (o.gt && geodesic_figures(tpath, T, maps, nmaps, gsrc, gtgt, ngt, gmean, curves))
+        goto done;
     for (int a = 0; a < nmaps; a++) {
         const bmap *P = maps[a];
         const char *ppath = ppaths[a];
@@ -414,8 +431,6 @@ int cli_eval(int argc, char **argv)
 oom:
     fprintf(stderr, "meshcorr eval: out of memory\n");
 done:
-    geod_solver_free(gs);
-    free(gerr);
     free(gsrc);
     free(gtgt);
     for (int a = 0; a < EVAL_MAX_MAPS; a++)

@@ -113,7 +113,21 @@ static int write_mesh_with(const char *path, const mesh *faces_of, const double 
     return 0;
 }
 
-int cli_match(int argc, char **argv)
+/* The command line of match. */
+typedef struct match_opts {
+    const char *out, *out_rev, *out_def, *out_rem, *out_rhm, *out_rhm_rev;
+    cli_job job;
+    ectm_params pe;
+    rhm_params rp;
+    double log_eps;
+    int threads, progress;
+    corr_chain stages;
+    int ectm_last;              /* the chain ends with ECTM */
+} match_opts;
+
+/* Reads the options: -1 to go on, else the exit status (a usage error,
+ * --help). */
+static int parse_options(int argc, char **argv, match_opts *o)
 {
     enum { O_OUT = 1, O_OUT_REVERSE, O_OUT_DEFORMED, O_OUT_REMESHED, O_LOG_EPS,
            O_THREADS, O_PROGRESS, O_OUT_STAGE };
@@ -126,47 +140,42 @@ int cli_match(int argc, char **argv)
         {"log-eps", required_argument, 0, O_LOG_EPS},
         {"threads", required_argument, 0, O_THREADS}, {"progress", required_argument, 0, O_PROGRESS},
         {"help", no_argument, 0, 'h'},              {0, 0, 0, 0}};
-    const char *out = NULL, *out_rev = NULL, *out_def = NULL, *out_rem = NULL;
-    const char *out_rhm = NULL, *out_rhm_rev = NULL;
-    cli_job job;
-    cli_job_init(&job, argc, argv);
-    ectm_params pe;
-    rhm_params rp;
-    ectm_params_init(&pe);               /* log_eps and threads: match's own options */
-    double log_eps = pe.log_eps;
-    int threads = 0;
-    int progress = CLI_PROGRESS_AUTO;
+    memset(o, 0, sizeof *o);
+    cli_job_init(&o->job, argc, argv);
+    ectm_params_init(&o->pe);               /* log_eps and threads: match's own options */
+    o->log_eps = o->pe.log_eps;
+    o->progress = CLI_PROGRESS_AUTO;
     int c;
     char *e;
     optind = 1;
     while ((c = cli_getopt("match", argc, argv, opts)) != -1) {
-        int r = cli_job_option(&job, "match", c, optarg);
+        int r = cli_job_option(&o->job, "match", c, optarg);
         if (r < 0)
             return cli_usage_see("match");
         if (r)
             continue;
         switch (c) {
-        case O_OUT: out = optarg; break;
-        case O_OUT_REVERSE: out_rev = optarg; break;
-        case O_OUT_DEFORMED: out_def = optarg; break;
-        case O_OUT_REMESHED: out_rem = optarg; break;
+        case O_OUT: o->out = optarg; break;
+        case O_OUT_REVERSE: o->out_rev = optarg; break;
+        case O_OUT_DEFORMED: o->out_def = optarg; break;
+        case O_OUT_REMESHED: o->out_rem = optarg; break;
         case O_OUT_STAGE:
-            if (cli_out_stage("match", optarg, &out_rhm, &out_rhm_rev))
+            if (cli_out_stage("match", optarg, &o->out_rhm, &o->out_rhm_rev))
                 return CLI_EXIT_USAGE;
             break;
         case O_LOG_EPS:
-            log_eps = strtod(optarg, &e);
-            if (!*optarg || *e || !(log_eps > 0) || !isfinite(log_eps))
+            o->log_eps = strtod(optarg, &e);
+            if (!*optarg || *e || !(o->log_eps > 0) || !isfinite(o->log_eps))
                 return cli_usage_error("match", "--log-eps: '%s' is not a number > 0", optarg);
             break;
         case O_THREADS:
-            threads = (int)strtol(optarg, &e, 10);
-            if (!*optarg || *e || threads < 0 || threads > MATCH_MAX_THREADS)
+            o->threads = (int)strtol(optarg, &e, 10);
+            if (!*optarg || *e || o->threads < 0 || o->threads > MATCH_MAX_THREADS)
                 return cli_usage_error("match", "--threads: '%s' is not an integer in [0, %d] (0: by the "
                                        "pair's size)", optarg, MATCH_MAX_THREADS);
             break;
         case O_PROGRESS:
-            if (cli_progress_parse(optarg, &progress))
+            if (cli_progress_parse(optarg, &o->progress))
                 return cli_usage_error("match", "--progress: '%s' is not auto, bar, text, json or none",
                                        optarg);
             break;
@@ -174,52 +183,121 @@ int cli_match(int argc, char **argv)
         default: return cli_usage_see("match");
         }
     }
+    return -1;
+}
+
+/* Checks the options together, the job's and the outputs included, and
+ * sets the engine's parameters: 0, else the exit status of a usage
+ * error. */
+static int check_options(int argc, match_opts *o)
+{
     if (argc - optind != 2)
         return cli_usage_error("match", "need SOURCE and TARGET mesh files (%d given)", argc - optind);
-    if (!out)
+    if (!o->out)
         return cli_usage_error("match", "need --out P.map");
-    if (cli_job_check(&job, "match") || cli_job_engine(&job, "match", threads, &pe, &rp))
+    if (cli_job_check(&o->job, "match") || cli_job_engine(&o->job, "match", o->threads, &o->pe, &o->rp))
         return cli_usage_see("match");
-    pe.log_eps = log_eps;
-    corr_chain stages = (corr_chain)job.w.stages;
-    int ectm_last = corr_chain_run(stages, !!job.init) & CORR_RUN_ECTM;
-    if (!ectm_last && out_def)
+    o->pe.log_eps = o->log_eps;
+    o->stages = (corr_chain)o->job.w.stages;
+    o->ectm_last = corr_chain_run(o->stages, !!o->job.init) & CORR_RUN_ECTM;
+    if (!o->ectm_last && o->out_def)
         return cli_usage_error("match", "--out-deformed needs the ECTM stage (the deformation is ECTM's)");
-    if (pe.model == ECTM_INJECTIVE && out_rev)
+    if (o->pe.model == ECTM_INJECTIVE && o->out_rev)
         return cli_usage_error("match", "--out-reverse needs the bijective model");
-    unsigned run = corr_chain_run(stages, !!job.init);
-    if ((out_rhm || out_rhm_rev) && (run & (CORR_RUN_RHM | CORR_RUN_ECTM)) !=
-                                        (CORR_RUN_RHM | CORR_RUN_ECTM))
+    unsigned run = corr_chain_run(o->stages, !!o->job.init);
+    if ((o->out_rhm || o->out_rhm_rev) && (run & (CORR_RUN_RHM | CORR_RUN_ECTM)) !=
+                                              (CORR_RUN_RHM | CORR_RUN_ECTM))
         return cli_usage_error("match", "--out-stage rhm needs a chain that runs RHM then ECTM "
                                "(stages all from landmarks, rhm,ectm or ddm,rhm,ectm); with "
                                "--stages rhm, --out is RHM's map");
-    if (pe.model == ECTM_INJECTIVE && out_rhm_rev)
+    if (o->pe.model == ECTM_INJECTIVE && o->out_rhm_rev)
         return cli_usage_error("match", "--out-stage rhm-reverse needs the bijective model");
-    if (cli_output_check("match", "--out", out) || cli_output_check("match", "--out-reverse", out_rev) ||
-        cli_output_check("match", "--out-deformed", out_def) ||
-        cli_output_check("match", "--out-remeshed", out_rem) ||
-        cli_output_check("match", "--out-stage rhm", out_rhm) ||
-        cli_output_check("match", "--out-stage rhm-reverse", out_rhm_rev))
+    if (cli_output_check("match", "--out", o->out) || cli_output_check("match", "--out-reverse", o->out_rev) ||
+        cli_output_check("match", "--out-deformed", o->out_def) ||
+        cli_output_check("match", "--out-remeshed", o->out_rem) ||
+        cli_output_check("match", "--out-stage rhm", o->out_rhm) ||
+        cli_output_check("match", "--out-stage rhm-reverse", o->out_rhm_rev))
         return CLI_EXIT_USAGE;
-    char err[1024];
-    progress = cli_progress_resolve(progress, stderr);
+    return 0;
+}
 
-    int status = 1;
+/* The maps of res (in the user's indexing: RHM's too when asked) with a
+ * comment saying what made them, the deformed source and the remeshed
+ * source, each where its option asks; -1 with the message printed. */
+static int write_outputs(const match_opts *o, const char *src, const char *tgt, const mesh *S,
+                         const mesh *T, const ectm_result *res)
+{
+    char err[1024], comment[512];
+    char chain[64] = "";
+    proto_param_value_name(PROTO_P_stages, (unsigned)o->stages, chain, sizeof chain);
+    if (!o->ectm_last)
+        snprintf(comment, sizeof comment, "meshcorr match %s -> %s, stages %s (%s)", src, tgt, chain,
+                 corr_chain_run(o->stages, !!o->job.init) & CORR_RUN_RHM ? "reversible harmonic map"
+                                                                          : "DDM-denoised map");
+    else
+        snprintf(comment, sizeof comment,
+                 "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",
+                 src, tgt, o->pe.model == ECTM_BIJECTIVE ? "bijective" : "injective",
+                 res->last.outer, res->last.energy);
+    if (bmap_write(o->out, res->P, comment, err, sizeof err) ||
+        (o->out_rev && res->Q && bmap_write(o->out_rev, res->Q, comment, err, sizeof err))) {
+        fprintf(stderr, "meshcorr match: %s\n", err);
+        return -1;
+    }
+    if (o->out_rhm || o->out_rhm_rev) {
+        char rc_comment[600];
+        snprintf(rc_comment, sizeof rc_comment, "meshcorr match %s -> %s, stages %s: the reversible "
+                 "harmonic map ECTM started from", src, tgt, chain);
+        if ((o->out_rhm && bmap_write(o->out_rhm, res->rhm_P, rc_comment, err, sizeof err)) ||
+            (o->out_rhm_rev && bmap_write(o->out_rhm_rev, res->rhm_Q, rc_comment, err, sizeof err))) {
+            fprintf(stderr, "meshcorr match: %s\n", err);
+            return -1;
+        }
+    }
+    if (o->out_def && write_mesh_with(o->out_def, S, res->Y, S->nv))
+        return -1;
+    if (o->out_rem) {
+        double *pt = malloc(sizeof(double) * 3 * (size_t)S->nv + 1);
+        if (!pt) {
+            fprintf(stderr, "meshcorr match: out of memory\n");
+            return -1;
+        }
+        bmap_apply(res->P, T->f, T->v, 3, pt);
+        int w = write_mesh_with(o->out_rem, S, pt, S->nv);
+        free(pt);
+        if (w)
+            return -1;
+    }
+    return 0;
+}
+
+int cli_match(int argc, char **argv)
+{
+    match_opts o;
+    int status = parse_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    if ((status = check_options(argc, &o)))
+        return status;
+    char err[1024];
+    int progress = cli_progress_resolve(o.progress, stderr);
+
+    status = 1;
     mesh *S = NULL, *T = NULL;
     bmap *P0 = NULL, *Q0 = NULL;
     lmk_set *L = NULL;
     ectm_result res = {0}, eng = {0};       /* the user's indexing, the engine's */
     corr_fix fix = {0};
     const char *src = argv[optind], *tgt = argv[optind + 1];
-    int repair = job.w.repair == 0;            /* "yes|no" */
+    int repair = o.job.w.repair == 0;          /* "yes|no" */
     if (!(S = load(src, repair, &status)) || !(T = load(tgt, repair, &status)) ||
-        cli_job_load(&job, "match", S, T, &L, &P0, &Q0))
+        cli_job_load(&o.job, "match", S, T, &L, &P0, &Q0))
         goto done;
     /* --threads, else as many as the pair's size pays for (as the worker) */
-    pe.threads = rp.threads = ompenv_threads_for(S->nv + T->nv, threads);
-    omp_set_num_threads(pe.threads);
-    corr_input user = { S, T, src, tgt, L, P0, Q0, &rp, stages, (int)job.w.ddm_k,
-                        (corr_ddm_mode)job.w.ddm_mode }, in;
+    o.pe.threads = o.rp.threads = ompenv_threads_for(S->nv + T->nv, o.threads);
+    omp_set_num_threads(o.pe.threads);
+    corr_input user = { S, T, src, tgt, L, P0, Q0, &o.rp, o.stages, (int)o.job.w.ddm_k,
+                        (corr_ddm_mode)o.job.w.ddm_mode }, in;
     int rc = corr_fix_open(&user, repair, &fix, &in, err, sizeof err);
     if (rc) {
         fprintf(stderr, "meshcorr match: %s\n", err);
@@ -228,7 +306,7 @@ int cli_match(int argc, char **argv)
     }
     if (fix.repaired)
         print_repairs(&fix, src, tgt);
-    rc = corr_run(&in, &pe, on_progress, &progress, &eng, err, sizeof err);
+    rc = corr_run(&in, &o.pe, on_progress, &progress, &eng, err, sizeof err);
     cli_progress_end(stderr, progress);
     if (!rc && fix.repaired)
         rc = corr_fix_to_user(&fix, &eng, &res, err, sizeof err);
@@ -242,51 +320,13 @@ int cli_match(int argc, char **argv)
         status = proto_kind_exit(-rc);
         goto done;
     }
-    char comment[512];
-    char chain[64] = "";
-    proto_param_value_name(PROTO_P_stages, (unsigned)stages, chain, sizeof chain);
-    if (!ectm_last)
-        snprintf(comment, sizeof comment, "meshcorr match %s -> %s, stages %s (%s)", src, tgt, chain,
-                 corr_chain_run(stages, !!job.init) & CORR_RUN_RHM ? "reversible harmonic map"
-                                                                    : "DDM-denoised map");
-    else
-        snprintf(comment, sizeof comment,
-                 "meshcorr match %s -> %s, %s model, %d iterations, final energy %.10g",
-                 src, tgt, pe.model == ECTM_BIJECTIVE ? "bijective" : "injective",
-                 res.last.outer, res.last.energy);
-    if (bmap_write(out, res.P, comment, err, sizeof err) ||
-        (out_rev && res.Q && bmap_write(out_rev, res.Q, comment, err, sizeof err))) {
-        fprintf(stderr, "meshcorr match: %s\n", err);
+    if (write_outputs(&o, src, tgt, S, T, &res))
         goto done;
-    }
-    if (out_rhm || out_rhm_rev) {
-        char rc_comment[600];
-        snprintf(rc_comment, sizeof rc_comment, "meshcorr match %s -> %s, stages %s: the reversible "
-                 "harmonic map ECTM started from", src, tgt, chain);
-        if ((out_rhm && bmap_write(out_rhm, res.rhm_P, rc_comment, err, sizeof err)) ||
-            (out_rhm_rev && bmap_write(out_rhm_rev, res.rhm_Q, rc_comment, err, sizeof err))) {
-            fprintf(stderr, "meshcorr match: %s\n", err);
-            goto done;
-        }
-    }
-    if (out_def && write_mesh_with(out_def, S, res.Y, S->nv))
-        goto done;
-    if (out_rem) {
-        double *pt = malloc(sizeof(double) * 3 * (size_t)S->nv + 1);
-        if (!pt) {
-            fprintf(stderr, "meshcorr match: out of memory\n");
-            goto done;
-        }
-        bmap_apply(res.P, T->f, T->v, 3, pt);
-        int w = write_mesh_with(out_rem, S, pt, S->nv);
-        free(pt);
-        if (w)
-            goto done;
-    }
     /* the last line: how good the map is; RHM's before it when it is
      * written too */
     const ectm_result *ran = fix.repaired ? &eng : &res;
-    if (((out_rhm || out_rhm_rev) && print_quality("rhm map quality", "RHM's map: ", in.S, in.T, ran->rhm_P)) ||
+    if (((o.out_rhm || o.out_rhm_rev) &&
+         print_quality("rhm map quality", "RHM's map: ", in.S, in.T, ran->rhm_P)) ||
         print_quality("map quality", "", in.S, in.T, ran->P))
         goto done;
     status = 0;

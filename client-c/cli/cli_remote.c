@@ -308,7 +308,32 @@ static void spec_of_job(const cli_job *j, mc_job_spec *s)
 #undef SPEC_PARAM
 }
 
-int cli_submit(int argc, char **argv)
+/* The command line of submit. */
+typedef struct submit_opts {
+    remote r;
+    mc_job_spec spec;            /* its parameters, priority and label */
+    cli_job job;
+    int watch, qbits;
+    watch_opts w;
+} submit_opts;
+
+static void submit_usage(void)
+{
+    printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
+           "         [--quantization BITS] [--watch [--progress auto|bar|text|json]]\n" REMOTE_USAGE
+           "prints the job id; with --watch then follows the job as `meshcorr watch` does\n"
+           "(and exits as it: 0 when the job COMPLETED)\n"
+           "Meshes go to the server lossless: it computes on exactly the positions read and\n"
+           "returns the map `meshcorr match` gives. --quantization BITS (1-%d; 16 is Draco's\n"
+           "usual) sends each coordinate quantized over the bounding box instead: a smaller\n"
+           "upload, but the map differs from the local one. A .drc file is sent as it is.\n"
+           "Job options:\n", MC_QUANTIZATION_MAX_BITS);
+    cli_job_usage(stdout);
+}
+
+/* Reads and checks the command line, the job's parameters into o->spec:
+ * -1 to go on, else the exit status (a usage error, --help). */
+static int submit_options(int argc, char **argv, submit_opts *o)
 {
     enum { O_PRIORITY = 1, O_LABEL, O_WATCH, O_PROGRESS, O_QUANTIZATION };
     static const struct option opts[] = {
@@ -317,69 +342,95 @@ int cli_submit(int argc, char **argv)
         {"quantization", required_argument, 0, O_QUANTIZATION},
         {"watch", no_argument, 0, O_WATCH}, {"progress", required_argument, 0, O_PROGRESS},
         {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
-    remote r;
-    remote_defaults(&r);
-    mc_job_spec spec;
-    mc_job_spec_init(&spec);
-    cli_job job;
-    cli_job_init(&job, argc, argv);
-    int c, watch = 0, qbits = MC_QUANTIZATION_LOSSLESS;
-    watch_opts w = {0, CLI_PROGRESS_AUTO, 0};
+    remote_defaults(&o->r);
+    mc_job_spec_init(&o->spec);
+    cli_job_init(&o->job, argc, argv);
+    o->watch = 0;
+    o->qbits = MC_QUANTIZATION_LOSSLESS;
+    o->w = (watch_opts){0, CLI_PROGRESS_AUTO, 0};
+    int c;
     char *e;
     optind = 1;
     while ((c = cli_getopt("submit", argc, argv, opts)) != -1) {
-        if (remote_opt(&r, c))
+        if (remote_opt(&o->r, c))
             continue;
-        int jr = cli_job_option(&job, "submit", c, optarg);
+        int jr = cli_job_option(&o->job, "submit", c, optarg);
         if (jr < 0)
             return cli_usage_see("submit");
         if (jr)
             continue;
         switch (c) {
         case O_PRIORITY:
-            spec.priority = (int32_t)strtol(optarg, &e, 10);
+            o->spec.priority = (int32_t)strtol(optarg, &e, 10);
             if (!*optarg || *e)
                 return cli_usage_error("submit", "--priority: '%s' is not an integer", optarg);
             break;
-        case O_LABEL: spec.label = optarg; break;
+        case O_LABEL: o->spec.label = optarg; break;
         case O_QUANTIZATION:
-            qbits = (int)strtol(optarg, &e, 10);
-            if (!*optarg || *e || qbits < 1 || qbits > MC_QUANTIZATION_MAX_BITS)
+            o->qbits = (int)strtol(optarg, &e, 10);
+            if (!*optarg || *e || o->qbits < 1 || o->qbits > MC_QUANTIZATION_MAX_BITS)
                 return cli_usage_error("submit", "--quantization: '%s' is not a number of bits from 1 to %d",
                                        optarg, MC_QUANTIZATION_MAX_BITS);
             break;
-        case O_WATCH: watch = 1; break;
+        case O_WATCH: o->watch = 1; break;
         case O_PROGRESS:
-            if (watch_opt("submit", 'p', &w))
+            if (watch_opt("submit", 'p', &o->w))
                 return CLI_EXIT_USAGE;
             break;
-        case 'h':
-            printf("usage: meshcorr submit SOURCE TARGET INPUTS [job options] [--priority N] [--label L]\n"
-                   "         [--quantization BITS] [--watch [--progress auto|bar|text|json]]\n" REMOTE_USAGE
-                   "prints the job id; with --watch then follows the job as `meshcorr watch` does\n"
-                   "(and exits as it: 0 when the job COMPLETED)\n"
-                   "Meshes go to the server lossless: it computes on exactly the positions read and\n"
-                   "returns the map `meshcorr match` gives. --quantization BITS (1-%d; 16 is Draco's\n"
-                   "usual) sends each coordinate quantized over the bounding box instead: a smaller\n"
-                   "upload, but the map differs from the local one. A .drc file is sent as it is.\n"
-                   "Job options:\n", MC_QUANTIZATION_MAX_BITS);
-            cli_job_usage(stdout);
-            return 0;
+        case 'h': submit_usage(); return 0;
         default: return cli_usage_see("submit");
         }
     }
     if (argc - optind != 2)
         return cli_usage_error("submit", "need SOURCE and TARGET mesh files (%d given)", argc - optind);
-    if (qbits != MC_QUANTIZATION_LOSSLESS && (is_drc(argv[optind]) || is_drc(argv[optind + 1])))
+    if (o->qbits != MC_QUANTIZATION_LOSSLESS && (is_drc(argv[optind]) || is_drc(argv[optind + 1])))
         return cli_usage_error("submit", "--quantization: a .drc file is sent as it is, with its own coding");
-    if (!watch && w.progress_given)
+    if (!o->watch && o->w.progress_given)
         return cli_usage_error("submit", "--progress goes with --watch");
-    if (cli_job_check(&job, "submit"))
+    if (cli_job_check(&o->job, "submit"))
         return cli_usage_see("submit");
-    spec_of_job(&job, &spec);
+    spec_of_job(&o->job, &o->spec);
+    return -1;
+}
+
+/* The landmarks and the given maps into the spec, in *lm, *pr and *qr
+ * (the caller frees them); -1 out of memory, with the message printed. */
+static int spec_inputs(const lmk_set *L, const bmap *P0, const bmap *Q0, mc_job_spec *spec, uint32_t **lm,
+                       mc_map_row **pr, mc_map_row **qr)
+{
+    if (L) {
+        *lm = malloc(2 * sizeof **lm * (size_t)L->n + 1);
+        for (int i = 0; *lm && i < L->n; i++) {
+            (*lm)[2 * i] = (uint32_t)L->src[i];
+            (*lm)[2 * i + 1] = (uint32_t)L->tgt[i];
+        }
+        spec->landmarks = *lm;
+        spec->nlandmarks = (uint32_t)L->n;
+    }
+    if (P0) {
+        spec->p = *pr = rows_of(P0);
+        spec->np = (uint32_t)P0->n;
+    }
+    if (Q0) {
+        spec->q = *qr = rows_of(Q0);
+        spec->nq = (uint32_t)Q0->n;
+    }
+    if ((L && !*lm) || (P0 && !*pr) || (Q0 && !*qr)) {
+        fprintf(stderr, "meshcorr submit: out of memory\n");
+        return -1;
+    }
+    return 0;
+}
+
+int cli_submit(int argc, char **argv)
+{
+    submit_opts o;
+    int status = submit_options(argc, argv, &o);
+    if (status >= 0)
+        return status;
     const char *src = argv[optind], *tgt = argv[optind + 1];
     char err[4096];
-    int status = 1;
+    status = 1;
     mesh *S = NULL, *T = NULL;
     lmk_set *L = NULL;
     bmap *P0 = NULL, *Q0 = NULL;
@@ -391,40 +442,21 @@ int cli_submit(int argc, char **argv)
         fprintf(stderr, "meshcorr submit: %s\n", err);
         goto done;
     }
-    if (cli_job_load(&job, "submit", S, T, &L, &P0, &Q0))
+    if (cli_job_load(&o.job, "submit", S, T, &L, &P0, &Q0))
         goto done;
-    if (mc_encode_mesh_file_quantized(src, qbits, &sb, &spec.source_len, err, sizeof err) ||
-        mc_encode_mesh_file_quantized(tgt, qbits, &tb, &spec.target_len, err, sizeof err)) {
+    if (mc_encode_mesh_file_quantized(src, o.qbits, &sb, &o.spec.source_len, err, sizeof err) ||
+        mc_encode_mesh_file_quantized(tgt, o.qbits, &tb, &o.spec.target_len, err, sizeof err)) {
         fprintf(stderr, "meshcorr submit: %s\n", err);
         goto done;
     }
-    spec.source = sb;
-    spec.target = tb;
-    if (L) {
-        lm = malloc(2 * sizeof *lm * (size_t)L->n + 1);
-        for (int i = 0; lm && i < L->n; i++) {
-            lm[2 * i] = (uint32_t)L->src[i];
-            lm[2 * i + 1] = (uint32_t)L->tgt[i];
-        }
-        spec.landmarks = lm;
-        spec.nlandmarks = (uint32_t)L->n;
-    }
-    if (P0) {
-        spec.p = pr = rows_of(P0);
-        spec.np = (uint32_t)P0->n;
-    }
-    if (Q0) {
-        spec.q = qr = rows_of(Q0);
-        spec.nq = (uint32_t)Q0->n;
-    }
-    if ((L && !lm) || (P0 && !pr) || (Q0 && !qr)) {
-        fprintf(stderr, "meshcorr submit: out of memory\n");
+    o.spec.source = sb;
+    o.spec.target = tb;
+    if (spec_inputs(L, P0, Q0, &o.spec, &lm, &pr, &qr))
         goto done;
-    }
-    if (!(cl = remote_connect("submit", &r)))
+    if (!(cl = remote_connect("submit", &o.r)))
         goto done;
     uint64_t id;
-    int rc = mc_submit(cl, &spec, &id);
+    int rc = mc_submit(cl, &o.spec, &id);
     if (rc) {
         fail("submit", cl, rc);
         cl = NULL;
@@ -433,8 +465,8 @@ int cli_submit(int argc, char **argv)
     printf("%llu\n", (unsigned long long)id);
     fflush(stdout);
     status = 0;
-    if (watch) {
-        status = watch_job("submit", cl, id, &w);
+    if (o.watch) {
+        status = watch_job("submit", cl, id, &o.w);
         cl = NULL;
     }
 done:
@@ -685,6 +717,126 @@ static int write_map(const char *path, const mc_map_row *rows, uint32_t n, int n
     return rc;
 }
 
+/* The deformed source of res, decoded from Draco, to path; -1 with the
+ * message printed. */
+static int write_deformed(const char *path, const mc_job_result *res)
+{
+    char err[1024];
+    mesh Y = {0};
+    int rc = 0;
+    if (dracob_decode(res->deformed, res->deformed_len, MESH_MAX_VERTICES, MESH_MAX_FACES, &Y.v, &Y.nv,
+                      &Y.f, &Y.nf, err, sizeof err) || mesh_write(path, &Y, err, sizeof err)) {
+        fprintf(stderr, "meshcorr result: deformed mesh: %s\n", err);
+        rc = -1;
+    }
+    free(Y.v);
+    free(Y.f);
+    return rc;
+}
+
+/* The files o asks for from job id's result res and RHM's maps st: the
+ * maps (their target's vertex count from --target, else the reverse map's
+ * rows) and the deformed source; -1 with the message printed. */
+static int write_result_files(const result_opts *o, uint64_t id, const mc_job_result *res,
+                              const mc_stage_maps *st)
+{
+    char comment[128], err[1024];
+    snprintf(comment, sizeof comment, "meshcorrd job %llu", (unsigned long long)id);
+    int nt = (int)res->nq;
+    if (o->target) {
+        mesh *T = NULL;
+        if (mesh_read(o->target, &T, err, sizeof err)) {
+            fprintf(stderr, "meshcorr result: %s\n", err);
+            return -1;
+        }
+        nt = T->nv;
+        mesh_free(T);
+    }
+    if (o->out && !nt) {
+        fprintf(stderr, "meshcorr result: injective job: give --target MESH for the map's header\n");
+        return -1;
+    }
+    if (o->out && write_map(o->out, res->p, res->np, nt, comment))
+        return -1;
+    if (o->out_rev && (!res->nq || write_map(o->out_rev, res->q, res->nq, (int)res->np, comment))) {
+        if (!res->nq)
+            fprintf(stderr, "meshcorr result: job %llu has no reverse map (injective)\n", (unsigned long long)id);
+        return -1;
+    }
+    if ((o->rhm || o->rhm_rev) && !st->np) {
+        fprintf(stderr, "meshcorr result: job %llu has no RHM map of its own (its chain did not run "
+                "RHM then ECTM)\n", (unsigned long long)id);
+        return -1;
+    }
+    char rcomment[160];
+    snprintf(rcomment, sizeof rcomment, "meshcorrd job %llu: the reversible harmonic map ECTM started from",
+             (unsigned long long)id);
+    if (o->rhm && (!nt || write_map(o->rhm, st->p, st->np, nt, rcomment))) {
+        if (!nt)
+            fprintf(stderr, "meshcorr result: injective job: give --target MESH for the map's header\n");
+        return -1;
+    }
+    if (o->rhm_rev && (!st->nq || write_map(o->rhm_rev, st->q, st->nq, (int)st->np, rcomment))) {
+        if (!st->nq)
+            fprintf(stderr, "meshcorr result: job %llu has no reverse RHM map (injective)\n",
+                    (unsigned long long)id);
+        return -1;
+    }
+    if (o->out_def && write_deformed(o->out_def, res))
+        return -1;
+    return 0;
+}
+
+/* Job id's metrics on stdout, one `name value` a line or (--json) one
+ * object with the files written, and the worse map's quality warning on
+ * stderr. */
+static void print_result_metrics(const result_opts *o, uint64_t id, const mc_job_result *res)
+{
+    double verdict = 0, fl[2] = {0, 0}, co[2] = {0, 0};
+    if (o->json)
+        printf("{\"id\":%llu,\"metrics\":{", (unsigned long long)id);
+    for (uint32_t i = 0; i < res->nmetrics; i++) {
+        const char *k = res->metric_keys[i];
+        double v = res->metric_values[i];
+        if (o->json) {
+            printf("%s", i ? "," : "");
+            json_str(k);
+            putchar(':');
+            json_num(v);
+        } else {
+            printf("%s %.10g\n", shown(k), v);
+        }
+        if (!strcmp(k, "quality_verdict"))
+            verdict = v;
+        for (int d = 0; d < 2; d++) {
+            if (!strcmp(k, d ? "reverse_flipped_fraction" : "flipped_fraction"))
+                fl[d] = v;
+            if (!strcmp(k, d ? "reverse_collapsed_fraction" : "collapsed_fraction"))
+                co[d] = v;
+        }
+    }
+    if (o->json) {
+        printf("},\"p_rows\":%u,\"q_rows\":%u", res->np, res->nq);
+        const char *const files[3][2] = {{"out", o->out}, {"out_reverse", o->out_rev}, {"out_deformed", o->out_def}};
+        for (int f = 0; f < 3; f++) {
+            printf(",\"%s\":", files[f][0]);
+            if (files[f][1])
+                json_str(files[f][1]);
+            else
+                printf("null");
+        }
+        printf("}\n");
+    }
+    if (verdict > 0) {
+        /* the worse of the two maps, by the worker's rule */
+        int d = metric_verdict(fl[1], co[1]) > metric_verdict(fl[0], co[0]);
+        char text[256];
+        metric_verdict_text((int)verdict, fl[d], co[d], text, sizeof text);
+        fprintf(stderr, "meshcorr result: warning: job %llu: %s%s\n", (unsigned long long)id,
+                d ? "the reverse map: " : "", text);
+    }
+}
+
 int cli_result(int argc, char **argv)
 {
     static const struct option extra[] = {
@@ -726,105 +878,11 @@ int cli_result(int argc, char **argv)
         mc_result_free(&res);
         return fail("result", c, rc);
     }
-    char comment[128], err[1024];
-    snprintf(comment, sizeof comment, "meshcorrd job %llu", (unsigned long long)id);
-    int nt = (int)res.nq;
-    mesh *T = NULL;
-    if (o.target) {
-        if (mesh_read(o.target, &T, err, sizeof err)) {
-            fprintf(stderr, "meshcorr result: %s\n", err);
-            goto done;
-        }
-        nt = T->nv;
-    }
-    if (o.out && !nt) {
-        fprintf(stderr, "meshcorr result: injective job: give --target MESH for the map's header\n");
+    if (write_result_files(&o, id, &res, &st))
         goto done;
-    }
-    if (o.out && write_map(o.out, res.p, res.np, nt, comment))
-        goto done;
-    if (o.out_rev && (!res.nq || write_map(o.out_rev, res.q, res.nq, (int)res.np, comment))) {
-        if (!res.nq)
-            fprintf(stderr, "meshcorr result: job %llu has no reverse map (injective)\n", (unsigned long long)id);
-        goto done;
-    }
-    if ((o.rhm || o.rhm_rev) && !st.np) {
-        fprintf(stderr, "meshcorr result: job %llu has no RHM map of its own (its chain did not run "
-                "RHM then ECTM)\n", (unsigned long long)id);
-        goto done;
-    }
-    char rcomment[160];
-    snprintf(rcomment, sizeof rcomment, "meshcorrd job %llu: the reversible harmonic map ECTM started from",
-             (unsigned long long)id);
-    if (o.rhm && (!nt || write_map(o.rhm, st.p, st.np, nt, rcomment))) {
-        if (!nt)
-            fprintf(stderr, "meshcorr result: injective job: give --target MESH for the map's header\n");
-        goto done;
-    }
-    if (o.rhm_rev && (!st.nq || write_map(o.rhm_rev, st.q, st.nq, (int)st.np, rcomment))) {
-        if (!st.nq)
-            fprintf(stderr, "meshcorr result: job %llu has no reverse RHM map (injective)\n",
-                    (unsigned long long)id);
-        goto done;
-    }
-    if (o.out_def) {
-        mesh Y = {0};
-        if (dracob_decode(res.deformed, res.deformed_len, MESH_MAX_VERTICES, MESH_MAX_FACES, &Y.v, &Y.nv,
-                          &Y.f, &Y.nf, err, sizeof err) || mesh_write(o.out_def, &Y, err, sizeof err)) {
-            fprintf(stderr, "meshcorr result: deformed mesh: %s\n", err);
-            free(Y.v);
-            free(Y.f);
-            goto done;
-        }
-        free(Y.v);
-        free(Y.f);
-    }
-    double verdict = 0, fl[2] = {0, 0}, co[2] = {0, 0};
-    if (o.json)
-        printf("{\"id\":%llu,\"metrics\":{", (unsigned long long)id);
-    for (uint32_t i = 0; i < res.nmetrics; i++) {
-        const char *k = res.metric_keys[i];
-        double v = res.metric_values[i];
-        if (o.json) {
-            printf("%s", i ? "," : "");
-            json_str(k);
-            putchar(':');
-            json_num(v);
-        } else {
-            printf("%s %.10g\n", shown(k), v);
-        }
-        if (!strcmp(k, "quality_verdict"))
-            verdict = v;
-        for (int d = 0; d < 2; d++) {
-            if (!strcmp(k, d ? "reverse_flipped_fraction" : "flipped_fraction"))
-                fl[d] = v;
-            if (!strcmp(k, d ? "reverse_collapsed_fraction" : "collapsed_fraction"))
-                co[d] = v;
-        }
-    }
-    if (o.json) {
-        printf("},\"p_rows\":%u,\"q_rows\":%u", res.np, res.nq);
-        const char *const files[3][2] = {{"out", o.out}, {"out_reverse", o.out_rev}, {"out_deformed", o.out_def}};
-        for (int f = 0; f < 3; f++) {
-            printf(",\"%s\":", files[f][0]);
-            if (files[f][1])
-                json_str(files[f][1]);
-            else
-                printf("null");
-        }
-        printf("}\n");
-    }
-    if (verdict > 0) {
-        /* the worse of the two maps, by the worker's rule */
-        int d = metric_verdict(fl[1], co[1]) > metric_verdict(fl[0], co[0]);
-        char text[256];
-        metric_verdict_text((int)verdict, fl[d], co[d], text, sizeof text);
-        fprintf(stderr, "meshcorr result: warning: job %llu: %s%s\n", (unsigned long long)id,
-                d ? "the reverse map: " : "", text);
-    }
+    print_result_metrics(&o, id, &res);
     status = 0;
 done:
-    mesh_free(T);
     mc_result_free(&res);
     mc_stage_maps_free(&st);
     mc_close(c);

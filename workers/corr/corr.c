@@ -333,6 +333,79 @@ int corr_run(const corr_input *in, const ectm_params *p, corr_progress_fn progre
     return run_chain(in, p, &rl, out, err, errsz);
 }
 
+/* The checks before a chain runs: the ECTM parameters, both meshes, the
+ * chain against its inputs, the sizes; *rp, RHM's parameters (the job's or
+ * the defaults), checked when the chain runs RHM; *run, the stages that
+ * run. */
+static int check_chain(const corr_input *in, const ectm_params *p, rhm_params *rp, unsigned *run,
+                       char *err, size_t errsz)
+{
+    int rc = ectm_params_check(p, err, errsz);
+    if (rc)
+        return rc;
+    if ((rc = corr_validate(in->S, in->S_name, err, errsz)) ||
+        (rc = corr_validate(in->T, in->T_name, err, errsz)))
+        return rc;
+    if (in->rhm)
+        *rp = *in->rhm;
+    else
+        rhm_params_init(rp);
+    int bij = p->model == ECTM_BIJECTIVE;
+    if ((rc = corr_chain_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
+                                rp->gamma, in->ddm_mode, err, errsz)) ||
+        (rc = corr_check_sizes(in, err, errsz)))
+        return rc;
+    *run = corr_chain_run(in->stages, !!in->P0);
+    if ((*run & CORR_RUN_RHM) && (rc = rhm_params_check(rp, err, errsz)))
+        return rc;
+    return KIND_OK;
+}
+
+/* ECTM from P (and Q, bijective) with the job's landmarks pinned in its P-
+ * and Q-steps, into out, then the fold repair on the maps it returns where
+ * the chain calls for it (see below); out is closed when the repair
+ * fails. */
+static int run_ectm(const corr_input *in, const ectm_params *p, relay *rl, unsigned run,
+                    const bmap *P, const bmap *Q, ectm_result *out, char *err, size_t errsz)
+{
+    ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
+                          in->L ? in->L->n : 0 };
+    int rc = ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz);
+    if (rc != KIND_OK)
+        return rc;
+    /* ECTM's projection folds where its deformed surface passes a thin
+     * part at an angle: the same repair runs on the maps it returns in the
+     * landmark pipeline, and on a given map's chain through RHM on each
+     * map that would be returned folded (over 5 %). Not on chains where
+     * ECTM starts from the given (or only denoised) map: there its folds
+     * are scattered over the whole map and the repair's regions raise the
+     * error (docs/decisions.md, "Fold repair after ECTM"). */
+    bmap *rP = out->P, *rQ = out->Q;
+    if (in->P0 && !(run & CORR_RUN_RHM))
+        rP = rQ = NULL;
+    else if (in->P0) {
+        rP = if_folded(in->S, in->T, out->P);
+        rQ = if_folded(in->T, in->S, out->Q);
+    }
+    fold_report rep[2];
+    if ((rP || rQ) && (rc = repair_reported(in, rl, rP, rQ, 1, rep, err, errsz)))
+        ectm_result_close(out);
+    return rc;
+}
+
+/* RHM's maps (*sP, *sQ: init's or the coarse chain's) stay in the result
+ * beside ECTM's: out owns them from here. */
+static void keep_rhm_maps(ectm_result *out, rhm_result *init, bmap **sP, bmap **sQ)
+{
+    out->rhm_P = *sP;
+    out->rhm_Q = *sQ;
+    if (*sP == init->P12)
+        init->P12 = NULL;
+    if (*sQ && *sQ == init->P21)
+        init->P21 = NULL;
+    *sP = *sQ = NULL;
+}
+
 /* corr_run's body on in, reporting through rl: the job's chain, or the
  * coarse pair's (run_coarse) as part of it. The outermost call plans the
  * job. */
@@ -340,25 +413,12 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
                      char *err, size_t errsz)
 {
     memset(out, 0, sizeof *out);
-    int rc = ectm_params_check(p, err, errsz);
+    rhm_params rp;
+    unsigned run = 0;
+    int rc = check_chain(in, p, &rp, &run, err, errsz);
     if (rc)
         return rc;
-    if ((rc = corr_validate(in->S, in->S_name, err, errsz)) ||
-        (rc = corr_validate(in->T, in->T_name, err, errsz)))
-        return rc;
-    rhm_params rp;
-    if (in->rhm)
-        rp = *in->rhm;
-    else
-        rhm_params_init(&rp);
     int bij = p->model == ECTM_BIJECTIVE;
-    if ((rc = corr_chain_check(in->stages, !!in->P0, !!in->Q0, in->L ? in->L->n : 0, !bij,
-                                rp.gamma, in->ddm_mode, err, errsz)) ||
-        (rc = corr_check_sizes(in, err, errsz)))
-        return rc;
-    unsigned run = corr_chain_run(in->stages, !!in->P0);
-    if ((run & CORR_RUN_RHM) && (rc = rhm_params_check(&rp, err, errsz)))
-        return rc;
     corr_input planned = *in;
     planned.rhm = &rp;
     if (rl->plan->n == 0)
@@ -413,39 +473,9 @@ static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm
             sQ = bij ? init.P21 : NULL;
         }
     }
-    /* the job's landmarks, pinned in ECTM's P- and Q-steps */
-    ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
-                          in->L ? in->L->n : 0 };
-    rc = ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz);
-    if (rc == KIND_OK) {
-        /* ECTM's projection folds where its deformed surface passes a thin
-         * part at an angle: the same repair runs on the maps it returns in the
-         * landmark pipeline, and on a given map's chain through RHM on each
-         * map that would be returned folded (over 5 %). Not on chains where
-         * ECTM starts from the given (or only denoised) map: there its folds
-         * are scattered over the whole map and the repair's regions raise the
-         * error (docs/decisions.md, "Fold repair after ECTM"). */
-        bmap *rP = out->P, *rQ = out->Q;
-        if (in->P0 && !(run & CORR_RUN_RHM))
-            rP = rQ = NULL;
-        else if (in->P0) {
-            rP = if_folded(in->S, in->T, out->P);
-            rQ = if_folded(in->T, in->S, out->Q);
-        }
-        fold_report rep[2];
-        if ((rP || rQ) && (rc = repair_reported(in, rl, rP, rQ, 1, rep, err, errsz)))
-            ectm_result_close(out);
-    }
-    if (rc == KIND_OK && (run & CORR_RUN_RHM)) {
-        /* RHM's maps stay in the result beside ECTM's */
-        out->rhm_P = sP;
-        out->rhm_Q = sQ;
-        if (sP == init.P12)
-            init.P12 = NULL;
-        if (sQ && sQ == init.P21)
-            init.P21 = NULL;
-        sP = sQ = NULL;
-    }
+    rc = run_ectm(in, p, rl, run, P, Q, out, err, errsz);
+    if (rc == KIND_OK && (run & CORR_RUN_RHM))
+        keep_rhm_maps(out, &init, &sP, &sQ);
 done:
     if (sP != init.P12)
         bmap_free(sP);

@@ -254,111 +254,146 @@ int ener_def_update_admissible(ener_def *d, const double *Y)
     return count;
 }
 
+/* Pass A on chunk c of faces: each face's unit normal into fn and its
+ * membrane gradient into gf (with grad), the chunk's logs in one tight loop;
+ * returns the chunk's membrane energy, summed in face order. */
+static inline double membrane_chunk(ener_def *d, const double *Y, const double *grad, int c)
+{
+    const int nf = d->nf;
+    const double log_eps = d->p.log_eps, alpha = d->p.alpha;
+    const int *f = d->f;
+    const ener__face *fr = d->fr;
+    double *fn = d->fn, *gf = d->gf;
+    const int t0 = c * ENER_CHUNK;
+    const int t1 = nf - t0 < ENER_CHUNK ? nf : t0 + ENER_CHUNK;
+    double det[ENER_CHUNK], logd[ENER_CHUNK];
+    for (int t = t0; t < t1; t++) {
+        const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+        const double *y2 = corner(Y, f, t, 2);
+        const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+        const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                             e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
+        double *un = fn + 4 * (size_t)t;
+        un[3] = ener__unit_normal_of(e1, e2, n, un);
+        det[t - t0] = ener__membrane_det(fr[t].ginv, n);
+    }
+    for (int k = 0; k < t1 - t0; k++)
+        logd[k] = log(det[k] > log_eps ? det[k] : log_eps);
+    double s = 0.0;
+    for (int t = t0; t < t1; t++) {
+        const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
+        const double *y2 = corner(Y, f, t, 2);
+        const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
+        const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
+                             e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
+        s += ener__membrane_finish(fr[t].ginv, fr[t].ahat, alpha * fr[t].ahat,
+                                   log_eps, e1, e2, n,
+                                   det[t - t0], logd[t - t0],
+                                   grad ? gf + 9 * (size_t)t : NULL);
+    }
+    return s;
+}
+
+/* Pass B on chunk c of interior edges: each edge's coefficient into ecoef
+ * (0 for an inadmissible edge or a zero normal); returns the chunk's bending
+ * energy, summed in edge order. */
+static inline double bending_chunk(ener_def *d, int c)
+{
+    const int ne = d->ne;
+    const double eta = d->p.eta;
+    const ener__edge *er = d->er;
+    const unsigned char *adm = d->adm;
+    const double *fn = d->fn;
+    double *ecoef = d->ecoef;
+    const int e1 = ne - c * ENER_CHUNK < ENER_CHUNK ? ne : c * ENER_CHUNK + ENER_CHUNK;
+    double s = 0.0;
+    for (int e = c * ENER_CHUNK; e < e1; e++) {
+        const double *n1 = fn + 4 * (size_t)er[e].t[0];
+        const double *n2 = fn + 4 * (size_t)er[e].t[1];
+        if (!adm[e] || n1[3] == 0.0 || n2[3] == 0.0) {
+            ecoef[e] = 0.0;
+            continue;
+        }
+        const double cs = er[e].sign * (n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]);
+        const double diff = er[e].cos_ref - cs;
+        s += er[e].weight * diff * diff;
+        ecoef[e] = -2.0 * eta * er[e].weight * diff * er[e].sign;
+    }
+    return s;
+}
+
+/* Pass C on face t: the bending gradient w.r.t. its normal, back-propagated
+ * onto its corners and added to gf. */
+static inline void bending_face_grad(ener_def *d, const double *Y, int t)
+{
+    const int *f = d->f, *fedge = d->fedge, *fnbr = d->fnbr;
+    const double *fn = d->fn, *ecoef = d->ecoef;
+    double u[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; k++) {
+        const int e = fedge[3 * t + k];
+        if (e < 0)
+            continue;
+        const double *m = fn + 4 * (size_t)fnbr[3 * t + k];
+        u[0] += ecoef[e] * m[0];
+        u[1] += ecoef[e] * m[1];
+        u[2] += ecoef[e] * m[2];
+    }
+    const double *n = fn + 4 * (size_t)t;
+    ener__unit_normal_backprop(corner(Y, f, t, 0), corner(Y, f, t, 1),
+                               corner(Y, f, t, 2), n, n[3], u,
+                               d->gf + 9 * (size_t)t);
+}
+
+/* Pass D on vertex i: the sum of its faces' corner gradients, in the sorted
+ * vertex -> face order, into grad. */
+static inline void vertex_grad(const ener_def *d, double *grad, int i)
+{
+    const int *vf_start = d->E->vf_start, *vf_face = d->E->vf_face;
+    const int *vf_corner = d->E->vf_corner;
+    const double *gf = d->gf;
+    double gx = 0.0, gy = 0.0, gz = 0.0;
+    for (int s = vf_start[i]; s < vf_start[i + 1]; s++) {
+        const double *g = gf + 9 * (size_t)vf_face[s] + 3 * vf_corner[s];
+        gx += g[0];
+        gy += g[1];
+        gz += g[2];
+    }
+    grad[3 * (size_t)i] = gx;
+    grad[3 * (size_t)i + 1] = gy;
+    grad[3 * (size_t)i + 2] = gz;
+}
+
 double ener_def_eval(ener_def *d, const double *Y, double *grad,
                      double *w_mem, double *w_bnd)
 {
     const int nf = d->nf, ne = d->ne, nv = d->nv;
     const int ncf = nchunks(nf), nce = nchunks(ne);
-    const double log_eps = d->p.log_eps, alpha = d->p.alpha, eta = d->p.eta;
-    const int *f = d->f, *fedge = d->fedge, *fnbr = d->fnbr;
-    const ener__face *fr = d->fr;
-    const ener__edge *er = d->er;
-    const unsigned char *adm = d->adm;
-    double *fn = d->fn, *gf = d->gf, *ecoef = d->ecoef, *chunk = d->chunk;
-    const int *vf_start = d->E->vf_start, *vf_face = d->E->vf_face;
-    const int *vf_corner = d->E->vf_corner;
+    const double alpha = d->p.alpha, eta = d->p.eta;
+    double *chunk = d->chunk;
 
 #pragma omp parallel
     {
-        /* A: normals and det G, the chunk's logs in one tight loop, then
-         * the membrane terms */
+        /* A: normals and det G, then the membrane terms */
 #pragma omp for schedule(static)
-        for (int c = 0; c < ncf; c++) {
-            const int t0 = c * ENER_CHUNK;
-            const int t1 = nf - t0 < ENER_CHUNK ? nf : t0 + ENER_CHUNK;
-            double det[ENER_CHUNK], logd[ENER_CHUNK];
-            for (int t = t0; t < t1; t++) {
-                const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
-                const double *y2 = corner(Y, f, t, 2);
-                const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
-                const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
-                const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
-                                     e1[2] * e2[0] - e1[0] * e2[2],
-                                     e1[0] * e2[1] - e1[1] * e2[0]};
-                double *un = fn + 4 * (size_t)t;
-                un[3] = ener__unit_normal_of(e1, e2, n, un);
-                det[t - t0] = ener__membrane_det(fr[t].ginv, n);
-            }
-            for (int k = 0; k < t1 - t0; k++)
-                logd[k] = log(det[k] > log_eps ? det[k] : log_eps);
-            double s = 0.0;
-            for (int t = t0; t < t1; t++) {
-                const double *y0 = corner(Y, f, t, 0), *y1 = corner(Y, f, t, 1);
-                const double *y2 = corner(Y, f, t, 2);
-                const double e1[3] = {y1[0] - y0[0], y1[1] - y0[1], y1[2] - y0[2]};
-                const double e2[3] = {y2[0] - y0[0], y2[1] - y0[1], y2[2] - y0[2]};
-                const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1],
-                                     e1[2] * e2[0] - e1[0] * e2[2],
-                                     e1[0] * e2[1] - e1[1] * e2[0]};
-                s += ener__membrane_finish(fr[t].ginv, fr[t].ahat, alpha * fr[t].ahat,
-                                           log_eps, e1, e2, n,
-                                           det[t - t0], logd[t - t0],
-                                           grad ? gf + 9 * (size_t)t : NULL);
-            }
-            chunk[c] = s;
-        }
+        for (int c = 0; c < ncf; c++)
+            chunk[c] = membrane_chunk(d, Y, grad, c);
         /* B: bending terms */
 #pragma omp for schedule(static)
-        for (int c = 0; c < nce; c++) {
-            const int e1 = ne - c * ENER_CHUNK < ENER_CHUNK ? ne : c * ENER_CHUNK + ENER_CHUNK;
-            double s = 0.0;
-            for (int e = c * ENER_CHUNK; e < e1; e++) {
-                const double *n1 = fn + 4 * (size_t)er[e].t[0];
-                const double *n2 = fn + 4 * (size_t)er[e].t[1];
-                if (!adm[e] || n1[3] == 0.0 || n2[3] == 0.0) {
-                    ecoef[e] = 0.0;
-                    continue;
-                }
-                const double cs = er[e].sign * (n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]);
-                const double diff = er[e].cos_ref - cs;
-                s += er[e].weight * diff * diff;
-                ecoef[e] = -2.0 * eta * er[e].weight * diff * er[e].sign;
-            }
-            chunk[ncf + c] = s;
-        }
+        for (int c = 0; c < nce; c++)
+            chunk[ncf + c] = bending_chunk(d, c);
         if (grad) {
             /* C: bending gradient per face through its normal */
 #pragma omp for schedule(static)
-            for (int t = 0; t < nf; t++) {
-                double u[3] = {0.0, 0.0, 0.0};
-                for (int k = 0; k < 3; k++) {
-                    const int e = fedge[3 * t + k];
-                    if (e < 0)
-                        continue;
-                    const double *m = fn + 4 * (size_t)fnbr[3 * t + k];
-                    u[0] += ecoef[e] * m[0];
-                    u[1] += ecoef[e] * m[1];
-                    u[2] += ecoef[e] * m[2];
-                }
-                const double *n = fn + 4 * (size_t)t;
-                ener__unit_normal_backprop(corner(Y, f, t, 0), corner(Y, f, t, 1),
-                                           corner(Y, f, t, 2), n, n[3], u,
-                                           gf + 9 * (size_t)t);
-            }
+            for (int t = 0; t < nf; t++)
+                bending_face_grad(d, Y, t);
             /* D: gather per vertex in sorted face order */
 #pragma omp for schedule(static)
-            for (int i = 0; i < nv; i++) {
-                double gx = 0.0, gy = 0.0, gz = 0.0;
-                for (int s = vf_start[i]; s < vf_start[i + 1]; s++) {
-                    const double *g = gf + 9 * (size_t)vf_face[s] + 3 * vf_corner[s];
-                    gx += g[0];
-                    gy += g[1];
-                    gz += g[2];
-                }
-                grad[3 * (size_t)i] = gx;
-                grad[3 * (size_t)i + 1] = gy;
-                grad[3 * (size_t)i + 2] = gz;
-            }
+            for (int i = 0; i < nv; i++)
+                vertex_grad(d, grad, i);
         }
     }
     double em = 0.0, eb = 0.0;

@@ -77,14 +77,11 @@ int wrk_result_build(const wrk_job *job, const ectm_result *res, uint64_t job_id
     return rc;
 }
 
-static int build(const wrk_job *job, const ectm_result *res, const ectm_result *user,
-                 uint64_t job_id, double elapsed, wrk_result *r, char *err, size_t errsz)
+/* The maps of user (P, Q, RHM's) as wire rows in r and the message; on
+ * failure r is closed. */
+static int build_maps(const ectm_result *user, wrk_result *r, char *err, size_t errsz)
 {
     proto_result_ok *ok = &r->msg.u.result_ok;
-    r->msg.type = PROTO_MSG_RESULT_OK;
-    ok->job_id = job_id;
-    corr_input in;              /* the engine's pair, for the metrics */
-    wrk_job_input(job, &in);
     if (!(r->p = rows_of(user->P)) || (user->Q && !(r->q = rows_of(user->Q)))) {
         wrk_result_close(r);
         return errbuf_set(err, errsz, PROTO_ENOMEM, "result maps: out of memory");
@@ -101,7 +98,14 @@ static int build(const wrk_job *job, const ectm_result *res, const ectm_result *
         ok->rhm_p = (proto_map){ r->rhm_p, (uint32_t)user->rhm_P->n };
     if (user->rhm_Q)
         ok->rhm_q = (proto_map){ r->rhm_q, (uint32_t)user->rhm_Q->n };
+    return 0;
+}
 
+/* The deformed source (ECTM's Y, or the map's image) in Draco, in r and
+ * the message; on failure r is closed. */
+static int build_deformed(const wrk_job *job, const ectm_result *user, wrk_result *r,
+                          char *err, size_t errsz)
+{
     /* a chain that ends before ECTM has no deformation: its mesh is the
      * map's image P X~ of the source (what ECTM's Y approximates) */
     double *image = NULL;
@@ -127,11 +131,20 @@ static int build(const wrk_job *job, const ectm_result *res, const ectm_result *
                           "deformed mesh: %zu Draco bytes, over PROTO_MAX_MESH_BYTES (%u)", len,
                           PROTO_MAX_MESH_BYTES);
     }
-    ok->deformed = (proto_blob){ r->deformed, (uint32_t)len };
+    r->msg.u.result_ok.deformed = (proto_blob){ r->deformed, (uint32_t)len };
+    return 0;
+}
 
+/* The metrics of res's maps on the engine's pair in (the reverse map's
+ * when there is one, the repair's counts, RHM's map's), in r and the
+ * message; on failure r is closed. */
+static int build_metrics(const wrk_job *job, const corr_input *in, const ectm_result *res,
+                         double elapsed, wrk_result *r, char *err, size_t errsz)
+{
+    proto_result_ok *ok = &r->msg.u.result_ok;
     metric_summary ms, mq = {0};
-    if (metric_summarize(in.S, in.T, res->P, &ms) ||
-        (res->Q && metric_summarize(in.T, in.S, res->Q, &mq))) {
+    if (metric_summarize(in->S, in->T, res->P, &ms) ||
+        (res->Q && metric_summarize(in->T, in->S, res->Q, &mq))) {
         wrk_result_close(r);
         return errbuf_set(err, errsz, PROTO_ENOMEM, "metrics: out of memory");
     }
@@ -164,7 +177,7 @@ static int build(const wrk_job *job, const ectm_result *res, const ectm_result *
     if (res->rhm_P) {
         /* RHM's map's quality, as the final map's, on the engine's pair */
         metric_summary mr;
-        if (metric_summarize(in.S, in.T, res->rhm_P, &mr)) {
+        if (metric_summarize(in->S, in->T, res->rhm_P, &mr)) {
             wrk_result_close(r);
             return errbuf_set(err, errsz, PROTO_ENOMEM, "metrics: out of memory");
         }
@@ -178,4 +191,19 @@ static int build(const wrk_job *job, const ectm_result *res, const ectm_result *
         ok->nmetrics += WRK_RHM_KEYS;
     }
     return 0;
+}
+
+static int build(const wrk_job *job, const ectm_result *res, const ectm_result *user,
+                 uint64_t job_id, double elapsed, wrk_result *r, char *err, size_t errsz)
+{
+    r->msg.type = PROTO_MSG_RESULT_OK;
+    r->msg.u.result_ok.job_id = job_id;
+    corr_input in;              /* the engine's pair, for the metrics */
+    wrk_job_input(job, &in);
+    int rc = build_maps(user, r, err, errsz);
+    if (!rc)
+        rc = build_deformed(job, user, r, err, errsz);
+    if (!rc)
+        rc = build_metrics(job, &in, res, elapsed, r, err, errsz);
+    return rc;
 }

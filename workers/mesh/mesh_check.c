@@ -125,7 +125,8 @@ double mesh_face_area(const double *v, const int *f, int *degenerate)
     return 0.5 * twice;
 }
 
-int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
+/* The report before any counting: sizes, no genus, every "first" at -1. */
+static void report_init(const mesh *m, mesh_check_report *r)
 {
     memset(r, 0, sizeof *r);
     r->nv = m->nv;
@@ -136,7 +137,131 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
     r->first_nonmanifold_edge[0] = r->first_nonmanifold_edge[1] = -1;
     r->first_duplicate_pair[0] = r->first_duplicate_pair[1] = -1;
     r->first_inconsistent_edge[0] = r->first_inconsistent_edge[1] = -1;
+}
 
+/* Non-finite vertices, and the bounding box of the finite ones. */
+static void check_vertices(const mesh *m, mesh_check_report *r)
+{
+    int first = 1;
+    for (int i = 0; i < m->nv; i++) {
+        const double *p = m->v + 3 * i;
+        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+            if (r->nonfinite_vertices++ == 0)
+                r->first_nonfinite_vertex = i;
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            if (first || p[k] < r->bbox_min[k])
+                r->bbox_min[k] = p[k];
+            if (first || p[k] > r->bbox_max[k])
+                r->bbox_max[k] = p[k];
+        }
+        first = 0;
+    }
+}
+
+/* Faces: index range, degeneracy, area; marks the vertices they use, keys
+ * each face in range by its sorted vertices (tk, *ntk) and gathers the
+ * half-edges (h, *nh) of those without a repeated vertex (ok). */
+static void check_faces(const mesh *m, mesh_check_report *r, int *used, tri_key *tk, int *ntk,
+                        half *h, int *nh, char *ok)
+{
+    const int nv = m->nv, nf = m->nf;
+    *nh = *ntk = 0;
+    for (int t = 0; t < nf; t++) {
+        const int *f = m->f + 3 * t;
+        if (f[0] < 0 || f[0] >= nv || f[1] < 0 || f[1] >= nv || f[2] < 0 || f[2] >= nv) {
+            if (r->bad_index_faces++ == 0)
+                r->first_bad_index_face = t;
+            continue;
+        }
+        for (int k = 0; k < 3; k++)
+            used[f[k]] = 1;
+        int degenerate;
+        double a = mesh_face_area(m->v, m->f + 3 * (size_t)t, &degenerate);
+        if (isfinite(a))
+            r->area += a;
+        if (degenerate && r->degenerate_faces++ == 0)
+            r->first_degenerate_face = t;
+        tk[*ntk].face = t;
+        memcpy(tk[*ntk].s, f, sizeof tk[*ntk].s);
+        sort3(tk[*ntk].s);
+        (*ntk)++;
+        if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2])
+            continue;  /* repeated vertex: no meaningful edges */
+        ok[t] = 1;
+        for (int k = 0; k < 3; k++) {
+            int a0 = f[k], b0 = f[(k + 1) % 3];
+            half *e = &h[(*nh)++];
+            e->face = t;
+            e->forward = a0 < b0;
+            e->a = e->forward ? a0 : b0;
+            e->b = e->forward ? b0 : a0;
+            e->ca = 3 * t + (e->forward ? k : (k + 1) % 3);
+            e->cb = 3 * t + (e->forward ? (k + 1) % 3 : k);
+        }
+    }
+}
+
+/* Edges: groups the nh half-edges, sorted by vertex pair, into edges,
+ * counting the boundary (onb, vpar: its loops), non-manifold and
+ * inconsistently oriented ones, and joins the corners each edge glues
+ * (cpar). */
+static void check_edges(const half *h, int nh, mesh_check_report *r, char *onb, int *vpar, int *cpar)
+{
+    for (int i = 0; i < nh;) {
+        int j = i;
+        while (j < nh && h[j].a == h[i].a && h[j].b == h[i].b)
+            j++;
+        int n = j - i;
+        r->ne++;
+        if (n == 1) {
+            onb[h[i].a] = onb[h[i].b] = 1;
+            uf_union(vpar, h[i].a, h[i].b);
+        } else if (n > 2) {
+            if (r->nonmanifold_edges++ == 0) {
+                r->first_nonmanifold_edge[0] = h[i].a;
+                r->first_nonmanifold_edge[1] = h[i].b;
+            }
+        } else if (h[i].forward == h[i + 1].forward && r->inconsistent_edges++ == 0) {
+            r->first_inconsistent_edge[0] = h[i].a;
+            r->first_inconsistent_edge[1] = h[i].b;
+        }
+        for (int k = i + 1; k < j; k++) {
+            uf_union(cpar, h[i].ca, h[k].ca);
+            uf_union(cpar, h[i].cb, h[k].cb);
+        }
+        i = j;
+    }
+}
+
+/* Fans: the corner sets of a vertex (fans: a count per vertex); more than
+ * one is a pinch. Counts the components and boundary loops too. */
+static void check_fans(const mesh *m, mesh_check_report *r, const char *ok, int *cpar, int *comp,
+                       const char *onb, int *vpar, int *fans)
+{
+    const int nv = m->nv, nf = m->nf;
+    memset(fans, 0, sizeof *fans * (size_t)nv);
+    for (int t = 0; t < nf; t++) {
+        if (!ok[t])
+            continue;
+        for (int k = 0; k < 3; k++)
+            if (uf_find(cpar, 3 * t + k) == 3 * t + k)
+                fans[m->f[3 * t + k]]++;
+    }
+    for (int i = 0; i < nv; i++) {
+        if (fans[i] > 0 && uf_find(comp, i) == i)
+            r->components++;
+        if (fans[i] > 1 && r->nonmanifold_vertices++ == 0)
+            r->first_nonmanifold_vertex = i;
+        if (onb[i] && uf_find(vpar, i) == i)
+            r->boundary_loops++;
+    }
+}
+
+int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
+{
+    report_init(m, r);
     int rc = MESH_CHECK_OK;
     const int nv = m->nv, nf = m->nf;
     char *ok = calloc((size_t)nf + 1, 1);           /* face usable for topology */
@@ -153,58 +278,9 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
         goto out;
     }
 
-    int first = 1;
-    for (int i = 0; i < nv; i++) {
-        const double *p = m->v + 3 * i;
-        if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
-            if (r->nonfinite_vertices++ == 0)
-                r->first_nonfinite_vertex = i;
-            continue;
-        }
-        for (int k = 0; k < 3; k++) {
-            if (first || p[k] < r->bbox_min[k])
-                r->bbox_min[k] = p[k];
-            if (first || p[k] > r->bbox_max[k])
-                r->bbox_max[k] = p[k];
-        }
-        first = 0;
-    }
-
-    /* Faces: index range, degeneracy, area; gather half-edges of the rest. */
-    int nh = 0, ntk = 0;
-    for (int t = 0; t < nf; t++) {
-        const int *f = m->f + 3 * t;
-        if (f[0] < 0 || f[0] >= nv || f[1] < 0 || f[1] >= nv || f[2] < 0 || f[2] >= nv) {
-            if (r->bad_index_faces++ == 0)
-                r->first_bad_index_face = t;
-            continue;
-        }
-        for (int k = 0; k < 3; k++)
-            used[f[k]] = 1;
-        int degenerate;
-        double a = mesh_face_area(m->v, m->f + 3 * (size_t)t, &degenerate);
-        if (isfinite(a))
-            r->area += a;
-        if (degenerate && r->degenerate_faces++ == 0)
-            r->first_degenerate_face = t;
-        tk[ntk].face = t;
-        memcpy(tk[ntk].s, f, sizeof tk[ntk].s);
-        sort3(tk[ntk].s);
-        ntk++;
-        if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2])
-            continue;  /* repeated vertex: no meaningful edges */
-        ok[t] = 1;
-        for (int k = 0; k < 3; k++) {
-            int a0 = f[k], b0 = f[(k + 1) % 3];
-            half *e = &h[nh++];
-            e->face = t;
-            e->forward = a0 < b0;
-            e->a = e->forward ? a0 : b0;
-            e->b = e->forward ? b0 : a0;
-            e->ca = 3 * t + (e->forward ? k : (k + 1) % 3);
-            e->cb = 3 * t + (e->forward ? (k + 1) % 3 : k);
-        }
-    }
+    check_vertices(m, r);
+    int nh, ntk;
+    check_faces(m, r, used, tk, &ntk, h, &nh, ok);
     int nrefd = 0;
     for (int i = 0; i < nv; i++) {
         if (used[i])
@@ -233,49 +309,8 @@ int mesh_check_run(const mesh *m, mesh_check_report *r, char *err, size_t errsz)
         cpar[c] = c;
     for (int i = 0; i < nv; i++)
         vpar[i] = i;
-    for (int i = 0; i < nh;) {
-        int j = i;
-        while (j < nh && h[j].a == h[i].a && h[j].b == h[i].b)
-            j++;
-        int n = j - i;
-        r->ne++;
-        if (n == 1) {
-            onb[h[i].a] = onb[h[i].b] = 1;
-            uf_union(vpar, h[i].a, h[i].b);
-        } else if (n > 2) {
-            if (r->nonmanifold_edges++ == 0) {
-                r->first_nonmanifold_edge[0] = h[i].a;
-                r->first_nonmanifold_edge[1] = h[i].b;
-            }
-        } else if (h[i].forward == h[i + 1].forward && r->inconsistent_edges++ == 0) {
-            r->first_inconsistent_edge[0] = h[i].a;
-            r->first_inconsistent_edge[1] = h[i].b;
-        }
-        for (int k = i + 1; k < j; k++) {
-            uf_union(cpar, h[i].ca, h[k].ca);
-            uf_union(cpar, h[i].cb, h[k].cb);
-        }
-        i = j;
-    }
-
-    /* Fans: the corner sets of a vertex; more than one is a pinch. */
-    int *fans = used;  /* reuse: per-vertex fan count */
-    memset(fans, 0, sizeof *fans * (size_t)nv);
-    for (int t = 0; t < nf; t++) {
-        if (!ok[t])
-            continue;
-        for (int k = 0; k < 3; k++)
-            if (uf_find(cpar, 3 * t + k) == 3 * t + k)
-                fans[m->f[3 * t + k]]++;
-    }
-    for (int i = 0; i < nv; i++) {
-        if (fans[i] > 0 && uf_find(comp, i) == i)
-            r->components++;
-        if (fans[i] > 1 && r->nonmanifold_vertices++ == 0)
-            r->first_nonmanifold_vertex = i;
-        if (onb[i] && uf_find(vpar, i) == i)
-            r->boundary_loops++;
-    }
+    check_edges(h, nh, r, onb, vpar, cpar);
+    check_fans(m, r, ok, cpar, comp, onb, vpar, used);  /* used, reused: per-vertex fan count */
     r->euler = (long)nrefd - r->ne + (nf - r->bad_index_faces);
     if (r->components == 1 && r->nonmanifold_edges == 0 && r->nonmanifold_vertices == 0
         && r->bad_index_faces == 0)

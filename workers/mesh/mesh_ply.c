@@ -101,6 +101,76 @@ static long where(const ply_reader *r, const unsigned char *base)
     return r->binary ? (long)(r->p - base) : r->lx.line;
 }
 
+/* An "element NAME COUNT" line (lx after the keyword): a new entry of el,
+ * its count checked against the limits. */
+static int parse_element(const char *path, mesh_lex *lx, ply_elem *el, int *nel, char *err, size_t errsz)
+{
+    const char *t;
+    size_t n;
+    if (*nel == PLY_MAX_ELEMENTS)
+        return errbuf_set(err, errsz, MESH_ELIMIT, "%s:%ld: more than %d elements",
+                          path, lx->line, PLY_MAX_ELEMENTS);
+    ply_elem *e = &el[(*nel)++];
+    memset(e, 0, sizeof *e);
+    n = mesh_lex_next_inline(lx, &t);
+    if (n == 0 || n >= sizeof e->name)
+        return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: bad element name", path, lx->line);
+    memcpy(e->name, t, n);
+    n = mesh_lex_next_inline(lx, &t);
+    long cnt;
+    if (mesh_lex_parse_long(t, n, &cnt) || cnt < 0)
+        return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: element %s: bad count",
+                          path, lx->line, e->name);
+    long limit = strcmp(e->name, "vertex") == 0 ? MESH_MAX_VERTICES : MESH_MAX_FACES;
+    if (cnt > limit)
+        return errbuf_set(err, errsz, MESH_ELIMIT,
+                          "%s:%ld: element %s has %ld items, over the limit of %ld",
+                          path, lx->line, e->name, cnt, limit);
+    e->count = cnt;
+    return MESH_OK;
+}
+
+/* A "property TYPE NAME" or "property list COUNT ITEM NAME" line (lx after
+ * the keyword): a property of the last element, with its role when it is
+ * x, y, z of a vertex or a face's index list. */
+static int parse_property(const char *path, mesh_lex *lx, ply_elem *el, int nel, char *err, size_t errsz)
+{
+    const char *t;
+    size_t n;
+    if (nel == 0)
+        return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: property before any element",
+                          path, lx->line);
+    ply_elem *e = &el[nel - 1];
+    if (e->nprop == PLY_MAX_PROPERTIES)
+        return errbuf_set(err, errsz, MESH_ELIMIT, "%s:%ld: element %s: more than %d properties",
+                          path, lx->line, e->name, PLY_MAX_PROPERTIES);
+    ply_prop *pr = &e->prop[e->nprop++];
+    memset(pr, 0, sizeof *pr);
+    n = mesh_lex_next_inline(lx, &t);
+    if (word_is(t, n, "list")) {
+        n = mesh_lex_next_inline(lx, &t);
+        pr->count = type_of(t, n);
+        n = mesh_lex_next_inline(lx, &t);
+        pr->type = type_of(t, n);
+        if (pr->count == T_NONE || pr->type == T_NONE || pr->count == T_F32 || pr->count == T_F64)
+            return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: bad list property types",
+                              path, lx->line);
+    } else {
+        pr->type = type_of(t, n);
+        if (pr->type == T_NONE)
+            return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: unknown property type \"%.*s\"",
+                              path, lx->line, (int)(n > 40 ? 40 : n), t);
+    }
+    n = mesh_lex_next_inline(lx, &t);
+    if (strcmp(e->name, "vertex") == 0 && pr->count == T_NONE && n == 1 && *t >= 'x' && *t <= 'z')
+        pr->role = 1 + (*t - 'x');
+    if (strcmp(e->name, "face") == 0 && pr->count != T_NONE
+        && (word_is(t, n, "vertex_indices") || word_is(t, n, "vertex_index")))
+        pr->role = 4;
+    mesh_lex_skip_line(lx);
+    return MESH_OK;
+}
+
 /* Parses the header; on success *data is the first byte after it. */
 static int parse_header(const char *path, const char *buf, size_t len, ply_elem *el, int *nel,
                         int *binary, size_t *data, char *err, size_t errsz)
@@ -145,58 +215,13 @@ static int parse_header(const char *path, const char *buf, size_t len, ply_elem 
             have_format = 1;
             mesh_lex_skip_line(&lx);
         } else if (word_is(t, n, "element")) {
-            if (*nel == PLY_MAX_ELEMENTS)
-                return errbuf_set(err, errsz, MESH_ELIMIT, "%s:%ld: more than %d elements",
-                                  path, lx.line, PLY_MAX_ELEMENTS);
-            ply_elem *e = &el[(*nel)++];
-            memset(e, 0, sizeof *e);
-            n = mesh_lex_next_inline(&lx, &t);
-            if (n == 0 || n >= sizeof e->name)
-                return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: bad element name", path, lx.line);
-            memcpy(e->name, t, n);
-            n = mesh_lex_next_inline(&lx, &t);
-            long cnt;
-            if (mesh_lex_parse_long(t, n, &cnt) || cnt < 0)
-                return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: element %s: bad count",
-                                  path, lx.line, e->name);
-            long limit = strcmp(e->name, "vertex") == 0 ? MESH_MAX_VERTICES : MESH_MAX_FACES;
-            if (cnt > limit)
-                return errbuf_set(err, errsz, MESH_ELIMIT,
-                                  "%s:%ld: element %s has %ld items, over the limit of %ld",
-                                  path, lx.line, e->name, cnt, limit);
-            e->count = cnt;
+            int rc = parse_element(path, &lx, el, nel, err, errsz);
+            if (rc)
+                return rc;
         } else if (word_is(t, n, "property")) {
-            if (*nel == 0)
-                return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: property before any element",
-                                  path, lx.line);
-            ply_elem *e = &el[*nel - 1];
-            if (e->nprop == PLY_MAX_PROPERTIES)
-                return errbuf_set(err, errsz, MESH_ELIMIT, "%s:%ld: element %s: more than %d properties",
-                                  path, lx.line, e->name, PLY_MAX_PROPERTIES);
-            ply_prop *pr = &e->prop[e->nprop++];
-            memset(pr, 0, sizeof *pr);
-            n = mesh_lex_next_inline(&lx, &t);
-            if (word_is(t, n, "list")) {
-                n = mesh_lex_next_inline(&lx, &t);
-                pr->count = type_of(t, n);
-                n = mesh_lex_next_inline(&lx, &t);
-                pr->type = type_of(t, n);
-                if (pr->count == T_NONE || pr->type == T_NONE || pr->count == T_F32 || pr->count == T_F64)
-                    return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: bad list property types",
-                                      path, lx.line);
-            } else {
-                pr->type = type_of(t, n);
-                if (pr->type == T_NONE)
-                    return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: unknown property type \"%.*s\"",
-                                      path, lx.line, (int)(n > 40 ? 40 : n), t);
-            }
-            n = mesh_lex_next_inline(&lx, &t);
-            if (strcmp(e->name, "vertex") == 0 && pr->count == T_NONE && n == 1 && *t >= 'x' && *t <= 'z')
-                pr->role = 1 + (*t - 'x');
-            if (strcmp(e->name, "face") == 0 && pr->count != T_NONE
-                && (word_is(t, n, "vertex_indices") || word_is(t, n, "vertex_index")))
-                pr->role = 4;
-            mesh_lex_skip_line(&lx);
+            int rc = parse_property(path, &lx, el, *nel, err, errsz);
+            if (rc)
+                return rc;
         } else {
             return errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: unknown header line \"%.*s\"",
                               path, lx.line, (int)(n > 40 ? 40 : n), t);
@@ -204,6 +229,111 @@ static int parse_header(const char *path, const char *buf, size_t len, ply_elem 
     }
     if (!have_format)
         return errbuf_set(err, errsz, MESH_EPARSE, "%s: no \"format\" line", path);
+    return MESH_OK;
+}
+
+/* Which elements are the mesh (*nv vertices, *nf faces) and whether the
+ * avail bytes of data after the header can hold every element announced. */
+static int check_sizes(const char *path, const ply_elem *el, int nel, int binary, size_t avail,
+                       long long *nv, long long *nf, char *err, size_t errsz)
+{
+    long long need = 0;
+    int have_xyz = 0, have_faces = 0;
+    *nv = *nf = 0;
+    for (int i = 0; i < nel; i++) {
+        const ply_elem *e = &el[i];
+        if (e->nprop == 0 && e->count > 0)
+            return errbuf_set(err, errsz, MESH_EPARSE, "%s: element %s has no properties", path, e->name);
+        long long rec = 0;  /* least bytes one item takes */
+        for (int k = 0; k < e->nprop; k++) {
+            const ply_prop *pr = &e->prop[k];
+            if (binary)
+                rec += pr->count == T_NONE ? type_size(pr->type) : type_size(pr->count);
+            else
+                rec += 2;  /* a digit and a separator */
+            if (pr->role >= 1 && pr->role <= 3)
+                have_xyz |= 1 << (pr->role - 1);
+            if (pr->role == 4)
+                have_faces = 1;
+        }
+        need += e->count * rec;
+        if (strcmp(e->name, "vertex") == 0)
+            *nv = e->count;
+        else if (strcmp(e->name, "face") == 0)
+            *nf = e->count;
+    }
+    if (have_xyz != 7)
+        return errbuf_set(err, errsz, MESH_EPARSE, "%s: element vertex lacks x, y or z", path);
+    if (*nf > 0 && !have_faces)
+        return errbuf_set(err, errsz, MESH_EPARSE,
+                          "%s: element face lacks a vertex_indices list", path);
+    if ((unsigned long long)need > avail)
+        return errbuf_set(err, errsz, MESH_EPARSE,
+                          "%s: header announces %lld vertices and %lld faces, more than the file "
+                          "holds (%zu bytes of data)", path, *nv, *nf, avail);
+    return MESH_OK;
+}
+
+/* The cnt items of list property pr of item j of element e; into face j of
+ * m when it is the face index list (each index checked against nv). */
+static int read_list(const char *path, ply_reader *r, const unsigned char *base, const ply_elem *e,
+                     const ply_prop *pr, long long j, long cnt, long long nv, mesh *m,
+                     char *err, size_t errsz)
+{
+    int is_f = strcmp(e->name, "face") == 0;
+    for (long q = 0; q < cnt; q++) {
+        double x;
+        if (read_value(r, pr->type, &x))
+            return errbuf_set(err, errsz, MESH_EPARSE,
+                              "%s: %s %lld: list item %ld missing (truncated file?) at %s %ld",
+                              path, e->name, j, q, r->binary ? "byte" : "line", where(r, base));
+        if (!(is_f && pr->role == 4))
+            continue;
+        if (!(x >= 0 && x < (double)nv) || x != (double)(long)x)
+            return errbuf_set(err, errsz, MESH_EINVAL,
+                              "%s: face %lld: vertex index %g out of range [0, %lld)",
+                              path, j, x, nv);
+        m->f[3 * j + q] = (int)x;
+    }
+    return MESH_OK;
+}
+
+/* Every item of every element, in the header's order, from r: the vertices'
+ * x y z and the faces' indices into m, the rest read past. */
+static int read_elements(const char *path, ply_reader *r, const unsigned char *base, const ply_elem *el,
+                         int nel, long long nv, mesh *m, char *err, size_t errsz)
+{
+    for (int i = 0; i < nel; i++) {
+        const ply_elem *e = &el[i];
+        int is_v = strcmp(e->name, "vertex") == 0, is_f = strcmp(e->name, "face") == 0;
+        for (long long j = 0; j < e->count; j++) {
+            for (int k = 0; k < e->nprop; k++) {
+                const ply_prop *pr = &e->prop[k];
+                double x;
+                if (read_value(r, pr->count == T_NONE ? pr->type : pr->count, &x))
+                    return errbuf_set(err, errsz, MESH_EPARSE,
+                                      "%s: %s %lld: property %d missing or not a number (truncated "
+                                      "file?) at %s %ld", path, e->name, j, k,
+                                      r->binary ? "byte" : "line", where(r, base));
+                if (pr->count == T_NONE) {
+                    if (is_v && pr->role)
+                        m->v[3 * j + pr->role - 1] = x;
+                    continue;
+                }
+                if (!(x >= 0 && x <= 255 * 255))
+                    return errbuf_set(err, errsz, MESH_EPARSE, "%s: %s %lld: bad list length %g",
+                                      path, e->name, j, x);
+                long cnt = (long)x;
+                if (is_f && pr->role == 4 && cnt != 3)
+                    return errbuf_set(err, errsz, MESH_EPARSE,
+                                      "%s: face %lld has %ld vertices; only triangles are accepted "
+                                      "(triangulate the mesh first)", path, j, cnt);
+                int rc = read_list(path, r, base, e, pr, j, cnt, nv, m, err, errsz);
+                if (rc)
+                    return rc;
+            }
+        }
+    }
     return MESH_OK;
 }
 
@@ -228,47 +358,10 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
         goto out;
 
     /* Sizes: which elements are the mesh, and can the file hold them all? */
-    long long nv = 0, nf = 0, need = 0;
-    int have_xyz = 0, have_faces = 0;
-    for (int i = 0; i < nel; i++) {
-        ply_elem *e = &el[i];
-        if (e->nprop == 0 && e->count > 0) {
-            rc = errbuf_set(err, errsz, MESH_EPARSE, "%s: element %s has no properties", path, e->name);
-            goto out;
-        }
-        long long rec = 0;  /* least bytes one item takes */
-        for (int k = 0; k < e->nprop; k++) {
-            const ply_prop *pr = &e->prop[k];
-            if (binary)
-                rec += pr->count == T_NONE ? type_size(pr->type) : type_size(pr->count);
-            else
-                rec += 2;  /* a digit and a separator */
-            if (pr->role >= 1 && pr->role <= 3)
-                have_xyz |= 1 << (pr->role - 1);
-            if (pr->role == 4)
-                have_faces = 1;
-        }
-        need += e->count * rec;
-        if (strcmp(e->name, "vertex") == 0)
-            nv = e->count;
-        else if (strcmp(e->name, "face") == 0)
-            nf = e->count;
-    }
-    if (have_xyz != 7) {
-        rc = errbuf_set(err, errsz, MESH_EPARSE, "%s: element vertex lacks x, y or z", path);
+    long long nv, nf;
+    rc = check_sizes(path, el, nel, binary, len - data, &nv, &nf, err, errsz);
+    if (rc)
         goto out;
-    }
-    if (nf > 0 && !have_faces) {
-        rc = errbuf_set(err, errsz, MESH_EPARSE,
-                        "%s: element face lacks a vertex_indices list", path);
-        goto out;
-    }
-    if ((unsigned long long)need > len - data) {
-        rc = errbuf_set(err, errsz, MESH_EPARSE,
-                        "%s: header announces %lld vertices and %lld faces, more than the file "
-                        "holds (%zu bytes of data)", path, nv, nf, len - data);
-        goto out;
-    }
     m = mesh_new((int)nv, (int)nf);
     if (!m) {
         rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
@@ -278,58 +371,9 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
     ply_reader r = { .binary = binary,
                      .p = (const unsigned char *)buf + data, .end = (const unsigned char *)buf + len };
     mesh_lex_init(&r.lx, buf + data, len - data, 0);
-    const unsigned char *base = (const unsigned char *)buf;
-    for (int i = 0; i < nel; i++) {
-        const ply_elem *e = &el[i];
-        int is_v = strcmp(e->name, "vertex") == 0, is_f = strcmp(e->name, "face") == 0;
-        for (long long j = 0; j < e->count; j++) {
-            for (int k = 0; k < e->nprop; k++) {
-                const ply_prop *pr = &e->prop[k];
-                double x;
-                if (read_value(&r, pr->count == T_NONE ? pr->type : pr->count, &x)) {
-                    rc = errbuf_set(err, errsz, MESH_EPARSE,
-                                    "%s: %s %lld: property %d missing or not a number (truncated "
-                                    "file?) at %s %ld", path, e->name, j, k,
-                                    binary ? "byte" : "line", where(&r, base));
-                    goto out;
-                }
-                if (pr->count == T_NONE) {
-                    if (is_v && pr->role)
-                        m->v[3 * j + pr->role - 1] = x;
-                    continue;
-                }
-                if (!(x >= 0 && x <= 255 * 255)) {
-                    rc = errbuf_set(err, errsz, MESH_EPARSE, "%s: %s %lld: bad list length %g",
-                                    path, e->name, j, x);
-                    goto out;
-                }
-                long cnt = (long)x;
-                if (is_f && pr->role == 4 && cnt != 3) {
-                    rc = errbuf_set(err, errsz, MESH_EPARSE,
-                                    "%s: face %lld has %ld vertices; only triangles are accepted "
-                                    "(triangulate the mesh first)", path, j, cnt);
-                    goto out;
-                }
-                for (long q = 0; q < cnt; q++) {
-                    if (read_value(&r, pr->type, &x)) {
-                        rc = errbuf_set(err, errsz, MESH_EPARSE,
-                                        "%s: %s %lld: list item %ld missing (truncated file?) at %s %ld",
-                                        path, e->name, j, q, binary ? "byte" : "line", where(&r, base));
-                        goto out;
-                    }
-                    if (!(is_f && pr->role == 4))
-                        continue;
-                    if (!(x >= 0 && x < (double)nv) || x != (double)(long)x) {
-                        rc = errbuf_set(err, errsz, MESH_EINVAL,
-                                        "%s: face %lld: vertex index %g out of range [0, %lld)",
-                                        path, j, x, nv);
-                        goto out;
-                    }
-                    m->f[3 * j + q] = (int)x;
-                }
-            }
-        }
-    }
+    rc = read_elements(path, &r, (const unsigned char *)buf, el, nel, nv, m, err, errsz);
+    if (rc)
+        goto out;
     *out = m;
     m = NULL;
     rc = MESH_OK;
