@@ -634,3 +634,53 @@ TEST_T(make_demos_job_returns_both_maps_within_the_fold_targets, 600)
     mesh_free(S);
     mesh_free(T);
 }
+
+/* The finishing policy's table covers every stage and chain: RHM's and
+ * carried maps are always repaired and not relaxed; ECTM's are repaired and
+ * relaxed in the landmark pipeline, only when folded on a given map's chain
+ * through RHM, never when ECTM starts from the given map. */
+TEST(the_finishing_policy_says_which_maps_get_the_fold_repair)
+{
+    mesh *S = testmesh_icosphere(1), *T = testmesh_icosphere(1);
+    bmap *I = bmap_new(S->nv, T->nv);
+    CHECK(S && T && I);
+    for (int v = 0; v < S->nv; v++) {   /* the identity: no fold */
+        for (int t = 0; t < T->nf; t++)
+            for (int k = 0; k < 3; k++)
+                if (T->f[3 * t + k] == v) {
+                    I->face[v] = t;
+                    I->w[3 * v] = I->w[3 * v + 1] = I->w[3 * v + 2] = 0;
+                    I->w[3 * v + k] = 1;
+                }
+    }
+    corr_input lm = { .S = S, .T = T }, given = { .S = S, .T = T, .P0 = I };
+    for (int rhm = 0; rhm < 2; rhm++) {
+        bmap *P = I, *Q = I;
+        CHECK_INT(corr_finish_select(&lm, CORR_AFTER_RHM, rhm, &P, &Q), 0);
+        CHECK(P == I && Q == I);
+        CHECK_INT(corr_finish_select(&given, CORR_AFTER_CARRY, rhm, &P, &Q), 0);
+        CHECK(P == I && Q == I);
+        CHECK_INT(corr_finish_select(&lm, CORR_AFTER_ECTM, rhm, &P, &Q), 1);
+        CHECK(P == I && Q == I);
+    }
+    bmap *P = I, *Q = NULL;
+    CHECK_INT(corr_finish_select(&given, CORR_AFTER_ECTM, 1, &P, &Q), 1);
+    CHECK(P == NULL && Q == NULL);      /* not folded: left as it is */
+    bmap *C = bmap_new(S->nv, T->nv);   /* every vertex onto one point: collapsed */
+    CHECK(C != NULL);
+    for (int v = 0; v < S->nv; v++) {
+        C->face[v] = 0;
+        C->w[3 * v] = 1;
+        C->w[3 * v + 1] = C->w[3 * v + 2] = 0;
+    }
+    P = C;
+    CHECK_INT(corr_finish_select(&given, CORR_AFTER_ECTM, 1, &P, &Q), 1);
+    CHECK(P == C && Q == NULL);
+    P = C;
+    CHECK_INT(corr_finish_select(&given, CORR_AFTER_ECTM, 0, &P, &Q), 0);
+    CHECK(P == NULL && Q == NULL);
+    bmap_free(C);
+    bmap_free(I);
+    mesh_free(S);
+    mesh_free(T);
+}

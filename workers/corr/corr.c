@@ -76,61 +76,23 @@ static int relay_repair(relay *rl, int done, int total)
     return forward(rl, &p);
 }
 
-int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
-                char *err, size_t errsz)
-{
-    fold_params fp;
-    fold_params_init(&fp);
-    memset(rep, 0, 2 * sizeof *rep);
-    int n = in->L ? in->L->n : 0;
-    const int *ls = in->L ? in->L->src : NULL, *lt = in->L ? in->L->tgt : NULL;
-    fold_report r;
-    int rc = P ? fold_repair(in->S, in->T, ls, n, &fp, P, &rep[0]) : 0;
-    if (!rc && Q)
-        rc = fold_repair(in->T, in->S, lt, n, &fp, Q, &rep[1]);
-    if (!rc && relax && P && !(rc = fold_relax(in->S, in->T, ls, n, P, &r))) {
-        rep[0].relaxed = r.relaxed;
-        rep[0].bad_after = r.bad_after;
-    }
-    if (!rc && relax && Q && !(rc = fold_relax(in->T, in->S, lt, n, Q, &r))) {
-        rep[1].relaxed = r.relaxed;
-        rep[1].bad_after = r.bad_after;
-    }
-    if (rc)
-        return errbuf_set(err, errsz, corr_from_fold(rc),
-                          "repairing the folds of the maps: %s", fold_strerror(rc));
-    return KIND_OK;
-}
-
-/* The share of bad triangles (flipped plus collapsed) of the map P from
- * A onto B; 2 (worse than any) when it cannot be measured. */
-static double folded_map(const mesh *A, const mesh *B, const bmap *P)
-{
-    metric_summary m;
-    if (metric_summarize(A, B, P, &m))
-        return 2;
-    return m.flipped_fraction + m.collapsed_fraction;
-}
-
 /* That share for the more folded of RHM's two maps. */
 static double folded(const corr_input *in, const rhm_result *r)
 {
-    double f1 = folded_map(in->S, in->T, r->P12), f2 = folded_map(in->T, in->S, r->P21);
+    double f1 = corr_folded(in->S, in->T, r->P12), f2 = corr_folded(in->T, in->S, r->P21);
     return f1 > f2 ? f1 : f2;
 }
 
-/* m when the map m from A onto B would be returned folded (metric_verdict), else NULL. */
-static bmap *if_folded(const mesh *A, const mesh *B, bmap *m)
+/* The finishing of P and Q (either may be NULL) after stage `after`
+ * (corr_finish_select, corr_repair) between two reports of the repair
+ * stage (rl NULL: none); a report's non-zero return cancels. */
+static int finish_reported(const corr_input *in, relay *rl, corr_after after, int through_rhm,
+                           bmap *P, bmap *Q, fold_report rep[2], char *err, size_t errsz)
 {
-    return m && metric_verdict(folded_map(A, B, m), 0) != METRIC_VERDICT_OK ? m : NULL;
-}
-
-/* corr_repair of P and Q (either may be NULL) between two reports of
- * the repair stage (rl NULL: none); a report's non-zero return cancels. */
-static int repair_reported(const corr_input *in, relay *rl, bmap *P, bmap *Q, int relax,
-                           fold_report rep[2], char *err, size_t errsz)
-{
+    int relax = corr_finish_select(in, after, through_rhm, &P, &Q);
     int total = !!P + !!Q, rc;
+    if (!total)
+        return KIND_OK;
     if (relay_repair(rl, 0, total))
         return errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled before the fold repair");
     if ((rc = corr_repair(in, P, Q, relax, rep, err, errsz)))
@@ -154,7 +116,7 @@ static int rhm_repaired(const corr_input *in, const rhm_params *q, relay *rl,
         memcpy((*raw)->face, out->P12->face, sizeof(int) * (size_t)out->P12->n);
         memcpy((*raw)->w, out->P12->w, sizeof(double) * 3 * (size_t)out->P12->n);
     }
-    return repair_reported(in, rl, out->P12, out->P21, 0, rep, err, errsz);
+    return finish_reported(in, rl, CORR_AFTER_RHM, 1, out->P12, out->P21, rep, err, errsz);
 }
 
 /* corr_rhm, with the repairs reported and a second run planned through rl
@@ -216,11 +178,19 @@ static int rhm_from_maps(const corr_input *in, const bmap *P, const bmap *Q,
 {
     fold_report rep[2];
     int rc = rhm_run_from_maps(in->S, in->T, in->L, P, Q, rp, relay_rhm, rl, out, err, errsz);
-    return rc ? rc : repair_reported(in, rl, out->P12, out->P21, 0, rep, err, errsz);
+    return rc ? rc : finish_reported(in, rl, CORR_AFTER_RHM, 1, out->P12, out->P21, rep, err, errsz);
 }
 
 static int run_chain(const corr_input *in, const ectm_params *p, relay *rl, ectm_result *out,
                      char *err, size_t errsz);
+
+/* The finishing of maps carried from the decimated pair to in's meshes. */
+static int finish_carried(const corr_input *in, bmap *P, bmap *Q, char *err, size_t errsz)
+{
+    fold_report rep[2];
+    int relax = corr_finish_select(in, CORR_AFTER_CARRY, 1, &P, &Q);
+    return P || Q ? corr_repair(in, P, Q, relax, rep, err, errsz) : KIND_OK;
+}
 
 /* The chain of in (from landmarks) on the decimated pair, its last maps
  * carried to in's meshes and repaired there: *P, *Q (Q may stay NULL);
@@ -249,18 +219,17 @@ static int run_coarse(const corr_input *in, const ectm_params *p, relay *rl, bma
     }
     rl->ectm_total = 2 * p->iterations;   /* the coarse ECTM's, then the fine one's */
     relay coarse = *rl;
-    fold_report rep[2];
     if (!(rc = run_chain(&c.in, p, &coarse, &cr, err, errsz))) {
         rl->ectm_before = cr.last.outer;   /* fewer than planned if it stopped early */
         if (relay_repair(rl, 0, 1 + !!cr.Q))
             rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled before the fold repair");
         else if (!(rc = corr_coarse_carry(in, &c, cr.P, cr.Q, 0, P, Q, err, errsz)) &&
-                 !(rc = corr_repair(in, *P, Q ? *Q : NULL, 0, rep, err, errsz)) &&
+                 !(rc = finish_carried(in, *P, Q ? *Q : NULL, err, errsz)) &&
                  relay_repair(rl, 1 + !!cr.Q, 1 + !!cr.Q))
             rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled after the fold repair");
         if (!rc && cr.rhm_P &&
             !(rc = corr_coarse_carry(in, &c, cr.rhm_P, cr.rhm_Q, 0, rP, rQ, err, errsz)))
-            rc = corr_repair(in, *rP, rQ ? *rQ : NULL, 0, rep, err, errsz);
+            rc = finish_carried(in, *rP, rQ ? *rQ : NULL, err, errsz);
     }
     ectm_result_close(&cr);
     corr_coarse_close(&c);
@@ -362,9 +331,8 @@ static int check_chain(const corr_input *in, const ectm_params *p, rhm_params *r
 }
 
 /* ECTM from P (and Q, bijective) with the job's landmarks pinned in its P-
- * and Q-steps, into out, then the fold repair on the maps it returns where
- * the chain calls for it (see below); out is closed when the repair
- * fails. */
+ * and Q-steps, into out, then the finishing of the maps it returns
+ * (corr_finish.c's policy); out is closed when the repair fails. */
 static int run_ectm(const corr_input *in, const ectm_params *p, relay *rl, unsigned run,
                     const bmap *P, const bmap *Q, ectm_result *out, char *err, size_t errsz)
 {
@@ -373,22 +341,9 @@ static int run_ectm(const corr_input *in, const ectm_params *p, relay *rl, unsig
     int rc = ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz);
     if (rc != KIND_OK)
         return rc;
-    /* ECTM's projection folds where its deformed surface passes a thin
-     * part at an angle: the same repair runs on the maps it returns in the
-     * landmark pipeline, and on a given map's chain through RHM on each
-     * map that would be returned folded (over 5 %). Not on chains where
-     * ECTM starts from the given (or only denoised) map: there its folds
-     * are scattered over the whole map and the repair's regions raise the
-     * error (docs/decisions.md, "Fold repair after ECTM"). */
-    bmap *rP = out->P, *rQ = out->Q;
-    if (in->P0 && !(run & CORR_RUN_RHM))
-        rP = rQ = NULL;
-    else if (in->P0) {
-        rP = if_folded(in->S, in->T, out->P);
-        rQ = if_folded(in->T, in->S, out->Q);
-    }
     fold_report rep[2];
-    if ((rP || rQ) && (rc = repair_reported(in, rl, rP, rQ, 1, rep, err, errsz)))
+    if ((rc = finish_reported(in, rl, CORR_AFTER_ECTM, !!(run & CORR_RUN_RHM), out->P, out->Q, rep,
+                              err, errsz)))
         ectm_result_close(out);
     return rc;
 }

@@ -231,16 +231,31 @@ int corr_check_sizes(const corr_input *in, char *err, size_t errsz);
 int corr_rhm(const corr_input *in, const rhm_params *rp, rhm_progress_fn progress, void *ctx,
              rhm_result *out, bmap **raw, fold_report rep[2], char *err, size_t errsz);
 
-/* The fold repair the pipeline applies to RHM's maps and to ECTM's: fold_repair of P
- * (S -> T) when it is not NULL and of Q (T -> S) when it is not NULL, the landmarks fixed
+/* The fold repair (corr_finish.c): fold_repair of P (S -> T) when it is
+ * not NULL and of Q (T -> S) when it is not NULL, the landmarks fixed
  * (in->L may be NULL), with fold_params_init's values; with relax, then
- * fold_relax of each: on ECTM's maps, which the pipeline returns, not on
- * RHM's, whose folds corr_rhm reads to choose the start and which ECTM
- * moves anyway. rep[0], rep[1]: P's and Q's reports (bad_after and
+ * fold_relax of each. rep[0], rep[1]: P's and Q's reports (bad_after and
  * relaxed: after fold_relax when it ran). KIND_OK, or KIND_ENOMEM,
  * KIND_EMESH or KIND_EINTERNAL (corr_from_fold). */
 int corr_repair(const corr_input *in, bmap *P, bmap *Q, int relax, fold_report rep[2],
                 char *err, size_t errsz);
+
+/* The stages after which the pipeline finishes maps. */
+typedef enum corr_after {
+    CORR_AFTER_RHM,     /* RHM's maps, from landmarks or from given maps */
+    CORR_AFTER_CARRY,   /* maps carried from the decimated pair to the meshes */
+    CORR_AFTER_ECTM,    /* ECTM's maps, which the job returns */
+} corr_after;
+/* The finishing policy, one table in corr_finish.c: which of *P and *Q
+ * (either may be NULL) get the fold repair after stage `after` of in's chain
+ * (through_rhm: the chain runs RHM; in->P0: it starts from a given map).
+ * Those that do not are set to NULL. Returns 1 when fold_relax follows the
+ * repair (on the maps the job returns), else 0. */
+int corr_finish_select(const corr_input *in, corr_after after, int through_rhm, bmap **P,
+                       bmap **Q);
+/* The share of bad triangles (flipped plus collapsed) of the map P from A
+ * onto B; 2 (worse than any) when it cannot be measured. */
+double corr_folded(const mesh *A, const mesh *B, const bmap *P);
 
 /* A job's parameters (the wire form of the one list, proto_params.h) as the
  * engine's: checked with proto_params_check (KIND_EPARAMS, "NAME = V: ..."
