@@ -65,7 +65,7 @@ static void bench_mesh(const char *name)
     if (mesh_read(path, &X, err, sizeof err) != 0 ||
         geo_edges_build(X, &E, err, sizeof err) != 0)
         FAILF("%s: %s", path, err);
-    ener_def_params p = {20.0, 6.667e-4, ENER_LOG_EPS_DEFAULT};
+    ener_def_params p = {20.0, 6.667e-4, ENER_LOG_EPS_DEFAULT, NULL};
     d = ener_def_new(X, &E, &p, err, sizeof err);
     Y = malloc(3 * (size_t)X->nv * sizeof *Y);
     grad = malloc(3 * (size_t)X->nv * sizeof *grad);

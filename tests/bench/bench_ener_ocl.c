@@ -65,7 +65,7 @@ static void bench(mesh *X, const char *name)
     CHECK(X != NULL);
     if (geo_edges_build(X, &E, err, sizeof err))
         FAILF("%s: %s", name, err);
-    ener_def_params p = {20.0, 6.667e-4, ENER_LOG_EPS_DEFAULT};
+    ener_def_params p = {20.0, 6.667e-4, ENER_LOG_EPS_DEFAULT, NULL};
     ener_backend *cpu = NULL, *ocl = NULL;
     if (ener_backend_new(X, &E, &p, "cpu", "", 2, &cpu, err, sizeof err))
         FAILF("cpu: %s", err);

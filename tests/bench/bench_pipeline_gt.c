@@ -261,6 +261,7 @@ static void run_pair(const void *arg, void *out)
     /* coarse to fine: the ECTM after the carried RHM maps is not the
      * pipeline's (ECTM runs on the decimated pair first), so stages all
      * from the landmarks again */
+    ep.scale_reference = corr_scale_reference(&in, rr.P, rr.Q);   /* as the pipeline's */
     if (corr_run(coarse ? &in : &in2, &ep, on_progress, &w, &er, err, sizeof err))
         goto score;
     /* from landmarks, corr_run repairs ECTM's maps too (a run from given

@@ -304,6 +304,7 @@ static void run_pair(const void *arg, void *out)
     corr_input in2 = { ri->S, ri->T, S_name, T_name, &Lg, rr.P12, rr.P21, &rp, CORR_CHAIN_ECTM, 0,
                        CORR_DDM_PLAIN };
     t0 = now();
+    ep.scale_reference = corr_scale_reference(&ing, rr.P12, rr.P21);   /* as the pipeline's */
     if (corr_run(&in2, &ep, on_progress, NULL, &er, err, sizeof err))
         goto score;
     /* from landmarks, corr_run repairs ECTM's maps too (a run from given
@@ -318,6 +319,7 @@ static void run_pair(const void *arg, void *out)
             FAILF("%s", err);
         corr_input in3 = { S, T, S_name, T_name, L, cP, cQ, &rp, CORR_CHAIN_ECTM, 0,
                            CORR_DDM_PLAIN };
+        ep.scale_reference = corr_scale_reference(&in0g, cP, cQ);
         if (corr_run(&in3, &ep, on_progress, NULL, &fr, err, sizeof err))
             FAILF("%s", err);
         if (corr_repair(&in0g, fr.P, fr.Q, 1, rep, err, sizeof err))

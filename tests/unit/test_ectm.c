@@ -7,7 +7,10 @@
 #include "geo/geo_area.h"
 #include "metric/metric.h"
 #include "support/testdemo.h"
+#include "support/testmesh.h"
 
+#include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct trace {
@@ -79,6 +82,59 @@ TEST(map_sized_for_other_meshes_is_refused)
     CHECK_INT(ectm_run(d.T, d.S, d.P0, NULL, NULL, &p, NULL, NULL, &r, err, sizeof err), KIND_EMAP);
     CHECK_STR_HAS(err, "6938 -> 9239");
     testdemo_free(&d);
+}
+
+/* The identity of a mesh onto itself or onto a copy scaled as a whole
+ * gives every face the factor 1; onto a copy whose upper half is grown,
+ * the upper faces get the larger factors, and the total area stays. */
+TEST(area_scale_follows_the_maps_regional_area)
+{
+    mesh *X = testmesh_icosphere(3), *Y = mesh_copy(X), *Z = mesh_copy(X);
+    bmap *I = bmap_new(X->nv, X->nv);
+    CHECK(X && Y && Z && I);
+    for (int v = 0; v < X->nv; v++)
+        for (int t = 0; t < X->nf; t++)
+            for (int k = 0; k < 3; k++)
+                if (X->f[3 * t + k] == v) {
+                    I->face[v] = t;
+                    I->w[3 * v] = I->w[3 * v + 1] = I->w[3 * v + 2] = 0;
+                    I->w[3 * v + k] = 1;
+                }
+    for (int i = 0; i < 3 * Y->nv; i++)
+        Y->v[i] *= 3;
+    for (int v = 0; v < Z->nv; v++)
+        if (Z->v[3 * v + 2] > 0)
+            for (int k = 0; k < 3; k++)
+                Z->v[3 * v + k] *= 1 + Z->v[3 * v + 2];
+    double *s1 = ectm_area_scale(X, X, I), *s3 = ectm_area_scale(X, Y, I);
+    double *sz = ectm_area_scale(X, Z, I);
+    double *a = malloc(sizeof(double) * (size_t)X->nf);
+    CHECK(s1 && s3 && sz && a);
+    geo_face_areas(X, a);
+    double up = 0, wu = 0, down = 0, wd = 0, total = 0, w = 0;
+    for (int t = 0; t < X->nf; t++) {
+        CHECK(fabs(s1[t] - 1) < 1e-9 && fabs(s3[t] - 1) < 1e-9);
+        double zc = (X->v[3 * X->f[3 * t] + 2] + X->v[3 * X->f[3 * t + 1] + 2] +
+                     X->v[3 * X->f[3 * t + 2] + 2]) / 3;
+        if (zc > 0.5)
+            up += a[t] * sz[t], wu += a[t];
+        else if (zc < -0.5)
+            down += a[t] * sz[t], wd += a[t];
+        total += a[t] * log(sz[t]);
+        w += a[t];
+    }
+    printf("  grown upper half: factor %.3f above z = 0.5, %.3f below z = -0.5\n", up / wu,
+           down / wd);
+    CHECK(up / wu > 1.5 * (down / wd));
+    CHECK(fabs(total / w) < 1e-9);
+    free(a);
+    free(s1);
+    free(s3);
+    free(sz);
+    bmap_free(I);
+    mesh_free(X);
+    mesh_free(Y);
+    mesh_free(Z);
 }
 
 TEST_T(energy_never_increases_at_fixed_beta, 300)

@@ -153,7 +153,7 @@ TEST_T(gradient_matches_finite_differences_on_perturbed_real_mesh, 60)
 {
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT});
+                 (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL});
     CHECK_INT(fx.X->nv, 2087);
     perturb(&fx, 0.1, 3);
     double wm, wb;
@@ -208,7 +208,7 @@ TEST_T(gradient_matches_finite_differences_with_collapsed_and_folded_faces, 60)
     /* ε large enough that a step of h keeps collapsed faces on the tangent line */
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){1.0, 1.0, 1e-2});
+                 (ener_def_params){1.0, 1.0, 1e-2, NULL});
     perturb(&fx, 0.05, 5);
     int moved[8];
     int nm = violent_deformation(&fx, moved);
@@ -227,7 +227,7 @@ TEST(energy_and_gradient_vanish_at_the_reference)
 {
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){20.0, 0.5, ENER_LOG_EPS_DEFAULT});
+                 (ener_def_params){20.0, 0.5, ENER_LOG_EPS_DEFAULT, NULL});
     double wm, wb;
     double e = ener_def_eval(fx.d, fx.Y, fx.g, &wm, &wb);
     CHECK_NEAR(e, 0.0, 1e-12 * fx.area * 20.0);
@@ -237,9 +237,31 @@ TEST(energy_and_gradient_vanish_at_the_reference)
     CHECK(gmax(&fx) < 1e-12 * gscale);
     fixture_close(&fx);
 
-    fixture_open(&fx, testmesh_icosphere(3), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT});
+    fixture_open(&fx, testmesh_icosphere(3), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL});
     CHECK_NEAR(ener_def_eval(fx.d, fx.Y, fx.g, NULL, NULL), 0.0, 1e-13);
     CHECK(gmax(&fx) < 1e-13);
+    fixture_close(&fx);
+}
+
+/* With every face's reference metric grown by 4, the membrane energy and
+ * its gradient vanish at twice the reference mesh (bending is unchanged by
+ * scale) and not at the reference itself. */
+TEST(a_grown_reference_rests_at_the_grown_mesh)
+{
+    mesh *X = testmesh_icosphere(3);
+    CHECK(X != NULL);
+    double *four = malloc(sizeof(double) * (size_t)X->nf);
+    CHECK(four != NULL);
+    for (int t = 0; t < X->nf; t++)
+        four[t] = 4.0;
+    fixture fx;
+    fixture_open(&fx, X, (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT, four});
+    free(four);   /* ener_def_new keeps no pointer to it */
+    CHECK(ener_def_eval(fx.d, fx.Y, fx.g, NULL, NULL) > 0.1);
+    for (int i = 0; i < 3 * X->nv; i++)
+        fx.Y[i] = 2 * X->v[i];
+    CHECK_NEAR(ener_def_eval(fx.d, fx.Y, fx.g, NULL, NULL), 0.0, 1e-12);
+    CHECK(gmax(&fx) < 1e-12);
     fixture_close(&fx);
 }
 
@@ -263,7 +285,7 @@ TEST(energy_invariant_and_gradient_covariant_under_rigid_motion)
 {
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){2.0, 0.3, ENER_LOG_EPS_DEFAULT});
+                 (ener_def_params){2.0, 0.3, ENER_LOG_EPS_DEFAULT, NULL});
     perturb(&fx, 0.1, 7);
     const int nv = fx.X->nv;
     double e0 = ener_def_eval(fx.d, fx.Y, fx.g, NULL, NULL);
@@ -295,7 +317,7 @@ TEST(uniform_scaling_gives_closed_form_membrane_and_zero_bending)
 {
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){3.0, 5.0, ENER_LOG_EPS_DEFAULT});
+                 (ener_def_params){3.0, 5.0, ENER_LOG_EPS_DEFAULT, NULL});
     const double scales[3] = {0.5, 1.3, 2.0};
     for (int q = 0; q < 3; q++) {
         double s = scales[q], s2 = s * s;
@@ -318,7 +340,7 @@ TEST(bending_sum_equals_the_single_edge_kernel_over_interior_edges)
      * edge with (i, j, k) and (j, i, l) taken from the faces. */
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT});
+                 (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL});
     perturb(&fx, 0.2, 9);
     double wb;
     ener_def_eval(fx.d, fx.Y, NULL, NULL, &wb);
@@ -369,7 +391,7 @@ TEST(same_bits_with_one_and_two_threads)
 {
     fixture fx;
     fixture_open(&fx, read_mesh("shrec07_bim/Meshes/386.off"),
-                 (ener_def_params){20.0, 0.1, ENER_LOG_EPS_DEFAULT});
+                 (ener_def_params){20.0, 0.1, ENER_LOG_EPS_DEFAULT, NULL});
     perturb(&fx, 0.3, 11);
     omp_set_dynamic(0);
     omp_set_num_threads(1);
@@ -394,7 +416,7 @@ TEST(same_bits_with_one_and_two_threads)
 TEST(collapsing_a_face_makes_its_edges_inadmissible)
 {
     fixture fx;
-    fixture_open(&fx, testmesh_icosphere(2), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT});
+    fixture_open(&fx, testmesh_icosphere(2), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL});
     const int all = fx.E.ne; /* closed: every edge is interior */
     CHECK_INT(ener_def_update_admissible(fx.d, fx.Y), all);
     /* collapse face 10 onto its first corner: the faces around the two moved
@@ -436,7 +458,7 @@ TEST(collapsing_a_face_makes_its_edges_inadmissible)
 TEST(a_sliver_face_makes_its_edges_inadmissible)
 {
     fixture fx;
-    fixture_open(&fx, testmesh_icosphere(2), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT});
+    fixture_open(&fx, testmesh_icosphere(2), (ener_def_params){1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL});
     const int all = fx.E.ne;
     const int *f = fx.X->f;
     const int t = 10;
@@ -478,13 +500,13 @@ TEST(construction_refuses_degenerate_reference_and_bad_parameters)
     mesh *m = testmesh_icosphere(1);
     geo_edges E;
     CHECK_INT(geo_edges_build(m, &E, err, sizeof err), 0);
-    ener_def_params bad = {-1.0, 1.0, ENER_LOG_EPS_DEFAULT};
+    ener_def_params bad = {-1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL};
     CHECK(ener_def_new(m, &E, &bad, err, sizeof err) == NULL);
     CHECK_STR_HAS(err, "alpha = -1");
-    bad = (ener_def_params){1.0, 1.0, 0.0};
+    bad = (ener_def_params){1.0, 1.0, 0.0, NULL};
     CHECK(ener_def_new(m, &E, &bad, err, sizeof err) == NULL);
     CHECK_STR_HAS(err, "log_eps");
-    ener_def_params ok = {1.0, 1.0, ENER_LOG_EPS_DEFAULT};
+    ener_def_params ok = {1.0, 1.0, ENER_LOG_EPS_DEFAULT, NULL};
     memcpy(m->v + 3 * m->f[3 * 4 + 1], m->v + 3 * m->f[3 * 4], 3 * sizeof(double));
     CHECK(ener_def_new(m, &E, &ok, err, sizeof err) == NULL);
     CHECK_STR_HAS(err, "zero area in the reference mesh");

@@ -37,7 +37,7 @@ static int need_fp64_device(void)
     return gpu;
 }
 
-static const ener_def_params PARAMS = { 20.0, 6.667e-4, 1e-20 };
+static const ener_def_params PARAMS = { 20.0, 6.667e-4, 1e-20, NULL };
 
 typedef struct pair {
     mesh *X;
@@ -45,7 +45,7 @@ typedef struct pair {
     ener_backend *cpu, *ocl;
 } pair;
 
-static void pair_open(pair *pr, mesh *X)
+static void pair_open(pair *pr, mesh *X, const ener_def_params *p)
 {
     char err[4096];
     memset(pr, 0, sizeof *pr);
@@ -53,9 +53,9 @@ static void pair_open(pair *pr, mesh *X)
     pr->X = X;
     if (geo_edges_build(X, &pr->E, err, sizeof err))
         FAILF("geo_edges_build: %s", err);
-    if (ener_backend_new(X, &pr->E, &PARAMS, "cpu", "", 2, &pr->cpu, err, sizeof err))
+    if (ener_backend_new(X, &pr->E, p, "cpu", "", 2, &pr->cpu, err, sizeof err))
         FAILF("cpu backend: %s", err);
-    if (ener_backend_new(X, &pr->E, &PARAMS, "opencl", "", 2, &pr->ocl, err, sizeof err))
+    if (ener_backend_new(X, &pr->E, p, "opencl", "", 2, &pr->ocl, err, sizeof err))
         FAILF("opencl backend: %s", err);
     CHECK_STR_HAS(ener_backend_name(pr->ocl), "opencl: ");
     CHECK(strcmp(ener_backend_name(pr->cpu), "cpu") == 0);
@@ -148,7 +148,7 @@ static mesh *read_mesh(const char *rel_path)
 static void parity_on(mesh *X, const char *name)
 {
     pair pr;
-    pair_open(&pr, X);
+    pair_open(&pr, X, &PARAMS);
     char what[128];
     /* at X both are zero up to rounding */
     double *g = malloc(3 * (size_t)X->nv * sizeof(double));
@@ -190,11 +190,33 @@ TEST(opencl_matches_cpu_on_icosphere)
     parity_on(testmesh_icosphere(4), "icosphere(4)");
 }
 
+/* A reference metric grown per face (ECTM's scaled reference) reaches the
+ * device as the CPU computes it. */
+TEST(opencl_matches_cpu_with_a_reference_scaled_per_face)
+{
+    need_fp64_device();
+    mesh *X = testmesh_icosphere(4);
+    CHECK(X != NULL);
+    double *scale = malloc(sizeof(double) * (size_t)X->nf);
+    CHECK(scale != NULL);
+    for (int t = 0; t < X->nf; t++)
+        scale[t] = 1 + 0.5 * sin(0.01 * t);
+    ener_def_params p = PARAMS;
+    p.face_scale = scale;
+    pair pr;
+    pair_open(&pr, X, &p);
+    free(scale);
+    double *Y = deformed(X, 0.2, 0, 13);
+    check_parity(&pr, Y, "icosphere(4) with a scaled reference");
+    free(Y);
+    pair_close(&pr);
+}
+
 TEST(admissible_counts_agree_as_faces_collapse)
 {
     need_fp64_device();
     pair pr;
-    pair_open(&pr, testmesh_icosphere(3));
+    pair_open(&pr, testmesh_icosphere(3), &PARAMS);
     size_t n = 3 * (size_t)pr.X->nv;
     double *Y = malloc(n * sizeof(double));
     CHECK(Y != NULL);

@@ -331,14 +331,18 @@ static int check_chain(const corr_input *in, const ectm_params *p, rhm_params *r
 }
 
 /* ECTM from P (and Q, bijective) with the job's landmarks pinned in its P-
- * and Q-steps, into out, then the finishing of the maps it returns
+ * and Q-steps, its reference scaled by RHM's maps where corr_scale.c
+ * says (else as p asks), into out, then the finishing of the maps it returns
  * (corr_finish.c's policy); out is closed when the repair fails. */
 static int run_ectm(const corr_input *in, const ectm_params *p, relay *rl, unsigned run,
                     const bmap *P, const bmap *Q, ectm_result *out, char *err, size_t errsz)
 {
     ectm_landmarks el = { in->L ? in->L->src : NULL, in->L ? in->L->tgt : NULL,
                           in->L ? in->L->n : 0 };
-    int rc = ectm_run(in->S, in->T, P, Q, &el, p, relay_ectm, rl, out, err, errsz);
+    ectm_params q = *p;
+    if (run & CORR_RUN_RHM)
+        q.scale_reference = corr_scale_reference(in, P, Q);
+    int rc = ectm_run(in->S, in->T, P, Q, &el, &q, relay_ectm, rl, out, err, errsz);
     if (rc != KIND_OK)
         return rc;
     fold_report rep[2];

@@ -542,6 +542,29 @@ static int outer_iteration(pair *pr, int k, double beta, ectm_report *r, double 
     return KIND_OK;
 }
 
+/* Both sides, each with the membrane's reference scaled by its initial
+ * map when p->scale_reference asks for it (the target's only with Q0). */
+static int sides_open(pair *pr, const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
+                      const ener_def_params *dp, const ectm_params *p, char *err, size_t errsz)
+{
+    int scaled = p->scale_reference && !p->partial;
+    ener_def_params ds = *dp, dt = *dp;
+    double *sS = scaled ? ectm_area_scale(S, T, P0) : NULL;
+    double *sT = scaled && Q0 && pr->bijective ? ectm_area_scale(T, S, Q0) : NULL;
+    int rc = KIND_OK;
+    if ((scaled && !sS) || (scaled && Q0 && pr->bijective && !sT))
+        rc = errbuf_set(err, errsz, KIND_ENOMEM, "out of memory for the reference's scale");
+    ds.face_scale = sS;
+    dt.face_scale = sT;
+    if (!rc)
+        rc = side_open(&pr->s[0], S, p->partial, &ds, p, "source", err, errsz);
+    if (!rc)
+        rc = side_open(&pr->s[1], T, p->partial, &dt, p, "target", err, errsz);
+    free(sS);
+    free(sT);
+    return rc;
+}
+
 int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
              const ectm_landmarks *L, const ectm_params *p, ectm_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz)
@@ -565,7 +588,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
     pr.p = *p;
     pr.bijective = p->model == ECTM_BIJECTIVE;
     double *scratch = NULL;
-    ener_def_params dp = { p->alpha, p->eta, p->log_eps };
+    ener_def_params dp = { p->alpha, p->eta, p->log_eps, NULL };
     double beta_scale = 1.0;
     if (p->partial) {
         /* α/s on the source, β/(s·s̃): areas of the unscaled inputs. */
@@ -574,9 +597,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         pr.p.alpha = dp.alpha;
         beta_scale = 1.0 / (s * st);
     }
-    if ((rc = side_open(&pr.s[0], S, p->partial, &dp, p, "source", err, errsz)))
-        goto done;
-    if ((rc = side_open(&pr.s[1], T, p->partial, &dp, p, "target", err, errsz)))
+    if ((rc = sides_open(&pr, S, T, P0, Q0, &dp, p, err, errsz)))
         goto done;
     side *a = &pr.s[0], *b = &pr.s[1];
     int nmax = a->X->nv > b->X->nv ? a->X->nv : b->X->nv;

@@ -42,6 +42,9 @@ typedef struct ectm_params {
     double stop_change;    /* stop when |ΔE|/E < this at fixed β; 0: never   */
     double log_eps;        /* −log extension threshold on det G       (> 0)  */
     int partial;           /* partial matching: no rescaling          (0/1)  */
+    int scale_reference;   /* the membrane's reference metric takes the
+                              initial maps' regional area scale
+                              (ectm_area_scale; not with partial)    (0/1)  */
     int threads;           /* OpenMP threads; 0: all cores                   */
     char backend[16];      /* W_def engine: "cpu" (default; "" too), "opencl",
                               "auto" (ener_backend.h)                        */
@@ -119,5 +122,11 @@ typedef struct ectm_landmarks {
 int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
              const ectm_landmarks *L, const ectm_params *p, ectm_progress_fn progress,
              void *ctx, ectm_result *out, char *err, size_t errsz);
+
+/* Per face of X, the regional area factor the map P (X onto Y) gives it
+ * (ectm_scale.c): exp of the face's log image-area ratio (both meshes at
+ * unit area), smoothed over its region and centred so that X's total area
+ * stays. A malloc'ed array of X->nf, NULL when out of memory. */
+double *ectm_area_scale(const mesh *X, const mesh *Y, const bmap *P);
 
 #endif

@@ -102,9 +102,10 @@ static int build_faces(ener_def *d, const mesh *X, char *err, size_t errsz)
                               ener_strerror(ENER_EDEGENERATE), t, X->f[3 * t],
                               X->f[3 * t + 1], X->f[3 * t + 2]);
         ener__face *r = &d->fr[t];
-        r->ginv[0] = g22 / det;
-        r->ginv[1] = -g12 / det;
-        r->ginv[2] = g11 / det;
+        double sc = d->p.face_scale ? d->p.face_scale[t] : 1.0;
+        r->ginv[0] = g22 / (det * sc);
+        r->ginv[1] = -g12 / (det * sc);
+        r->ginv[2] = g11 / (det * sc);
         r->ahat = 0.5 * sqrt(det);
     }
     return ENER_OK;
@@ -193,6 +194,7 @@ ener_def *ener_def_new(const mesh *X, const geo_edges *E, const ener_def_params 
     if (build_faces(d, X, err, errsz) != ENER_OK)
         goto fail;
     build_edges(d, X);
+    d->p.face_scale = NULL;
     memset(d->adm, 1, ne);
     return d;
 nomem:

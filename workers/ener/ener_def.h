@@ -51,6 +51,8 @@ typedef struct ener_def_params {
     double alpha;    /* membrane weight (≥ 0) */
     double eta;      /* bending weight (≥ 0) */
     double log_eps;  /* tangent-line extension of −log below this det G (> 0) */
+    const double *face_scale;  /* per face, the factor of the reference metric
+                                  ĝ (its area grows by it); NULL: 1 */
 } ener_def_params;
 
 typedef struct ener_def ener_def;
