@@ -364,6 +364,12 @@ int mc_encode_mesh_quantized(const double *v, int nv, const int *f, int nf, int 
  * share OpenMP's thread count. */
 int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn cb, void *ctx,
              mc_job_result *out, char *err, size_t errsz);
+/* mc_match, and in *stage (not NULL) RHM's maps that ECTM started from,
+ * as mc_result_stage gives them for the same job on a server (np = nq = 0
+ * when the chain did not run RHM then ECTM); free with mc_stage_maps_free.
+ * libmeshcorr-engine.so.1, version MESHCORR_ENGINE_1.1. */
+int mc_match_stages(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn cb,
+                    void *ctx, mc_job_result *out, mc_stage_maps *stage, char *err, size_t errsz);
 
 #ifdef __cplusplus
 }

@@ -1,11 +1,13 @@
-/* mc_match.c — mc_match(), libmeshcorr-engine.so's one export: a job run in
- * the caller's process the way a meshcorrd worker runs it. The job takes the
- * server's road all the way: the client's mapping of mc_job_spec to a
- * SUBMIT (mc__wire.h), encoded and decoded by the protocol codec with its
- * limits, the worker's mapping of a SUBMIT to engine inputs and its checks
- * (wrk_job_from_submit), corr_run, the worker's RESULT_OK (wrk_result_build)
- * and the client's copy of it into mc_job_result; progress goes through the
- * worker's PROGRESS record. So the in-process map is the server's map. */
+/* mc_match.c — mc_match() and mc_match_stages(), libmeshcorr-engine.so's
+ * exports: a job run in the caller's process the way a meshcorrd worker
+ * runs it. The job takes the server's road all the way: the client's
+ * mapping of mc_job_spec to a SUBMIT (mc__wire.h), encoded and decoded by
+ * the protocol codec with its limits, the worker's mapping of a SUBMIT to
+ * engine inputs and its checks (wrk_job_from_submit), corr_run, the
+ * worker's RESULT_OK (wrk_result_build) and the client's copy of it into
+ * mc_job_result (and mc_stage_maps, as mc_result_stage copies it); progress
+ * goes through the worker's PROGRESS record. So the in-process map is the
+ * server's map. */
 #include "mc__wire.h"
 #include "main/worker.h"
 
@@ -70,11 +72,19 @@ static int submit_as_received(const mc_job_spec *spec, proto_buf *frame, proto_m
 int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn cb, void *ctx,
              mc_job_result *out, char *err, size_t errsz)
 {
+    return mc_match_stages(spec, threads, what, cb, ctx, out, NULL, err, errsz);
+}
+
+int mc_match_stages(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn cb,
+                    void *ctx, mc_job_result *out, mc_stage_maps *stage, char *err, size_t errsz)
+{
     if (!out) {
         snprintf(err, errsz, "mc_match: out is NULL");
         return MC_EARG;
     }
     memset(out, 0, sizeof *out);
+    if (stage)
+        memset(stage, 0, sizeof *stage);
     if (threads < 0 || threads > MC_MATCH_MAX_THREADS) {
         snprintf(err, errsz, "threads = %d: expected 0 (by the pair's size) to %d", threads,
                  MC_MATCH_MAX_THREADS);
@@ -109,8 +119,11 @@ int mc_match(const mc_job_spec *spec, int threads, unsigned what, mc_progress_fn
     }
     if ((rc = wrk_result_build(&job, &res, 0, since(&run.t0), &result, err, errsz)))
         goto done;
-    if ((rc = mc__result_of(&result.msg.u.result_ok, what, out)))
+    if ((rc = mc__result_of(&result.msg.u.result_ok, what, out)) ||
+        (stage && (rc = mc__stage_of(&result.msg.u.result_ok, stage)))) {
+        mc_result_free(out);
         snprintf(err, errsz, "out of memory for the result");
+    }
 done:
     if (rc == PROTO_ENOMEM)
         rc = MC_ENOMEM;

@@ -608,6 +608,10 @@ def case_rhm_stage_maps_same_as_cli():
     cli("result", str(job.id), "--out-stage", "rhm=" + rm, "--out-stage", "rhm-reverse=" + rqm,
         "--server", UNIX)
     assert meshcorr.read_map(rm) == r and meshcorr.read_map(rqm) == rq
+    # in this process: the same maps, the final and RHM's
+    local = meshcorr.match(SRC, TGT, landmarks=LANDMARKS, stages=True, **JOB)
+    assert local.p == res.p and local.stages["rhm"] == r and local.stages["rhm-reverse"] == rq
+    assert meshcorr.match(SRC, TGT, landmarks=LANDMARKS, **JOB).stages == {}   # not asked
 
 
 if __name__ == "__main__":

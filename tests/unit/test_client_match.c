@@ -1,11 +1,12 @@
 /* test_client_match.c — mc_match, the in-process job of
  * libmeshcorr-engine.so.1 (loaded with dlopen, as a binding does): the same
  * icosphere job through a real meshcorrd and through mc_match gives the
- * same maps bit for bit, the same metrics and the same progress records;
- * a progress callback that returns non-zero ends the job MC_ECANCELLED;
- * refusals carry the server's codes and messages; the library exports
- * mc_match alone and `make install-lib` installs it. And mc_read_mesh, the
- * reader Python's read_mesh uses: the file's arrays in its order. */
+ * same maps bit for bit (RHM's too, through mc_match_stages), the same
+ * metrics and the same progress records; a progress callback that returns
+ * non-zero ends the job MC_ECANCELLED; refusals carry the server's codes
+ * and messages; the library exports mc_match and mc_match_stages and `make
+ * install-lib` installs it. And mc_read_mesh, the reader Python's
+ * read_mesh uses: the file's arrays in its order. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
 #include "support/testrun.h"
@@ -22,14 +23,23 @@
 typedef int (*match_fn)(const mc_job_spec *, int, unsigned, mc_progress_fn, void *, mc_job_result *, char *,
                         size_t);
 
-static match_fn load_match(void)
+typedef int (*match_stages_fn)(const mc_job_spec *, int, unsigned, mc_progress_fn, void *,
+                               mc_job_result *, mc_stage_maps *, char *, size_t);
+
+/* The engine library's export `name`. */
+static void *engine_symbol(const char *name)
 {
     void *h = dlopen(ENGINE_SO, RTLD_NOW | RTLD_LOCAL);
     if (!h)
         FAILF("dlopen %s: %s", ENGINE_SO, dlerror());
-    match_fn f = (match_fn)(uintptr_t)dlsym(h, "mc_match");
+    void *f = dlsym(h, name);
     CHECK(f != NULL);
     return f;
+}
+
+static match_fn load_match(void)
+{
+    return (match_fn)(uintptr_t)engine_symbol("mc_match");
 }
 
 /* The icosphere job of testdaemon_submit (162 vertices, 6 landmarks). */
@@ -153,6 +163,23 @@ TEST_T(in_process_job_gives_the_daemons_maps_metrics_and_progress, 180)
         last_ectm--;
     CHECK(last_ectm >= 0);
     CHECK_INT(mr.p[last_ectm].outer, 4);
+    /* RHM's maps: mc_match_stages gives the daemon's (mc_result_stage) */
+    match_stages_fn match_stages = (match_stages_fn)(uintptr_t)engine_symbol("mc_match_stages");
+    mc_stage_maps ss, sl;
+    mc_job_result r2;
+    CHECK_INT(mc_result_stage(c, id, "rhm", &ss), 0);
+    rc = match_stages(&j.spec, 0, MC_WANT_P, NULL, NULL, &r2, &sl, err, sizeof err);
+    if (rc)
+        FAILF("mc_match_stages: %s (%s)", mc_err_name(rc), err);
+    CHECK_INT(sl.np, 162);
+    CHECK_INT(sl.np, ss.np);
+    CHECK_INT(sl.nq, ss.nq);
+    check_same_map(sl.p, ss.p, sl.np);
+    check_same_map(sl.q, ss.q, sl.nq);
+    check_same_map(r2.p, rs.p, r2.np);
+    mc_stage_maps_free(&ss);
+    mc_stage_maps_free(&sl);
+    mc_result_free(&r2);
     mc_result_free(&rs);
     mc_result_free(&rl);
     mc_close(c);
@@ -223,11 +250,11 @@ TEST_T(refusals_have_the_servers_codes_and_messages, 120)
     testdaemon_stop(&d, SIGTERM);
 }
 
-TEST_T(engine_library_exports_mc_match_alone_and_installs_beside_libmeshcorr, 180)
+TEST_T(engine_library_exports_mc_match_and_mc_match_stages_and_installs_beside_libmeshcorr, 180)
 {
     char out[8192], path[800];
     CHECK_INT(testrunf(out, sizeof out, "nm -D --defined-only " ENGINE_SO " | awk '$2 == \"T\" { print $3 }'"), 0);
-    CHECK_INT(strcmp(out, "mc_match@@MESHCORR_ENGINE_1\n"), 0);
+    CHECK_INT(strcmp(out, "mc_match@@MESHCORR_ENGINE_1\nmc_match_stages@@MESHCORR_ENGINE_1.1\n"), 0);
     CHECK_INT(testrunf(out, sizeof out, "env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s install-lib "
                        "DESTDIR=%s/dest PREFIX=/opt/mc 2>&1", harness_tmpdir()), 0);
     snprintf(path, sizeof path, "%s/dest/opt/mc/lib/libmeshcorr-engine.so.1", harness_tmpdir());

@@ -281,7 +281,7 @@ _engine_lock = threading.Lock()
 
 
 def engine():
-    """libmeshcorr-engine.so.1 with mc_match declared, loaded on the first
+    """libmeshcorr-engine.so.1 with mc_match and mc_match_stages declared, loaded on the first
     call. OpenMP threads then wait passively (OMP_WAIT_POLICY=passive, as
     meshcorr's programs run) unless the environment says otherwise."""
     global _engine
@@ -299,5 +299,9 @@ def engine():
             e.mc_match.restype = ctypes.c_int
             e.mc_match.argtypes = [ctypes.POINTER(JobSpec), ctypes.c_int, ctypes.c_uint, PROGRESS_FN,
                                    ctypes.c_void_p, ctypes.POINTER(JobResult), c_err, ctypes.c_size_t]
+            e.mc_match_stages.restype = ctypes.c_int
+            e.mc_match_stages.argtypes = [ctypes.POINTER(JobSpec), ctypes.c_int, ctypes.c_uint, PROGRESS_FN,
+                                          ctypes.c_void_p, ctypes.POINTER(JobResult), ctypes.POINTER(StageMaps),
+                                          c_err, ctypes.c_size_t]
             _engine = e
         return _engine

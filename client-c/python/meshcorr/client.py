@@ -17,7 +17,7 @@ from ._lib import check, errbuf, lib
 from ._spec import MeshLike, Spec
 from .errors import (MC_EADDRESS, MC_EARG, MC_ETIMEOUT, ClientClosedError, InvalidInputError, MeshcorrError,
                      MeshcorrTimeoutError)
-from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, map_of, number, progress_dict, result_of
+from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, add_stages, number, progress_dict, result_of
 
 
 def _default_server() -> str:
@@ -363,10 +363,7 @@ class Job:
             s = _lib.StageMaps()
             self.client._check(lib.mc_result_stage(c, self.id, b"rhm", ctypes.byref(s)))
             try:
-                if s.np:
-                    res.stages["rhm"] = map_of(s.p, s.np, res.p.n_target)
-                if s.nq:
-                    res.stages["rhm-reverse"] = map_of(s.q, s.nq, s.np)
+                add_stages(res, s)
             finally:
                 lib.mc_stage_maps_free(ctypes.byref(s))
         return res

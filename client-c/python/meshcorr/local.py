@@ -1,5 +1,5 @@
 """local.py — match(): a job run in this process by the engine
-(libmeshcorr-engine.so.1's mc_match), with no daemon. It takes the inputs
+(libmeshcorr-engine.so.1's mc_match_stages), with no daemon. It takes the inputs
 and parameters of Client.submit() and returns what Job.result() returns:
 the same checks, the same engine run, the same maps as meshcorrd gives
 for the same job."""
@@ -13,7 +13,7 @@ from typing import Any, Callable, Dict, List, Optional
 from . import _lib
 from ._lib import errbuf
 from ._spec import MeshLike, Spec
-from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, progress_dict, result_of
+from .result import WANT_DEFORMED, WANT_METRICS, WANT_P, WANT_Q, Result, add_stages, progress_dict, result_of
 
 ProgressCallback = Callable[[Dict[str, Any]], Optional[bool]]
 
@@ -21,12 +21,13 @@ ProgressCallback = Callable[[Dict[str, Any]], Optional[bool]]
 def match(source: MeshLike, target: MeshLike, landmarks: Optional[Any] = None, init: Optional[Any] = None,
           init_reverse: Optional[Any] = None, init_base: Optional[int] = None, quantization: int = 0,
           device: Optional[str] = None, progress: Optional[ProgressCallback] = None, threads: int = 0,
-          deformed: bool = False, metrics: bool = True, **params: Any) -> Result:
+          deformed: bool = False, metrics: bool = True, stages: bool = False, **params: Any) -> Result:
     """Runs the job in this process and returns its Result. The arguments
     are Client.submit()'s (source, target: paths or (V, F) arrays;
     landmarks; init, init_reverse, init_base; quantization; device; the
-    job parameters of PARAMS by name), and deformed, metrics as
-    Job.result()'s. The meshes travel as they would to a server (Draco,
+    job parameters of PARAMS by name), and deformed, metrics, stages as
+    Job.result()'s (stages: RHM's maps that ECTM started from in
+    Result.stages). The meshes travel as they would to a server (Draco,
     lossless unless quantization says), so the maps are the ones meshcorrd
     returns for the same job. progress: called with each progress record
     (the dicts Job.watch() yields) in this thread; returning True stops the
@@ -51,7 +52,7 @@ def match(source: MeshLike, target: MeshLike, landmarks: Optional[Any] = None, i
 
     cb = _lib.PROGRESS_FN(on_progress)
     want = WANT_P | WANT_Q | (WANT_DEFORMED if deformed else 0) | (WANT_METRICS if metrics else 0)
-    r, err = _lib.JobResult(), errbuf()
+    r, sm, err = _lib.JobResult(), _lib.StageMaps(), errbuf()
     # Ctrl-C while the engine runs: Python's handler would raise
     # KeyboardInterrupt inside the C callback, where ctypes drops it, so a
     # handler of ours notes it, the callback (run once per record) stops the
@@ -61,7 +62,8 @@ def match(source: MeshLike, target: MeshLike, landmarks: Optional[Any] = None, i
             signal.getsignal(signal.SIGINT) is signal.default_int_handler):
         old = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
     try:
-        rc = engine.mc_match(ctypes.byref(s.spec), int(threads), want, cb, None, ctypes.byref(r), err, len(err))
+        rc = engine.mc_match_stages(ctypes.byref(s.spec), int(threads), want, cb, None, ctypes.byref(r),
+                                    ctypes.byref(sm) if stages else None, err, len(err))
     finally:
         if old is not None:
             signal.signal(signal.SIGINT, old)
@@ -71,6 +73,9 @@ def match(source: MeshLike, target: MeshLike, landmarks: Optional[Any] = None, i
         if raised:
             raise raised[0]
         _lib.check(rc, err.value)
-        return result_of(r, s.target_vertices() if s.injective else None, "the job")
+        res = result_of(r, s.target_vertices() if s.injective else None, "the job")
+        add_stages(res, sm)
+        return res
     finally:
         _lib.lib.mc_result_free(ctypes.byref(r))
+        _lib.lib.mc_stage_maps_free(ctypes.byref(sm))

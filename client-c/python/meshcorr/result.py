@@ -38,7 +38,8 @@ class Result:
     repair: what the input repair did, {"source": {count: n}, "target":
     {...}} from the metrics repair_source_* and repair_target_*, or None
     when neither mesh needed it (docs/repair.md); stages: a stage's maps
-    from before the final ones when asked for (Job.result(stages=True)):
+    from before the final ones when asked for (Job.result(stages=True),
+    match(stages=True)):
     {"rhm": Map, "rhm-reverse": Map} on a chain RHM then ECTM, their
     quality in metrics as rhm_*; else {}."""
 
@@ -76,6 +77,15 @@ def map_of(rows: Any, n: int, n_target: int) -> Map:
                               (n * ctypes.sizeof(_lib.MapRow),))
     rec = a.view(_lib.MAP_ROW_DTYPE)
     return Map(rec["face"].astype(np.int32), rec["w"].copy(), n_target)
+
+
+def add_stages(res: Result, s: Any) -> None:
+    """RHM's maps of the mc_stage_maps s into res.stages ("rhm", and
+    "rhm-reverse" for the bijective model), where the job has them."""
+    if s.np:
+        res.stages["rhm"] = map_of(s.p, s.np, res.p.n_target)
+    if s.nq:
+        res.stages["rhm-reverse"] = map_of(s.q, s.nq, s.np)
 
 
 def result_of(r: _lib.JobResult, n_target: Optional[int], what: str) -> Result:
