@@ -54,7 +54,8 @@ CLIENT_LIB := $(BUILD)/libmeshcorr.a
 CLIENT_SO  := $(BUILD)/libmeshcorr.so.1
 # libmeshcorr-engine.so.1: mc_match, a job run in the caller's process
 # (client-c/local/) the way a worker runs it: the worker's job mapping, the
-# engine and the codec linked in; exports mc_match only. The Python
+# engine and the codec linked in; exports mc_match and mc_match_stages
+# only (client-c/local/meshcorr-engine.map). The Python
 # package loads it for meshcorr.match(), so libmeshcorr.so stays slim.
 LOCAL_C    := $(wildcard client-c/local/*.c)
 LOCAL_OBJ  := $(LOCAL_C:%.c=$(BUILD)/obj/%.o) \
