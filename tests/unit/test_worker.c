@@ -395,6 +395,8 @@ TEST_T(worker_landmark_job_builds_its_initial_map_and_finishes, 60)
     double rf = metric(ok, "rhm_flipped_fraction");
     CHECK(rf >= 0 && rf <= 1);
     CHECK(isfinite(metric(ok, "rhm_mean_abs_log_area")));
+    double sr = metric(ok, "ectm_scaled_reference");   /* 1 only from smooth RHM maps */
+    CHECK(sr == 0 || (sr == 1 && metric(ok, "rhm_median_conformal") <= 0.02));
     proto_msg_free(&m);
     free(file);
 }

@@ -635,6 +635,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         prev_beta = beta;
     }
     rc = KIND_OK;
+    out->scaled = p->scale_reference && !p->partial;
     out->Y = unscaled(a->Y, a->X->nv, &b->frame);
     if (pr.bijective)
         out->Yt = unscaled(b->Y, b->X->nv, &a->frame);

@@ -97,6 +97,8 @@ typedef struct ectm_result {
     ectm_report last;
     bmap *rhm_P;   /* the pipeline's (corr_run) RHM maps that ECTM started */
     bmap *rhm_Q;   /* from, for a chain RHM then ECTM; NULL from ectm_run  */
+    int scaled;    /* 1 when the membrane's reference took the initial
+                      maps' regional scale (ectm_params.scale_reference) */
 } ectm_result;
 void ectm_result_close(ectm_result *r);
 

@@ -107,10 +107,11 @@ void wrk_progress_send(wrk_progress *pg, const corr_progress *cp, double elapsed
  * the client's indexing (corr_fix_to_user), the metrics are the repaired
  * pair's, and the repair's counts follow them (WRK_REPAIR_KEYS). On a
  * chain RHM then ECTM, RHM's maps go out too (rhm_p, rhm_q) with their
- * quality under the keys rhm_NAME (WRK_RHM_KEYS). The message borrows
+ * quality under the keys rhm_NAME and whether ECTM's reference took their
+ * scale, ectm_scaled_reference (WRK_RHM_KEYS). The message borrows
  * from r. */
 #define WRK_BASE_METRICS 12
-#define WRK_RHM_KEYS 4
+#define WRK_RHM_KEYS 5
 #define WRK_REPAIR_KEYS (2 * (0 REPAIR_COUNTS(WRK_ONE)))
 #define WRK_ONE(name, text) + 1
 typedef struct wrk_result {

@@ -186,6 +186,7 @@ static int build_metrics(const wrk_job *job, const corr_input *in, const ectm_re
             { "rhm_median_conformal", mr.median_conformal },
             { "rhm_flipped_fraction", mr.flipped_fraction },
             { "rhm_collapsed_fraction", mr.collapsed_fraction },
+            { "ectm_scaled_reference", res->scaled },
         };
         memcpy(r->metrics + ok->nmetrics, rm, sizeof rm);
         ok->nmetrics += WRK_RHM_KEYS;
