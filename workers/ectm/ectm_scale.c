@@ -24,19 +24,6 @@
  * face collapsed to a point must not dominate its region. */
 #define SCALE_CLAMP 16.0
 
-/* The map's image of X's vertices on Y (nv by 3). */
-static void image_points(const mesh *X, const mesh *Y, const bmap *P, double *img)
-{
-    for (int i = 0; i < X->nv; i++) {
-        const int *g = Y->f + 3 * (size_t)P->face[i];
-        const double *w = P->w + 3 * (size_t)i;
-        for (int k = 0; k < 3; k++)
-            img[3 * (size_t)i + k] = w[0] * Y->v[3 * (size_t)g[0] + k] +
-                                     w[1] * Y->v[3 * (size_t)g[1] + k] +
-                                     w[2] * Y->v[3 * (size_t)g[2] + k];
-    }
-}
-
 /* One round: each vertex takes the area-weighted mean of its faces' r,
  * each face the mean of its corners'. */
 static void smooth_round(const mesh *X, const double *a, double *r, double *vs, double *vw)
@@ -69,7 +56,7 @@ double *ectm_area_scale(const mesh *X, const mesh *Y, const bmap *P)
         r = NULL;
         goto out;
     }
-    image_points(X, Y, P, img);
+    bmap_apply(P, Y->f, Y->v, 3, img);   /* X's vertices on Y */
     double AX = geo_total_area(X), AY = geo_total_area(Y);
     geo_face_areas(X, a);
     for (size_t t = 0; t < nf; t++) {
