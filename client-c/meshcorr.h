@@ -333,6 +333,24 @@ int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, 
  * the file named in err. */
 int mc_read_mesh(const char *path, double **v, int *nv, int **f, int *nf, char *err, size_t errsz);
 
+/* Landmark files as an mc_job_spec's landmarks, read by the engine's one
+ * reader as `meshcorr match` and `meshcorr submit` read them. With
+ * target_path NULL, path is a pairs file (--landmarks: `source_vertex
+ * target_vertex` a line); else path and target_path are a source and a
+ * target list (--source-landmarks, --target-landmarks: one vertex id a
+ * line, or BIM .vts `id x y z` / .pid `id 0 0 0` lines; line k of one goes
+ * with line k of the other). Ids are 0-based unless one_based
+ * (--one-based). sv is snv by 3 source positions, tv tnv by 3 target
+ * positions (mc_read_mesh's arrays; read only): the ids must be vertices of
+ * their mesh, no source vertex twice, PROTO_MIN_LANDMARKS to
+ * PROTO_MAX_LANDMARKS pairs, and a .vts file's positions must be its
+ * vertices'. *landmarks is malloc()ed: *n (source, target) pairs, 2 * *n
+ * 0-based ids; free() it. A file that cannot be read: MC_EFILE; one the
+ * reader refuses: MC_EBAD_LANDMARKS; both with the file (and the line) in
+ * err. Version MESHCORR_1.4. */
+int mc_read_landmarks(const char *path, const char *target_path, int one_based, const double *sv, int snv,
+                      const double *tv, int tnv, uint32_t **landmarks, uint32_t *n, char *err, size_t errsz);
+
 /* Position coding of the two calls below: MC_QUANTIZATION_LOSSLESS (what
  * the calls above use) or 1..MC_QUANTIZATION_MAX_BITS bits per coordinate
  * over the bounding box. Quantizing trades the server's exact view of the

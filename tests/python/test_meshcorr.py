@@ -458,6 +458,46 @@ def case_landmarks_must_be_integer_vertex_ids():
     assert all(m == maps[0] for m in maps[1:])
 
 
+def case_landmark_files_read_by_the_clis_reader():
+    """A landmark file's path (str or os.PathLike) and a tuple of two lists
+    give the job of the equivalent array, in match() and submit(); a missing
+    file, a malformed one and one out of range raise BadLandmarksError with
+    the reader's file and line; a value that is neither an array nor a path
+    is refused saying what landmarks may be, a str never taken apart."""
+    import pathlib
+    c = meshcorr.Client(UNIX)
+
+    def write(name, text):
+        path = os.path.join(DIR, name)
+        open(path, "w").write(text)
+        return path
+
+    pairs = write("pairs.txt", "# source target\n" + open(E["MESHCORR_TEST_LMK"]).read())
+    src_list = write("src.txt", "".join("%d\n" % i for i in range(6)))
+    tgt_list = write("tgt.txt", "".join("%d\n" % i for i in range(6)))
+    missing = os.path.join(DIR, "none.txt")
+    for fn in (c.submit, meshcorr.match):
+        e = expect(ValueError, fn, SRC, TGT, landmarks=missing, has=missing, **JOB)
+        assert isinstance(e, meshcorr.BadLandmarksError) and e.field == "landmarks", e
+        for text, where in (("0 0\n1 x\n2 2\n", "bad.txt:2: "), ("0 0\n1 1\n2 500\n", "bad.txt:3: "),
+                            ("0\n1\n2\n", "bad.txt:1: ")):
+            e = expect(ValueError, fn, SRC, TGT, landmarks=write("bad.txt", text), has=where, **JOB)
+            assert isinstance(e, meshcorr.BadLandmarksError) and e.field == "landmarks", e
+        want = "expected a (k, 2) array of (source, target) vertex ids or a landmark file's path, got "
+        for bad, has in (({0: 0, 1: 1, 2: 2}, want + "dict"), (pairs.encode(), want + "bytes"), (7, want + "int"),
+                         (["0 0", "1 1", "2 2"], "landmarks[0] = '0 0': a str, not a (source, target) pair")):
+            e = expect(ValueError, fn, SRC, TGT, landmarks=bad, has=has, **JOB)
+            assert isinstance(e, meshcorr.BadLandmarksError) and e.field == "landmarks", e
+    assert c.list() == []                        # nothing was sent
+    arrays = meshcorr.match(SRC, TGT, landmarks=LANDMARKS, **JOB)
+    for lm in (pairs, pathlib.Path(pairs), (src_list, pathlib.Path(tgt_list))):
+        local = meshcorr.match(SRC, TGT, landmarks=lm, **JOB)
+        assert local.p == arrays.p and local.q == arrays.q, lm
+    job = c.submit(SRC, TGT, landmarks=pairs, **JOB)
+    assert job.wait(timeout=120) == "COMPLETED", job.reason
+    assert job.result().p == arrays.p
+
+
 def case_match_in_process_equals_the_daemons_job():
     """9: the same job through meshcorrd and through match(): the same
     maps, metrics and progress records, and the same refusals; a progress

@@ -172,6 +172,62 @@ TEST(draco_bytes_decode_back_to_the_arrays_and_junk_is_refused)
     mesh_free(m);
 }
 
+/* mc_read_landmarks is the CLI's reader: a pairs file, two lists (a BIM
+ * .vts list's base told by its positions), --one-based; a missing file and
+ * a malformed one are refused naming the file and line; exported in its
+ * own version node. */
+TEST(landmark_files_read_as_the_clis_pairs_and_lists_with_file_and_line_errors)
+{
+    mesh *m = testmesh_icosphere(1);   /* 42 vertices */
+    CHECK(m);
+    uint32_t *lm = NULL, n = 0;
+    char err[512], src[512], tgt[512], out[512];
+    const char *p = testfile_text("pairs.txt", "# source target\n0 5\n1 6\n\n2 7\n3 8\n");
+    CHECK_INT(mc_read_landmarks(p, NULL, 0, m->v, m->nv, m->v, m->nv, &lm, &n, err, sizeof err), 0);
+    CHECK_INT(n, 4);
+    for (uint32_t k = 0; k < n; k++) {
+        CHECK_INT(lm[2 * k], k);
+        CHECK_INT(lm[2 * k + 1], k + 5);
+    }
+    free(lm);
+
+    snprintf(src, sizeof src, "%s", testfile_text("a.txt", "1\n2\n3\n"));
+    snprintf(tgt, sizeof tgt, "%s", testfile_text("b.txt", "4\n5\n6\n"));
+    CHECK_INT(mc_read_landmarks(src, tgt, 1, m->v, m->nv, m->v, m->nv, &lm, &n, err, sizeof err), 0);
+    CHECK_INT(n, 3);
+    CHECK(lm[0] == 0 && lm[1] == 3 && lm[4] == 2 && lm[5] == 5);
+    free(lm);
+    /* a .vts list whose positions are each line's vertex at base 1 */
+    char vts[512] = "";
+    for (int i = 0; i < 3; i++)
+        snprintf(vts + strlen(vts), sizeof vts - strlen(vts), "%d %.17g %.17g %.17g\n", i + 1,
+                 m->v[3 * i], m->v[3 * i + 1], m->v[3 * i + 2]);
+    snprintf(src, sizeof src, "%s", testfile_text("a.vts", vts));
+    CHECK_INT(mc_read_landmarks(src, tgt, 0, m->v, m->nv, m->v, m->nv, &lm, &n, err, sizeof err), 0);
+    CHECK(n == 3 && lm[0] == 0 && lm[2] == 1 && lm[1] == 4);
+    free(lm);
+
+    CHECK_INT(mc_read_landmarks("/nonexistent/lm.txt", NULL, 0, m->v, m->nv, m->v, m->nv, &lm, &n, err,
+                                sizeof err), MC_EFILE);
+    CHECK(!lm && n == 0);
+    CHECK_STR_HAS(err, "/nonexistent/lm.txt");
+    p = testfile_text("junk.txt", "0 1\n2 x\n3 4\n");
+    CHECK_INT(mc_read_landmarks(p, NULL, 0, m->v, m->nv, m->v, m->nv, &lm, &n, err, sizeof err),
+              MC_EBAD_LANDMARKS);
+    CHECK_STR_HAS(err, "junk.txt:2:");
+    p = testfile_text("far.txt", "0 1\n2 3\n4 99\n");
+    CHECK_INT(mc_read_landmarks(p, NULL, 0, m->v, m->nv, m->v, m->nv, &lm, &n, err, sizeof err),
+              MC_EBAD_LANDMARKS);
+    CHECK_STR_HAS(err, "far.txt:3:");
+    CHECK_STR_HAS(err, "99");
+    CHECK_INT(mc_read_landmarks(NULL, NULL, 0, m->v, m->nv, m->v, m->nv, &lm, &n, err, sizeof err), MC_EARG);
+    CHECK_INT(mc_read_landmarks(p, NULL, 0, m->v, 0, m->v, m->nv, &lm, &n, err, sizeof err), MC_EARG);
+
+    CHECK_INT(testrunf(out, sizeof out, "nm -D --defined-only build/libmeshcorr.so.1 | grep -w mc_read_landmarks"), 0);
+    CHECK_STR_HAS(out, "mc_read_landmarks@@MESHCORR_1.4");
+    mesh_free(m);
+}
+
 TEST(parameter_list_as_data_sets_each_member_as_the_cli_parses_its_option)
 {
 #define COUNT_ROW(...) +1

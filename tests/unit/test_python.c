@@ -176,6 +176,11 @@ TEST_T(repaired_meshes_have_the_record_on_the_result_and_repair_no_refuses, 120)
     run_case("repair_record_and_keyword");
 }
 
+TEST_T(a_landmark_file_path_is_read_by_the_clis_reader_and_gives_the_arrays_job, 120)
+{
+    run_case("landmark_files_read_by_the_clis_reader");
+}
+
 TEST_T(match_in_process_gives_the_daemons_maps_progress_and_refusals, 180)
 {
     run_case("match_in_process_equals_the_daemons_job");

@@ -257,6 +257,9 @@ _declare("mc_interrupt", None, c_client_p)
 _declare("mc_read_mesh", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
          ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.POINTER(ctypes.c_int)), ctypes.POINTER(ctypes.c_int),
          c_err, ctypes.c_size_t)
+_declare("mc_read_landmarks", ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_int,
+         ctypes.POINTER(ctypes.c_double), ctypes.c_int, ctypes.POINTER(ctypes.c_double), ctypes.c_int,
+         ctypes.POINTER(ctypes.POINTER(ctypes.c_uint32)), ctypes.POINTER(ctypes.c_uint32), c_err, ctypes.c_size_t)
 VERSION = lib.mc_version().decode()
 
 

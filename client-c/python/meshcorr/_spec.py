@@ -1,13 +1,15 @@
 """_spec.py — a job's inputs as the mc_job_spec both Client.submit() and
 match() hand to libmeshcorr: meshes (a file's path or (V, F) arrays) as
-Draco bytes, landmarks checked element by element, initial maps as rows,
-parameters by name from the one list. The spec points into buffers this
-object keeps alive."""
+Draco bytes, landmarks checked element by element or read from landmark
+files by libmeshcorr (the CLI's reader), initial maps as rows, parameters
+by name from the one list. The spec points into buffers this object keeps
+alive."""
 from __future__ import annotations
 
 import ctypes
 import numbers
 import os
+from collections.abc import Mapping
 from typing import Any, Optional, Tuple, Union
 
 import numpy as np
@@ -105,12 +107,73 @@ def _vertex_id(x: Any, where: str) -> int:
     return int(x)
 
 
+# Values that are never landmark pairs nor rows of them: refused by type,
+# never iterated (a str would be taken apart character by character).
+_NOT_PAIRS = (str, bytes, bytearray, os.PathLike, Mapping)
+_WANT = "landmarks: expected a (k, 2) array of (source, target) vertex ids or a landmark file's path, got %s"
+
+
+def _landmark_files(landmarks: Any) -> Optional[Tuple[Any, Any]]:
+    """(pairs file, None) of a str or os.PathLike, (source list, target
+    list) of a tuple of two of them; None for anything else (a list of two
+    strs is refused as rows that are not pairs)."""
+    if isinstance(landmarks, (str, os.PathLike)):
+        return landmarks, None
+    if (isinstance(landmarks, tuple) and len(landmarks) == 2 and
+            all(isinstance(x, (str, os.PathLike)) for x in landmarks)):
+        return landmarks[0], landmarks[1]
+    return None
+
+
+def _positions(mesh: MeshLike) -> np.ndarray:
+    """A mesh's (n, 3) float64 positions: a file's as the engine reads it
+    (read_mesh, the CLI's reader), or V of (V, F)."""
+    if _is_path(mesh):
+        from .mesh import read_mesh     # mesh.py imports this module
+        return read_mesh(mesh)[0]
+    return np.ascontiguousarray(mesh[0], dtype=np.float64)
+
+
+def read_landmarks(path: Any, target_path: Any, source: MeshLike, target: MeshLike) -> np.ndarray:
+    """A landmark file as a (k, 2) uint32 array of 0-based (source, target)
+    vertex ids, read by libmeshcorr's mc_read_landmarks, the reader and
+    checks of `meshcorr match`: with target_path None, path is a pairs file
+    (--landmarks); else path and target_path are a source and a target
+    list (--source-landmarks, --target-landmarks). The ids are checked
+    against the meshes. A file that cannot be read or that the reader
+    refuses raises BadLandmarksError with the reader's message (the file,
+    and the line)."""
+    sv, tv = _positions(source), _positions(target)
+    out, n, err = ctypes.POINTER(ctypes.c_uint32)(), ctypes.c_uint32(), errbuf()
+    dp = ctypes.POINTER(ctypes.c_double)
+    tp = None if target_path is None else os.fsencode(target_path)
+    rc = lib.mc_read_landmarks(os.fsencode(path), tp, 0,      # one_based 0: the CLI's base rule without --one-based
+                               sv.ctypes.data_as(dp), len(sv), tv.ctypes.data_as(dp), len(tv), ctypes.byref(out),
+                               ctypes.byref(n), err, len(err))
+    try:
+        check(rc, err.value, BadLandmarksError if rc == MC_EFILE else None, "landmarks")
+        return np.ctypeslib.as_array(out, (n.value, 2)).copy()
+    finally:
+        _lib.free(out)
+
+
+def landmark_pairs(landmarks: Any, source: MeshLike, target: MeshLike) -> np.ndarray:
+    """submit()'s and match()'s landmarks as a (k, 2) uint32 array: a
+    landmark file's path, or a pair of paths (source list, target list),
+    read against the meshes by read_landmarks; else landmark_array."""
+    files = _landmark_files(landmarks)
+    if files:
+        return read_landmarks(files[0], files[1], source, target)
+    return landmark_array(landmarks)
+
+
 def landmark_array(landmarks: Any) -> np.ndarray:
     """Landmarks as a (k, 2) uint32 array of (source, target) vertex ids:
     a numpy integer array of shape (k, 2), or k pairs of integers. A float
     that is not whole (1.5), a negative, a bool or anything else that is not
     a vertex id is refused (BadLandmarksError, a ValueError) naming the
-    element, e.g. "landmarks[3][1] = 1.5"."""
+    element, e.g. "landmarks[3][1] = 1.5"; a str, bytes or dict, or a row
+    that is one, is refused by its type."""
     shape_msg = "landmarks: expected (k, 2) (source, target) vertex id pairs, got %s"
     if isinstance(landmarks, np.ndarray):
         a = landmarks
@@ -129,10 +192,17 @@ def landmark_array(landmarks: Any) -> np.ndarray:
         if a.dtype.kind == "b":
             rows = [[np.bool_(x) for x in r] for r in rows]
     else:
+        if isinstance(landmarks, _NOT_PAIRS):
+            raise _lib.error(MC_EARG, _WANT % type(landmarks).__name__, BadLandmarksError, "landmarks")
         try:
-            rows = [list(r) for r in landmarks]
+            rows = []
+            for i, r in enumerate(landmarks):
+                if isinstance(r, _NOT_PAIRS):
+                    raise _lib.error(MC_EARG, "landmarks[%d] = %r: a %s, not a (source, target) pair"
+                                     % (i, r, type(r).__name__), BadLandmarksError, "landmarks")
+                rows.append(list(r))
         except TypeError:
-            raise _lib.error(MC_EARG, shape_msg % type(landmarks).__name__, BadLandmarksError,
+            raise _lib.error(MC_EARG, _WANT % type(landmarks).__name__, BadLandmarksError,
                              "landmarks") from None
     out = np.empty((len(rows), 2), dtype=np.uint32)
     for i, r in enumerate(rows):
@@ -170,7 +240,7 @@ class Spec:
         spec.target, spec.target_len = ctypes.cast(self.target[0], _lib.c_u8p), self.target[1]
         self._keep: list = []
         if landmarks is not None:
-            lm = landmark_array(landmarks)
+            lm = landmark_pairs(landmarks, source, target)
             self._keep.append(lm)
             spec.landmarks = lm.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
             spec.nlandmarks = len(lm)

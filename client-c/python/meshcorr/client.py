@@ -153,16 +153,21 @@ class Client:
         (.off .obj .ply, or .drc sent as it is) or (V, F) numpy arrays;
         landmarks: (k, 2) (source, target) vertex ids (integers: a numpy
         integer array or pairs; anything else is refused naming the
-        element); init, init_reverse: initial maps P and Q (a Map; a map
-        file, meshcorr-map 1 or a vertex map, one target vertex a line, 0- or
-        1-based by the rule of `meshcorr match --init-base` unless init_base
-        says; or an array of 0-based target vertex ids); quantization: bits
-        per coordinate (0 lossless); device: an OpenCL device name part
-        (backend "opencl:DEVICE"); params: the job parameters of PARAMS by
-        name (model="injective", iterations=5, beta0=1e3, partial=True,
-        backend="cpu", stages="ddm,ectm", ...). A bad value is refused with
-        the server's message (BadParamsError, BadLandmarksError,
-        BadMeshError: ValueErrors, with .field naming the argument)."""
+        element), or a landmark file's path (str or os.PathLike: pairs,
+        `source_vertex target_vertex` a line, read by libmeshcorr with the
+        reader of `meshcorr submit --landmarks`), or a tuple of two paths
+        (a source and a target list: --source-landmarks and
+        --target-landmarks); init, init_reverse: initial maps P and Q (a
+        Map; a map file, meshcorr-map 1 or a vertex map, one target vertex
+        a line, 0- or 1-based by the rule of `meshcorr match --init-base`
+        unless init_base says; or an array of 0-based target vertex ids);
+        quantization: bits per coordinate (0 lossless); device: an OpenCL
+        device name part (backend "opencl:DEVICE"); params: the job
+        parameters of PARAMS by name (model="injective", iterations=5,
+        beta0=1e3, partial=True, backend="cpu", stages="ddm,ectm", ...). A
+        bad value is refused with the server's message (BadParamsError,
+        BadLandmarksError, BadMeshError: ValueErrors, with .field naming the
+        argument)."""
         c = self._handle()
         s = Spec(source, target, landmarks, init, init_reverse, priority, label, quantization, device, init_base,
                  params)

@@ -24,8 +24,10 @@ def match(source: MeshLike, target: MeshLike, landmarks: Optional[Any] = None, i
           deformed: bool = False, metrics: bool = True, stages: bool = False, **params: Any) -> Result:
     """Runs the job in this process and returns its Result. The arguments
     are Client.submit()'s (source, target: paths or (V, F) arrays;
-    landmarks; init, init_reverse, init_base; quantization; device; the
-    job parameters of PARAMS by name), and deformed, metrics, stages as
+    landmarks: (k, 2) vertex ids, or a landmark file's path as `meshcorr
+    match --landmarks` reads it; init, init_reverse, init_base;
+    quantization; device; the job parameters of PARAMS by name), and
+    deformed, metrics, stages as
     Job.result()'s (stages: RHM's maps that ECTM started from in
     Result.stages). The meshes travel as they would to a server (Draco,
     lossless unless quantization says), so the maps are the ones meshcorrd
