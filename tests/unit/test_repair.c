@@ -241,6 +241,31 @@ TEST(each_kind_of_mess_is_repaired_and_counted)
     mesh_free(c);
 }
 
+/* Two vertices of one piece at the same position (as cow.off's 44 and
+ * 2903): the weld makes them one vertex with two fans and the split undoes
+ * it; each copy stands for the vertex whose faces it carries, in the
+ * vertex map as in the rows. */
+TEST(a_pinch_the_weld_made_is_undone_into_the_vertices_given)
+{
+    mesh *m = clean();
+    int a = 17, b = 300;
+    memcpy(m->v + 3 * b, m->v + 3 * a, 3 * sizeof(double));
+    repair_mesh r;
+    char err[2048];
+    CHECK_INT(repair_mesh_run(m, "pinch", NULL, &r, err, sizeof err), REPAIR_OK);
+    CHECK_INT(r.n.split_vertices, 1);
+    CHECK_INT(r.n.welded, 0);
+    CHECK_INT(r.m->nv, m->nv);
+    CHECK(r.row[a] != r.row[b]);
+    CHECK_INT(r.vert[r.row[a]], a);
+    CHECK_INT(r.vert[r.row[b]], b);
+    for (int t = 0; t < r.m->nf; t++)   /* every corner stands for its own face's vertex */
+        for (int k = 0; k < 3; k++)
+            CHECK_INT(r.vert[r.m->f[3 * t + k]], m->f[3 * r.face[t] + r.corner[3 * t + k]]);
+    repair_mesh_close(&r);
+    mesh_free(m);
+}
+
 /* The job as the engine runs it: repaired, matched, back in the messy
  * mesh's indexing. */
 static void match(const messy *x, const mesh *c, int *lm, int nl)

@@ -125,8 +125,10 @@ static int build_kept(const mesh *u, const int *sf, const int *svert, int snv, i
 }
 
 /* Each user vertex's row: the copy its own faces use (out->row, -1 for a
- * vertex no kept face uses), each corner's place in its user face, and
- * the count of user vertices that share a row; -1 out of memory. */
+ * vertex no kept face uses), each corner's place in its user face, the
+ * count of user vertices that share a row, and each copy's user vertex
+ * (out->vert): the first whose row it is, so that the copies of a weld the
+ * split undid stand for the vertices given; -1 out of memory. */
 static int user_rows(const mesh *u, repair_mesh *out)
 {
     const int nv = u->nv, kv = out->m->nv, kf = out->m->nf;
@@ -156,6 +158,11 @@ static int user_rows(const mesh *u, repair_mesh *out)
     for (int i = 0; i < nv; i++)
         if (out->row[i] >= 0 && owner[out->row[i]] != i)
             out->n.welded++;
+    for (int i = 0; i < kv; i++)
+        owner[i] = -1;
+    for (int i = 0; i < nv; i++)
+        if (out->row[i] >= 0 && owner[out->row[i]] < 0)
+            owner[out->row[i]] = out->vert[out->row[i]] = i;
     free(owner);
     return 0;
 }

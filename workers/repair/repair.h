@@ -76,8 +76,10 @@ typedef struct repair_mesh {
     mesh *m;          /* the mesh the engine uses (owned)                      */
     int nv_user;      /* the user's vertex and face counts                     */
     int nf_user;
-    int *vert;        /* m->nv: the user vertex each vertex stands for (a
-                         welded group's first)                                 */
+    int *vert;        /* m->nv: the user vertex each vertex stands for: the
+                         first user vertex whose row it is (a welded group's
+                         first; a copy the split made, the vertex whose
+                         faces it carries)                                     */
     int *face;        /* m->nf: the user face each face is                     */
     unsigned char *corner; /* m->nf by 3: the corner of the user face each
                               corner stands for (faces may be flipped)        */
