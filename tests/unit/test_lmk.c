@@ -84,6 +84,13 @@ TEST(refuses_too_few_and_unparsable_rows)
     CHECK_INT(lmk_read_lists(p, b, 0, m, m, &l, err, sizeof err), LMK_ECOUNT);
     CHECK_STR_HAS(err, "has 4 landmarks but");
     CHECK_INT(lmk_read_pairs("/nonexistent/x", 0, m, m, &l, err, sizeof err), LMK_EIO);
+    /* a file with no line to read is refused as such, not taken for a layout */
+    p = testfile_text("empty.txt", "");
+    CHECK_INT(lmk_read_pairs(p, 0, m, m, &l, err, sizeof err), LMK_ECOUNT);
+    CHECK_STR_HAS(err, "empty.txt: no vertex ids");
+    p = testfile_text("comments.txt", "# source target\n\n");
+    CHECK_INT(lmk_read_lists(p, p, 0, m, m, &l, err, sizeof err), LMK_ECOUNT);
+    CHECK_STR_HAS(err, "comments.txt: no vertex ids");
     mesh_free(m);
 }
 TEST(arrays_follow_the_file_rule_with_one_based_messages)

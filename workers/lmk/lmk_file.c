@@ -124,6 +124,9 @@ int lmk__file_read(const char *path, int max, lmk__file *f, char *err, size_t er
     }
     if (ferror(fp))
         rc = errbuf_set(err, errsz, LMK_EIO, "%s: read error: %s", path, strerror(errno));
+    else if (!f->n)
+        rc = errbuf_set(err, errsz, LMK_ECOUNT, "%s: no vertex ids (the file is empty, or "
+                        "has only comments and blank lines)", path);
     f->layout = f->cols == 1 ? LMK__IDS : f->cols == 2 ? LMK__PAIRS : zero_tail ? LMK__PID : LMK__VTS;
 out:
     fclose(fp);
