@@ -496,6 +496,16 @@ def case_landmark_files_read_by_the_clis_reader():
     job = c.submit(SRC, TGT, landmarks=pairs, **JOB)
     assert job.wait(timeout=120) == "COMPLETED", job.reason
     assert job.result().p == arrays.p
+    # 1-based lists (BCICP, FAUST): refused as a path with the way to read
+    # them, read by read_landmarks(..., one_based=True)
+    ns, nt = len(meshcorr.read_mesh(SRC)[0]), len(meshcorr.read_mesh(TGT)[0])
+    src1 = write("src1.txt", "".join("%d\n" % i for i in (1, 2, 3, 4, 5, ns)))
+    tgt1 = write("tgt1.txt", "".join("%d\n" % i for i in (1, 2, 3, 4, 5, nt)))
+    e = expect(ValueError, meshcorr.match, SRC, TGT, landmarks=(src1, tgt1), has="one_based=True", **JOB)
+    assert isinstance(e, meshcorr.BadLandmarksError) and "looks 1-based" in str(e), e
+    lm = meshcorr.read_landmarks(src1, SRC, TGT, tgt1, one_based=True)
+    assert lm.tolist() == [[0, 0], [1, 1], [2, 2], [3, 3], [4, 4], [ns - 1, nt - 1]], lm
+    assert np.array_equal(meshcorr.read_landmarks(pairs, SRC, TGT), np.asarray(LANDMARKS, dtype=np.uint32))
 
 
 def case_match_in_process_equals_the_daemons_job():

@@ -28,9 +28,10 @@ from .errors import (AccessDeniedError, BadLandmarksError, BadMapError, BadMeshE
 from .local import match
 from .map import Map, read_map, read_vertex_map, vertex_map, write_map
 from .mesh import read_mesh
+from ._spec import read_landmarks
 from .result import Result
 
-__all__ = ["Client", "Job", "Result", "Map", "match", "read_mesh", "read_map", "read_vertex_map", "vertex_map",
+__all__ = ["Client", "Job", "Result", "Map", "match", "read_mesh", "read_landmarks", "read_map", "read_vertex_map", "vertex_map",
            "write_map", "PARAMS", "__version__",
            "MeshcorrError", "InvalidInputError", "BadMeshError", "BadLandmarksError", "BadParamsError",
            "BadMapError", "ClientClosedError", "MeshFileNotFoundError", "AccessDeniedError", "JobNotFoundError", "JobStateError",

@@ -134,24 +134,29 @@ def _positions(mesh: MeshLike) -> np.ndarray:
     return np.ascontiguousarray(mesh[0], dtype=np.float64)
 
 
-def read_landmarks(path: Any, target_path: Any, source: MeshLike, target: MeshLike) -> np.ndarray:
-    """A landmark file as a (k, 2) uint32 array of 0-based (source, target)
-    vertex ids, read by libmeshcorr's mc_read_landmarks, the reader and
-    checks of `meshcorr match`: with target_path None, path is a pairs file
-    (--landmarks); else path and target_path are a source and a target
-    list (--source-landmarks, --target-landmarks). The ids are checked
-    against the meshes. A file that cannot be read or that the reader
-    refuses raises BadLandmarksError with the reader's message (the file,
-    and the line)."""
+def read_landmarks(path: Any, source: MeshLike, target: MeshLike, target_path: Any = None,
+                   one_based: bool = False) -> np.ndarray:
+    """A landmark file as a (k, 2) uint32 array of 0-based (source,
+    target) vertex ids, read by libmeshcorr's mc_read_landmarks, the reader
+    and checks of `meshcorr match`: path a pairs file (--landmarks), or with
+    target_path a source and a target list (--source-landmarks,
+    --target-landmarks); one_based as --one-based (BCICP and FAUST .vts
+    lists). source and target are the meshes the ids are checked against
+    (a file's path or (V, F)). A file that cannot be read or that the
+    reader refuses raises BadLandmarksError with the reader's message (the
+    file, and the line)."""
     sv, tv = _positions(source), _positions(target)
     out, n, err = ctypes.POINTER(ctypes.c_uint32)(), ctypes.c_uint32(), errbuf()
     dp = ctypes.POINTER(ctypes.c_double)
     tp = None if target_path is None else os.fsencode(target_path)
-    rc = lib.mc_read_landmarks(os.fsencode(path), tp, 0,      # one_based 0: the CLI's base rule without --one-based
+    rc = lib.mc_read_landmarks(os.fsencode(path), tp, 1 if one_based else 0,
                                sv.ctypes.data_as(dp), len(sv), tv.ctypes.data_as(dp), len(tv), ctypes.byref(out),
                                ctypes.byref(n), err, len(err))
     try:
-        check(rc, err.value, BadLandmarksError if rc == MC_EFILE else None, "landmarks")
+        msg = err.value.decode(errors="replace")
+        if rc and not one_based and "looks 1-based" in msg:
+            msg += " (meshcorr.read_landmarks(..., one_based=True) reads a 1-based file)"
+        check(rc, msg, BadLandmarksError if rc == MC_EFILE else None, "landmarks")
         return np.ctypeslib.as_array(out, (n.value, 2)).copy()
     finally:
         _lib.free(out)
@@ -163,7 +168,7 @@ def landmark_pairs(landmarks: Any, source: MeshLike, target: MeshLike) -> np.nda
     read against the meshes by read_landmarks; else landmark_array."""
     files = _landmark_files(landmarks)
     if files:
-        return read_landmarks(files[0], files[1], source, target)
+        return read_landmarks(files[0], source, target, files[1])
     return landmark_array(landmarks)
 
 
