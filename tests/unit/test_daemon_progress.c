@@ -112,6 +112,7 @@ TEST_T(a_waiting_jobs_place_in_the_queue_is_watched_listed_and_followed, 180)
     CHECK_INT(testrunf(out, sizeof out, "build/meshcorr list --server %s", d.unix_addr), 0);
     CHECK_STR_HAS(out, "PROGRESS");
     CHECK_STR_HAS(out, "1 ahead");
+    CHECK_STR_HAS(out, "next");                   /* b's row, as watch says it */
     CHECK_INT(testrunf(out, sizeof out, "timeout 2 build/meshcorr watch %llu --server %s", (unsigned long long)j,
                        d.unix_addr), 124);
     char line[64];
