@@ -40,6 +40,28 @@ static const char *shown(const char *s)
     return stresc(s, b, sizeof bufs[0]);
 }
 
+/* A message or a reason from the server (its lines apart, as a job's
+ * checks write them: "X is not usable by the optimizer:\nX: ...") as the
+ * terminal may show it: each line through stresc, the lines after the
+ * first indented. Labels and names stay on one line (shown). */
+static const char *shown_lines(const char *s)
+{
+    static char buf[STRESC_SIZE(4096) + 1024];
+    size_t o = 0;
+    buf[0] = '\0';
+    for (const char *p = s; p && o + 1 < sizeof buf;) {
+        const char *nl = strchr(p, '\n');
+        size_t n = nl ? (size_t)(nl - p) : strlen(p);
+        stresc_n(p, n, buf + o, sizeof buf - o);
+        o += strlen(buf + o);
+        if (!nl)
+            break;
+        o += (size_t)snprintf(buf + o, o < sizeof buf ? sizeof buf - o : 0, "\n  ");
+        p = nl + 1;
+    }
+    return buf;
+}
+
 typedef struct remote {
     const char *server, *token;
     const char *token_file;    /* when set, the token is this file's first line */
@@ -138,7 +160,7 @@ static mc_client *remote_connect(const char *cmd, remote *r)
 
 static int fail(const char *cmd, mc_client *c, int rc)
 {
-    fprintf(stderr, "meshcorr %s: %s\n", cmd, shown(mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc)));
+    fprintf(stderr, "meshcorr %s: %s\n", cmd, shown_lines(mc_errmsg(c)[0] ? mc_errmsg(c) : mc_strerror(rc)));
     mc_close(c);
     return 1;
 }
@@ -284,7 +306,7 @@ static int watch_job(const char *cmd, mc_client *c, uint64_t id, watch_opts *w)
     }
     fflush(stdout);
     fprintf(stderr, "meshcorr %s: job %llu %s%s%s\n", cmd, (unsigned long long)id,
-            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", shown(reason));
+            mc_state_name(state) ? mc_state_name(state) : "?", reason[0] ? ": " : "", shown_lines(reason));
     int kind = proto_kind_of_code(mc_reason_error(reason));
     if (!kind && state == MC_CANCELLED)
         kind = PROTO_KIND_CANCELLED;
@@ -459,6 +481,8 @@ int cli_submit(int argc, char **argv)
     int rc = mc_submit(cl, &o.spec, &id);
     if (rc) {
         fail("submit", cl, rc);
+        if (rc == MC_EBAD_MESH)    /* the server names the meshes by their role */
+            fprintf(stderr, "meshcorr submit: the source mesh is %s, the target mesh %s\n", src, tgt);
         cl = NULL;
         goto done;
     }
@@ -636,7 +660,7 @@ int cli_status(int argc, char **argv)
     printf("job       %llu\nstate     %s\nuser      %s\nlabel     %s\npriority  %d\n", (unsigned long long)s.job_id,
            mc_state_name(s.state), shown(s.user), shown(s.label), s.priority);
     if (s.reason[0])
-        printf("reason    %s\n", shown(s.reason));
+        printf("reason    %s\n", shown_lines(s.reason));
     print_time("submitted", s.submit_ms);
     print_time("started", s.start_ms);
     print_time("ended", s.end_ms);

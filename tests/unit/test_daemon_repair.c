@@ -164,7 +164,9 @@ TEST_T(repair_no_refuses_the_pinched_mesh_in_match_and_at_submit, 120)
                       given, d.unix_addr);
     CHECK(rc != 0);
     CHECK_STR_HAS(out, "BAD_MESH");
-    CHECK_STR_HAS(out, "source mesh is not usable by the optimizer");
-    CHECK_STR_HAS(out, "non-manifold vertices");
+    CHECK_STR_HAS(out, "source mesh is not usable by the optimizer:\n  source mesh: 1 non-manifold vertices");
+    char named[1600];                  /* and which file the source mesh is */
+    snprintf(named, sizeof named, "meshcorr submit: the source mesh is %s, the target mesh %s", s_path, t_path);
+    CHECK_STR_HAS(out, named);
     testdaemon_stop(&d, SIGTERM);
 }
