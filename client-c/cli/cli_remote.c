@@ -942,8 +942,9 @@ int cli_delete(int argc, char **argv)
     return simple("delete", "usage: meshcorr delete ID\n" REMOTE_USAGE, argc, argv, mc_delete, "deleted");
 }
 
-/* A LIST row's progress column: "3 ahead" or "next" while it waits (as
- * watch says), "42 %" while it runs, "100 %" once COMPLETED, else "-". */
+/* A LIST row's progress column: how many jobs are ahead, or "next", while
+ * it waits (as watch says), the percentage done while it runs and once
+ * COMPLETED, else "-". */
 static const char *list_progress(const mc_job_info *j, char *buf, size_t sz)
 {
     if (j->state == MC_PENDING && j->ahead)
