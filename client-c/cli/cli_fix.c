@@ -76,6 +76,9 @@ int cli_fix(int argc, char **argv)
     snprintf(prefix, sizeof prefix, "meshcorr fix: %s: repaired", pos[0]);
     if (repair_counts_text(&r.n, prefix, text, sizeof text))
         fputs(text, stderr);
+    else if (m->polygons)
+        fprintf(stderr, "meshcorr fix: %s: nothing to repair; its %d polygon%s written as triangles\n",
+                pos[0], m->polygons, m->polygons == 1 ? "" : "s");
     else
         fprintf(stderr, "meshcorr fix: %s: nothing to repair\n", pos[0]);
     if (mesh_write(pos[1], r.m, err, sizeof err))

@@ -51,8 +51,13 @@ int cli_info(int argc, char **argv)
         return 1;
     }
     printf("%s\n", path);
-    printf("  vertices        %d\n  faces           %d\n  edges           %d\n",
-           r.nv, r.nf, r.ne);
+    printf("  vertices        %d\n", r.nv);
+    if (m->polygons)
+        printf("  faces           %d triangles (the file's %d polygon%s split into triangles)\n",
+               r.nf, m->polygons, m->polygons == 1 ? "" : "s");
+    else
+        printf("  faces           %d\n", r.nf);
+    printf("  edges           %d\n", r.ne);
     printf("  components      %d\n  boundary loops  %d\n  euler           %ld\n",
            r.components, r.boundary_loops, r.euler);
     if (r.genus >= 0)

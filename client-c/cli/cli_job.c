@@ -227,3 +227,11 @@ int cli_job_load(const cli_job *j, const char *cmd, const mesh *S, const mesh *T
     }
     return 0;
 }
+
+void cli_job_note_polygons(const char *cmd, const char *path, const mesh *m)
+{
+    if (m->polygons)
+        fprintf(stderr, "meshcorr %s: %s: %d polygon%s split into triangles; the faces a map names on "
+                "it are those triangles (meshcorr convert writes them)\n", cmd, path, m->polygons,
+                m->polygons == 1 ? "" : "s");
+}

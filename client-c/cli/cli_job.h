@@ -69,6 +69,9 @@ int cli_job_check(cli_job *j, const char *cmd);
 /* The engine's parameters of the job (corr_params_from_job); -1 with a
  * message when they are out of range (not after cli_job_check). */
 int cli_job_engine(const cli_job *j, const char *cmd, int threads, ectm_params *p, rhm_params *r);
+/* A line on stderr when the file at path had polygon faces (m->polygons):
+ * the faces a map names on it are the triangles they were split into. */
+void cli_job_note_polygons(const char *cmd, const char *path, const mesh *m);
 /* Reads the landmark set (or NULL) and the initial maps (or NULL) against
  * the two meshes; -1 with the reader's message printed. An initial map is
  * a meshcorr-map 1 file or a vertex map (vmap.h; base --init-base, else

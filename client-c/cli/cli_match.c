@@ -64,6 +64,7 @@ static mesh *load(const char *path, int repair, int *status)
         *status = proto_kind_exit(-rc);
         return NULL;
     }
+    cli_job_note_polygons("match", path, m);
     return m;
 }
 
@@ -105,7 +106,7 @@ static int print_quality(const char *what, const char *whose, const mesh *S, con
 static int write_mesh_with(const char *path, const mesh *faces_of, const double *v, int nv)
 {
     char err[1024];
-    mesh out = { nv, faces_of->nf, (double *)v, faces_of->f };
+    mesh out = { nv, faces_of->nf, (double *)v, faces_of->f, 0 };
     if (mesh_write(path, &out, err, sizeof err)) {
         fprintf(stderr, "meshcorr match: %s\n", err);
         return -1;

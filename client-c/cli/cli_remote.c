@@ -464,6 +464,8 @@ int cli_submit(int argc, char **argv)
         fprintf(stderr, "meshcorr submit: %s\n", err);
         goto done;
     }
+    cli_job_note_polygons("submit", src, S);
+    cli_job_note_polygons("submit", tgt, T);
     if (cli_job_load(&o.job, "submit", S, T, &L, &P0, &Q0))
         goto done;
     if (mc_encode_mesh_file_quantized(src, o.qbits, &sb, &o.spec.source_len, err, sizeof err) ||

@@ -25,7 +25,8 @@ static unsigned rnd(unsigned long long *st, unsigned n)
 static size_t mutate(unsigned char *b, size_t len, size_t cap, unsigned long long *st)
 {
     static const char *tokens[] = { "-1", "nan", "1e308", "4294967296", "\n", " ", "/", "//",
-                                    "f ", "v ", "999999999", "list", "3", "0" };
+                                    "f ", "v ", "999999999", "list", "3", "0", "4", "7 ",
+                                    "65537" };
     int edits = 1 + (int)rnd(st, 4);
     for (int e = 0; e < edits && len > 0; e++) {
         size_t at = rnd(st, (unsigned)len);
@@ -165,7 +166,7 @@ TEST_T(fuzz_draco_decoder, 60)
         decoded++;
         for (int i = 0; i < 3 * nf; i++)
             CHECK(f[i] >= 0 && f[i] < nv);
-        mesh dm = { nv, nf, v, f };
+        mesh dm = { nv, nf, v, f, 0 };
         mesh_check_report r;
         CHECK_INT(mesh_check_run(&dm, &r, err, sizeof err), 0);
         free(v);

@@ -322,6 +322,8 @@ def case_errors_are_builtin_subclasses():
     open(garbage, "w").write("OFF\n3 1 0\n0 0 0\n1 0\n")
     e = expect(meshcorr.BadMeshError, meshcorr.read_mesh, garbage, has="garbage.off")
     assert isinstance(e, ValueError)
+    quads = (V, np.hstack([F, F[:, :1]]))
+    expect(meshcorr.BadMeshError, c.submit, SRC, quads, landmarks=LANDMARKS, has="pass the file's path")
     e = expect(LookupError, c.job(999).status)
     assert isinstance(e, meshcorr.JobNotFoundError) and e.name == "NOT_FOUND", e
     long_job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, beta_ramp=4, inner_iterations=10)
@@ -386,7 +388,8 @@ def case_timeouts_raise_timeout_error_and_the_job_keeps_running():
 
 def case_read_mesh_gives_the_engines_arrays():
     """6: read_mesh of OFF, OBJ, PLY and Draco (written by `meshcorr
-    convert`) gives the file's arrays in its order."""
+    convert`) gives the file's arrays in its order; a polygon comes back
+    as its triangles."""
     V, F = read_off(SRC)
     for ext in ("off", "obj", "ply", "drc"):
         path = os.path.join(DIR, "s." + ext)
@@ -394,6 +397,12 @@ def case_read_mesh_gives_the_engines_arrays():
         V2, F2 = meshcorr.read_mesh(path)
         assert V2.dtype == np.float64 and F2.dtype == np.int32 and V2.shape == V.shape, (ext, V2.shape)
         assert np.array_equal(V2, V) and np.array_equal(F2, F), ext
+    # a quad of an OBJ file comes back as its two triangles, in its place
+    quad = os.path.join(DIR, "quad.obj")
+    with open(quad, "w") as fp:
+        fp.write("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 5 2\nf 1 2 3 4\n")
+    V2, F2 = meshcorr.read_mesh(quad)
+    assert F2.tolist() == [[0, 4, 1], [0, 1, 2], [0, 2, 3]], F2.tolist()
 
 
 def case_maps_give_vertex_ids_and_carry_fields():

@@ -102,7 +102,7 @@ TEST(drc_keeps_unreferenced_vertices_and_order_of_generated_torus)
     int *f = NULL, nv = 0, nf = 0;
     CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf,
                             err, sizeof err), 0);
-    mesh got = { nv, nf, v, f };
+    mesh got = { nv, nf, v, f, 0 };
     check_same_order(m, &got, 16);
     CHECK_NEAR(v[3 * t->nv], 9.0, 1e-3);
     free(v);
@@ -112,7 +112,7 @@ TEST(drc_keeps_unreferenced_vertices_and_order_of_generated_torus)
     CHECK_INT(dracob_encode(m->v, m->nv, m->f, m->nf, DRACOB_LOSSLESS, &buf, &len, err, sizeof err), 0);
     CHECK_INT(dracob_decode(buf, len, MESH_MAX_VERTICES, MESH_MAX_FACES, &v, &nv, &f, &nf,
                             err, sizeof err), 0);
-    got = (mesh){ nv, nf, v, f };
+    got = (mesh){ nv, nf, v, f, 0 };
     check_same_order(m, &got, DRACOB_LOSSLESS);
     free(v);
     free(f);
@@ -251,7 +251,7 @@ TEST(drc_lossless_is_exact_on_a_real_mesh_float32_when_it_can_and_16_bits_smalle
     CHECK_INT(mesh_read(harness_data_path("tosca_hires/Meshes/wolf0.off"), &m, err, sizeof err), 0);
     double *v = NULL;
     size_t lossless = round_trip(m, DRACOB_LOSSLESS, &v);
-    mesh got = { m->nv, m->nf, v, m->f };
+    mesh got = { m->nv, m->nf, v, m->f, 0 };
     check_same_order(m, &got, DRACOB_LOSSLESS);
     free(v);
     size_t q16 = round_trip(m, 16, &v);

@@ -55,16 +55,25 @@ TEST(obj_round_trip_keeps_order_and_exact_positions)
     mesh_free(m2);
 }
 
-TEST(obj_refuses_polygon_naming_file_line_and_face)
+TEST(obj_splits_a_polygon_naming_vertices_listed_after_it)
 {
     char err[512];
     mesh *m = NULL;
-    const char *p = testfile_text("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 2 3 4\n");
+    /* the pentagon is concave at its 4th corner, and comes before its last vertex */
+    const char *p = testfile_text("penta.obj", "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 1 0.5 0\n"
+                                               "f 1/1 2/2 3/3 4/4 5/5\nf 1 2 3\nv 0 2 0\n");
+    CHECK_INT(mesh_read(p, &m, err, sizeof err), MESH_OK);
+    CHECK_INT(m->nf, 4);
+    CHECK_INT(m->polygons, 1);
+    const int want[] = { 1, 2, 3, 0, 1, 3, 0, 3, 4, 0, 1, 2 };   /* ears clipped, in place */
+    for (int i = 0; i < 12; i++)
+        CHECK_INT(m->f[i], want[i]);
+    mesh_free(m);
+    m = NULL;
+    p = testfile_text("two.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2\n");
     CHECK_INT(mesh_read(p, &m, err, sizeof err), MESH_EPARSE);
     CHECK(m == NULL);
-    CHECK_STR_HAS(err, "quad.obj:6");
-    CHECK_STR_HAS(err, "face 1 has 4 vertices");
-    CHECK_STR_HAS(err, "only triangles");
+    CHECK_STR_HAS(err, "two.obj:5: face 1 has 2 vertices; a face needs 3");
 }
 
 TEST(obj_refuses_index_out_of_range_and_zero_index)

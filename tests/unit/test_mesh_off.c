@@ -1,4 +1,5 @@
-/* test_mesh_off.c — OFF reading and writing: counts, order, refusals. */
+/* test_mesh_off.c — OFF reading and writing: counts, order, polygons, the
+ * COFF / NOFF / STOFF variants, refusals. */
 #include "support/harness.h"
 #include "mesh/mesh.h"
 
@@ -53,13 +54,24 @@ TEST(off_refuses_index_out_of_range_naming_line)
     CHECK_STR_HAS(err, "out of range");
 }
 
-TEST(off_refuses_polygon)
+TEST(off_splits_a_quad_in_its_place_and_refuses_a_face_of_two)
 {
     char err[512];
     mesh *m = NULL;
-    const char *p = write_file("quad.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+    const char *p = write_file("quad.off", "OFF\n5 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n"
+                                           "3 0 4 1\n4 0 1 2 3\n3 3 4 0\n");
+    CHECK_INT(mesh_read(p, &m, err, sizeof err), MESH_OK);
+    CHECK_INT(m->nf, 4);
+    CHECK_INT(m->polygons, 1);
+    const int want[] = { 0, 4, 1, 0, 1, 2, 0, 2, 3, 3, 4, 0 };   /* the quad's two where it stood */
+    for (int i = 0; i < 12; i++)
+        CHECK_INT(m->f[i], want[i]);
+    mesh_free(m);
+    m = NULL;
+    p = write_file("two.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n1 1 0\n2 0 1\n");
     CHECK_INT(mesh_read(p, &m, err, sizeof err), MESH_EPARSE);
-    CHECK_STR_HAS(err, "only triangles");
+    CHECK(m == NULL);
+    CHECK_STR_HAS(err, "two.off:6: face 0 has 2 vertices; a face needs 3");
 }
 
 TEST(off_refuses_counts_larger_than_file)
@@ -78,4 +90,29 @@ TEST(off_refuses_truncated_vertex)
     const char *p = write_file("trunc.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1\n");
     CHECK(mesh_read(p, &m, err, sizeof err) < 0);
     CHECK_STR_HAS(err, "vertex 2");
+}
+
+TEST(off_reads_colour_normal_and_texture_variants_and_names_a_header_it_does_not)
+{
+    char err[512];
+    mesh *m = NULL;
+    const char *p = write_file("c.off", "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n"
+                                         "0 1 0 0 0 255 255\n3 0 1 2 10 20 30\n");
+    CHECK_INT(mesh_read_off(p, &m, err, sizeof err), MESH_OK);
+    CHECK_INT(m->nv, 3);
+    CHECK_NEAR(m->v[3 * 2 + 1], 1.0, 0);
+    CHECK_INT(m->f[2], 2);
+    mesh_free(m);
+    m = NULL;
+    p = write_file("n.off", "STCNOFF 3 1 0\n0 0 0 0 0 1 1 1 1 1 0 0\n1 0 0 0 0 1 1 1 1 1 1 0\n"
+                            "0 1 0 0 0 1 1 1 1 1 0 1\n3 0 1 2\n");
+    CHECK_INT(mesh_read_off(p, &m, err, sizeof err), MESH_OK);
+    CHECK_NEAR(m->v[3 * 1], 1.0, 0);
+    mesh_free(m);
+    m = NULL;
+    p = write_file("four.off", "4OFF\n3 1 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n3 0 1 2\n");
+    CHECK_INT(mesh_read_off(p, &m, err, sizeof err), MESH_EPARSE);
+    CHECK(m == NULL);
+    CHECK_STR_HAS(err, "four.off:1: expected the header \"OFF\"");
+    CHECK_STR_HAS(err, "got \"4OFF\"");
 }

@@ -1,5 +1,5 @@
-/* test_mesh_ply.c — PLY reading (ascii, binary little endian, extra
- * properties and elements) and writing; refusals of truncated and oversized
+/* test_mesh_ply.c — PLY reading (ascii, binary in either byte order, extra
+ * properties and elements, polygons) and writing; refusals of truncated and oversized
  * files. */
 #include "support/harness.h"
 #include "support/testfile.h"
@@ -8,10 +8,14 @@
 
 #include <string.h>
 
-/* Appends little-endian bytes of a value of size n. */
+/* The byte order put() writes in: 0 little endian, 1 big endian. */
+static int big;
+
+/* Appends the bytes of a value of size n in put's byte order. */
 static size_t put(unsigned char *b, size_t at, const void *x, int n)
 {
-    memcpy(b + at, x, (size_t)n);  /* the test machine is little endian */
+    for (int i = 0; i < n; i++)    /* the test machine is little endian */
+        b[at + (size_t)i] = ((const unsigned char *)x)[big ? n - 1 - i : i];
     return at + (size_t)n;
 }
 
@@ -37,13 +41,17 @@ TEST(ply_reads_ascii_with_extra_properties_and_elements)
     mesh_free(m);
 }
 
-TEST(ply_reads_binary_float_with_uint_list)
+/* A binary PLY of 3 vertices (float x y z with a double between) and one
+ * face (int count, uint indices, a short after), in put's byte order, is
+ * read, and refused when truncated. */
+static void check_binary(void)
 {
-    const char *hdr = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
-                      "property float x\nproperty double nx\nproperty float y\nproperty float z\n"
-                      "element face 1\nproperty list int uint vertex_indices\nproperty short s\n"
-                      "end_header\n";
-    unsigned char b[512];
+    char hdr[512];
+    snprintf(hdr, sizeof hdr, "ply\nformat binary_%s_endian 1.0\nelement vertex 3\n"
+             "property float x\nproperty double nx\nproperty float y\nproperty float z\n"
+             "element face 1\nproperty list int uint vertex_indices\nproperty short s\n"
+             "end_header\n", big ? "big" : "little");
+    unsigned char b[1024];
     size_t at = strlen(hdr);
     memcpy(b, hdr, at);
     for (int i = 0; i < 3; i++) {
@@ -58,7 +66,8 @@ TEST(ply_reads_binary_float_with_uint_list)
     unsigned idx[3] = { 2, 0, 1 };
     short s = -3;
     at = put(b, at, &cnt, 4);
-    at = put(b, at, idx, 12);
+    for (int i = 0; i < 3; i++)
+        at = put(b, at, idx + i, 4);
     at = put(b, at, &s, 2);
     char err[512];
     mesh *m = NULL;
@@ -77,6 +86,13 @@ TEST(ply_reads_binary_float_with_uint_list)
     CHECK(mesh_read(testfile_write("t2.ply", b, strlen(hdr) + 30), &m, err, sizeof err) < 0);
     CHECK_STR_HAS(err, "more than the file holds");
     CHECK(m == NULL);
+}
+
+TEST(ply_reads_binary_in_either_byte_order)
+{
+    for (big = 0; big < 2; big++)
+        check_binary();
+    big = 0;
 }
 
 TEST(ply_round_trip_is_exact_and_keeps_order)
@@ -115,7 +131,7 @@ TEST(ply_refuses_count_over_limit_naming_element_and_limit)
     CHECK_STR_HAS(err, "more than the file holds");
 }
 
-TEST(ply_refuses_polygon_big_endian_and_bad_index)
+TEST(ply_splits_a_quad_and_refuses_an_unknown_format_and_bad_index)
 {
     char err[512];
     mesh *m = NULL;
@@ -124,12 +140,18 @@ TEST(ply_refuses_polygon_big_endian_and_bad_index)
                        "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n";
     char text[1024];
     snprintf(text, sizeof text, "%s4 0 1 2 3\n", head);
-    CHECK_INT(mesh_read(testfile_text("quad.ply", text), &m, err, sizeof err), MESH_EPARSE);
-    CHECK_STR_HAS(err, "face 0 has 4 vertices");
+    CHECK_INT(mesh_read(testfile_text("quad.ply", text), &m, err, sizeof err), MESH_OK);
+    CHECK_INT(m->nf, 2);
+    CHECK_INT(m->polygons, 1);
+    mesh_free(m);
+    m = NULL;
+    snprintf(text, sizeof text, "%s2 0 1\n", head);
+    CHECK_INT(mesh_read(testfile_text("two.ply", text), &m, err, sizeof err), MESH_EPARSE);
+    CHECK_STR_HAS(err, "face 0 has 2 vertices; a face needs 3");
     snprintf(text, sizeof text, "%s3 0 1 4\n", head);
     CHECK_INT(mesh_read(testfile_text("idx.ply", text), &m, err, sizeof err), MESH_EINVAL);
     CHECK_STR_HAS(err, "out of range");
-    CHECK_INT(mesh_read(testfile_text("be.ply", "ply\nformat binary_big_endian 1.0\nend_header\n"),
+    CHECK_INT(mesh_read(testfile_text("me.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"),
                         &m, err, sizeof err), MESH_EFORMAT);
-    CHECK_STR_HAS(err, "binary_big_endian");
+    CHECK_STR_HAS(err, "unsupported PLY format \"binary_middle_endian\"");
 }

@@ -6,13 +6,15 @@
  * against the identity, and every input vertex gets a row; with repair off
  * the job is refused as before; pieces the landmarks pair are matched pair
  * by pair; a coarse mesh matches its fine subdivision
- * with no repair (coarse to fine); `meshcorr info` and `meshcorr fix` show
- * and write the repair. */
+ * with no repair (coarse to fine); a mesh of quads is read and matched
+ * from the CLI; `meshcorr info` and `meshcorr fix` show and write the
+ * repair. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "support/testrun.h"
 #include "corr/corr.h"
 #include "geo/geo_area.h"
+#include "map/bmap.h"
 #include "mesh/mesh_check.h"
 
 #include <math.h>
@@ -425,6 +427,105 @@ TEST(info_and_fix_show_and_write_the_repair)
     mesh_free(r);
     free(x.orig);
     mesh_free(x.m);
+    mesh_free(c);
+}
+
+/* The clean mesh written as a file of quads: each triangle paired with an
+ * unpaired neighbour across an edge becomes one quad, the rest stay
+ * triangles. Returns the number of quads. */
+static int write_quads(const mesh *c, const char *path)
+{
+    int *mate = malloc(sizeof(int) * (size_t)c->nf), nq = 0;
+    for (int t = 0; t < c->nf; t++)
+        mate[t] = -1;
+    for (int t = 0; t < c->nf; t++)
+        for (int u = t + 1; u < c->nf && mate[t] < 0; u++) {
+            int shared = 0;
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    shared += c->f[3 * t + i] == c->f[3 * u + j];
+            if (shared == 2 && mate[u] < 0) {
+                mate[t] = u;
+                mate[u] = t;
+                nq++;
+            }
+        }
+    FILE *fp = fopen(path, "w");
+    fprintf(fp, "OFF\n%d %d 0\n", c->nv, c->nf - nq);
+    for (int v = 0; v < c->nv; v++)
+        fprintf(fp, "%.17g %.17g %.17g\n", c->v[3 * v], c->v[3 * v + 1], c->v[3 * v + 2]);
+    for (int t = 0; t < c->nf; t++) {
+        const int *a = c->f + 3 * t;
+        if (mate[t] < 0) {
+            fprintf(fp, "3 %d %d %d\n", a[0], a[1], a[2]);
+            continue;
+        }
+        if (mate[t] < t)
+            continue;
+        const int *b = c->f + 3 * mate[t];
+        for (int i = 0; i < 3; i++) {       /* a's edge (a[i], a[i+1]) is b's: b's third corner between */
+            int p = a[i], q = a[(i + 1) % 3], far = -1;
+            for (int j = 0; j < 3; j++)
+                if (b[j] != p && b[j] != q)
+                    far = b[j];
+            int on = 0;
+            for (int j = 0; j < 3; j++)
+                on += b[j] == p || b[j] == q;
+            if (on == 2) {
+                fprintf(fp, "4 %d %d %d %d\n", p, far, q, a[(i + 2) % 3]);
+                break;
+            }
+        }
+    }
+    fclose(fp);
+    free(mate);
+    return nq;
+}
+
+TEST_T(a_mesh_of_quads_matches_its_clean_original_from_the_cli, 600)
+{
+    mesh *c = clean(), *T = bent(c);
+    char src[600], tgt[600], lmk[600], out[600], text[8192], err[512];
+    snprintf(src, sizeof src, "%s/quads.off", harness_tmpdir());
+    snprintf(tgt, sizeof tgt, "%s/bent.off", harness_tmpdir());
+    snprintf(lmk, sizeof lmk, "%s/quads.lmk", harness_tmpdir());
+    snprintf(out, sizeof out, "%s/quads.map", harness_tmpdir());
+    int nq = write_quads(c, src);
+    CHECK(nq > c->nf / 3);
+    CHECK_INT(mesh_write(tgt, T, err, sizeof err), 0);
+    FILE *fp = fopen(lmk, "w");
+    for (int v = 0; v < 640; v += 80)
+        fprintf(fp, "%d %d\n", v, v);
+    fclose(fp);
+    char want[128];
+    snprintf(want, sizeof want, "faces           %d triangles (the file's %d polygons split", c->nf, nq);
+    CHECK_INT(testrunf(text, sizeof text, "build/meshcorr info %s 2>&1", src), 0);
+    CHECK_STR_HAS(text, want);
+    char fixed[600];
+    snprintf(fixed, sizeof fixed, "%s/quads-fixed.off", harness_tmpdir());
+    CHECK_INT(testrunf(text, sizeof text, "build/meshcorr fix %s %s 2>&1", src, fixed), 0);
+    snprintf(want, sizeof want, "nothing to repair; its %d polygons written as triangles", nq);
+    CHECK_STR_HAS(text, want);
+    CHECK_INT(testrunf(text, sizeof text,
+                       "build/meshcorr match %s %s --landmarks %s --out %s --iterations 40 "
+                       "--progress none 2>&1", src, tgt, lmk, out), 0);
+    snprintf(want, sizeof want, "quads.off: %d polygons split into triangles; the faces a map names", nq);
+    CHECK_STR_HAS(text, want);
+    mesh *q = NULL;
+    bmap *P = NULL;
+    CHECK_INT(mesh_read(src, &q, err, sizeof err), 0);
+    CHECK_INT(bmap_read(out, q, T, &P, err, sizeof err), 0);
+    CHECK_INT(P->n, c->nv);
+    messy x = { q, malloc(sizeof(int) * (size_t)c->nv), c->nv };
+    for (int v = 0; v < c->nv; v++)
+        x.orig[v] = v;
+    double e = identity_error(&x, T, P);
+    printf("  %d quads; identity error %.5f\n", nq, e);
+    CHECK(e <= 0.01);
+    free(x.orig);
+    bmap_free(P);
+    mesh_free(q);
+    mesh_free(T);
     mesh_free(c);
 }
 

@@ -261,7 +261,7 @@ TEST(distances_start_matches_landmark_distances_and_sets_the_split_variables)
         CHECK(dd <= 32);
         for (int q = 0; q < ROWS; q++)
             memcpy(Qs + q * dd, Za + (size_t)q * stride * dd, sizeof(double) * dd);
-        mesh emb = { b->n, b->m->nf, NULL, b->m->f };
+        mesh emb = { b->n, b->m->nf, NULL, b->m->f, 0 };
         proj_closest_brute(&emb, dd, Zb, ROWS, Qs, face, bary, cost);
         for (int q = 0; q < ROWS; q++) {
             int l = q * stride;
@@ -451,7 +451,7 @@ TEST_T(p_step_equals_brute_force_projection, 60)
             double *Qs = malloc(sizeof(double) * (size_t)rows * d);
             for (int r = 0; r < rows; r++)
                 memcpy(Qs + (size_t)r * d, Q + (size_t)r * stride * d, sizeof(double) * d);
-            mesh emb = { b->n, b->m->nf, NULL, b->m->f };
+            mesh emb = { b->n, b->m->nf, NULL, b->m->f, 0 };
             proj_closest_brute(&emb, d, Z, rows, Qs, face, bary, cost);
             for (int r = 0; r < rows; r++) {
                 int l = r * stride;

@@ -422,7 +422,7 @@ static int solve_y(pair *pr, int ai, double beta, ectm_terms *terms, double *scr
  * a's image P_a·X_b (a's connectivity, positions a->PX). */
 static int reverse_by_nearest(side *a, side *b, char *err, size_t errsz)
 {
-    mesh img = { a->X->nv, a->X->nf, a->PX, a->X->f };
+    mesh img = { a->X->nv, a->X->nf, a->PX, a->X->f, 0 };
     proj_tree *t = proj_tree_new(&img, err, errsz);
     if (!t)
         return KIND_ENOMEM;

@@ -116,7 +116,7 @@ static int build_deformed(const wrk_job *job, const ectm_result *user, wrk_resul
         }
         bmap_apply(user->P, job->T->f, job->T->v, 3, image);
     }
-    mesh deformed = { job->S->nv, job->S->nf, user->Y ? user->Y : image, job->S->f };
+    mesh deformed = { job->S->nv, job->S->nf, user->Y ? user->Y : image, job->S->f, 0 };
     size_t len = 0;
     char detail[512];
     int erc = mesh_encode_drc(&deformed, &r->deformed, &len, detail, sizeof detail);

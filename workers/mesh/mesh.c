@@ -41,6 +41,7 @@ mesh *mesh_copy(const mesh *m)
         return NULL;
     memcpy(c->v, m->v, sizeof *m->v * 3 * (size_t)m->nv);
     memcpy(c->f, m->f, sizeof *m->f * 3 * (size_t)m->nf);
+    c->polygons = m->polygons;
     return c;
 }
 

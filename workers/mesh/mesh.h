@@ -40,6 +40,8 @@ typedef struct mesh {
     int nf;      /* number of triangles */
     double *v;   /* nv by 3 positions */
     int *f;      /* nf by 3 vertex indices, 0-based */
+    int polygons; /* faces of the file with more than 3 corners, each split
+                     into triangles where it stood (0 when all were triangles) */
 } mesh;
 
 /* Allocates a mesh with room for nv vertices and nf faces (contents zero).
@@ -59,10 +61,11 @@ int mesh_write(const char *path, const mesh *m, char *err, size_t errsz);
 #define MESH_DRC_QUANTIZATION_BITS 0
 
 /* Per-format entry points; mesh_read/mesh_write pick one by extension.
- * OFF and OBJ: text, triangles only (a polygon is refused naming file, line
- * and face). OBJ: "f a", "f a/b", "f a/b/c", "f a//c", negative (relative)
+ * OFF, OBJ and PLY faces may be polygons: each is split into triangles in
+ * its place (mesh_faces.c), so the faces of m are numbered after the split.
+ * OFF and OBJ: text. OBJ: "f a", "f a/b", "f a/b/c", "f a//c", negative (relative)
  * indices; v/f lines only, everything else skipped. PLY: ascii and
- * binary_little_endian, vertex x y z of any scalar type, face list
+ * binary in either byte order, vertex x y z of any scalar type, face list
  * vertex_indices (or vertex_index), other properties and elements skipped;
  * written as binary_little_endian with double positions (exact round trip).
  * DRC: see draco_bridge.h for the vertex-order rule. */

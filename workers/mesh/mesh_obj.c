@@ -1,10 +1,11 @@
 /* mesh_obj.c — Wavefront OBJ reader and writer (geometry only). Reads "v"
  * and "f" lines; vn, vt, g, o, s, usemtl, l and others are skipped. Face
  * corners may be "a", "a/b", "a/b/c" or "a//c"; negative indices count back
- * from the last vertex read. Faces must be triangles, as in OFF: a polygon is
- * refused naming file, line and face. Face indices are range-checked here;
+ * from the last vertex read. A polygon is split into triangles in its place
+ * once every vertex is read (mesh_faces.c). Face indices are range-checked here;
  * everything else about validity is mesh_check's. */
 #include "mesh/mesh.h"
+#include "mesh/mesh__faces.h"
 #include "mesh/mesh_lex.h"
 #include "util/errbuf.h"
 
@@ -45,6 +46,9 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
     if (rc)
         return rc;
     long nv, nf;
+    int tri[3], *corners = NULL;
+    mesh__faces F;
+    memset(&F, 0, sizeof F);
     count_lines(buf, len, &nv, &nf);
     if (nv > MESH_MAX_VERTICES || nf > MESH_MAX_FACES) {
         rc = errbuf_set(err, errsz, MESH_ELIMIT,
@@ -52,7 +56,8 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
                         path, nv, nf, MESH_MAX_VERTICES, MESH_MAX_FACES);
         goto out;
     }
-    m = mesh_new((int)nv, (int)nf);
+    m = mesh_new((int)nv, 0);
+    mesh__faces_init(&F, nf);
     if (!m) {
         rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
         goto out;
@@ -78,14 +83,17 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
             const char *c;
             size_t cn;
             while ((cn = mesh_lex_next_inline(&lx, &c)) > 0) {
-                if (k == 3) {
-                    int deg = 4;
-                    while (mesh_lex_next_inline(&lx, &c) > 0)
-                        deg++;
+                if (k == MESH_MAX_FACE_CORNERS) {
                     rc = errbuf_set(err, errsz, MESH_EPARSE,
-                                    "%s:%ld: face %ld has %d vertices; only triangles are accepted "
-                                    "(triangulate the mesh first)", path, lx.line, jf, deg);
+                                    "%s:%ld: face %ld has over %d vertices", path, lx.line, jf,
+                                    MESH_MAX_FACE_CORNERS);
                     goto out;
+                }
+                if (k == 3 && !corners) {
+                    if (!(corners = malloc(sizeof(int) * MESH_MAX_FACE_CORNERS))) {
+                        rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
+                        goto out;
+                    }
                 }
                 size_t in = 0;
                 while (in < cn && c[in] != '/')
@@ -104,22 +112,35 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
                                     path, lx.line, jf, idx, idx > 0 ? nv : iv);
                     goto out;
                 }
-                m->f[3 * jf + k++] = (int)z;
+                if (k == 3)
+                    memcpy(corners, tri, sizeof tri);
+                (k < 3 ? tri : corners)[k] = (int)z;
+                k++;
             }
             if (k < 3) {
                 rc = errbuf_set(err, errsz, MESH_EPARSE,
-                                "%s:%ld: face %ld has %d vertices; a triangle needs 3",
+                                "%s:%ld: face %ld has %d vertices; a face needs 3",
                                 path, lx.line, jf, k);
+                goto out;
+            }
+            if ((rc = mesh__faces_add(&F, k > 3 ? corners : tri, k))) {
+                mesh__faces_error(rc, path, lx.line, err, errsz);
                 goto out;
             }
             jf++;
         }
         mesh_lex_skip_line(&lx);
     }
+    if ((rc = mesh__faces_finish(&F, m))) {
+        mesh__faces_error(rc, path, 0, err, errsz);
+        goto out;
+    }
     *out = m;
     m = NULL;
     rc = MESH_OK;
 out:
+    mesh__faces_free(&F);
+    free(corners);
     mesh_free(m);
     free(buf);
     return rc;

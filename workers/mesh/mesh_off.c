@@ -1,9 +1,11 @@
-/* mesh_off.c — OFF reader and writer. Accepts "OFF" alone on its line or
- * followed by the counts, '#' comments, an edge count that is ignored.
- * Faces must be triangles: a polygon is refused with its line number.
+/* mesh_off.c — OFF reader and writer. Accepts "OFF" (or COFF, NOFF, STOFF:
+ * what follows a vertex's x y z is skipped) alone on its line or followed
+ * by the counts, '#' comments, an edge count that is ignored.
+ * A polygon is split into triangles in its place (mesh_faces.c).
  * Reads only; validation (ranges of values, manifoldness) is mesh_check's,
  * except face indices, which are range-checked here to keep the mesh safe. */
 #include "mesh/mesh.h"
+#include "mesh/mesh__faces.h"
 #include "mesh/mesh_lex.h"
 #include "util/errbuf.h"
 
@@ -11,6 +13,23 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Whether the header word t (n bytes) is [ST][C][N]OFF: the variants with
+ * texture coordinates, colours or normals after each vertex's x y z, which
+ * the reader skips with the rest of the line. */
+static int off_header(const char *t, size_t n)
+{
+    if (n < 3 || memcmp(t + n - 3, "OFF", 3) != 0)
+        return 0;
+    size_t i = 0;
+    if (n - 3 >= 2 && memcmp(t, "ST", 2) == 0)
+        i = 2;
+    if (i < n - 3 && t[i] == 'C')
+        i++;
+    if (i < n - 3 && t[i] == 'N')
+        i++;
+    return i == n - 3;
+}
 
 int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz)
 {
@@ -26,8 +45,11 @@ int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz)
     mesh_lex_init(&lx, buf, len, 1);
     const char *t;
     size_t n = mesh_lex_next(&lx, &t);
-    if (n < 3 || memcmp(t, "OFF", 3) != 0 || n != 3) {
-        rc = errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: expected the header \"OFF\"", path, lx.line);
+    if (!off_header(t, n)) {
+        rc = errbuf_set(err, errsz, MESH_EPARSE,
+                        "%s:%ld: expected the header \"OFF\" (or COFF, NOFF, STOFF and their "
+                        "combinations; 4OFF and nOFF, of other dimensions, are not read), got \"%.*s\"",
+                        path, lx.line, (int)(n > 20 ? 20 : n), t);
         goto out;
     }
     long nv, nf, ne;
@@ -54,7 +76,7 @@ int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz)
                         path, nv, nf);
         goto out;
     }
-    m = mesh_new((int)nv, (int)nf);
+    m = mesh_new((int)nv, 0);
     if (!m) {
         rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
         goto out;
@@ -70,36 +92,56 @@ int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz)
         }
         mesh_lex_skip_line(&lx);  /* optional colours etc. */
     }
+    int *corners = NULL;
+    rc = MESH_OK;
+    mesh__faces F;
+    mesh__faces_init(&F, nf);
     for (long i = 0; i < nf; i++) {
         long deg;
         if (mesh_lex_long(&lx, &deg)) {
             rc = errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: face %ld: missing vertex count",
                             path, lx.line, i);
-            goto out;
+            goto faces_out;
         }
-        if (deg != 3) {
+        if (deg < 3 || deg > MESH_MAX_FACE_CORNERS) {
             rc = errbuf_set(err, errsz, MESH_EPARSE,
-                            "%s:%ld: face %ld has %ld vertices; only triangles are accepted "
-                            "(triangulate the mesh first)", path, lx.line, i, deg);
-            goto out;
+                            "%s:%ld: face %ld has %ld vertices; a face needs 3 to %d",
+                            path, lx.line, i, deg, MESH_MAX_FACE_CORNERS);
+            goto faces_out;
         }
-        for (int k = 0; k < 3; k++) {
+        if (deg > 3 && !corners && !(corners = malloc(sizeof(int) * MESH_MAX_FACE_CORNERS))) {
+            rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
+            goto faces_out;
+        }
+        int tri[3], *c = deg > 3 ? corners : tri;
+        for (long k = 0; k < deg; k++) {
             long idx;
             if (mesh_lex_long(&lx, &idx)) {
-                rc = errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: face %ld: index %d is missing or not an integer",
+                rc = errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: face %ld: index %ld is missing or not an integer",
                                 path, lx.line, i, k);
-                goto out;
+                goto faces_out;
             }
             if (idx < 0 || idx >= nv) {
                 rc = errbuf_set(err, errsz, MESH_EINVAL,
                                 "%s:%ld: face %ld: vertex index %ld out of range [0, %ld)",
                                 path, lx.line, i, idx, nv);
-                goto out;
+                goto faces_out;
             }
-            m->f[3 * i + k] = (int)idx;
+            c[k] = (int)idx;
+        }
+        if ((rc = mesh__faces_add(&F, c, (int)deg))) {
+            mesh__faces_error(rc, path, lx.line, err, errsz);
+            goto faces_out;
         }
         mesh_lex_skip_line(&lx);
     }
+    if ((rc = mesh__faces_finish(&F, m)))
+        errbuf_set(err, errsz, rc, "%s: out of memory", path);
+faces_out:
+    mesh__faces_free(&F);
+    free(corners);
+    if (rc)
+        goto out;
     *out = m;
     m = NULL;
     rc = MESH_OK;

@@ -1,11 +1,13 @@
-/* mesh_ply.c — PLY reader (ascii and binary_little_endian) and writer
+/* mesh_ply.c — PLY reader (ascii, binary_little_endian and
+ * binary_big_endian, as older scanners write it) and writer
  * (binary_little_endian, double positions, so a round trip is exact).
  * The header is parsed into a small element/property table; elements other
  * than "vertex" and "face", and properties other than x y z and the face
  * index list, are read past and dropped. Every element count is checked
  * against the limits and against the bytes left in the file before any
- * allocation. Faces must be triangles, as in OFF. */
+ * allocation. A polygon is split into triangles in its place (mesh_faces.c). */
 #include "mesh/mesh.h"
+#include "mesh/mesh__faces.h"
 #include "mesh/mesh_lex.h"
 #include "util/errbuf.h"
 
@@ -39,6 +41,9 @@ typedef struct ply_elem {
     int nprop;
     ply_prop prop[PLY_MAX_PROPERTIES];
 } ply_elem;
+
+/* ply_reader.binary: 0 for ascii, else the byte order. */
+enum { PLY_LITTLE_ENDIAN = 1, PLY_BIG_ENDIAN = 2 };
 
 typedef struct ply_reader {
     int binary;
@@ -79,8 +84,8 @@ static int read_value(ply_reader *r, enum ply_type t, double *out)
     memcpy(b, r->p, (size_t)sz);
     r->p += sz;
     uint64_t u = 0;
-    for (int i = sz - 1; i >= 0; i--)
-        u = (u << 8) | b[i];
+    for (int i = 0; i < sz; i++)   /* most significant byte first */
+        u = (u << 8) | b[r->binary == PLY_BIG_ENDIAN ? i : sz - 1 - i];
     switch (t) {
     case T_I8:  *out = (int8_t)u; break;
     case T_U8:  *out = (uint8_t)u; break;
@@ -207,11 +212,14 @@ static int parse_header(const char *path, const char *buf, size_t len, ply_elem 
             if (word_is(t, n, "ascii"))
                 *binary = 0;
             else if (word_is(t, n, "binary_little_endian"))
-                *binary = 1;
+                *binary = PLY_LITTLE_ENDIAN;
+            else if (word_is(t, n, "binary_big_endian"))
+                *binary = PLY_BIG_ENDIAN;
             else
                 return errbuf_set(err, errsz, MESH_EFORMAT,
-                                  "%s:%ld: unsupported PLY format \"%.*s\" (ascii or "
-                                  "binary_little_endian)", path, lx.line, (int)(n > 40 ? 40 : n), t);
+                                  "%s:%ld: unsupported PLY format \"%.*s\" (ascii, "
+                                  "binary_little_endian or binary_big_endian)", path, lx.line,
+                                  (int)(n > 40 ? 40 : n), t);
             have_format = 1;
             mesh_lex_skip_line(&lx);
         } else if (word_is(t, n, "element")) {
@@ -274,10 +282,10 @@ static int check_sizes(const char *path, const ply_elem *el, int nel, int binary
     return MESH_OK;
 }
 
-/* The cnt items of list property pr of item j of element e; into face j of
- * m when it is the face index list (each index checked against nv). */
+/* The cnt items of list property pr of item j of element e; into corner
+ * when it is the face index list (each index checked against nv). */
 static int read_list(const char *path, ply_reader *r, const unsigned char *base, const ply_elem *e,
-                     const ply_prop *pr, long long j, long cnt, long long nv, mesh *m,
+                     const ply_prop *pr, long long j, long cnt, long long nv, int *corner,
                      char *err, size_t errsz)
 {
     int is_f = strcmp(e->name, "face") == 0;
@@ -293,15 +301,17 @@ static int read_list(const char *path, ply_reader *r, const unsigned char *base,
             return errbuf_set(err, errsz, MESH_EINVAL,
                               "%s: face %lld: vertex index %g out of range [0, %lld)",
                               path, j, x, nv);
-        m->f[3 * j + q] = (int)x;
+        corner[q] = (int)x;
     }
     return MESH_OK;
 }
 
 /* Every item of every element, in the header's order, from r: the vertices'
- * x y z and the faces' indices into m, the rest read past. */
+ * x y z into m, the faces' indices into F (corner: room for 255 * 255), the
+ * rest read past. */
 static int read_elements(const char *path, ply_reader *r, const unsigned char *base, const ply_elem *el,
-                         int nel, long long nv, mesh *m, char *err, size_t errsz)
+                         int nel, long long nv, mesh *m, mesh__faces *F, int *corner, char *err,
+                         size_t errsz)
 {
     for (int i = 0; i < nel; i++) {
         const ply_elem *e = &el[i];
@@ -324,13 +334,15 @@ static int read_elements(const char *path, ply_reader *r, const unsigned char *b
                     return errbuf_set(err, errsz, MESH_EPARSE, "%s: %s %lld: bad list length %g",
                                       path, e->name, j, x);
                 long cnt = (long)x;
-                if (is_f && pr->role == 4 && cnt != 3)
+                int faces = is_f && pr->role == 4;
+                if (faces && cnt < 3)
                     return errbuf_set(err, errsz, MESH_EPARSE,
-                                      "%s: face %lld has %ld vertices; only triangles are accepted "
-                                      "(triangulate the mesh first)", path, j, cnt);
-                int rc = read_list(path, r, base, e, pr, j, cnt, nv, m, err, errsz);
+                                      "%s: face %lld has %ld vertices; a face needs 3", path, j, cnt);
+                int rc = read_list(path, r, base, e, pr, j, cnt, nv, corner, err, errsz);
                 if (rc)
                     return rc;
+                if (faces && (rc = mesh__faces_add(F, corner, (int)cnt)))
+                    return mesh__faces_error(rc, path, 0, err, errsz);
             }
         }
     }
@@ -343,7 +355,9 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
     size_t len = 0, data = 0;
     mesh *m = NULL;
     ply_elem *el = NULL;
-    int nel = 0, binary = 0;
+    int nel = 0, binary = 0, *corner = NULL;
+    mesh__faces F;
+    memset(&F, 0, sizeof F);
     *out = NULL;
     int rc = mesh_lex_slurp(path, MESH_MAX_FILE_BYTES, &buf, &len, err, errsz);
     if (rc)
@@ -362,8 +376,9 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
     rc = check_sizes(path, el, nel, binary, len - data, &nv, &nf, err, errsz);
     if (rc)
         goto out;
-    m = mesh_new((int)nv, (int)nf);
-    if (!m) {
+    m = mesh_new((int)nv, 0);
+    mesh__faces_init(&F, nf);
+    if (!m || !(corner = malloc(sizeof(int) * 255 * 255))) {
         rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
         goto out;
     }
@@ -371,13 +386,19 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
     ply_reader r = { .binary = binary,
                      .p = (const unsigned char *)buf + data, .end = (const unsigned char *)buf + len };
     mesh_lex_init(&r.lx, buf + data, len - data, 0);
-    rc = read_elements(path, &r, (const unsigned char *)buf, el, nel, nv, m, err, errsz);
+    rc = read_elements(path, &r, (const unsigned char *)buf, el, nel, nv, m, &F, corner, err, errsz);
     if (rc)
         goto out;
+    if ((rc = mesh__faces_finish(&F, m))) {
+        mesh__faces_error(rc, path, 0, err, errsz);
+        goto out;
+    }
     *out = m;
     m = NULL;
     rc = MESH_OK;
 out:
+    mesh__faces_free(&F);
+    free(corner);
     mesh_free(m);
     free(el);
     free(buf);

@@ -61,8 +61,10 @@ def encode(mesh: MeshLike, qbits: int, field: str) -> Tuple[ctypes.Array, int]:
         V = np.ascontiguousarray(V, dtype=np.float64)
         F = np.ascontiguousarray(F, dtype=np.intc)
         if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
+            hint = ("; F of polygons: pass the file's path instead (its reader splits them into triangles)"
+                    if F.ndim == 2 and F.shape[1] > 3 else "")
             raise _lib.error(MC_EARG, "%s: V must be (n, 3) positions and F (m, 3) vertex indices, got V %s "
-                             "and F %s" % (field, V.shape, F.shape), BadMeshError, field)
+                             "and F %s%s" % (field, V.shape, F.shape, hint), BadMeshError, field)
         rc = lib.mc_encode_mesh_quantized(V.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), len(V),
                                           F.ctypes.data_as(ctypes.POINTER(ctypes.c_int)), len(F), qbits,
                                           ctypes.byref(out), ctypes.byref(n), err, len(err))

@@ -19,7 +19,8 @@ from .errors import MC_EFILE, BadMeshError
 def read_mesh(path: PathLike) -> Tuple[np.ndarray, np.ndarray]:
     """(V, F) of a mesh file (.off .obj .ply .drc, by extension): V a
     float64 (n, 3) array of positions, F an int32 (m, 3) array of 0-based
-    vertex indices, in the file's order. MeshFileNotFoundError (a
+    vertex indices, in the file's order (a polygon face split into
+    triangles where it stands: these are the faces a map's rows name). MeshFileNotFoundError (a
     FileNotFoundError) when it does not exist; BadMeshError (a ValueError)
     naming the file, line and field when it does not parse."""
     open_check(path, "path")
