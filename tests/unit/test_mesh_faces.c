@@ -2,8 +2,9 @@
  * (mesh_faces.c), against brute force: random simple polygons, convex and
  * not, tilted in space, come out as k - 2 triangles that keep the
  * polygon's orientation and add up to its area (the shoelace formula); a
- * convex quad is cut along its shorter diagonal; a flat-degenerate polygon
- * still gives k - 2 triangles. */
+ * flat convex quad is cut along its shorter diagonal, a concave one along
+ * the other; two sharply bent quads round a vertex do not both cut the
+ * same diagonal; a flat-degenerate polygon still gives k - 2 triangles. */
 #include "support/harness.h"
 #include "support/testfile.h"
 #include "mesh/mesh.h"
@@ -85,15 +86,53 @@ TEST(random_simple_polygons_split_into_triangles_that_tile_them)
     }
 }
 
-TEST(a_convex_quad_is_cut_along_its_shorter_diagonal)
+/* The flat quad xy, tilted by the angles a, b, is cut along 1-3. */
+static void check_cut_along_1_3(const double *xy, double a, double b)
 {
     char err[512];
-    const double kite[] = { 0, 0, 3, -0.5, 4, 0, 3, 0.5 };   /* 0-2 is 4 long, 1-3 is 1 */
-    mesh *m = read_polygon(kite, 4, 0.3, 0.2, err, sizeof err);
-    CHECK(m);
+    mesh *m = read_polygon(xy, 4, a, b, err, sizeof err);
+    if (!m)
+        FAILF("%s", err);
     const int want[] = { 1, 2, 3, 1, 3, 0 };
     for (int i = 0; i < 6; i++)
         CHECK_INT(m->f[i], want[i]);
+    mesh_free(m);
+}
+
+TEST(a_convex_quad_is_cut_along_its_shorter_diagonal)
+{
+    const double kite[] = { 0, 0, 3, -0.5, 4, 0, 3, 0.5 };   /* 0-2 is 4 long, 1-3 is 1 */
+    check_cut_along_1_3(kite, 0.3, 0.2);
+}
+
+TEST(a_concave_quad_is_cut_through_its_reflex_corner_though_that_diagonal_is_longer)
+{
+    const double dart[] = { 0, 0, 1, -3, 2, 0, 1, -0.5 };   /* reflex at 3; 0-2 is 2 long, 1-3 is 2.5 */
+    check_cut_along_1_3(dart, 0.4, -0.7);
+}
+
+TEST(two_bent_quads_round_a_vertex_do_not_make_one_triangle_twice)
+{
+    /* Two quads of make demo's cow.off paired from its triangles round
+     * vertex 2 (cow.off's 1395), bent so sharply that each alone is cut
+     * along 1-3 (cow.off's 1423-1394), which gives triangle 1 2 3 twice. */
+    char err[512];
+    mesh *m = NULL;
+    const char *p = testfile_text("bent.off", "OFF\n5 2 0\n"
+                                              "0.317696 0.274306 -0.132233\n0.318424 0.263405 -0.137703\n"
+                                              "0.313153 0.266184 -0.139079\n0.314267 0.26159 -0.128118\n"
+                                              "0.31663 0.250333 -0.138926\n4 0 1 2 3\n4 2 1 4 3\n");
+    CHECK_INT(mesh_read(p, &m, err, sizeof err), MESH_OK);
+    CHECK_INT(m->nf, 4);
+    for (int a = 0; a < 4; a++)
+        for (int b = a + 1; b < 4; b++) {
+            int same = 0;
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    same += m->f[3 * a + i] == m->f[3 * b + j];
+            if (same == 3)
+                FAILF("triangles %d and %d are on the same three vertices", a, b);
+        }
     mesh_free(m);
 }
 

@@ -1,9 +1,9 @@
 /* mesh_faces.c — see mesh__faces.h: the faces a reader collects, and the
- * split of a polygon into triangles. A convex quad is cut along its shorter
- * diagonal; any other polygon is cut by ear clipping in the plane of its
- * Newell normal, and a polygon with no ear left (degenerate, or crossing
- * itself) by a fan, whose slivers the repair then removes. Every triangle
- * keeps the polygon's orientation. */
+ * split of a polygon into triangles. A quad is cut along the diagonal that
+ * folds it least (the shorter one when it is nearly flat); a larger polygon
+ * by ear clipping in the plane of its Newell normal, and one with no ear
+ * left (degenerate, or crossing itself) by a fan, whose slivers the repair
+ * then removes. Every triangle keeps the polygon's orientation. */
 #include "mesh/mesh__faces.h"
 
 #include "util/errbuf.h"
@@ -12,6 +12,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Two splits of a quad whose normals' cosines differ by at most this
+ * (about 8 degrees of fold near flat) count as equally flat. */
+#define QUAD_AGREE 0.01
 
 void mesh__faces_init(mesh__faces *F, long n)
 {
@@ -147,10 +151,49 @@ static void clip_ears(const int *c, const double *q, int k, int *at, int *out)
         emit(&out, c[at[0]], c[at[i]], c[at[i + 1]]);
 }
 
-/* Polygon c (k >= 4 corners) of positions v into k - 2 triangles at out.
+/* How well the triangles (a, b, c) and (a, c, d) of a quad split along
+ * a-c agree: the cosine between their normals, -2 when one has no area. */
+static double agreement(const double *v, int a, int b, int c, int d)
+{
+    double e1[3], e2[3], e3[3], n1[3], n2[3];
+    sub(v + 3 * (size_t)b, v + 3 * (size_t)a, e1);
+    sub(v + 3 * (size_t)c, v + 3 * (size_t)a, e2);
+    sub(v + 3 * (size_t)d, v + 3 * (size_t)a, e3);
+    cross(e1, e2, n1);
+    cross(e2, e3, n2);
+    double l = sqrt(dot(n1, n1) * dot(n2, n2));
+    return l > 0 ? dot(n1, n2) / l : -2;
+}
+
+/* Quad c as two triangles at out: (0 1 2)(0 2 3) along02, else (1 2 3)(1 3 0). */
+static void cut_quad(const int *c, int along02, int *out)
+{
+    int s = along02 ? 0 : 1;
+    emit(&out, c[s], c[s + 1], c[(s + 2) % 4]);
+    emit(&out, c[s], c[(s + 2) % 4], c[(s + 3) % 4]);
+}
+
+/* Quad c into two triangles at out: along the diagonal whose triangles
+ * agree better (a concave quad's other diagonal gives one turned over; a
+ * bent one's, a sharper fold), along the shorter one when the two agree
+ * within QUAD_AGREE (nearly flat either way, the better-shaped pair). */
+static void split_quad(const double *v, const int *c, int *out)
+{
+    double a02 = agreement(v, c[0], c[1], c[2], c[3]), a13 = agreement(v, c[1], c[2], c[3], c[0]);
+    double d02[3], d13[3];
+    sub(v + 3 * (size_t)c[2], v + 3 * (size_t)c[0], d02);
+    sub(v + 3 * (size_t)c[3], v + 3 * (size_t)c[1], d13);
+    cut_quad(c, fabs(a02 - a13) <= QUAD_AGREE ? dot(d02, d02) <= dot(d13, d13) : a02 > a13, out);
+}
+
+/* Polygon c (k >= 5 corners) of positions v into k - 2 triangles at out.
  * q: scratch of 2k doubles, at: of k ints. */
 static void split(const double *v, const int *c, int k, int *out, double *q, int *at)
 {
+    if (k == 4) {
+        split_quad(v, c, out);
+        return;
+    }
     double n[3] = { 0, 0, 0 };
     for (int i = 0; i < k; i++) {   /* Newell's normal */
         const double *a = v + 3 * (size_t)c[i], *b = v + 3 * (size_t)c[(i + 1) % k];
@@ -180,21 +223,71 @@ static void split(const double *v, const int *c, int k, int *out, double *q, int
         q[2 * i] = dot(d, u);
         q[2 * i + 1] = dot(d, w);
     }
-    if (k == 4 && area2(q, q + 2, q + 4) > 0 && area2(q + 2, q + 4, q + 6) > 0 &&
-        area2(q + 4, q + 6, q) > 0 && area2(q + 6, q, q + 2) > 0) {
-        double d02[3], d13[3];
-        sub(v + 3 * (size_t)c[2], v + 3 * (size_t)c[0], d02);
-        sub(v + 3 * (size_t)c[3], v + 3 * (size_t)c[1], d13);
-        if (dot(d02, d02) <= dot(d13, d13)) {
-            emit(&out, c[0], c[1], c[2]);
-            emit(&out, c[0], c[2], c[3]);
-        } else {
-            emit(&out, c[1], c[2], c[3]);
-            emit(&out, c[1], c[3], c[0]);
-        }
-        return;
-    }
     clip_ears(c, q, k, at, out);
+}
+
+/* An undirected edge as one sortable key. */
+static unsigned long long edge_key(int a, int b)
+{
+    return a < b ? (unsigned long long)a << 32 | (unsigned)b : (unsigned long long)b << 32 | (unsigned)a;
+}
+
+static int by_key(const void *x, const void *y)
+{
+    unsigned long long a = *(const unsigned long long *)x, b = *(const unsigned long long *)y;
+    return (a > b) - (a < b);
+}
+
+/* How many of the nk sorted keys are k. */
+static long key_count(const unsigned long long *keys, long nk, unsigned long long k)
+{
+    long lo = 0, hi = nk;
+    while (lo < hi) {
+        long mid = lo + (hi - lo) / 2;
+        if (keys[mid] < k)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    long n = 0;
+    while (lo + n < nk && keys[lo + n] == k)
+        n++;
+    return n;
+}
+
+/* A quad cut along an edge that other faces have too (around a vertex of
+ * two quads, say, both cuts along the same diagonal give one triangle
+ * twice) is cut along its other diagonal instead, when no face has that
+ * one. Returns -1 out of memory. */
+static int unshare_quad_cuts(mesh__faces *F)
+{
+    long nq = 0;
+    for (long i = 0; i < F->npoly; i++)
+        nq += F->poly[3 * i + 2] == 4;
+    if (!nq)
+        return 0;
+    long nk = 3 * F->ntri;
+    unsigned long long *keys = malloc(sizeof *keys * ((size_t)nk + 1));
+    if (!keys)
+        return -1;
+    for (long t = 0; t < F->ntri; t++)
+        for (int k = 0; k < 3; k++)
+            keys[3 * t + k] = edge_key(F->tri[3 * t + k], F->tri[3 * t + (k + 1) % 3]);
+    qsort(keys, (size_t)nk, sizeof *keys, by_key);
+    for (long i = 0; i < F->npoly; i++) {
+        const long *p = F->poly + 3 * i;
+        if (p[2] != 4)
+            continue;
+        const int *c = F->corner + p[1];
+        int *t = F->tri + 3 * p[0];
+        int along02 = t[0] == c[0] && t[2] == c[2];   /* cut_quad's two ways */
+        unsigned long long cut = along02 ? edge_key(c[0], c[2]) : edge_key(c[1], c[3]);
+        unsigned long long other = along02 ? edge_key(c[1], c[3]) : edge_key(c[0], c[2]);
+        if (key_count(keys, nk, cut) > 2 && key_count(keys, nk, other) == 0)
+            cut_quad(c, !along02, t);
+    }
+    free(keys);
+    return 0;
 }
 
 int mesh__faces_finish(mesh__faces *F, mesh *m)
@@ -215,6 +308,8 @@ int mesh__faces_finish(mesh__faces *F, mesh *m)
     }
     free(q);
     free(at);
+    if (unshare_quad_cuts(F))
+        return MESH_ENOMEM;
     free(m->f);
     m->f = F->tri ? F->tri : calloc(1, sizeof(int));
     m->nf = (int)F->ntri;
