@@ -9,8 +9,10 @@
 
 #include <stddef.h>
 
-/* The most corners one face may have. */
-#define MESH_MAX_FACE_CORNERS 65536
+/* The most corners one face may have: ear clipping takes time growing with
+ * the cube of a polygon's corners at worst, and no modelling tool or
+ * scanner writes faces near this. */
+#define MESH_MAX_FACE_CORNERS 1024
 
 typedef struct mesh__faces {
     int *tri;          /* ntri by 3: the triangles, a polygon's slots zero until finished */

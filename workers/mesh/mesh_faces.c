@@ -120,12 +120,13 @@ static void emit(int **out, int a, int b, int c)
  * at: scratch of k ints. */
 static void clip_ears(const int *c, const double *q, int k, int *at, int *out)
 {
-    int n = k;
+    int n = k, from = 0;
     for (int i = 0; i < k; i++)
         at[i] = i;
     while (n > 3) {
         int found = -1;
-        for (int i = 0; i < n && found < 0; i++) {
+        for (int s = 0; s < n && found < 0; s++) {   /* from the last ear on: its neighbours */
+            int i = (from + s) % n;
             int a = at[(i + n - 1) % n], b = at[i], d = at[(i + 1) % n];
             if (area2(q + 2 * a, q + 2 * b, q + 2 * d) <= 0)
                 continue;   /* reflex or flat: not an ear */
@@ -146,6 +147,7 @@ static void clip_ears(const int *c, const double *q, int k, int *at, int *out)
         emit(&out, c[at[(found + n - 1) % n]], c[at[found]], c[at[(found + 1) % n]]);
         memmove(at + found, at + found + 1, sizeof(int) * (size_t)(n - found - 1));
         n--;
+        from = found > 0 ? found - 1 : 0;
     }
     for (int i = 1; i + 1 < n; i++)
         emit(&out, c[at[0]], c[at[i]], c[at[i + 1]]);

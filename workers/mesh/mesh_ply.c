@@ -307,8 +307,8 @@ static int read_list(const char *path, ply_reader *r, const unsigned char *base,
 }
 
 /* Every item of every element, in the header's order, from r: the vertices'
- * x y z into m, the faces' indices into F (corner: room for 255 * 255), the
- * rest read past. */
+ * x y z into m, the faces' indices into F (corner: room for
+ * MESH_MAX_FACE_CORNERS), the rest read past. */
 static int read_elements(const char *path, ply_reader *r, const unsigned char *base, const ply_elem *el,
                          int nel, long long nv, mesh *m, mesh__faces *F, int *corner, char *err,
                          size_t errsz)
@@ -335,9 +335,10 @@ static int read_elements(const char *path, ply_reader *r, const unsigned char *b
                                       path, e->name, j, x);
                 long cnt = (long)x;
                 int faces = is_f && pr->role == 4;
-                if (faces && cnt < 3)
+                if (faces && (cnt < 3 || cnt > MESH_MAX_FACE_CORNERS))
                     return errbuf_set(err, errsz, MESH_EPARSE,
-                                      "%s: face %lld has %ld vertices; a face needs 3", path, j, cnt);
+                                      "%s: face %lld has %ld vertices; a face needs 3 to %d", path, j,
+                                      cnt, MESH_MAX_FACE_CORNERS);
                 int rc = read_list(path, r, base, e, pr, j, cnt, nv, corner, err, errsz);
                 if (rc)
                     return rc;
@@ -378,7 +379,7 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
         goto out;
     m = mesh_new((int)nv, 0);
     mesh__faces_init(&F, nf);
-    if (!m || !(corner = malloc(sizeof(int) * 255 * 255))) {
+    if (!m || !(corner = malloc(sizeof(int) * MESH_MAX_FACE_CORNERS))) {
         rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
         goto out;
     }
