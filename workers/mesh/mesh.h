@@ -63,8 +63,8 @@ int mesh_write(const char *path, const mesh *m, char *err, size_t errsz);
 /* Per-format entry points; mesh_read/mesh_write pick one by extension.
  * OFF, OBJ and PLY faces may be polygons: each is split into triangles in
  * its place (mesh_faces.c), so the faces of m are numbered after the split.
- * OFF and OBJ: text. OBJ: "f a", "f a/b", "f a/b/c", "f a//c", negative (relative)
- * indices; v/f lines only, everything else skipped. PLY: ascii and
+ * OFF and OBJ: text. OBJ: "f a", "f a/b", "f a/b/c", "f a//c", negative
+ * (relative) indices; v/f lines only, everything else skipped. PLY: ascii and
  * binary in either byte order, vertex x y z of any scalar type, face list
  * vertex_indices (or vertex_index), other properties and elements skipped;
  * written as binary_little_endian with double positions (exact round trip).

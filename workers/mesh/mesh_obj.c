@@ -46,7 +46,7 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
     if (rc)
         return rc;
     long nv, nf;
-    int tri[3], *corners = NULL;
+    int c[MESH_MAX_FACE_CORNERS];
     mesh__faces F;
     memset(&F, 0, sizeof F);
     count_lines(buf, len, &nv, &nf);
@@ -80,29 +80,23 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
             iv++;
         } else if (is_word(t, n, "f")) {
             int k = 0;
-            const char *c;
+            const char *w;
             size_t cn;
-            while ((cn = mesh_lex_next_inline(&lx, &c)) > 0) {
+            while ((cn = mesh_lex_next_inline(&lx, &w)) > 0) {
                 if (k == MESH_MAX_FACE_CORNERS) {
                     rc = errbuf_set(err, errsz, MESH_EPARSE,
                                     "%s:%ld: face %ld has over %d vertices", path, lx.line, jf,
                                     MESH_MAX_FACE_CORNERS);
                     goto out;
                 }
-                if (k == 3 && !corners) {
-                    if (!(corners = malloc(sizeof(int) * MESH_MAX_FACE_CORNERS))) {
-                        rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
-                        goto out;
-                    }
-                }
                 size_t in = 0;
-                while (in < cn && c[in] != '/')
+                while (in < cn && w[in] != '/')
                     in++;
                 long idx;
-                if (mesh_lex_parse_long(c, in, &idx) || idx == 0) {
+                if (mesh_lex_parse_long(w, in, &idx) || idx == 0) {
                     rc = errbuf_set(err, errsz, MESH_EPARSE,
                                     "%s:%ld: face %ld: corner %d \"%.*s\" is not a vertex index",
-                                    path, lx.line, jf, k, (int)(cn > 40 ? 40 : cn), c);
+                                    path, lx.line, jf, k, (int)(cn > 40 ? 40 : cn), w);
                     goto out;
                 }
                 long z = idx > 0 ? idx - 1 : iv + idx;  /* negative: relative */
@@ -112,10 +106,7 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
                                     path, lx.line, jf, idx, idx > 0 ? nv : iv);
                     goto out;
                 }
-                if (k == 3)
-                    memcpy(corners, tri, sizeof tri);
-                (k < 3 ? tri : corners)[k] = (int)z;
-                k++;
+                c[k++] = (int)z;
             }
             if (k < 3) {
                 rc = errbuf_set(err, errsz, MESH_EPARSE,
@@ -123,7 +114,7 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
                                 path, lx.line, jf, k);
                 goto out;
             }
-            if ((rc = mesh__faces_add(&F, k > 3 ? corners : tri, k))) {
+            if ((rc = mesh__faces_add(&F, c, k))) {
                 mesh__faces_error(rc, path, lx.line, err, errsz);
                 goto out;
             }
@@ -140,7 +131,6 @@ int mesh_read_obj(const char *path, mesh **out, char *err, size_t errsz)
     rc = MESH_OK;
 out:
     mesh__faces_free(&F);
-    free(corners);
     mesh_free(m);
     free(buf);
     return rc;

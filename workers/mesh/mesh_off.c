@@ -36,6 +36,9 @@ int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz)
     char *buf = NULL;
     size_t len = 0;
     mesh *m = NULL;
+    int c[MESH_MAX_FACE_CORNERS];
+    mesh__faces F;
+    memset(&F, 0, sizeof F);
     *out = NULL;
     int rc = mesh_lex_slurp(path, MESH_MAX_FILE_BYTES, &buf, &len, err, errsz);
     if (rc)
@@ -92,60 +95,50 @@ int mesh_read_off(const char *path, mesh **out, char *err, size_t errsz)
         }
         mesh_lex_skip_line(&lx);  /* optional colours etc. */
     }
-    int *corners = NULL;
-    rc = MESH_OK;
-    mesh__faces F;
     mesh__faces_init(&F, nf);
     for (long i = 0; i < nf; i++) {
         long deg;
         if (mesh_lex_long(&lx, &deg)) {
             rc = errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: face %ld: missing vertex count",
                             path, lx.line, i);
-            goto faces_out;
+            goto out;
         }
         if (deg < 3 || deg > MESH_MAX_FACE_CORNERS) {
             rc = errbuf_set(err, errsz, MESH_EPARSE,
                             "%s:%ld: face %ld has %ld vertices; a face needs 3 to %d",
                             path, lx.line, i, deg, MESH_MAX_FACE_CORNERS);
-            goto faces_out;
+            goto out;
         }
-        if (deg > 3 && !corners && !(corners = malloc(sizeof(int) * MESH_MAX_FACE_CORNERS))) {
-            rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
-            goto faces_out;
-        }
-        int tri[3], *c = deg > 3 ? corners : tri;
         for (long k = 0; k < deg; k++) {
             long idx;
             if (mesh_lex_long(&lx, &idx)) {
                 rc = errbuf_set(err, errsz, MESH_EPARSE, "%s:%ld: face %ld: index %ld is missing or not an integer",
                                 path, lx.line, i, k);
-                goto faces_out;
+                goto out;
             }
             if (idx < 0 || idx >= nv) {
                 rc = errbuf_set(err, errsz, MESH_EINVAL,
                                 "%s:%ld: face %ld: vertex index %ld out of range [0, %ld)",
                                 path, lx.line, i, idx, nv);
-                goto faces_out;
+                goto out;
             }
             c[k] = (int)idx;
         }
         if ((rc = mesh__faces_add(&F, c, (int)deg))) {
             mesh__faces_error(rc, path, lx.line, err, errsz);
-            goto faces_out;
+            goto out;
         }
         mesh_lex_skip_line(&lx);
     }
-    if ((rc = mesh__faces_finish(&F, m)))
-        errbuf_set(err, errsz, rc, "%s: out of memory", path);
-faces_out:
-    mesh__faces_free(&F);
-    free(corners);
-    if (rc)
+    if ((rc = mesh__faces_finish(&F, m))) {
+        mesh__faces_error(rc, path, 0, err, errsz);
         goto out;
+    }
     *out = m;
     m = NULL;
     rc = MESH_OK;
 out:
+    mesh__faces_free(&F);
     mesh_free(m);
     free(buf);
     return rc;

@@ -356,7 +356,7 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
     size_t len = 0, data = 0;
     mesh *m = NULL;
     ply_elem *el = NULL;
-    int nel = 0, binary = 0, *corner = NULL;
+    int nel = 0, binary = 0, corner[MESH_MAX_FACE_CORNERS];
     mesh__faces F;
     memset(&F, 0, sizeof F);
     *out = NULL;
@@ -379,7 +379,7 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
         goto out;
     m = mesh_new((int)nv, 0);
     mesh__faces_init(&F, nf);
-    if (!m || !(corner = malloc(sizeof(int) * MESH_MAX_FACE_CORNERS))) {
+    if (!m) {
         rc = errbuf_set(err, errsz, MESH_ENOMEM, "%s: out of memory", path);
         goto out;
     }
@@ -399,7 +399,6 @@ int mesh_read_ply(const char *path, mesh **out, char *err, size_t errsz)
     rc = MESH_OK;
 out:
     mesh__faces_free(&F);
-    free(corner);
     mesh_free(m);
     free(el);
     free(buf);
