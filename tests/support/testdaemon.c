@@ -65,6 +65,22 @@ static const char *run_as(const testdaemon *d, const char *tokens)
     return testdaemon_user();
 }
 
+#define READY "meshcorrd ready:"
+
+/* How many lines of d's log have what. */
+static int log_count(const testdaemon *d, const char *what)
+{
+    FILE *fp = fopen(d->log, "r");
+    if (!fp)
+        return 0;
+    char line[4096];
+    int n = 0;
+    while (fgets(line, sizeof line, fp))
+        n += strstr(line, what) != NULL;
+    fclose(fp);
+    return n;
+}
+
 void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
 {
     snprintf(d->dir, sizeof d->dir, "%s/%s", harness_tmpdir(), name);
@@ -101,6 +117,7 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     for (int i = 0; args && args[i] && k < 62; i++)
         argv[k++] = args[i];
     argv[k] = NULL;
+    int ready = log_count(d, READY);
     fflush(stdout);
     fflush(stderr);
     pid_t parent = getpid();
@@ -134,7 +151,9 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
                 if (!d->tls_addr[0] && strncmp(more, "tls:", 4) == 0)
                     snprintf(d->tls_addr, sizeof d->tls_addr, "%s", more);
             fclose(fp);
-            if (ok)
+            /* the port file is written with the binds, before the drop from
+             * root: the daemon is started once it says it is ready */
+            if (ok && log_count(d, READY) > ready)
                 return;
         }
         int st;
@@ -142,7 +161,7 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
             FAILF("meshcorrd exited at start (status %d); log %s", st, d->log);
         sleep_ms(10);
     }
-    FAILF("meshcorrd did not write its port file; log %s", d->log);
+    FAILF("meshcorrd did not write its port file and say it is ready; log %s", d->log);
 }
 
 void testdaemon_token_line(const char *token, const char *user, int admin, char *line, size_t sz)
@@ -528,15 +547,7 @@ void testdaemon_demo_close(testdaemon_demo *dm)
 
 int testdaemon_log_has(const testdaemon *d, const char *what)
 {
-    FILE *fp = fopen(d->log, "r");
-    if (!fp)
-        return 0;
-    char line[4096];
-    int found = 0;
-    while (!found && fgets(line, sizeof line, fp))
-        found = strstr(line, what) != NULL;
-    fclose(fp);
-    return found;
+    return log_count(d, what) > 0;
 }
 
 static int cmp_double(const void *a, const void *b)
