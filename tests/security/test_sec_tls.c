@@ -190,20 +190,6 @@ static mc_client *tls_client(const char *addr, const char *ca)
     return c;
 }
 
-/* Lines of the daemon's log holding what. */
-static int log_count(const testdaemon *d, const char *what)
-{
-    FILE *fp = fopen(d->log, "r");
-    if (!fp)
-        return 0;
-    char line[4096];
-    int n = 0;
-    while (fgets(line, sizeof line, fp))
-        n += strstr(line, what) != NULL;
-    fclose(fp);
-    return n;
-}
-
 /* Waits up to 10 s for a log line holding what. */
 static void wait_log(const testdaemon *d, const char *what)
 {
@@ -399,7 +385,7 @@ TEST(a_tls_1_0_or_1_1_client_is_refused_while_1_2_and_1_3_are_served)
     dial t1;
     static const char *const old[] = {"NORMAL:-VERS-ALL:+VERS-TLS1.0", "NORMAL:-VERS-ALL:+VERS-TLS1.1"};
     for (int i = 0; i < 2; i++) {
-        int before = log_count(&d, "TLS handshake failed");
+        int before = testdaemon_log_count(&d, "TLS handshake failed");
         int rc = tls_dial(&t1, port, old[i], t.ca, "localhost");
         if (rc == 0)
             FAILF("%s: the daemon completed the handshake", old[i]);
@@ -408,9 +394,9 @@ TEST(a_tls_1_0_or_1_1_client_is_refused_while_1_2_and_1_3_are_served)
             FAILF("%s: handshake ended with %s (alert %s), not the server's protocol_version alert", old[i],
                   gnutls_strerror(rc), gnutls_alert_get_name(gnutls_alert_get(t1.s)));
         tls_hangup(&t1);
-        for (int k = 0; k < 100 && log_count(&d, "TLS handshake failed") == before; k++)
+        for (int k = 0; k < 100 && testdaemon_log_count(&d, "TLS handshake failed") == before; k++)
             testdaemon_sleep_ms(20);
-        CHECK(log_count(&d, "TLS handshake failed") > before);
+        CHECK(testdaemon_log_count(&d, "TLS handshake failed") > before);
     }
     /* the same client code with a version the daemon takes gets through */
     static const char *const good[] = {"NORMAL:-VERS-ALL:+VERS-TLS1.2", "NORMAL:-VERS-ALL:+VERS-TLS1.3"};

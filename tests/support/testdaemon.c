@@ -67,8 +67,7 @@ static const char *run_as(const testdaemon *d, const char *tokens)
 
 #define READY "meshcorrd ready:"
 
-/* How many lines of d's log have what. */
-static int log_count(const testdaemon *d, const char *what)
+int testdaemon_log_count(const testdaemon *d, const char *what)
 {
     FILE *fp = fopen(d->log, "r");
     if (!fp)
@@ -117,7 +116,7 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
     for (int i = 0; args && args[i] && k < 62; i++)
         argv[k++] = args[i];
     argv[k] = NULL;
-    int ready = log_count(d, READY);
+    int ready = testdaemon_log_count(d, READY);
     fflush(stdout);
     fflush(stderr);
     pid_t parent = getpid();
@@ -153,7 +152,7 @@ void testdaemon_start(testdaemon *d, const char *name, const char *const *args)
             fclose(fp);
             /* the port file is written with the binds, before the drop from
              * root: the daemon is started once it says it is ready */
-            if (ok && log_count(d, READY) > ready)
+            if (ok && testdaemon_log_count(d, READY) > ready)
                 return;
         }
         int st;
@@ -547,7 +546,7 @@ void testdaemon_demo_close(testdaemon_demo *dm)
 
 int testdaemon_log_has(const testdaemon *d, const char *what)
 {
-    return log_count(d, what) > 0;
+    return testdaemon_log_count(d, what) > 0;
 }
 
 static int cmp_double(const void *a, const void *b)

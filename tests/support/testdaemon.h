@@ -68,6 +68,8 @@ int testdaemon_prlimit(const testdaemon *d, int resource, const struct rlimit *n
 mc_client *testdaemon_client(const testdaemon *d, const char *token);
 /* 1 when a line of the daemon's log contains what. */
 int testdaemon_log_has(const testdaemon *d, const char *what);
+/* How many lines of the daemon's log contain what. */
+int testdaemon_log_count(const testdaemon *d, const char *what);
 /* Medians of the daemon log's "checked in X ms (Y ms CPU)" figures, one per
  * SUBMIT check: X, and Y in *cpu_ms (fails the test when there is none). */
 double testdaemon_checked_ms(const testdaemon *d, double *cpu_ms);
