@@ -5,7 +5,7 @@
  * run 381 -> 390 on both backends, comparing the final maps (same face for
  * how many vertices) and energies. Prints figures and the load average (the
  * machine is shared); fails only when something cannot run or the backends
- * disagree beyond the issue's bounds, never on time. */
+ * disagree beyond the bounds below, never on time. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "ectm/ectm.h"
@@ -119,7 +119,7 @@ static int on_iter(void *ctx, const ectm_report *r)
     return 0;
 }
 
-/* The issue's acceptance check: the full demo run gives the same final map
+/* The acceptance check: the full demo run gives the same final map
  * on both backends (same face for >= 99.9 % of vertices). Long: set
  * MESHCORR_BENCH_FULL=1 to run it. */
 TEST_T(ectm_381_390_full_run_same_map_on_both_backends, 7200)

@@ -517,7 +517,7 @@ static void print_cost(const int *ran, const pair_fig *figs)
         printf(" %s e = %.2f%s", what[a], testfit_exponent(x, y[a], n), a + 1 < NSERIES ? ";" : "");
     qsort(job, (size_t)n, sizeof *job, cmp_double);
     printf("\njob time (start + rhm + ectm stages): median %.1f s, from %.1f to %.1f s "
-           "(issue 16's target: median <= 20 s)\n",
+           "(target: median <= 20 s)\n",
            n % 2 ? job[n / 2] : 0.5 * (job[n / 2 - 1] + job[n / 2]), job[0], job[n - 1]);
 }
 

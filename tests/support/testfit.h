@@ -1,5 +1,5 @@
 /* testfit.h — the exponent of a cost-against-size fit, for the speed
- * benchmarks (issue 16): the least-squares slope of log y against log x.
+ * benchmarks: the least-squares slope of log y against log x.
  * Test code only. */
 #ifndef TESTFIT_H
 #define TESTFIT_H

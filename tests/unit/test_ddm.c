@@ -187,7 +187,7 @@ TEST_T(bad_arguments_are_refused, 20)
 /* DDM denoising of the published baseline maps of TOSCA gorilla_01 ->
  * man_01 (BIM, 0-based, and BCICP, 1-based; 900 GT points), k1 = k2 =
  * 100: the geodesic error stays within +0.005 of the input's and the
- * median conformal distortion drops to at most half (issue 13's criteria).
+ * median conformal distortion drops to at most half.
  * Measured with k = 30 / 60 / 100 on gorilla_01 -> man_01, man_02,
  * woman_01: smaller k smooths more and raised the BCICP maps' error (by
  * 0.011 at k = 30 on man_01); k = 100 met both criteria on all six maps

@@ -265,7 +265,7 @@ TEST_T(demo_381_390_matches_authors_result, 1800)
            r.last.t_project, r.last.t_solve);
     CHECK_NEAR(uv0, 0.0447, 0.0005);     /* the README's figure for the initial map */
     CHECK(uv1 < uv0 / 4);
-    CHECK(uv1 <= 0.005);                 /* issue 16: the same map, faster (0.0024: their code re-run) */
+    CHECK(uv1 <= 0.005);                 /* the authors' map (0.0024: their code re-run) */
     CHECK(m1.mean_abs_log_area < 0.75 * m0.mean_abs_log_area);
     ectm_result_close(&r);
     testdemo_free(&d);
