@@ -7,7 +7,8 @@
  * and so is a collapsed region with a landmark far beyond its boundary's
  * image (the landmarks dragged to their images); the last step moves
  * single vertices whose faces fold back into place, the landmarks not,
- * judged face by face by the metric's own rule. */
+ * judged face by face by the metric's own rule, as far as their
+ * neighbours spread on a much finer target. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "fold/fold.h"
@@ -414,6 +415,36 @@ static double dist3(const double *a, const double *b)
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
+/* Pushes up to most vertices (every step-th whose star touches no star
+ * pushed before) 1.6 times the way to a neighbour: img (m's vertices on
+ * entry) gets their images, touched their stars' vertices, *first the
+ * first one pushed. Returns how many were pushed. */
+static int push_stars(const mesh *m, const geo_edges *E, int step, int most, double *img,
+                      unsigned char *touched, int *first)
+{
+    int n = 0;
+    *first = -1;
+    for (int v = 0; v < m->nv && n < most; v += step) {
+        int free_star = !touched[v];
+        for (int i = E->vf_start[v]; i < E->vf_start[v + 1] && free_star; i++)
+            for (int k = 0; k < 3; k++)
+                free_star &= !touched[m->f[3 * E->vf_face[i] + k]];
+        if (!free_star)
+            continue;
+        const int *f = m->f + 3 * E->vf_face[E->vf_start[v]];
+        int u = f[0] == v ? f[1] : f[0];
+        for (int d = 0; d < 3; d++)
+            img[3 * v + d] = m->v[3 * v + d] + 1.6 * (m->v[3 * u + d] - m->v[3 * v + d]);
+        for (int i = E->vf_start[v]; i < E->vf_start[v + 1]; i++)
+            for (int k = 0; k < 3; k++)
+                touched[m->f[3 * E->vf_face[i] + k]] = 1;
+        if (*first < 0)
+            *first = v;
+        n++;
+    }
+    return n;
+}
+
 /* The identity of a sphere onto itself with a few scattered vertices'
  * images pushed past a neighbour's (1.6 times the way to it): each such
  * star folds over (the region remaps are not run here). The relaxation
@@ -434,25 +465,7 @@ TEST(relaxation_moves_single_folded_vertices_back_but_not_landmarks)
     double *img = malloc(sizeof(double) * 3 * (size_t)nv);
     memcpy(img, m->v, sizeof(double) * 3 * (size_t)nv);
     unsigned char *touched = calloc((size_t)nv, 1), *badv = calloc((size_t)nv, 1);
-    int lm = -1, nmoved = 0;
-    for (int v = 0; v < nv && nmoved < 8; v += 37) {
-        int free_star = !touched[v];
-        for (int i = E.vf_start[v]; i < E.vf_start[v + 1] && free_star; i++)
-            for (int k = 0; k < 3; k++)
-                free_star &= !touched[m->f[3 * E.vf_face[i] + k]];
-        if (!free_star)
-            continue;
-        const int *f = m->f + 3 * E.vf_face[E.vf_start[v]];
-        int u = f[0] == v ? f[1] : f[0];
-        for (int d = 0; d < 3; d++)
-            img[3 * v + d] = m->v[3 * v + d] + 1.6 * (m->v[3 * u + d] - m->v[3 * v + d]);
-        for (int i = E.vf_start[v]; i < E.vf_start[v + 1]; i++)
-            for (int k = 0; k < 3; k++)
-                touched[m->f[3 * E.vf_face[i] + k]] = 1;
-        if (lm < 0)
-            lm = v;
-        nmoved++;
-    }
+    int lm, nmoved = push_stars(m, &E, 37, 8, img, touched, &lm);
     CHECK(nmoved >= 4);
     bmap *P = map_of_points(m, img, nv), *before = map_of_points(m, img, nv);
     unsigned char *kind = malloc((size_t)nf), *k2 = malloc((size_t)nf);
@@ -518,6 +531,70 @@ TEST(relaxation_moves_single_folded_vertices_back_but_not_landmarks)
     bmap_free(P);
     bmap_free(before);
     mesh_free(m);
+}
+
+/* The icosphere of level 2 onto that of level 5 (each source edge spans
+ * eight target edges): a few vertices pushed past a neighbour, their
+ * images taken to T's closest points. Each pushed vertex must travel
+ * farther than the faces its star lands in and their neighbours to get
+ * back among its neighbours; the relaxation looks as far as the
+ * neighbours spread, unfolds every face and leaves the other vertices. */
+TEST(relaxation_reaches_as_far_as_the_neighbours_spread_on_a_finer_target)
+{
+    mesh *S = testmesh_icosphere(2), *T = testmesh_icosphere(5);
+    int nv = S->nv;
+    geo_edges E;
+    char err[128];
+    CHECK(geo_edges_build(S, &E, err, sizeof err) == 0);
+    double *img = malloc(sizeof(double) * 3 * (size_t)nv);
+    memcpy(img, S->v, sizeof(double) * 3 * (size_t)nv);
+    unsigned char *touched = calloc((size_t)nv, 1);
+    int first, nmoved = push_stars(S, &E, 29, 4, img, touched, &first);
+    CHECK_INT(nmoved, 4);
+    bmap *P = map_of_points(T, img, nv), *before = map_of_points(T, img, nv);
+    int bad = count_bad(S, T, P, METRIC_FACE_FLIPPED);
+    CHECK(bad >= 2 * nmoved);
+    fold_report rep;
+    CHECK_INT(fold_relax(S, T, NULL, 0, P, &rep), FOLD_OK);
+    printf("  %d stars pushed over onto a target 64 times finer: %d -> %d bad faces, %d moves\n", nmoved,
+           rep.bad_before, rep.bad_after, rep.relaxed);
+    CHECK_INT(rep.bad_after, 0);
+    CHECK_INT(count_bad(S, T, P, METRIC_FACE_FLIPPED) + count_bad(S, T, P, METRIC_FACE_COLLAPSED), 0);
+    bmap_apply(P, T->f, T->v, 3, img);
+    double worst = 0;
+    for (int v = 0; v < nv; v++) {
+        if (!touched[v]) {
+            CHECK_INT(P->face[v], before->face[v]);
+            CHECK(memcmp(P->w + 3 * v, before->w + 3 * v, 3 * sizeof(double)) == 0);
+            continue;
+        }
+        /* a moved vertex lies well inside its neighbours' images: nearer
+         * their mean than a third of their spread */
+        double c[3] = { 0, 0, 0 }, spread = 0;
+        int n = 0;
+        for (int i = E.vf_start[v]; i < E.vf_start[v + 1]; i++)
+            for (int k = 0; k < 3; k++) {
+                int u = S->f[3 * E.vf_face[i] + k];
+                for (int d = 0; d < 3 && u != v; d++)
+                    c[d] += img[3 * u + d];
+                n += u != v;
+            }
+        for (int d = 0; d < 3; d++)
+            c[d] /= n;
+        for (int i = E.vf_start[v]; i < E.vf_start[v + 1]; i++)
+            for (int k = 0; k < 3; k++)
+                spread = fmax(spread, dist3(img + 3 * S->f[3 * E.vf_face[i] + k], c));
+        worst = fmax(worst, dist3(img + 3 * v, c) / spread);
+    }
+    printf("  farthest from its neighbours' mean: %.2f of their spread\n", worst);
+    CHECK(worst < 1.0 / 3);
+    geo_edges_close(&E);
+    free(img);
+    free(touched);
+    bmap_free(P);
+    bmap_free(before);
+    mesh_free(S);
+    mesh_free(T);
 }
 
 /* Signed doubled area of patch face q in the placement uv (loc: the mesh's

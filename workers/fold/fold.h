@@ -118,8 +118,15 @@ int fold_repair(const mesh *S, const mesh *T, const int *fixed, int nfixed,
  * (a collapsed one counting as more than all of them), when that is fewer
  * than now: the thesis' one-ring relaxation (§3.4.7) as a search. The
  * points tried: ten of each target face that the vertex's or its
- * neighbours' images lie in or touch; among equally good ones, the
- * nearest to its neighbours' images' mean. Each sweep takes the vertices
+ * neighbours' images lie in, and of each face reached from them with a
+ * corner within twice the neighbours' spread (their farthest image from
+ * their mean) of that mean, and where none of those will do, 28 of each
+ * of the 64 faces found first; among equally good ones, the nearest to the
+ * mean. Where no point leaves fewer bad faces, a point that leaves as
+ * many is taken when the faces' least lean (the cosine between an
+ * image's normal and the target's normals where its corners land) rises
+ * by 0.05: a sliver turned over, which no single move unfolds, is
+ * unfolded by such moves of its corners in turn. Each sweep takes the vertices
  * most astray first (their image's distance from their neighbours'
  * images' mean over the neighbours' spread: of a vertex pushed past a
  * neighbour and that neighbour, the one to move); sweeps while a vertex

@@ -1,6 +1,6 @@
 /* fold_relax.c — see fold.h: the last step after the repair, each vertex
- * of a bad face moved alone to the nearby point of the target that leaves
- * its faces the fewest bad ones. */
+ * of a bad face moved alone to the point among its neighbours' images
+ * that leaves its faces the fewest bad ones, or as many turned over less. */
 #include "fold/fold.h"
 #include "fold/fold__kinds.h"
 #include "geo/geo_edges.h"
@@ -8,21 +8,46 @@
 #include "geo/geo_normals.h"
 #include "metric/metric.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* Sweeps at most: while a vertex moves. */
 #define FOLD__RELAX_SWEEPS 10
+/* A move that leaves as many bad faces is made when it raises the least
+ * lean of the vertex's faces by this much. */
+#define FOLD__RELAX_LEAN 0.05
+/* The points tried for a vertex lie within this multiple of its
+ * neighbours' farthest image from their mean. */
+#define FOLD__RELAX_REACH 2.0
+/* Target faces tried for one vertex at most, and on the fine grid. */
+#define FOLD__RELAX_FACES 4096
+#define FOLD__RELAX_FINE_FACES 64
 
 /* The points of a target face tried: its centre, and toward each corner,
- * each edge. */
-static const double samples[][3] = {
+ * each edge ... */
+static const double coarse[][3] = {
     { 1.0 / 3, 1.0 / 3, 1.0 / 3 }, { 0.6, 0.2, 0.2 }, { 0.2, 0.6, 0.2 }, { 0.2, 0.2, 0.6 },
     { 0.8, 0.1, 0.1 }, { 0.1, 0.8, 0.1 }, { 0.1, 0.1, 0.8 },
     { 0.45, 0.45, 0.1 }, { 0.45, 0.1, 0.45 }, { 0.1, 0.45, 0.45 },
 };
-#define NSAMPLES ((int)(sizeof samples / sizeof samples[0]))
+#define NCOARSE ((int)(sizeof coarse / sizeof coarse[0]))
+/* ... and, where none of those will do, a grid of 28 in each of the
+ * FOLD__RELAX_FINE_FACES faces tried first (those nearest the star). */
+static const double fine[][3] = {
+    { 1.0 / 27, 1.0 / 27, 25.0 / 27 }, { 1.0 / 27, 5.0 / 27, 21.0 / 27 }, { 1.0 / 27, 9.0 / 27, 17.0 / 27 },
+    { 1.0 / 27, 13.0 / 27, 13.0 / 27 }, { 1.0 / 27, 17.0 / 27, 9.0 / 27 }, { 1.0 / 27, 21.0 / 27, 5.0 / 27 },
+    { 1.0 / 27, 25.0 / 27, 1.0 / 27 }, { 5.0 / 27, 1.0 / 27, 21.0 / 27 }, { 5.0 / 27, 5.0 / 27, 17.0 / 27 },
+    { 5.0 / 27, 9.0 / 27, 13.0 / 27 }, { 5.0 / 27, 13.0 / 27, 9.0 / 27 }, { 5.0 / 27, 17.0 / 27, 5.0 / 27 },
+    { 5.0 / 27, 21.0 / 27, 1.0 / 27 }, { 9.0 / 27, 1.0 / 27, 17.0 / 27 }, { 9.0 / 27, 5.0 / 27, 13.0 / 27 },
+    { 9.0 / 27, 9.0 / 27, 9.0 / 27 }, { 9.0 / 27, 13.0 / 27, 5.0 / 27 }, { 9.0 / 27, 17.0 / 27, 1.0 / 27 },
+    { 13.0 / 27, 1.0 / 27, 13.0 / 27 }, { 13.0 / 27, 5.0 / 27, 9.0 / 27 }, { 13.0 / 27, 9.0 / 27, 5.0 / 27 },
+    { 13.0 / 27, 13.0 / 27, 1.0 / 27 }, { 17.0 / 27, 1.0 / 27, 9.0 / 27 }, { 17.0 / 27, 5.0 / 27, 5.0 / 27 },
+    { 17.0 / 27, 9.0 / 27, 1.0 / 27 }, { 21.0 / 27, 1.0 / 27, 5.0 / 27 }, { 21.0 / 27, 5.0 / 27, 1.0 / 27 },
+    { 25.0 / 27, 1.0 / 27, 1.0 / 27 },
+};
+#define NFINE ((int)(sizeof fine / sizeof fine[0]))
 
 typedef struct relax {
     const mesh *S, *T;
@@ -40,15 +65,46 @@ static int kind_of(const relax *r, int t)
 }
 
 /* The bad faces round vertex v, a collapsed one counting as more than all
- * of them (fold_repair's badness, on a star). */
-static int star_cost(const relax *r, int v)
+ * of them (fold_repair's badness, on a star); the count stops once it is
+ * past bound. */
+static int star_cost(const relax *r, int v, int bound)
 {
     int a = r->ES->vf_start[v], b = r->ES->vf_start[v + 1], n = 0;
-    for (int i = a; i < b; i++) {
+    for (int i = a; i < b && n <= bound; i++) {
         int k = kind_of(r, r->ES->vf_face[i]);
         n += k == METRIC_FACE_COLLAPSED ? b - a + 1 : k != METRIC_FACE_OK;
     }
     return n;
+}
+
+/* How far the image of face t leans from the target's normals where its
+ * corners land: the cosine between its normal and their sum (-1 for a face
+ * turned over flat, 1 for one lying along the target). */
+static double lean(const relax *r, int t)
+{
+    const int *f = r->S->f + 3 * t;
+    const double *a = r->img + 3 * f[0], *b = r->img + 3 * f[1], *c = r->img + 3 * f[2];
+    double n[3] = { (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
+                    (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
+                    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) };
+    double m[3] = { 0, 0, 0 };
+    for (int k = 0; k < 3; k++) {
+        const int *tf = r->T->f + 3 * r->R->face[f[k]];
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                m[d] += r->R->w[3 * f[k] + j] * r->tn[3 * tf[j] + d];
+    }
+    double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), mm = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    return nn > 0 && mm > 0 ? (n[0] * m[0] + n[1] * m[1] + n[2] * m[2]) / (nn * mm) : -1;
+}
+
+/* The least lean of v's faces. */
+static double star_lean(const relax *r, int v)
+{
+    double l = 1;
+    for (int i = r->ES->vf_start[v]; i < r->ES->vf_start[v + 1]; i++)
+        l = fmin(l, lean(r, r->ES->vf_face[i]));
+    return l;
 }
 
 /* Row v of R set to (face, w), its image with it. */
@@ -136,6 +192,44 @@ static int mendable(const relax *r, int v)
     return bad && good;
 }
 
+/* The search for one vertex's point: the star's cost now, the best found
+ * and where (face, weights), that point's distance from the neighbours'
+ * mean x, and the least lean a point as bad as now must beat. */
+typedef struct search {
+    int cost, best, bf;
+    double bw[3], near, blean, x[3];
+} search;
+
+/* Tries the points pts (np per face) of the n target faces for vertex v:
+ * one with fewer bad faces than now, the nearest to x among the fewest;
+ * failing that, one as bad that leans the star clearly less over. */
+static void try_points(relax *r, int v, search *q, const int *faces, int n, const double (*pts)[3], int np)
+{
+    for (int i = 0; i < n; i++)
+        for (int s = 0; s < np; s++) {
+            place(r, v, faces[i], pts[s]);
+            int c = star_cost(r, v, q->best);
+            if (c > q->best || c > q->cost)
+                continue;
+            if (c == q->cost) {
+                double l = star_lean(r, v);
+                if (q->best == q->cost && l > q->blean) {
+                    q->blean = l;
+                    q->bf = faces[i];
+                    memcpy(q->bw, pts[s], sizeof q->bw);
+                }
+                continue;
+            }
+            double d = dist2(r->img + 3 * v, q->x);
+            if (c < q->best || d < q->near) {
+                q->best = c;
+                q->near = d;
+                q->bf = faces[i];
+                memcpy(q->bw, pts[s], sizeof q->bw);
+            }
+        }
+}
+
 /* Moves vertex v to its best point when that lowers its star's cost;
  * returns whether it moved. mark: T->nf bytes, all 0; list: T->nf ints. */
 static int relax_vertex(relax *r, int v, unsigned char *mark, int *list)
@@ -144,42 +238,42 @@ static int relax_vertex(relax *r, int v, unsigned char *mark, int *list)
     const geo_edges *ES = r->ES, *ET = r->ET;
     if (!mendable(r, v))
         return 0;
-    int cost = star_cost(r, v);
-    /* the faces the star's vertices land in, and those touching them */
+    int cost = star_cost(r, v, INT_MAX);
+    double x[3], reach = 0;
+    neighbours_mean(r, v, x);
+    /* the faces the star's vertices land in, and from them every face
+     * with a corner within FOLD__RELAX_REACH times the neighbours' reach
+     * of their mean (a vertex belongs among its neighbours, however far
+     * they spread on T) */
     int n = 0;
     for (int i = ES->vf_start[v]; i < ES->vf_start[v + 1]; i++)
-        for (int k = 0; k < 3; k++)
-            add(r->R->face[S->f[3 * ES->vf_face[i] + k]], mark, list, &n);
-    for (int m = n, i = 0; i < m; i++)
+        for (int k = 0; k < 3; k++) {
+            int u = S->f[3 * ES->vf_face[i] + k];
+            add(r->R->face[u], mark, list, &n);
+            if (u != v)
+                reach = fmax(reach, dist2(r->img + 3 * u, x));
+        }
+    for (int i = 0; i < n && n < FOLD__RELAX_FACES; i++)
         for (int k = 0; k < 3; k++) {
             int u = T->f[3 * list[i] + k];
-            for (int j = ET->vf_start[u]; j < ET->vf_start[u + 1]; j++)
+            if (dist2(T->v + 3 * u, x) > FOLD__RELAX_REACH * FOLD__RELAX_REACH * reach)
+                continue;
+            for (int j = ET->vf_start[u]; j < ET->vf_start[u + 1] && n < FOLD__RELAX_FACES; j++)
                 add(ET->vf_face[j], mark, list, &n);
         }
-    int bf = r->R->face[v], best = cost;
-    double x[3], bw[3], near = INFINITY;
-    memcpy(bw, r->R->w + 3 * v, sizeof bw);
-    neighbours_mean(r, v, x);
-    for (int i = 0; i < n; i++)
-        for (int s = 0; s < NSAMPLES; s++) {
-            place(r, v, list[i], samples[s]);
-            int c = star_cost(r, v);
-            if (c > best || c >= cost)
-                continue;
-            double d = dist2(r->img + 3 * v, x);
-            if (c < best || d < near) {
-                best = c;
-                near = d;
-                bf = list[i];
-                memcpy(bw, samples[s], sizeof bw);
-            }
-        }
+    search q = { cost, cost, r->R->face[v], { 0 }, INFINITY, 0, { x[0], x[1], x[2] } };
+    memcpy(q.bw, r->R->w + 3 * v, sizeof q.bw);
+    double now = star_lean(r, v);
+    q.blean = now + FOLD__RELAX_LEAN;
+    try_points(r, v, &q, list, n, coarse, NCOARSE);
+    if (q.best == cost && !(q.blean > now + FOLD__RELAX_LEAN))
+        try_points(r, v, &q, list, n < FOLD__RELAX_FINE_FACES ? n : FOLD__RELAX_FINE_FACES, fine, NFINE);
     for (int i = 0; i < n; i++)
         mark[list[i]] = 0;
-    place(r, v, bf, bw);
+    place(r, v, q.bf, q.bw);
     for (int i = ES->vf_start[v]; i < ES->vf_start[v + 1]; i++)
         r->kind[ES->vf_face[i]] = (unsigned char)kind_of(r, ES->vf_face[i]);
-    return best < cost;
+    return q.best < cost || q.blean > now + FOLD__RELAX_LEAN;
 }
 
 int fold_relax(const mesh *S, const mesh *T, const int *fixed, int nfixed, bmap *P,
