@@ -329,8 +329,8 @@ int mc_decode_mesh(const unsigned char *bytes, size_t len, double **v, int *nv, 
 /* A mesh file (.off .obj .ply .drc, by extension) as arrays, read by the
  * engine's readers as mc_encode_mesh_file reads it (vertex order kept,
  * each polygon face split into triangles where it stands): *v nv by 3
- * doubles, *f nf by 3 0-based indices, both malloc()ed, free() them. A file that cannot be opened or read: MC_EFILE,
- * the file named in err. */
+ * doubles, *f nf by 3 0-based indices, both malloc()ed, free() them. A
+ * file that cannot be opened or read: MC_EFILE, the file named in err. */
 int mc_read_mesh(const char *path, double **v, int *nv, int **f, int *nf, char *err, size_t errsz);
 
 /* Landmark files as an mc_job_spec's landmarks, read by the engine's one

@@ -34,20 +34,10 @@ static const double coarse[][3] = {
 };
 #define NCOARSE ((int)(sizeof coarse / sizeof coarse[0]))
 /* ... and, where none of those will do, a grid of 28 in each of the
- * FOLD__RELAX_FINE_FACES faces tried first (those nearest the star). */
-static const double fine[][3] = {
-    { 1.0 / 27, 1.0 / 27, 25.0 / 27 }, { 1.0 / 27, 5.0 / 27, 21.0 / 27 }, { 1.0 / 27, 9.0 / 27, 17.0 / 27 },
-    { 1.0 / 27, 13.0 / 27, 13.0 / 27 }, { 1.0 / 27, 17.0 / 27, 9.0 / 27 }, { 1.0 / 27, 21.0 / 27, 5.0 / 27 },
-    { 1.0 / 27, 25.0 / 27, 1.0 / 27 }, { 5.0 / 27, 1.0 / 27, 21.0 / 27 }, { 5.0 / 27, 5.0 / 27, 17.0 / 27 },
-    { 5.0 / 27, 9.0 / 27, 13.0 / 27 }, { 5.0 / 27, 13.0 / 27, 9.0 / 27 }, { 5.0 / 27, 17.0 / 27, 5.0 / 27 },
-    { 5.0 / 27, 21.0 / 27, 1.0 / 27 }, { 9.0 / 27, 1.0 / 27, 17.0 / 27 }, { 9.0 / 27, 5.0 / 27, 13.0 / 27 },
-    { 9.0 / 27, 9.0 / 27, 9.0 / 27 }, { 9.0 / 27, 13.0 / 27, 5.0 / 27 }, { 9.0 / 27, 17.0 / 27, 1.0 / 27 },
-    { 13.0 / 27, 1.0 / 27, 13.0 / 27 }, { 13.0 / 27, 5.0 / 27, 9.0 / 27 }, { 13.0 / 27, 9.0 / 27, 5.0 / 27 },
-    { 13.0 / 27, 13.0 / 27, 1.0 / 27 }, { 17.0 / 27, 1.0 / 27, 9.0 / 27 }, { 17.0 / 27, 5.0 / 27, 5.0 / 27 },
-    { 17.0 / 27, 9.0 / 27, 1.0 / 27 }, { 21.0 / 27, 1.0 / 27, 5.0 / 27 }, { 21.0 / 27, 5.0 / 27, 1.0 / 27 },
-    { 25.0 / 27, 1.0 / 27, 1.0 / 27 },
-};
-#define NFINE ((int)(sizeof fine / sizeof fine[0]))
+ * FOLD__RELAX_FINE_FACES faces tried first (those nearest the star):
+ * (4i + 1, 4j + 1, 4k + 1) / 27 for i + j + k = 6. */
+#define FINE_STEPS 6
+#define NFINE ((FINE_STEPS + 1) * (FINE_STEPS + 2) / 2)
 
 typedef struct relax {
     const mesh *S, *T;
@@ -56,6 +46,7 @@ typedef struct relax {
     double *img, *tn;             /* R's images (S->nv by 3), T's vertex normals */
     double area_S, area_T;
     unsigned char *kind;
+    double fine[NFINE][3];        /* the fine grid's points */
 } relax;
 
 /* Face t's kind for the repair under the current images. */
@@ -82,18 +73,8 @@ static int star_cost(const relax *r, int v, int bound)
  * turned over flat, 1 for one lying along the target). */
 static double lean(const relax *r, int t)
 {
-    const int *f = r->S->f + 3 * t;
-    const double *a = r->img + 3 * f[0], *b = r->img + 3 * f[1], *c = r->img + 3 * f[2];
-    double n[3] = { (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
-                    (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
-                    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) };
-    double m[3] = { 0, 0, 0 };
-    for (int k = 0; k < 3; k++) {
-        const int *tf = r->T->f + 3 * r->R->face[f[k]];
-        for (int j = 0; j < 3; j++)
-            for (int d = 0; d < 3; d++)
-                m[d] += r->R->w[3 * f[k] + j] * r->tn[3 * tf[j] + d];
-    }
+    double n[3], m[3];
+    metric_face_normals(r->S, r->T, r->R, r->img, r->tn, t, n, m);
     double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), mm = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
     return nn > 0 && mm > 0 ? (n[0] * m[0] + n[1] * m[1] + n[2] * m[2]) / (nn * mm) : -1;
 }
@@ -267,7 +248,7 @@ static int relax_vertex(relax *r, int v, unsigned char *mark, int *list)
     q.blean = now + FOLD__RELAX_LEAN;
     try_points(r, v, &q, list, n, coarse, NCOARSE);
     if (q.best == cost && !(q.blean > now + FOLD__RELAX_LEAN))
-        try_points(r, v, &q, list, n < FOLD__RELAX_FINE_FACES ? n : FOLD__RELAX_FINE_FACES, fine, NFINE);
+        try_points(r, v, &q, list, n < FOLD__RELAX_FINE_FACES ? n : FOLD__RELAX_FINE_FACES, r->fine, NFINE);
     for (int i = 0; i < n; i++)
         mark[list[i]] = 0;
     place(r, v, q.bf, q.bw);
@@ -285,7 +266,7 @@ int fold_relax(const mesh *S, const mesh *T, const int *fixed, int nfixed, bmap 
     geo_edges ES = {0}, ET = {0};
     relax r = { S, T, &ES, &ET, P, malloc(sizeof(double) * (3 * (size_t)S->nv + 1)),
                 malloc(sizeof(double) * (3 * (size_t)T->nv + 1)), geo_total_area(S),
-                geo_total_area(T), malloc((size_t)S->nf + 1) };
+                geo_total_area(T), malloc((size_t)S->nf + 1), { { 0 } } };
     unsigned char *mark = calloc((size_t)T->nf + 1, 1), *fx = calloc((size_t)S->nv + 1, 1);
     int *list = malloc(sizeof(int) * ((size_t)T->nf + 1)), rc = FOLD_ENOMEM;
     stray *order = malloc(sizeof(stray) * ((size_t)S->nv + 1));
@@ -299,6 +280,12 @@ int fold_relax(const mesh *S, const mesh *T, const int *fixed, int nfixed, bmap 
             fx[fixed[k]] = 1;
     bmap_apply(P, T->f, T->v, 3, r.img);
     geo_vertex_normals(T, r.tn);
+    for (int i = 0, k = 0; i <= FINE_STEPS; i++)
+        for (int j = 0; i + j <= FINE_STEPS; j++, k++) {
+            r.fine[k][0] = (4.0 * i + 1) / (4 * FINE_STEPS + 3);
+            r.fine[k][1] = (4.0 * j + 1) / (4 * FINE_STEPS + 3);
+            r.fine[k][2] = (4.0 * (FINE_STEPS - i - j) + 1) / (4 * FINE_STEPS + 3);
+        }
     /* each sweep the most astray first: of a vertex pushed past its
      * neighbour and that neighbour, it is the one to move */
     for (int sweep = 0; sweep < FOLD__RELAX_SWEEPS; sweep++) {

@@ -75,6 +75,24 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+void metric_face_normals(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                         const double *tn, int t, double n[3], double m[3])
+{
+    const int *f = S->f + 3 * t;
+    const double *a = img + 3 * f[0], *b = img + 3 * f[1], *c = img + 3 * f[2];
+    n[0] = (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]);
+    n[1] = (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]);
+    n[2] = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    m[0] = m[1] = m[2] = 0;
+    for (int k = 0; k < 3; k++) {
+        int row = f[k];
+        const int *tf = T->f + 3 * P->face[row];
+        for (int j = 0; j < 3; j++)
+            for (int d = 0; d < 3; d++)
+                m[d] += P->w[3 * row + j] * tn[3 * tf[j] + d];
+    }
+}
+
 /* The fold rule of metric_fold_faces on one face, with the image img, the
  * target's vertex normals tn and the face's area distortion lr and
  * conformal distortion cf. */
@@ -83,21 +101,9 @@ static int face_kind(const mesh *S, const mesh *T, const bmap *P, const double *
 {
     if (!(exp(lr) > 1e-12) || !isfinite(cf))
         return METRIC_FACE_COLLAPSED;
-    const int *f = S->f + 3 * t;
-    const double *a = img + 3 * f[0], *b = img + 3 * f[1], *c = img + 3 * f[2];
-    double n[3] = { (b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
-                    (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]),
-                    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) };
-    /* the target's normal where the triangle's corners land */
-    double dot = 0;
-    for (int k = 0; k < 3; k++) {
-        int row = f[k];
-        const int *tf = T->f + 3 * P->face[row];
-        for (int j = 0; j < 3; j++)
-            for (int d = 0; d < 3; d++)
-                dot += P->w[3 * row + j] * tn[3 * tf[j] + d] * n[d];
-    }
-    return dot < 0 ? METRIC_FACE_FLIPPED : METRIC_FACE_OK;
+    double n[3], m[3];
+    metric_face_normals(S, T, P, img, tn, t, n, m);
+    return n[0] * m[0] + n[1] * m[1] + n[2] * m[2] < 0 ? METRIC_FACE_FLIPPED : METRIC_FACE_OK;
 }
 
 int metric_face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,

@@ -60,6 +60,12 @@ int metric_fold_faces(const mesh *S, const mesh *T, const bmap *P, unsigned char
 int metric_face_kind(const mesh *S, const mesh *T, const bmap *P, const double *img,
                      const double *tn, double src_area, double tgt_area, int t, double *lr);
 
+/* What that rule compares for face t: n, the normal of its image (img's
+ * corners, unnormalised), and m, the sum of the target's vertex normals tn
+ * interpolated where its corners land. */
+void metric_face_normals(const mesh *S, const mesh *T, const bmap *P, const double *img,
+                         const double *tn, int t, double n[3], double m[3]);
+
 /* The verdict a result carries (the one rule for the worker and the
  * clients): METRIC_VERDICT_REVERSED when more than half of the triangles
  * are flipped (the map reverses orientation: a shape mirrored front onto

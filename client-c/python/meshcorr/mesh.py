@@ -21,8 +21,9 @@ def read_mesh(path: PathLike) -> Tuple[np.ndarray, np.ndarray]:
     float64 (n, 3) array of positions, F an int32 (m, 3) array of 0-based
     vertex indices, in the file's order (a polygon face split into
     triangles where it stands: these are the faces a map's rows name).
-    MeshFileNotFoundError (a FileNotFoundError) when it does not exist; BadMeshError (a ValueError)
-    naming the file, line and field when it does not parse."""
+    MeshFileNotFoundError (a FileNotFoundError) when it does not exist;
+    BadMeshError (a ValueError) naming the file, line and field when it
+    does not parse."""
     open_check(path, "path")
     v, nv = ctypes.POINTER(ctypes.c_double)(), ctypes.c_int()
     f, nf, err = ctypes.POINTER(ctypes.c_int)(), ctypes.c_int(), errbuf()
