@@ -16,6 +16,7 @@
  * Python's Client(ca=...) verify the same way. */
 #include "support/harness.h"
 #include "support/testdaemon.h"
+#include "support/testhttp.h"
 #include "support/testrun.h"
 #include "support/testtls.h"
 #include "proto.h"
@@ -79,18 +80,6 @@ static int tcp_connect(int port)
     if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof a) != 0)
         FAILF("connect 127.0.0.1:%d: %s", port, strerror(errno));
     return fd;
-}
-
-static int free_port(void)
-{
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET};
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
 }
 
 /* Everything the server sends on fd until it closes, at most timeout_s:
@@ -638,7 +627,7 @@ TEST(metrics_and_web_logins_are_served_over_https_with_the_same_certificate)
     testtls_make(&t, "certs");
     testdaemon d;
     char port[16];
-    int mport = free_port();
+    int mport = testhttp_free_port();
     snprintf(port, sizeof port, "%d", mport);
     const char *extra[] = {"--metrics", port, NULL};
     start_tls_daemon(&d, "tls-metrics", &t, extra);
@@ -698,7 +687,7 @@ TEST_T(sighup_serves_a_renewed_certificate_and_keeps_the_old_one_when_the_new_is
     snprintf(live.key, sizeof live.key, "%s", key);
     testdaemon d;
     char port[16];
-    int mport = free_port();
+    int mport = testhttp_free_port();
     snprintf(port, sizeof port, "%d", mport);
     const char *extra[] = {"--metrics", port, NULL};
     start_tls_daemon(&d, "tls-reload", &live, extra);

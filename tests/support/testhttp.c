@@ -9,19 +9,46 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
+
+/* Ports handed out by bind(0), which the daemon's own "tcp:...:0"
+ * listeners take: a port chosen here lies below them, so the daemon
+ * cannot take it before the option that names it is read. */
+static int ephemeral_low(void)
+{
+    int lo = 32768, hi;
+    FILE *fp = fopen("/proc/sys/net/ipv4/ip_local_port_range", "r");
+    if (fp) {
+        if (fscanf(fp, "%d %d", &lo, &hi) != 2)
+            lo = 32768;
+        fclose(fp);
+    }
+    return lo;
+}
 
 int testhttp_free_port(void)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {0};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t l = sizeof a;
-    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) || getsockname(fd, (struct sockaddr *)&a, &l))
-        FAILF("free port: %s", strerror(errno));
-    close(fd);
-    return ntohs(a.sin_port);
+    int lo = 10000, hi = ephemeral_low();
+    if (hi <= lo + 100)
+        FAILF("free port: the ephemeral range starts at %d", hi);
+    int start = lo + (int)(((unsigned)getpid() * 7919u + (unsigned)time(NULL)) % (unsigned)(hi - lo));
+    for (int i = 0; i < hi - lo; i++) {
+        int port = lo + (start - lo + i) % (hi - lo);
+        int fd = socket(AF_INET, SOCK_STREAM, 0);
+        if (fd < 0)
+            FAILF("free port: %s", strerror(errno));
+        struct sockaddr_in a = {0};
+        a.sin_family = AF_INET;
+        a.sin_port = htons((uint16_t)port);
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        int ok = !bind(fd, (struct sockaddr *)&a, sizeof a);
+        close(fd);
+        if (ok)
+            return port;
+    }
+    FAILF("free port: none free in [%d, %d)", lo, hi);
+    return -1;
 }
 
 int testhttp_request(int port, const char *method, const char *path, const char *headers, const char *body,

@@ -5,7 +5,8 @@
 #define TESTHTTP_H
 #include <stddef.h>
 
-/* A loopback TCP port nobody listens on now (fails the test if none). */
+/* A loopback TCP port nobody listens on now, below the range bind(0)
+ * hands out (fails the test if none). */
 int testhttp_free_port(void);
 
 /* method path to 127.0.0.1:port, HTTP/1.0, with the extra header lines
