@@ -67,14 +67,14 @@
       "outer iterations of the linear ramp beta0 -> beta1 (1: beta1 throughout)")                \
     X(gamma, "gamma", F64, 1e4, 0, INFINITY, 0, ECTM, gamma, "",                                 \
       "reverse-map weight gamma (bijective model)")                                              \
-    X(iterations, "iterations", U32, 300, 1, 1000000, 0, ECTM, iterations, "",                   \
-      "ECTM: outer iterations K (the RHM stage before it has its own count, rhm_iterations)")    \
+    X(iterations, "iterations", U32, 600, 1, 1000000, 0, ECTM, iterations, "",                   \
+      "ECTM: outer iterations K at most (the RHM stage before it has its own count, rhm_iterations)") \
     X(inner_iterations, "inner-iterations", U32, 50, 1, 100000, 0, ECTM, inner_iterations, "",  \
       "ECTM: L-BFGS iterations per Y-step at most")                                              \
     X(tolerance, "tolerance", F64, 1e-8, 0, INFINITY, PROTO_PARAM_OPEN_MIN, ECTM, tolerance, "", \
       "L-BFGS gradient tolerance")                                                               \
-    X(stop_change, "stop-change", F64, 0, 0, INFINITY, 0, ECTM, stop_change, "",                 \
-      "stop when the relative energy change at fixed beta is below this (0: never)")             \
+    X(stop_change, "stop-change", F64, 0.1, 0, INFINITY, 0, ECTM, stop_change, "",               \
+      "ECTM: stop once the energy fell by under this share in 100 outer iterations at one beta (0: run all)") \
     X(rhm_iterations, "rhm-iterations", U32, 200, 1, 1000000, PROTO_PARAM_ZERO_DEFAULT, RHM,     \
       iterations, "", "RHM: at most this many iterations (not ECTM's: that count is iterations)") \
     X(rhm_dim, "rhm-dim", U32, 8, 3, PROTO_RHM_MAX_DIM, PROTO_PARAM_ZERO_DEFAULT, RHM, dim, "",                 \

@@ -130,7 +130,7 @@ def case_arrays_same_map_as_files():
 
 def case_cancel():
     c = meshcorr.Client(UNIX)
-    job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, beta_ramp=4, inner_iterations=10,
+    job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, stop_change=0, beta_ramp=4, inner_iterations=10,
                    rhm_iterations=3)
     for r in job.watch():
         if r["stage"] == "ectm":
@@ -326,7 +326,7 @@ def case_errors_are_builtin_subclasses():
     expect(meshcorr.BadMeshError, c.submit, SRC, quads, landmarks=LANDMARKS, has="pass the file's path")
     e = expect(LookupError, c.job(999).status)
     assert isinstance(e, meshcorr.JobNotFoundError) and e.name == "NOT_FOUND", e
-    long_job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, beta_ramp=4, inner_iterations=10)
+    long_job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, stop_change=0, beta_ramp=4, inner_iterations=10)
     e = expect(meshcorr.ServerBusyError, c.submit, SRC, TGT, landmarks=LANDMARKS, **JOB)
     assert e.name == "USER_LIMIT" and isinstance(e, meshcorr.MeshcorrError), e
     long_job.cancel()
@@ -346,7 +346,7 @@ def case_timeouts_raise_timeout_error_and_the_job_keeps_running():
     never answers HELLO is a TimeoutError of Client(timeout=)."""
     c = meshcorr.Client(UNIX)
     threads = threading.active_count()
-    job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, beta_ramp=4, inner_iterations=10)
+    job = c.submit(SRC, TGT, landmarks=LANDMARKS, iterations=100000, stop_change=0, beta_ramp=4, inner_iterations=10)
     t0 = time.monotonic()
     e = expect(TimeoutError, job.wait, timeout=0.5, has="keeps running")
     assert isinstance(e, meshcorr.MeshcorrTimeoutError) and 0.5 <= time.monotonic() - t0 < 5, time.monotonic() - t0
@@ -548,7 +548,7 @@ def case_match_in_process_equals_the_daemons_job():
         b = expect(ValueError, meshcorr.match, SRC, TGT, **args)
         assert (type(a), a.code, a.message, a.field) == (type(b), b.code, b.message, b.field), (a, b)
     # the callback stops the job, or raises through it
-    e = expect(meshcorr.JobCancelledError, meshcorr.match, SRC, TGT, landmarks=LANDMARKS, iterations=1000,
+    e = expect(meshcorr.JobCancelledError, meshcorr.match, SRC, TGT, landmarks=LANDMARKS, iterations=1000, stop_change=0,
                beta_ramp=4, inner_iterations=10, progress=lambda r: r["stage"] == "ectm" and r["outer"] == 2,
                has="cancelled by the progress callback after 2 of 1000")
     assert e.code == -25 and e.name == "CANCELLED", e
@@ -559,11 +559,11 @@ def case_match_in_process_equals_the_daemons_job():
     def boom(r):
         raise Stop("from the callback")
 
-    expect(Stop, meshcorr.match, SRC, TGT, landmarks=LANDMARKS, iterations=1000, progress=boom)
+    expect(Stop, meshcorr.match, SRC, TGT, landmarks=LANDMARKS, iterations=1000, stop_change=0, progress=boom)
     # Ctrl-C stops the engine and comes out as KeyboardInterrupt
     threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT)).start()
     t0 = time.monotonic()
-    expect(KeyboardInterrupt, meshcorr.match, SRC, TGT, landmarks=LANDMARKS, iterations=100000, beta_ramp=4,
+    expect(KeyboardInterrupt, meshcorr.match, SRC, TGT, landmarks=LANDMARKS, iterations=100000, stop_change=0, beta_ramp=4,
            inner_iterations=10)
     assert time.monotonic() - t0 < 6, time.monotonic() - t0
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

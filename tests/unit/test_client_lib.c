@@ -274,7 +274,7 @@ TEST(parameter_list_as_data_sets_each_member_as_the_cli_parses_its_option)
     CHECK_INT(s.coarse, 6000);                                   /* its default */
     CHECK_INT(mc_job_spec_set(&s, "coarse", "0", err, sizeof err), 0);   /* off */
     CHECK_INT(s.coarse, 0);
-    CHECK(s.alpha == 20 && s.iterations == 300);                 /* the others keep their defaults */
+    CHECK(s.alpha == 20 && s.iterations == 600);                 /* the others keep their defaults */
     CHECK_INT(mc_job_spec_set(&s, "model", "sideways", err, sizeof err), MC_EARG);
     CHECK_STR_HAS(err, "sideways");
     CHECK_INT(mc_job_spec_set(&s, "iterations", "many", err, sizeof err), MC_EARG);

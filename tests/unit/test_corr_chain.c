@@ -517,7 +517,7 @@ TEST_T(a_given_maps_chain_repairs_ectms_folded_maps_only_through_rhm, 300)
  * identity is their ground truth — not the midpoints', as the two meshes'
  * face lists differ in 240 faces). The chain runs on the decimated pair
  * (RHM, then ECTM: its iterations and the input pair's counted as one
- * run of twice the iterations, so a progress bar does not restart), the maps come back on the input meshes with ECTM's
+ * run of at most twice the iterations, so a progress bar does not restart), the maps come back on the input meshes with ECTM's
  * deformation of them, near the identity and unfolded; stages rhm stops
  * after the coarse RHM's maps are carried back. */
 TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
@@ -550,7 +550,8 @@ TEST_T(landmark_chain_on_a_fine_pair_runs_coarse_to_fine, 900)
         }
         rhm += l.stage[i] == CORR_STAGE_RHM;
     }
-    CHECK_INT(ectm, 2 * p.iterations);
+    printf("  ectm: %d outer iterations over both runs, of at most %d\n", ectm, 2 * p.iterations);
+    CHECK(ectm > ECTM_STOP_WINDOW && ectm <= 2 * p.iterations);   /* each run stops once settled */
     CHECK(rhm >= rp.min_iterations);
     CHECK(r.P && r.Q && r.Y);
     CHECK_INT(r.P->n, S->nv);

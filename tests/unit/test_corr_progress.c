@@ -244,6 +244,6 @@ TEST(each_iteration_count_names_its_stage_in_the_help)
 {
     static char out[1 << 16];
     CHECK_INT(testrun("build/meshcorr match --help 2>&1", out, sizeof out), 0);
-    CHECK_STR_HAS(out, "ECTM: outer iterations K (the RHM stage before it has its own count, rhm_iterations)");
+    CHECK_STR_HAS(out, "ECTM: outer iterations K at most (the RHM stage before it has its own count, rhm_iterations)");
     CHECK_STR_HAS(out, "RHM: at most this many iterations (not ECTM's: that count is iterations)");
 }

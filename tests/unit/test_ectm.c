@@ -1,5 +1,5 @@
 /* test_ectm.c — the ECTM alternating optimisation: parameters, monotone
- * energy at fixed β, cancellation, injective and partial models, and the
+ * energy at fixed β, the stop rule, cancellation, injective and partial models, and the
  * authors' own demo input (SHREC'07 381 -> 390, HOT initial maps) against
  * their published result. */
 #include "support/harness.h"
@@ -15,15 +15,15 @@
 
 typedef struct trace {
     int n;
-    double energy[400];
-    double beta[400];
+    double energy[700];
+    double beta[700];
     int cancel_at;
 } trace;
 
 static int record(void *ctx, const ectm_report *r)
 {
     trace *t = ctx;
-    if (t->n < 400) {
+    if (t->n < 700) {
         t->energy[t->n] = r->energy;
         t->beta[t->n] = r->beta;
         t->n++;
@@ -46,7 +46,8 @@ TEST(params_defaults_are_released_code_values)
     CHECK_NEAR(ectm_beta(&p, 200), 1e5, 1e-9);
     CHECK_NEAR(ectm_beta(&p, 300), 1e5, 1e-9);
     CHECK_NEAR(p.gamma, 1e4, 0);
-    CHECK_INT(p.iterations, 300);
+    CHECK_INT(p.iterations, 600);
+    CHECK_NEAR(p.stop_change, 0.1, 0);
     ectm_params_paper(&p);
     CHECK_NEAR(ectm_beta(&p, 1), 1e3, 1e-9);
     CHECK_NEAR(ectm_beta(&p, 200), 2e5, 1e-9);
@@ -161,6 +162,54 @@ TEST_T(energy_never_increases_at_fixed_beta, 300)
     testdemo_free(&d);
 }
 
+/* The identity of a sphere onto a copy stretched along z: the energy
+ * settles within the first iterations. The stop rule waits until β has
+ * been constant for a whole window (ramp 50, so iteration 150), then stops
+ * at its first look; stop_change 0 runs every iteration. */
+TEST_T(stop_rule_ends_a_settled_run_after_one_window_at_constant_beta, 300)
+{
+    mesh *X = testmesh_icosphere(2), *Y = mesh_copy(X);
+    CHECK(X && Y);
+    for (int v = 0; v < Y->nv; v++)
+        Y->v[3 * v + 2] *= 1.3;
+    bmap *I = bmap_new(X->nv, X->nv);
+    CHECK(I != NULL);
+    for (int t = 0; t < X->nf; t++)
+        for (int k = 0; k < 3; k++) {
+            int v = X->f[3 * t + k];
+            I->face[v] = t;
+            for (int j = 0; j < 3; j++)
+                I->w[3 * v + j] = j == k;
+        }
+    ectm_params p;
+    ectm_params_init(&p);
+    p.threads = 1;
+    p.beta_ramp = 50;
+    p.iterations = 400;
+    trace t = {0};
+    ectm_result r;
+    char err[256];
+    if (ectm_run(X, Y, I, I, NULL, &p, record, &t, &r, err, sizeof err))
+        FAILF("%s", err);
+    printf("  stopped after %d of %d iterations, energy %.9g -> %.9g over the last %d\n", t.n,
+           p.iterations, t.energy[t.n - 1 - ECTM_STOP_WINDOW], t.energy[t.n - 1], ECTM_STOP_WINDOW);
+    CHECK_INT(t.n, 50 + ECTM_STOP_WINDOW);
+    CHECK_INT(r.last.outer, t.n);
+    CHECK(t.energy[t.n - 1 - ECTM_STOP_WINDOW] - t.energy[t.n - 1] < p.stop_change * t.energy[t.n - 1]);
+    ectm_result_close(&r);
+
+    p.stop_change = 0;
+    p.iterations = 180;
+    memset(&t, 0, sizeof t);
+    if (ectm_run(X, Y, I, I, NULL, &p, record, &t, &r, err, sizeof err))
+        FAILF("%s", err);
+    CHECK_INT(t.n, 180);
+    ectm_result_close(&r);
+    bmap_free(I);
+    mesh_free(X);
+    mesh_free(Y);
+}
+
 TEST_T(progress_callback_cancels_run, 300)
 {
     testdemo d;
@@ -263,6 +312,8 @@ TEST_T(demo_381_390_matches_authors_result, 1800)
     printf("  flipped %.2f%%, collapsed %.2f%%; time %.1f s (projection %.1f s, L-BFGS %.1f s)\n",
            100 * m1.flipped_fraction, 100 * m1.collapsed_fraction, r.last.elapsed,
            r.last.t_project, r.last.t_solve);
+    printf("  outer iterations run: %d of at most %d\n", r.last.outer, p.iterations);
+    CHECK_INT(r.last.outer, 300);        /* the released code's count: the stop rule ends it there */
     CHECK_NEAR(uv0, 0.0447, 0.0005);     /* the README's figure for the initial map */
     CHECK(uv1 < uv0 / 4);
     CHECK(uv1 <= 0.005);                 /* the authors' map (0.0024: their code re-run) */

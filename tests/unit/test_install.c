@@ -82,5 +82,5 @@ TEST_T(install_puts_headers_in_include_meshcorr_and_docs_where_the_unit_points, 
     if (rc)
         FAILF("building with <meshcorr/meshcorr.h> failed:\n%s", out);
     CHECK_INT(testrunf(out, sizeof out, "LD_LIBRARY_PATH=%s/lib %s", root, bin), 0);
-    CHECK_STR_HAS(out, "unix:/run/meshcorr/meshcorrd.sock 300 3\n");
+    CHECK_STR_HAS(out, "unix:/run/meshcorr/meshcorrd.sock 600 3\n");
 }

@@ -611,7 +611,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
     memset(&r, 0, sizeof r);
     r.total = p->iterations;
     r.gamma = p->gamma;
-    double prev_energy = NAN, prev_beta = NAN;
+    double window[ECTM_STOP_WINDOW];   /* the last energies, by k mod the window */
     for (int k = 1; k <= p->iterations; k++) {
         double beta = ectm_beta(p, k) * beta_scale;
         r.outer = k;
@@ -628,11 +628,13 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
             rc = errbuf_set(err, errsz, KIND_ECANCELLED, "cancelled at outer iteration %d", k);
             goto done;
         }
-        if (p->stop_change > 0 && beta == prev_beta &&
-            fabs(prev_energy - r.energy) < p->stop_change * fabs(r.energy))
+        /* The energy W iterations ago sits in the slot this one takes. */
+        double *then = &window[k % ECTM_STOP_WINDOW];
+        if (p->stop_change > 0 && k > ECTM_STOP_WINDOW &&
+            ectm_beta(p, k - ECTM_STOP_WINDOW) == ectm_beta(p, k) &&
+            *then - r.energy < p->stop_change * fabs(r.energy))
             break;
-        prev_energy = r.energy;
-        prev_beta = beta;
+        *then = r.energy;
     }
     rc = KIND_OK;
     out->scaled = p->scale_reference && !p->partial;

@@ -10,11 +10,11 @@ import numpy as np
 import meshcorr
 
 source, target, pairs, out = sys.argv[1:5]
-iterations = int(sys.argv[5]) if len(sys.argv) > 5 else 300
+params = {"iterations": int(sys.argv[5])} if len(sys.argv) > 5 else {}   # else the default
 landmarks = np.loadtxt(pairs, dtype=int, comments="#", ndmin=2)
 
 client = meshcorr.Client()
-job = client.submit(source, target, landmarks=landmarks, iterations=iterations, label="submit_pair.py")
+job = client.submit(source, target, landmarks=landmarks, label="submit_pair.py", **params)
 print("job", job.id)
 for p in job.watch():
     print("%-5s %3d/%d energy %.4e beta %.2e %.1f s"
