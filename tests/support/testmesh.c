@@ -24,6 +24,32 @@ double testmesh_rand(unsigned long long *s)
     return (double)(*s >> 11) / 9007199254740992.0;
 }
 
+bmap *testmesh_identity(const mesh *X)
+{
+    bmap *I = bmap_new(X->nv, X->nv);
+    if (!I)
+        return NULL;
+    for (int t = 0; t < X->nf; t++)
+        for (int k = 0; k < 3; k++) {
+            int v = X->f[3 * t + k];
+            I->face[v] = t;
+            for (int j = 0; j < 3; j++)
+                I->w[3 * v + j] = j == k;
+        }
+    return I;
+}
+
+double testmesh_mean_edge(const mesh *X)
+{
+    double edge = 0;
+    for (int t = 0; t < X->nf; t++) {
+        const double *a = X->v + 3 * X->f[3 * t], *b = X->v + 3 * X->f[3 * t + 1];
+        edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                     (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    return X->nf ? edge / X->nf : 0;
+}
+
 static int midpoint(double *v, int *nv, int *key_a, int *key_b, int *key_m, int *nk, int a, int b)
 {
     int lo = a < b ? a : b, hi = a < b ? b : a;

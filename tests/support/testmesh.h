@@ -1,11 +1,13 @@
 /* testmesh.h — meshes the tests generate, with known closed forms:
  * an icosphere (radius 1, closed, genus 0), a stretched sphere, a torus (radii R, r, closed,
  * genus 1) and a flat open disk (radius 1, one boundary loop); and a real
- * mesh of ../shared/data read for a test. Test code only: never linked
+ * mesh of ../shared/data read for a test; the identity map of a mesh.
+ * Test code only: never linked
  * into the engine. Caller frees with mesh_free. */
 #ifndef TESTMESH_H
 #define TESTMESH_H
 #include "mesh/mesh.h"
+#include "map/bmap.h"
 
 /* Subdivided icosahedron projected to the unit sphere: 10*4^level + 2 vertices. */
 mesh *testmesh_icosphere(int level);
@@ -31,6 +33,12 @@ mesh *testmesh_subdivided(const mesh *m);
 /* The mesh at rel under the data folder (harness_data_path); the test
  * fails with mesh_read's message when it cannot be read. */
 mesh *testmesh_read(const char *rel);
+/* Each vertex of X onto the same vertex of a mesh with X's faces (its
+ * row: a face of X holding it, weight 1 at that corner); NULL when out of
+ * memory. Caller frees with bmap_free. */
+bmap *testmesh_identity(const mesh *X);
+/* The mean length of each face's first edge. */
+double testmesh_mean_edge(const mesh *X);
 /* Deterministic pseudo-random numbers in [0, 1) for tests (xorshift). */
 double testmesh_rand(unsigned long long *state);
 

@@ -216,19 +216,12 @@ TEST(apply_identity_like_maps_returns_vertex_values)
      * (identity-like): P·Z returns that vertex's row of Z; a face centre
      * returns the mean of its three rows. */
     mesh *m = testmesh_icosphere(2);
-    bmap *P = bmap_new(m->nv, m->nv);
+    bmap *P = testmesh_identity(m);
     const int d = 5;
     double *Z = malloc(sizeof(double) * d * m->nv), *out = malloc(sizeof(double) * d * m->nv);
     for (int j = 0; j < m->nv; j++)
         for (int k = 0; k < d; k++)
             Z[d * j + k] = k < 3 ? m->v[3 * j + k] : j * 0.5 + k;
-    for (int t = 0; t < m->nf; t++)
-        for (int c = 0; c < 3; c++) {
-            int v = m->f[3 * t + c];
-            P->face[v] = t;
-            for (int k = 0; k < 3; k++)
-                P->w[3 * v + k] = k == c;
-        }
     bmap_apply(P, m->f, Z, d, out);
     for (int i = 0; i < d * m->nv; i++)
         CHECK(out[i] == Z[i]);

@@ -91,16 +91,8 @@ TEST(map_sized_for_other_meshes_is_refused)
 TEST(area_scale_follows_the_maps_regional_area)
 {
     mesh *X = testmesh_icosphere(3), *Y = mesh_copy(X), *Z = mesh_copy(X);
-    bmap *I = bmap_new(X->nv, X->nv);
+    bmap *I = testmesh_identity(X);
     CHECK(X && Y && Z && I);
-    for (int v = 0; v < X->nv; v++)
-        for (int t = 0; t < X->nf; t++)
-            for (int k = 0; k < 3; k++)
-                if (X->f[3 * t + k] == v) {
-                    I->face[v] = t;
-                    I->w[3 * v] = I->w[3 * v + 1] = I->w[3 * v + 2] = 0;
-                    I->w[3 * v + k] = 1;
-                }
     for (int i = 0; i < 3 * Y->nv; i++)
         Y->v[i] *= 3;
     for (int v = 0; v < Z->nv; v++)
@@ -172,15 +164,8 @@ TEST_T(stop_rule_ends_a_settled_run_after_one_window_at_constant_beta, 300)
     CHECK(X && Y);
     for (int v = 0; v < Y->nv; v++)
         Y->v[3 * v + 2] *= 1.3;
-    bmap *I = bmap_new(X->nv, X->nv);
+    bmap *I = testmesh_identity(X);
     CHECK(I != NULL);
-    for (int t = 0; t < X->nf; t++)
-        for (int k = 0; k < 3; k++) {
-            int v = X->f[3 * t + k];
-            I->face[v] = t;
-            for (int j = 0; j < 3; j++)
-                I->w[3 * v + j] = j == k;
-        }
     ectm_params p;
     ectm_params_init(&p);
     p.threads = 1;

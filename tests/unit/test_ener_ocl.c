@@ -115,13 +115,7 @@ static double *deformed(const mesh *X, double amp, int damage, unsigned long lon
     size_t n = 3 * (size_t)X->nv;
     double *Y = malloc(n * sizeof(double));
     CHECK(Y != NULL);
-    double edge = 0;
-    for (int t = 0; t < X->nf; t++) {
-        const double *a = X->v + 3 * X->f[3 * t], *b = X->v + 3 * X->f[3 * t + 1];
-        edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                     (a[2] - b[2]) * (a[2] - b[2]));
-    }
-    edge /= X->nf;
+    double edge = testmesh_mean_edge(X);
     for (size_t i = 0; i < n; i++)
         Y[i] = X->v[i] + amp * edge * (2 * testmesh_rand(&seed) - 1);
     if (damage)

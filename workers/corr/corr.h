@@ -254,8 +254,8 @@ typedef enum corr_after {
 int corr_finish_select(const corr_input *in, corr_after after, int through_rhm, bmap **P,
                        bmap **Q);
 /* 1 when ECTM from RHM's maps P and Q (Q may be NULL) scales its membrane's
- * reference by their regional area (ectm_params.scale_reference): when both
- * are smooth (corr_scale.c). */
+ * reference by their regional area (ectm_params.scale_reference): when they
+ * keep areas well on the whole (corr_scale.c). */
 int corr_scale_reference(const corr_input *in, const bmap *P, const bmap *Q);
 /* The share of bad triangles (flipped plus collapsed) of the map P from A
  * onto B; 2 (worse than any) when it cannot be measured. */

@@ -4,11 +4,12 @@
  * A pair that differs in the share of the area its parts take (a
  * caricature's head, a bird's wings) is penalised by a membrane that keeps
  * each face's area: ECTM then moves a good map away from the right points.
- * Given a smooth initial map, the reference metric of each face is grown by
- * the area factor the map gives its region: the log of each face's image
- * area over its own (both meshes at unit area), clamped, smoothed by rounds
- * of face -> vertex -> face averaging so that only the regional scale
- * remains, and centred so that the total area stays. */
+ * Given an initial map that keeps areas well on the whole (corr_scale.c
+ * decides), the reference metric of each face is grown by the area factor
+ * the map gives its region: the log of each face's image area over its own
+ * (both meshes at unit area), clamped, smoothed by rounds of face -> vertex
+ * -> face averaging so that only the regional scale remains, and centred
+ * so that the total area stays. */
 #include "ectm/ectm.h"
 #include "geo/geo_area.h"
 #include "mesh/mesh_check.h"
