@@ -63,8 +63,8 @@ typedef struct ectm_params {
 /* The authors' released code's values, which produced their published demo
  * result (../shared/data/ectm_demo_381_390/README.md): α = 20,
  * η = 6.667e-4, β = 500·min(k, 200), γ = 1e4, 50 L-BFGS iterations,
- * tolerance 1e-8, ε = 1e-20, bijective. Their K = 300 is where the
- * stop rule here ends their demo (stop_change 0.1, at most K = 600). */
+ * tolerance 1e-8, ε = 1e-20, bijective; in place of their fixed count of
+ * outer iterations, the stop rule (stop_change) under a cap (iterations). */
 void ectm_params_init(ectm_params *p);
 /* The values the paper's text gives: α = 20, η = 1e-3, β 1e3 → 2e5 over
  * 200 iterations, γ = 2e4 (twice the released code's β and γ). */
