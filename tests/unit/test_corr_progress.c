@@ -3,7 +3,9 @@
  * step's expected cost from the one table, never falling, from the first
  * report (a real one: the start map's) to 1 at the last; the time left is
  * known once some of the job is done; a second RHM run (start auto) and
- * coarse to fine's two ECTM runs are parts of one fraction; and the two
+ * coarse to fine's two ECTM runs are parts of one fraction; ECTM's
+ * iterations past the first its stop rule may end it at count once a run
+ * reaches them; and the two
  * iteration counts belong to their stages (--iterations is ECTM's, RHM's is
  * rhm_iterations). */
 #include "support/harness.h"
@@ -151,19 +153,42 @@ static void feed_repair(corr__plan *pl, double *t, double *last)
     }
 }
 
+/* ECTM's reports from..upto fed by hand. */
+static void feed_ectm(corr__plan *pl, int from, int upto, double *t, double *last)
+{
+    ectm_report e = {0};
+    e.total = upto;
+    for (int k = from; k <= upto; k++) {
+        e.outer = k;
+        corr_progress cp = {.stage = CORR_STAGE_ECTM, .ectm = &e, .elapsed = *t += 1};
+        corr__plan_update(pl, &cp);
+        if (cp.fraction < *last || cp.fraction >= 1)
+            FAILF("ectm %d: fraction %.6f after %.6f", k, cp.fraction, *last);
+        *last = cp.fraction;
+    }
+}
+
+/* The level-1 icosphere pair, 6 landmarks, RHM's 4 iterations, ECTM's
+ * defaults: a job whose plan the tests feed by hand. */
+static lmk_set six = {6, lsrc, lsrc};
+
+static corr_input small_job(mesh **S, mesh **T, rhm_params *rp, ectm_params *p)
+{
+    pair(1, S, T);
+    rhm_params_init(rp);
+    rp->iterations = 4;
+    ectm_params_init(p);
+    return (corr_input){*S, *T, "s", "t", &six, NULL, NULL, rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
+}
+
 TEST(start_autos_second_rhm_run_continues_the_fraction_whether_it_runs_or_not)
 {
     mesh *S, *T;
-    pair(1, &S, &T);
-    lmk_set L = {6, lsrc, lsrc};
     rhm_params rp;
-    rhm_params_init(&rp);
-    rp.iterations = 4;
-    CHECK_INT(rp.start, RHM_START_AUTO);
     ectm_params p;
-    ectm_params_init(&p);
+    corr_input in = small_job(&S, &T, &rp, &p);
+    CHECK_INT(rp.start, RHM_START_AUTO);
     p.iterations = 3;
-    corr_input in = {S, T, "s", "t", &L, NULL, NULL, &rp, CORR_CHAIN_ALL, 0, CORR_DDM_AUTO};
     for (int again = 0; again < 2; again++) {
         corr__plan pl;
         corr__plan_build(&pl, &in, &p, &rp);
@@ -179,18 +204,56 @@ TEST(start_autos_second_rhm_run_continues_the_fraction_whether_it_runs_or_not)
             feed_rhm(&pl, &t, &last);
             feed_repair(&pl, &t, &last);
         }
-        ectm_report e = {0};
-        e.total = 3;
-        for (int k = 1; k <= 3; k++) {
-            e.outer = k;
-            corr_progress cp = {.stage = CORR_STAGE_ECTM, .ectm = &e, .elapsed = t += 1};
-            corr__plan_update(&pl, &cp);
-            CHECK(cp.fraction >= last && cp.fraction < 1);
-            last = cp.fraction;
-        }
+        feed_ectm(&pl, 1, 3, &t, &last);
         feed_repair(&pl, &t, &last);
         CHECK(last == 1);
         CHECK(pl.last == 1);
+    }
+    mesh_free(S);
+    mesh_free(T);
+}
+
+/* ECTM with its stop rule: its iterations up to the first at which the
+ * rule may end the run count in full, those beyond it to the cap at
+ * CORR__BEYOND_SHARE, so that a run that ends there (most do) ends near
+ * the fraction the plan gave it; a run that goes on counts them in full
+ * from there, the fraction never falling, to 1 either way. */
+TEST(ectm_iterations_past_the_first_possible_stop_count_once_a_run_reaches_them)
+{
+    mesh *S, *T;
+    rhm_params rp;
+    ectm_params p;
+    corr_input in = small_job(&S, &T, &rp, &p);
+    rp.start = RHM_START_DISTANCES;
+    CHECK_INT(p.iterations, 600);
+    CHECK_INT(ectm_first_stop(&p), 300);
+    int nv = S->nv + T->nv;
+    for (int on = 0; on < 2; on++) {
+        corr__plan pl;
+        corr__plan_build(&pl, &in, &p, &rp);
+        CHECK_INT(pl.n, 6);   /* start, RHM, repair, ECTM to 300, beyond, repair */
+        CHECK_INT(pl.s[3].count, 300);
+        CHECK_INT(pl.s[4].count, 300);
+        CHECK(pl.s[4].beyond && !pl.s[3].beyond);
+        double last = 0, t = 0;
+        feed_rhm(&pl, &t, &last);
+        feed_repair(&pl, &t, &last);
+        feed_ectm(&pl, 1, 300, &t, &last);
+        /* at the first possible stop: all but the beyond share and the last repair */
+        double ectm = corr__plan_cost(CORR__ECTM, nv), relax = corr__plan_cost(CORR__REPAIR_RELAX, nv);
+        double total = corr__plan_cost(CORR__START, nv) + 4 * corr__plan_cost(CORR__RHM, nv) +
+                       corr__plan_cost(CORR__REPAIR, nv) + 300 * ectm +
+                       CORR__BEYOND_SHARE * 300 * ectm + relax;
+        CHECK_NEAR(last, (total - CORR__BEYOND_SHARE * 300 * ectm - relax) / total, 1e-9);
+        if (on) {
+            double at300 = last;
+            feed_ectm(&pl, 301, 450, &t, &last);
+            CHECK(!pl.s[4].beyond);
+            CHECK_NEAR(pl.s[4].done, 0.5, 1e-12);
+            CHECK(last > at300);
+        }
+        feed_repair(&pl, &t, &last);
+        CHECK(last == 1);
     }
     mesh_free(S);
     mesh_free(T);

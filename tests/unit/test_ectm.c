@@ -179,6 +179,7 @@ TEST_T(stop_rule_ends_a_settled_run_after_one_window_at_constant_beta, 300)
     printf("  stopped after %d of %d iterations, energy %.9g -> %.9g over the last %d\n", t.n,
            p.iterations, t.energy[t.n - 1 - ECTM_STOP_WINDOW], t.energy[t.n - 1], ECTM_STOP_WINDOW);
     CHECK_INT(t.n, 50 + ECTM_STOP_WINDOW);
+    CHECK_INT(ectm_first_stop(&p), t.n);   /* what the job's progress plans on */
     CHECK_INT(r.last.outer, t.n);
     CHECK(t.energy[t.n - 1 - ECTM_STOP_WINDOW] - t.energy[t.n - 1] < p.stop_change * t.energy[t.n - 1]);
     ectm_result_close(&r);
@@ -189,10 +190,28 @@ TEST_T(stop_rule_ends_a_settled_run_after_one_window_at_constant_beta, 300)
     if (ectm_run(X, Y, I, I, NULL, &p, record, &t, &r, err, sizeof err))
         FAILF("%s", err);
     CHECK_INT(t.n, 180);
+    CHECK_INT(ectm_first_stop(&p), 180);
     ectm_result_close(&r);
     bmap_free(I);
     mesh_free(X);
     mesh_free(Y);
+}
+
+/* The first iteration at which the stop rule may end a run: a window
+ * after β stops growing, or the cap when that comes later. */
+TEST(first_possible_stop_is_a_window_after_the_ramp_within_the_cap)
+{
+    ectm_params p;
+    ectm_params_init(&p);
+    CHECK_INT(ectm_first_stop(&p), p.beta_ramp + ECTM_STOP_WINDOW);
+    CHECK(!ectm_stop_may_end(&p, p.beta_ramp + ECTM_STOP_WINDOW - 1));
+    p.beta_ramp = 1;
+    CHECK_INT(ectm_first_stop(&p), ECTM_STOP_WINDOW + 1);
+    p.iterations = 80;
+    CHECK_INT(ectm_first_stop(&p), 80);
+    ectm_params_init(&p);
+    p.stop_change = 0;
+    CHECK_INT(ectm_first_stop(&p), p.iterations);
 }
 
 TEST_T(progress_callback_cancels_run, 300)

@@ -36,12 +36,19 @@ typedef struct corr__step {
     double done;         /* 0..1                                             */
     int maybe;           /* start auto's second RHM run: its cost weighted by
                             CORR__RERUN_SHARE until corr__plan_rerun decides */
+    int beyond;          /* ECTM's iterations past the first at which its stop
+                            rule may end the run: weighted by
+                            CORR__BEYOND_SHARE until a report reaches them */
 } corr__step;
 
 /* The share of start-auto jobs whose first RHM run's maps stay folded, so
  * that RHM runs again from the functional-map start: the weight of those
  * steps until it is known (docs/decisions.md, 2026-12-06). */
 #define CORR__RERUN_SHARE 0.25
+/* The expected share of ECTM's iterations from the first at which its stop
+ * rule may end a run to the cap that a job runs: most jobs end at the first
+ * (docs/decisions.md, 2026-12-06). */
+#define CORR__BEYOND_SHARE 0.05
 
 typedef struct corr__plan {
     corr__step s[CORR__MAX_STEPS];

@@ -83,12 +83,26 @@ static void add_rhm(corr__plan *pl, const rhm_params *rp, int nv)
     }
 }
 
+/* ECTM's iterations on nv vertices: in full up to the first at which its
+ * stop rule may end the run, the rest to the cap weighted by how much of
+ * them jobs run. */
+static void add_ectm(corr__plan *pl, const ectm_params *p, int nv)
+{
+    int first = ectm_first_stop(p);
+    add(pl, CORR__ECTM, nv, first);
+    if (first < p->iterations && pl->n < CORR__MAX_STEPS) {
+        add(pl, CORR__ECTM, nv, p->iterations - first);
+        pl->s[pl->n - 1].beyond = 1;
+        pl->s[pl->n - 1].cost *= CORR__BEYOND_SHARE;
+    }
+}
+
 void corr__plan_build(corr__plan *pl, const corr_input *in, const ectm_params *p,
                       const rhm_params *rp)
 {
     memset(pl, 0, sizeof *pl);
     unsigned run = corr_chain_run(in->stages, !!in->P0);
-    int nv = in->S->nv + in->T->nv, K = p->iterations;
+    int nv = in->S->nv + in->T->nv;
     int bij = p->model == ECTM_BIJECTIVE;
     if (run & CORR_RUN_DDM)
         add(pl, CORR__DDM, nv, in->Q0 && bij ? 2 : 1);
@@ -97,12 +111,12 @@ void corr__plan_build(corr__plan *pl, const corr_input *in, const ectm_params *p
         add(pl, CORR__DECIMATE, nv, 1);
         add_rhm(pl, rp, nc);
         if (run & CORR_RUN_ECTM) {
-            add(pl, CORR__ECTM, nc, K);
+            add_ectm(pl, p, nc);
             add(pl, CORR__REPAIR_RELAX, nc, 1);
         }
         add(pl, CORR__REPAIR, nv, 1);           /* the maps carried to the meshes */
         if (run & CORR_RUN_ECTM) {
-            add(pl, CORR__ECTM, nv, K);
+            add_ectm(pl, p, nv);
             add(pl, CORR__REPAIR_RELAX, nv, 1);
         }
         return;
@@ -117,7 +131,7 @@ void corr__plan_build(corr__plan *pl, const corr_input *in, const ectm_params *p
         }
     }
     if (run & CORR_RUN_ECTM) {
-        add(pl, CORR__ECTM, nv, K);
+        add_ectm(pl, p, nv);
         if (!in->P0)             /* a given map's chain repairs only a folded map */
             add(pl, CORR__REPAIR_RELAX, nv, 1);
     }
@@ -132,9 +146,16 @@ static double done_cost(const corr__plan *pl)
     return done;
 }
 
+/* After a re-plan: the fraction goes on from where it is over what is
+ * left. */
+static void rebase(corr__plan *pl)
+{
+    pl->base = pl->last;
+    pl->base_cost = done_cost(pl);
+}
+
 void corr__plan_rerun(corr__plan *pl, int runs)
 {
-    double done = done_cost(pl);
     int k = pl->cur;
     while (k < pl->n && !pl->s[k].maybe)
         k++;
@@ -152,8 +173,7 @@ void corr__plan_rerun(corr__plan *pl, int runs)
         memmove(&pl->s[k], &pl->s[end], sizeof pl->s[0] * (size_t)(pl->n - end));
         pl->n -= end - k;
     }
-    pl->base = pl->last;       /* the fraction goes on from here over what is left */
-    pl->base_cost = done;
+    rebase(pl);
 }
 
 static int is_start(corr__phase ph)
@@ -165,7 +185,7 @@ static int is_start(corr__phase ph)
  * before RHM has decided to run it). */
 static int takes(const corr__step *s, corr_stage st)
 {
-    if (s->maybe)
+    if (s->maybe || s->beyond)
         return 0;
     switch (st) {
     case CORR_STAGE_START: return is_start(s->phase);
@@ -191,6 +211,22 @@ static int step_of(corr__plan *pl, corr_stage st)
     return -1;
 }
 
+/* An ECTM report past the iterations its step counts in full: the run
+ * goes on beyond the first iteration at which its stop rule may end it,
+ * and the next step, which weighted those iterations by
+ * CORR__BEYOND_SHARE, counts them in full from here. */
+static void reach_beyond(corr__plan *pl, int outer)
+{
+    if (pl->cur + 1 >= pl->n)
+        return;
+    corr__step *s = &pl->s[pl->cur], *x = s + 1;
+    if (s->phase != CORR__ECTM || s->done == 0 || !x->beyond || outer - s->first <= s->count)
+        return;
+    x->cost /= CORR__BEYOND_SHARE;
+    x->beyond = 0;
+    rebase(pl);
+}
+
 static double frac(double done, double total)
 {
     return total > 0 ? fmin(1, fmax(0, done / total)) : 0;
@@ -202,6 +238,8 @@ void corr__plan_update(corr__plan *pl, corr_progress *cp)
     cp->eta_s = NAN;
     if (pl->n == 0)
         return;
+    if (cp->ectm)
+        reach_beyond(pl, cp->ectm->outer);
     int j = step_of(pl, cp->stage);
     if (j >= 0) {
         for (int i = pl->cur; i < j; i++)

@@ -630,9 +630,7 @@ int ectm_run(const mesh *S, const mesh *T, const bmap *P0, const bmap *Q0,
         }
         /* The energy W iterations ago sits in the slot this one takes. */
         double *then = &window[k % ECTM_STOP_WINDOW];
-        if (p->stop_change > 0 && k > ECTM_STOP_WINDOW &&
-            ectm_beta(p, k - ECTM_STOP_WINDOW) == ectm_beta(p, k) &&
-            *then - r.energy < p->stop_change * fabs(r.energy))
+        if (ectm_stop_may_end(p, k) && *then - r.energy < p->stop_change * fabs(r.energy))
             break;
         *then = r.energy;
     }

@@ -74,6 +74,12 @@ void ectm_params_paper(ectm_params *p);
 int ectm_params_check(const ectm_params *p, char *err, size_t errsz);
 /* β at outer iteration k (1-based). */
 double ectm_beta(const ectm_params *p, int k);
+/* Whether the stop rule looks at outer iteration k: stop_change is on and
+ * the last ECTM_STOP_WINDOW iterations ran at one β. */
+int ectm_stop_may_end(const ectm_params *p, int k);
+/* The first outer iteration at which the stop rule may end a run, or the
+ * cap (iterations) when it cannot end one sooner. */
+int ectm_first_stop(const ectm_params *p);
 
 /* One direction's terms: 0 = source (P, Y), 1 = target (Q, Ỹ). */
 typedef struct ectm_terms {

@@ -64,3 +64,17 @@ double ectm_beta(const ectm_params *p, int k)
     double t = (double)(k - 1) / (p->beta_ramp - 1);
     return p->beta0 + (p->beta1 - p->beta0) * (t < 0 ? 0 : t);
 }
+
+int ectm_stop_may_end(const ectm_params *p, int k)
+{
+    return p->stop_change > 0 && k > ECTM_STOP_WINDOW &&
+           ectm_beta(p, k - ECTM_STOP_WINDOW) == ectm_beta(p, k);
+}
+
+int ectm_first_stop(const ectm_params *p)
+{
+    for (int k = 1; k < p->iterations; k++)
+        if (ectm_stop_may_end(p, k))
+            return k;
+    return p->iterations;
+}
