@@ -4,8 +4,8 @@
  * report (a real one: the start map's) to 1 at the last; the time left is
  * known once some of the job is done; a second RHM run (start auto) and
  * coarse to fine's two ECTM runs are parts of one fraction; ECTM's
- * iterations past the first its stop rule may end it at count once a run
- * reaches them; and the two
+ * iterations past the first at which its stop rule may end the run count
+ * in full once a run reaches them; and the two
  * iteration counts belong to their stages (--iterations is ECTM's, RHM's is
  * rhm_iterations). */
 #include "support/harness.h"
@@ -168,10 +168,10 @@ static void feed_ectm(corr__plan *pl, int from, int upto, double *t, double *las
     }
 }
 
-/* The level-1 icosphere pair, 6 landmarks, RHM's 4 iterations, ECTM's
- * defaults: a job whose plan the tests feed by hand. */
 static lmk_set six = {6, lsrc, lsrc};
 
+/* The level-1 icosphere pair, 6 landmarks, RHM's 4 iterations, ECTM's
+ * defaults: a job whose plan the tests feed by hand. */
 static corr_input small_job(mesh **S, mesh **T, rhm_params *rp, ectm_params *p)
 {
     pair(1, S, T);
