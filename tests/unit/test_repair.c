@@ -5,10 +5,10 @@
  * against their clean original by the real pipeline with error <= 0.01
  * against the identity, and every input vertex gets a row; with repair off
  * the job is refused as before; pieces the landmarks pair are matched pair
- * by pair; a coarse mesh matches its fine subdivision
- * with no repair (coarse to fine); a mesh of quads is read and matched
- * from the CLI; `meshcorr info` and `meshcorr fix` show and write the
- * repair. */
+ * by pair; a mesh of about 1600 vertices and its subdivision of about
+ * 100 000 match either way with no repair (coarse to fine); a mesh of
+ * quads is read and matched from the CLI; `meshcorr info` and `meshcorr
+ * fix` show and write the repair. */
 #include "support/harness.h"
 #include "support/testmesh.h"
 #include "support/testrun.h"
@@ -343,46 +343,53 @@ TEST(repair_off_refuses_as_before)
 
 
 /* Different resolutions need no repair: coarse to fine matches a mesh of
- * about 1000 vertices onto a bent copy of it subdivided twice (about
- * 16000, over twice the coarse size, so the chain runs on its decimated
- * copy); the subdivision keeps the coarse vertices as its first ones, so
- * the identity of those is the ground truth. */
-TEST_T(a_coarse_mesh_matches_its_fine_subdivision_through_coarse_to_fine, 900)
+ * about 1600 vertices and a bent copy of it subdivided three times (about
+ * 100 000, so the chain runs on its decimated copy), either one the
+ * source. The subdivision keeps the coarse vertices as its first ones, so
+ * the identity of those is the ground truth both ways: the coarse mesh's
+ * vertices onto the fine one's, and the fine mesh's first vertices back
+ * onto the coarse one's. */
+TEST_T(a_coarse_mesh_and_its_fine_subdivision_match_through_coarse_to_fine, 900)
 {
-    mesh *c = testmesh_spheroid(2.5, 30, 34);
-    mesh *f1 = testmesh_subdivided(c), *f = testmesh_subdivided(f1);
+    mesh *c = testmesh_spheroid(2.5, 38, 42);
+    mesh *f1 = testmesh_subdivided(c), *f2 = testmesh_subdivided(f1), *f = testmesh_subdivided(f2);
     mesh_free(f1);
+    mesh_free(f2);
     CHECK(c && f);
     for (int i = 0; i < f->nv; i++) {
         double *p = f->v + 3 * i;
         p[0] += 0.15 * sin(p[2]);
     }
-    printf("  %d vertices onto %d\n", c->nv, f->nv);
-    CHECK(c->nv < 1100 && f->nv > 15000);
+    CHECK(c->nv < 2000 && f->nv > 100000);
     int lm[16];
     for (int k = 0; k < 8; k++)
         lm[k] = lm[8 + k] = (int)((long)k * (c->nv - 1) / 7);
     lmk_set L = { 8, lm, lm + 8 };
-    corr_input in = { c, f, "coarse", "fine", &L, NULL, NULL, NULL, CORR_CHAIN_ALL, 0,
-                      CORR_DDM_AUTO };
-    CHECK(corr_coarse_wanted(&in));
-    ectm_params p;
-    ectm_params_init(&p);
-    p.iterations = 40;
-    ectm_result res;
-    char err[2048];
-    if (corr_run(&in, &p, NULL, NULL, &res, err, sizeof err))
-        FAILF("corr_run: %s", err);
-    messy x = { c, NULL, c->nv };
     int *orig = malloc(sizeof(int) * (size_t)c->nv);
     for (int i = 0; i < c->nv; i++)
         orig[i] = i;
-    x.orig = orig;
-    double e = identity_error(&x, f, res.P);
-    printf("  identity error %.5f\n", e);
-    CHECK(e <= 0.01);
+    messy there = { c, orig, c->nv }, back = { f, orig, c->nv };
+    for (int fine_first = 0; fine_first < 2; fine_first++) {
+        corr_input in = { fine_first ? f : c, fine_first ? c : f, fine_first ? "fine" : "coarse",
+                          fine_first ? "coarse" : "fine", &L, NULL, NULL, NULL, CORR_CHAIN_ALL, 0,
+                          CORR_DDM_AUTO };
+        CHECK(corr_coarse_wanted(&in));
+        ectm_params p;
+        ectm_params_init(&p);
+        p.iterations = 40;
+        ectm_result res;
+        char err[2048];
+        if (corr_run(&in, &p, NULL, NULL, &res, err, sizeof err))
+            FAILF("corr_run: %s", err);
+        const bmap *to_fine = fine_first ? res.Q : res.P, *to_coarse = fine_first ? res.P : res.Q;
+        CHECK(to_fine && to_fine->n == c->nv && to_coarse && to_coarse->n == f->nv);
+        double e = identity_error(&there, f, to_fine), eb = identity_error(&back, c, to_coarse);
+        printf("  %d vertices onto %d: identity error %.5f, back %.5f\n", in.S->nv, in.T->nv, e, eb);
+        CHECK(e <= 0.01);
+        CHECK(eb <= 0.01);
+        ectm_result_close(&res);
+    }
     free(orig);
-    ectm_result_close(&res);
     mesh_free(c);
     mesh_free(f);
 }
