@@ -29,7 +29,9 @@
  * flipped <= 2 %, collapsed <= 0.5 %, full error <= RHM's + 0.003, area
  * distortion below ECTM's input's (the repaired map), error <= 0.05; over
  * the classes: curvature ratio <= 0.75 in at least 8, median error <=
- * 0.035; wolf: error <= 0.01 and flipped <= 1 %. Last, the job time per
+ * 0.035; wolf: error <= 0.01 and flipped <= 1 %. Then how precisely each
+ * SHREC'07 pair's landmarks are placed (landmark_mirror_gap: on shapes
+ * posed symmetrically, the held-out error's floor). Last, the job time per
  * pair, its median, and the exponent of a least-squares fit of log time
  * against log(source + target vertices) per stage. Each pair runs in its
  * own process (support/testapart.h). Prints figures, never fails on
@@ -55,10 +57,13 @@
 #include "support/testcowcamel.h"
 #include "support/testfit.h"
 #include "corr/corr.h"
+#include "embed/embed.h"
+#include "geo/geo_area.h"
 #include "metric/metric.h"
 #include "rhm/rhm__problem.h"
 #include "start/start.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -90,6 +95,7 @@ typedef struct pair_fig {
     double err[NSTAGES], curv[NSTAGES], secs[NSTAGES];
     double lerr[NSTAGES][HELD_SHOWN];  /* --per-landmark: the first HELD_SHOWN held out */
     metric_summary ms[NSTAGES];
+    double mirror[2];        /* SHREC'07: landmark_mirror_gap of source, target */
     char why[1024];          /* non-empty: the run stopped there */
 } pair_fig;
 
@@ -138,6 +144,69 @@ static int on_progress(void *ctx, const corr_progress *p)
     return 0;
 }
 
+/* How precisely the class's landmarks are placed on mesh m (ids: its
+ * landmarks, n of them; cls: the SHREC'07 class): the plane that fits the
+ * symmetry of Corrs/<cls>.sym.info (normal: the main direction of the
+ * differences between the landmarks of its pairs; through the mean of
+ * their midpoints and of the landmarks it fixes), and the mean distance
+ * from each paired landmark's mirror image to its partner, / sqrt(area).
+ * On a shape posed symmetrically that is about the held-out error a
+ * perfect map would score: two independent placements of one point. NAN
+ * without pairs. */
+static double landmark_mirror_gap(const mesh *m, const int *ids, int n, int cls)
+{
+    char rel[64];
+    snprintf(rel, sizeof rel, "shrec07_bim/Corrs/%d.sym.info", cls);
+    FILE *fp = fopen(harness_data_path(rel), "r");
+    if (!fp)
+        FAILF("%s: %s", rel, strerror(errno));
+    int pa[64], pb[64], fixed[64], np = 0, nf = 0;
+    char line[128];
+    while (fgets(line, sizeof line, fp)) {
+        int a, b, k = sscanf(line, "%d %d", &a, &b);
+        if (k >= 1 && (a < 0 || a >= n || (k == 2 && (b < 0 || b >= n))))
+            FAILF("%s: landmark %d of %d", rel, a, n);
+        if (k == 2 && np < 64)
+            pa[np] = a, pb[np++] = b;
+        else if (k == 1 && nf < 64)
+            fixed[nf++] = a;
+    }
+    fclose(fp);
+    if (!np)
+        return NAN;
+    const double *v = m->v;
+    double C[9] = {0}, nrm[3], w[1];
+    for (int i = 0; i < np; i++) {
+        double d[3];
+        for (int c = 0; c < 3; c++)
+            d[c] = v[3 * ids[pa[i]] + c] - v[3 * ids[pb[i]] + c];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                C[3 * r + c] += d[r] * d[c];
+    }
+    if (embed_top_eigenpairs(C, 3, 1, w, nrm, NULL))
+        FAILF("%s: the symmetry plane's normal", rel);
+    double off = 0;
+    for (int i = 0; i < np; i++)
+        for (int c = 0; c < 3; c++)
+            off += 0.5 * (v[3 * ids[pa[i]] + c] + v[3 * ids[pb[i]] + c]) * nrm[c];
+    for (int i = 0; i < nf; i++)
+        for (int c = 0; c < 3; c++)
+            off += v[3 * ids[fixed[i]] + c] * nrm[c];
+    off /= np + nf;
+    double gap = 0;
+    for (int i = 0; i < np; i++) {
+        const double *a = v + 3 * ids[pa[i]], *b = v + 3 * ids[pb[i]];
+        double h = a[0] * nrm[0] + a[1] * nrm[1] + a[2] * nrm[2] - off, d2 = 0;
+        for (int c = 0; c < 3; c++) {
+            double x = a[c] - 2 * h * nrm[c] - b[c];
+            d2 += x * x;
+        }
+        gap += sqrt(d2);
+    }
+    return gap / (np * sqrt(geo_total_area(m)));
+}
+
 static void run_pair(const void *arg, void *out)
 {
     const pair_job *job = arg;
@@ -172,6 +241,8 @@ static void run_pair(const void *arg, void *out)
         lt = read_ids(p, T->nv, &nb);
         if (nb != n)
             FAILF("%s: %d landmarks, %d.vts has %d", p, nb, ps->a, n);
+        fig->mirror[0] = landmark_mirror_gap(S, ls, n, (ps->a + 19) / 20);
+        fig->mirror[1] = landmark_mirror_gap(T, lt, n, (ps->b + 19) / 20);
     } else {
         snprintf(S_name, sizeof S_name, "wolf0.off");
         snprintf(T_name, sizeof T_name, "wolf2.off");
@@ -491,6 +562,25 @@ static void print_targets(const int *ran, const pair_fig *figs)
     }
 }
 
+/* landmark_mirror_gap of each SHREC'07 pair that ran, four to a line. */
+static void print_placement(const int *ran, const pair_fig *figs)
+{
+    int k = 0;
+    for (int i = 0; i < NPAIRS; i++) {
+        if (!ran[i] || pairs[i].a <= 0 || !figs[i].nS)
+            continue;
+        if (!k)
+            printf("\nthe landmarks' own placement (a paired landmark's mirror image across "
+                   "the class's symmetry plane from its partner, mean / sqrt(area), source / "
+                   "target; on shapes posed symmetrically about what a perfect map's held-out "
+                   "error is):\n");
+        printf("  %-10s %.4f / %.4f%s", pairs[i].label, figs[i].mirror[0], figs[i].mirror[1],
+               ++k % 4 ? "" : "\n");
+    }
+    if (k % 4)
+        printf("\n");
+}
+
 /* Job times and their growth with the pair's size. */
 static void print_cost(const int *ran, const pair_fig *figs)
 {
@@ -588,5 +678,6 @@ TEST_T(shrec07_classes_from_landmarks, 86400)
         if (ran[i])
             print_rows(&pairs[i], &figs[i]);
     print_targets(ran, figs);
+    print_placement(ran, figs);
     print_cost(ran, figs);
 }
