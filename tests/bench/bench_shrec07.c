@@ -165,7 +165,8 @@ static double landmark_mirror_gap(const mesh *m, const int *ids, int n, int cls)
     while (fgets(line, sizeof line, fp)) {
         int a, b, k = sscanf(line, "%d %d", &a, &b);
         if (k >= 1 && (a < 0 || a >= n || (k == 2 && (b < 0 || b >= n))))
-            FAILF("%s: landmark %d of %d", rel, a, n);
+            FAILF("%s: line \"%.*s\" names a landmark outside 0..%d", rel,
+                  (int)strcspn(line, "\n"), line, n - 1);
         if (k == 2 && np < 64)
             pa[np] = a, pb[np++] = b;
         else if (k == 1 && nf < 64)
